@@ -1,0 +1,118 @@
+//! The structured error reply: what every failing request receives (via `reply_err`).
+
+use serde::{Deserialize, Serialize};
+
+use crate::codec::Message;
+
+/// What kind of failure a request met. Stable strings on the wire (`snake_case`), so a
+/// client in any language can branch on them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ErrorCode {
+    /// The payload is not valid JSON for the expected message.
+    Malformed,
+    /// The payload's protocol version is not the one this service speaks.
+    UnsupportedVersion,
+    /// The payload is a valid roam message, but not the kind this key expects.
+    WrongMessage,
+    /// The request is well formed but its content is not acceptable (a cell outside the
+    /// map, a negative resolution, an unknown layer name...).
+    InvalidRequest,
+    /// A size, count or time limit was exceeded; [`ErrorReply::limit`] names it.
+    LimitExceeded,
+    /// The request was based on a version that is no longer the latest.
+    StaleVersion,
+    /// A named thing (file, layer, robot) does not exist.
+    NotFound,
+    /// A file exists but its content is damaged or in the wrong format.
+    CorruptFile,
+    /// The service is shutting down or overloaded; try again later or elsewhere.
+    Unavailable,
+    /// A bug or an I/O failure on the service's side; the message says what failed.
+    Internal,
+}
+
+impl ErrorCode {
+    /// The wire string of this code, for logs and messages.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ErrorCode::Malformed => "malformed",
+            ErrorCode::UnsupportedVersion => "unsupported_version",
+            ErrorCode::WrongMessage => "wrong_message",
+            ErrorCode::InvalidRequest => "invalid_request",
+            ErrorCode::LimitExceeded => "limit_exceeded",
+            ErrorCode::StaleVersion => "stale_version",
+            ErrorCode::NotFound => "not_found",
+            ErrorCode::CorruptFile => "corrupt_file",
+            ErrorCode::Unavailable => "unavailable",
+            ErrorCode::Internal => "internal",
+        }
+    }
+}
+
+/// The limit a request ran into: its name (as in the config and the README), the limit
+/// and what the request asked for.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LimitHit {
+    /// The limit's name, e.g. `max_layer_cells`.
+    pub name: String,
+    /// The largest value the service accepts.
+    pub max: u64,
+    /// The value the request had.
+    pub actual: u64,
+}
+
+/// The error reply: a code to branch on, a sentence that tells the user what to change,
+/// and the limit that was hit where one was.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ErrorReply {
+    pub code: ErrorCode,
+    pub message: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limit: Option<LimitHit>,
+}
+
+impl ErrorReply {
+    pub fn new(code: ErrorCode, message: impl Into<String>) -> Self {
+        ErrorReply {
+            code,
+            message: message.into(),
+            limit: None,
+        }
+    }
+
+    /// A [`ErrorCode::LimitExceeded`] reply naming the limit.
+    pub fn limit(name: &str, max: u64, actual: u64, message: impl Into<String>) -> Self {
+        ErrorReply {
+            code: ErrorCode::LimitExceeded,
+            message: message.into(),
+            limit: Some(LimitHit {
+                name: name.to_owned(),
+                max,
+                actual,
+            }),
+        }
+    }
+}
+
+impl std::fmt::Display for ErrorReply {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.code.as_str(), self.message)?;
+        if let Some(limit) = &self.limit {
+            write!(
+                f,
+                " (limit {}: at most {}, got {})",
+                limit.name, limit.max, limit.actual
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for ErrorReply {}
+
+impl Message for ErrorReply {
+    const KIND: &'static str = "error";
+}

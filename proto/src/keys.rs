@@ -1,0 +1,139 @@
+//! Every key expression roam uses, built here and nowhere else.
+//!
+//! All keys live under one configurable root (default [`DEFAULT_ROOT`]), so two stacks
+//! on one network never see each other and a fleet can share one router. Each function
+//! says who publishes or answers on the key, what the payload is, and how often.
+
+/// The key root used when none is configured.
+pub const DEFAULT_ROOT: &str = "roam";
+
+/// Why a root, layer name, service or instance name cannot be part of a key.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("'{value}' cannot be used as a {what}: use 1 to {MAX_SEGMENT_LEN} characters from a-z, A-Z, 0-9, '_' and '-'{extra}")]
+pub struct KeyError {
+    pub what: &'static str,
+    pub value: String,
+    extra: &'static str,
+}
+
+/// The longest name accepted for one key segment.
+pub const MAX_SEGMENT_LEN: usize = 64;
+
+fn is_segment(s: &str) -> bool {
+    !s.is_empty()
+        && s.len() <= MAX_SEGMENT_LEN
+        && s
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
+}
+
+/// Checks a name that becomes one key segment (a layer, a service, an instance, a robot).
+pub fn check_name(what: &'static str, value: &str) -> Result<(), KeyError> {
+    if is_segment(value) {
+        Ok(())
+    } else {
+        Err(KeyError {
+            what,
+            value: value.to_owned(),
+            extra: "",
+        })
+    }
+}
+
+/// Checks a key root: one or more segments separated by '/'.
+pub fn check_root(root: &str) -> Result<(), KeyError> {
+    if root.split('/').all(is_segment) {
+        Ok(())
+    } else {
+        Err(KeyError {
+            what: "key root",
+            value: root.to_owned(),
+            extra: ", in segments separated by '/'",
+        })
+    }
+}
+
+/// `<root>/@live/<service>/<instance>`: a liveliness token each running service holds
+/// for as long as it runs. No payload. Watch `<root>/@live/**` to see who is up.
+pub fn liveliness(root: &str, service: &str, instance: &str) -> String {
+    format!("{root}/@live/{service}/{instance}")
+}
+
+/// `<root>/@live/<service>/*`: every running instance of one service.
+pub fn liveliness_of(root: &str, service: &str) -> String {
+    format!("{root}/@live/{service}/*")
+}
+
+/// `<root>/@live/**`: every running service.
+pub fn liveliness_all(root: &str) -> String {
+    format!("{root}/@live/**")
+}
+
+/// `<root>/map/layer/<layer>`: the map server publishes a
+/// [`Layer`](crate::map::Layer) here each time the layer changes (congestion control
+/// `Block`, so large layers are never dropped), and answers a `get` with the latest one.
+/// Rate: on change only.
+pub fn map_layer(root: &str, layer: &str) -> String {
+    format!("{root}/map/layer/{layer}")
+}
+
+/// `<root>/map/layer/*`: subscribe here to follow every layer.
+pub fn map_layer_any(root: &str) -> String {
+    format!("{root}/map/layer/*")
+}
+
+/// `<root>/map/update/<layer>`: the map server answers a `get` carrying a
+/// [`LayerUpdate`](crate::map::LayerUpdate) with an [`UpdateAck`](crate::map::UpdateAck),
+/// or an error reply (stale version, cell outside the map, limit). Any service that
+/// owns a layer (the mapper's change rates, localization's PEB) writes it here.
+pub fn map_update(root: &str, layer: &str) -> String {
+    format!("{root}/map/update/{layer}")
+}
+
+/// `<root>/map/update/*`: the map server's update queryable declaration.
+pub fn map_update_any(root: &str) -> String {
+    format!("{root}/map/update/*")
+}
+
+/// `<root>/map/layers`: the map server answers a `get` (no payload) with a
+/// [`LayerList`](crate::map::LayerList): every layer's name, version, size and warnings.
+pub fn map_index(root: &str) -> String {
+    format!("{root}/map/layers")
+}
+
+/// `<root>/map/load`: the map server answers a `get` carrying a
+/// [`LoadMap`](crate::map::LoadMap) (a ROS `map.yaml` or a roam scenario on the server's
+/// file system) by replacing its source layers, with a [`LayerList`](crate::map::LayerList).
+pub fn map_load(root: &str) -> String {
+    format!("{root}/map/load")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_with_key_syntax_are_refused() {
+        for bad in ["", "a/b", "a*", "$x", "a b", "ü", &"x".repeat(65)] {
+            assert!(check_name("layer", bad).is_err(), "{bad:?} accepted");
+        }
+        assert!(check_name("layer", "change_rate-2").is_ok());
+    }
+
+    #[test]
+    fn roots_may_have_segments() {
+        assert!(check_root("roam").is_ok());
+        assert!(check_root("site-a/roam").is_ok());
+        assert!(check_root("site-a//roam").is_err());
+        assert!(check_root("roam/**").is_err());
+    }
+
+    #[test]
+    fn keys_have_the_documented_shape() {
+        assert_eq!(liveliness("roam", "map-server", "a1"), "roam/@live/map-server/a1");
+        assert_eq!(map_layer("r", "occupancy"), "r/map/layer/occupancy");
+        assert_eq!(map_update("r", "peb"), "r/map/update/peb");
+        assert_eq!(map_index("r"), "r/map/layers");
+        assert_eq!(map_load("r"), "r/map/load");
+    }
+}

@@ -1,0 +1,16 @@
+//! roam's wire contract: every message, every key expression, the codec and the error reply.
+//!
+//! This crate holds no algorithm and does no I/O. A service and its clients agree on
+//! exactly what is here, and nothing else: [`keys`] builds every key expression,
+//! [`codec`] turns a message into bytes and back (refusing unknown protocol versions and
+//! trailing garbage), [`error`] is the structured reply every failing request gets, and
+//! the remaining modules are the message types grouped by the service that owns them.
+
+pub mod cells;
+pub mod codec;
+pub mod error;
+pub mod keys;
+pub mod map;
+
+pub use codec::{decode, encode, DecodeError, Message, PROTOCOL_VERSION};
+pub use error::{ErrorCode, ErrorReply, LimitHit};

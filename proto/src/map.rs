@@ -1,0 +1,143 @@
+//! Messages of the map server: layers, their versions, updates and loads.
+
+use serde::{Deserialize, Serialize};
+
+use crate::cells::{Cells, Dtype};
+use crate::codec::Message;
+
+/// Where a grid sits in the world: size in cells, metres per cell, and the world pose
+/// of the corner of cell (0, 0) (ROS `origin`: x, y in metres, yaw in radians).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridMeta {
+    pub width: u32,
+    pub height: u32,
+    /// Metres per cell.
+    pub resolution: f64,
+    pub origin: Origin,
+}
+
+/// A planar pose: metres and radians.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Origin {
+    pub x: f64,
+    pub y: f64,
+    #[serde(default)]
+    pub yaw: f64,
+}
+
+impl GridMeta {
+    /// Number of cells (`width * height`), without overflow.
+    pub fn cell_count(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height)
+    }
+}
+
+/// One layer as the map server holds it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Layer {
+    pub name: String,
+    /// Starts at 1 and grows by one with each accepted change.
+    pub version: u64,
+    pub meta: GridMeta,
+    /// The layer this one is computed from (`inflated` from `occupancy`, `heuristic`
+    /// from `information`); derived layers cannot be written directly.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub derived_from: Option<String>,
+    pub cells: Cells,
+}
+
+impl Message for Layer {
+    const KIND: &'static str = "layer";
+}
+
+/// A layer without its cells.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayerInfo {
+    pub name: String,
+    pub version: u64,
+    pub meta: GridMeta,
+    pub dtype: Dtype,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub derived_from: Option<String>,
+}
+
+/// Every layer the map server holds, and what it had to tell about its state (a
+/// persisted file found corrupt and the copy it fell back to, for example).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayerList {
+    pub layers: Vec<LayerInfo>,
+    #[serde(default)]
+    pub warnings: Vec<String>,
+}
+
+impl Message for LayerList {
+    const KIND: &'static str = "layer_list";
+}
+
+/// A change to one layer, based on the version the writer last saw. The map server
+/// refuses it with `stale_version` when the layer has moved on, so two writers never
+/// silently overwrite each other. `base_version` 0 means "the layer does not exist yet".
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayerUpdate {
+    pub base_version: u64,
+    pub change: LayerChange,
+}
+
+impl Message for LayerUpdate {
+    const KIND: &'static str = "layer_update";
+}
+
+/// What a [`LayerUpdate`] does.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "op", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LayerChange {
+    /// Set individual cells (grid indices, row 0 at the origin).
+    SetCells { cells: Vec<CellWrite> },
+    /// Replace the whole layer, possibly with another size or element type.
+    Replace { meta: GridMeta, cells: Cells },
+}
+
+/// One cell write: column `x`, row `y`, and the new value (rounded to the layer's type).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CellWrite {
+    pub x: u32,
+    pub y: u32,
+    pub value: f64,
+}
+
+/// The answer to an accepted [`LayerUpdate`]: the layer's new version, and the derived
+/// layers that were recomputed with it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UpdateAck {
+    pub layer: String,
+    pub version: u64,
+    #[serde(default)]
+    pub derived: Vec<LayerInfo>,
+}
+
+impl Message for UpdateAck {
+    const KIND: &'static str = "update_ack";
+}
+
+/// Ask the map server to load a map file from its own file system: a ROS `map.yaml`
+/// (occupancy) or a roam scenario (occupancy and information). When `base_version` is
+/// given, the load is refused if `occupancy` has moved past it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadMap {
+    pub path: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_version: Option<u64>,
+}
+
+impl Message for LoadMap {
+    const KIND: &'static str = "load_map";
+}

@@ -1,0 +1,22 @@
+//! Shared plumbing for every roam service, and nothing else.
+//!
+//! - [`session`]: the Zenoh session from the service's config file, `ZENOH_CONFIG` and
+//!   command-line flags, layered in that order;
+//! - [`service`]: a running service's session, liveliness token, cancellation tree and
+//!   graceful stop;
+//! - [`signals`]: SIGINT / SIGTERM as a cancellation;
+//! - [`config_file`]: reading a service's YAML/JSON config file with errors that name it;
+//! - [`reply`] and [`client`]: the two ends of a query, with roam's codec and error reply;
+//! - [`telemetry`]: tracing from `RUST_LOG`.
+
+pub mod client;
+pub mod config_file;
+pub mod reply;
+pub mod service;
+pub mod session;
+pub mod signals;
+pub mod telemetry;
+
+pub use client::{ClientError, Requester};
+pub use service::{Service, ServiceError};
+pub use session::{SessionArgs, SessionError};

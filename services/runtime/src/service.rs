@@ -1,0 +1,188 @@
+//! A running service: its Zenoh session, its liveliness token, one cancellation tree for
+//! all its tasks, and the graceful stop that undoes all of it.
+//!
+//! The life of a service:
+//! 1. [`Service::start`] opens the session and declares `<root>/@live/<service>/<instance>`;
+//! 2. the service declares its queryables and subscribers and spawns its loops with
+//!    [`Service::spawn`]; each loop selects on [`Service::cancelled`];
+//! 3. on cancellation (a signal, a test, the stack stopping) [`Service::shutdown`] lets
+//!    the loops refuse new work, waits for in-flight work up to a grace period, reports
+//!    the tasks that did not stop, drops the liveliness token and closes the session.
+
+use std::future::Future;
+use std::time::Duration;
+
+use roam_proto::keys;
+use tokio_util::sync::CancellationToken;
+use tokio_util::task::TaskTracker;
+use zenoh::liveliness::LivelinessToken;
+use zenoh::Session;
+
+use crate::session::{self, SessionError};
+
+/// How long [`Service::shutdown`] waits for in-flight work by default.
+pub const DEFAULT_GRACE: Duration = Duration::from_millis(1500);
+
+/// Why a service could not start or stop cleanly.
+#[derive(Debug, thiserror::Error)]
+pub enum ServiceError {
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    #[error("invalid name: {0}")]
+    Name(#[from] keys::KeyError),
+    #[error("cannot declare {what} on '{key}': {reason}")]
+    Declare {
+        what: &'static str,
+        key: String,
+        reason: String,
+    },
+    #[error("{count} task(s) of {service} did not stop within {grace:?}")]
+    StopTimeout {
+        service: &'static str,
+        count: usize,
+        grace: Duration,
+    },
+    #[error("closing the Zenoh session of {service} failed: {reason}")]
+    Close {
+        service: &'static str,
+        reason: String,
+    },
+}
+
+/// A started service. Dropping it without [`Service::shutdown`] still closes the
+/// session (Zenoh does on drop), but skips the grace period for in-flight work.
+#[derive(Debug)]
+pub struct Service {
+    name: &'static str,
+    root: String,
+    instance: String,
+    session: Session,
+    token: Option<LivelinessToken>,
+    cancel: CancellationToken,
+    tasks: TaskTracker,
+}
+
+impl Service {
+    /// Opens the session and declares the liveliness token. `instance` defaults to the
+    /// session's Zenoh id, which is unique. The service stops when `cancel` is cancelled.
+    pub async fn start(
+        name: &'static str,
+        root: &str,
+        instance: Option<&str>,
+        config: zenoh::Config,
+        cancel: CancellationToken,
+    ) -> Result<Self, ServiceError> {
+        keys::check_root(root)?;
+        keys::check_name("service name", name)?;
+        if let Some(instance) = instance {
+            keys::check_name("instance name", instance)?;
+        }
+        let session = session::open(config).await?;
+        let instance = instance
+            .map(str::to_owned)
+            .unwrap_or_else(|| session.zid().to_string());
+        let key = keys::liveliness(root, name, &instance);
+        let token = session
+            .liveliness()
+            .declare_token(&key)
+            .await
+            .map_err(|e| ServiceError::Declare {
+                what: "liveliness token",
+                key: key.clone(),
+                reason: e.to_string(),
+            })?;
+        tracing::info!(service = name, %instance, %key, "service started");
+        Ok(Service {
+            name,
+            root: root.to_owned(),
+            instance,
+            session,
+            token: Some(token),
+            cancel,
+            tasks: TaskTracker::new(),
+        })
+    }
+
+    pub fn name(&self) -> &'static str {
+        self.name
+    }
+
+    pub fn root(&self) -> &str {
+        &self.root
+    }
+
+    pub fn instance(&self) -> &str {
+        &self.instance
+    }
+
+    pub fn session(&self) -> &Session {
+        &self.session
+    }
+
+    /// The token that stops this service; clone it into loops.
+    pub fn cancel_token(&self) -> CancellationToken {
+        self.cancel.clone()
+    }
+
+    /// Resolves when the service has been told to stop.
+    pub async fn cancelled(&self) {
+        self.cancel.cancelled().await
+    }
+
+    /// Spawns a task that [`Service::shutdown`] waits for.
+    pub fn spawn<F>(&self, task: F)
+    where
+        F: Future<Output = ()> + Send + 'static,
+    {
+        self.tasks.spawn(task);
+    }
+
+    /// A tracker for per-request tasks, so shutdown waits for them too.
+    pub fn tracker(&self) -> TaskTracker {
+        self.tasks.clone()
+    }
+
+    /// Declares a queryable, mapping the error to a [`ServiceError`] that names the key.
+    pub async fn declare_queryable(
+        &self,
+        key: &str,
+    ) -> Result<zenoh::query::Queryable<zenoh::handlers::FifoChannelHandler<zenoh::query::Query>>, ServiceError> {
+        self.session
+            .declare_queryable(key)
+            .complete(true)
+            .await
+            .map_err(|e| ServiceError::Declare {
+                what: "queryable",
+                key: key.to_owned(),
+                reason: e.to_string(),
+            })
+    }
+
+    /// Stops the service: cancels its loops, waits up to `grace` for in-flight work,
+    /// drops the liveliness token and closes the session. Returns an error naming how
+    /// many tasks did not stop in time (the session is closed all the same).
+    pub async fn shutdown(mut self, grace: Duration) -> Result<(), ServiceError> {
+        self.cancel.cancel();
+        self.tasks.close();
+        let late = tokio::time::timeout(grace, self.tasks.wait()).await.is_err();
+        let pending = self.tasks.len();
+        if let Some(token) = self.token.take() {
+            if let Err(e) = token.undeclare().await {
+                tracing::warn!(service = self.name, "undeclaring the liveliness token failed: {e}");
+            }
+        }
+        self.session.close().await.map_err(|e| ServiceError::Close {
+            service: self.name,
+            reason: e.to_string(),
+        })?;
+        tracing::info!(service = self.name, instance = %self.instance, "service stopped");
+        if late {
+            return Err(ServiceError::StopTimeout {
+                service: self.name,
+                count: pending,
+                grace,
+            });
+        }
+        Ok(())
+    }
+}
