@@ -1,0 +1,51 @@
+//! The map server's config file (YAML). Every field has a default; unknown fields are
+//! refused.
+//!
+//! ```yaml
+//! root: roam                     # key root
+//! map: config/maps/depot.yaml    # ROS map.yaml or roam scenario; absent: the built-in world
+//! data_dir: /var/lib/roam/map    # persistence; absent: layers live in memory only
+//! robot_radius_m: 0.25           # overrides the scenario's
+//! heuristic_compression: 0.25    # paper 000 c_h
+//! lethal_threshold: 65           # occupancy value from which a cell is an obstacle
+//! limits: { max_layer_cells: 16777216, max_cells_per_update: 100000,
+//!           max_request_bytes: 100663296, max_layers: 64 }
+//! zenoh: { mode: client, connect: { endpoints: ["tcp/router:7447"] } }
+//! ```
+
+use std::path::PathBuf;
+
+use serde::Deserialize;
+
+use crate::store::Limits;
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MapServerConfig {
+    pub root: String,
+    pub instance: Option<String>,
+    pub map: Option<PathBuf>,
+    pub data_dir: Option<PathBuf>,
+    pub robot_radius_m: Option<f64>,
+    pub heuristic_compression: f64,
+    pub lethal_threshold: i8,
+    pub limits: Limits,
+    /// A Zenoh config fragment, lowest precedence (see `roam_runtime::session`).
+    pub zenoh: Option<serde_json::Value>,
+}
+
+impl Default for MapServerConfig {
+    fn default() -> Self {
+        MapServerConfig {
+            root: roam_proto::keys::DEFAULT_ROOT.to_owned(),
+            instance: None,
+            map: None,
+            data_dir: None,
+            robot_radius_m: None,
+            heuristic_compression: 0.25,
+            lethal_threshold: 65,
+            limits: Limits::default(),
+            zenoh: None,
+        }
+    }
+}

@@ -1,0 +1,90 @@
+//! Reading a map file the map server is pointed at: a ROS `map.yaml` (it has an
+//! `image:` key) or a roam scenario.
+
+use std::path::{Path, PathBuf};
+
+use roam_proto::{ErrorCode, ErrorReply};
+
+use crate::grid::Grid;
+use crate::ros_map::{self, RosMapError};
+use crate::scenario::{self, ScenarioError};
+
+/// The embedded default world: a paper-000-like 20 × 20 m downtime world (see
+/// `config/scenarios/downtime.yaml`), used when no map is configured.
+pub const BUILTIN_SCENARIO: &str = include_str!("../../../config/scenarios/downtime.yaml");
+
+/// The name the built-in scenario goes by in messages.
+pub const BUILTIN_NAME: &str = "<built-in downtime world>";
+
+/// What a map file gives the map server.
+#[derive(Debug, Clone)]
+pub struct MapContent {
+    pub occupancy: Grid<i8>,
+    pub information: Option<Grid<u8>>,
+    pub robot_radius_m: Option<f64>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum MapFileError {
+    #[error(transparent)]
+    Ros(#[from] RosMapError),
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+}
+
+impl MapFileError {
+    /// The error reply for a load request.
+    pub fn to_reply(&self) -> ErrorReply {
+        let message = self.to_string();
+        match self {
+            MapFileError::Ros(RosMapError::Missing { .. }) | MapFileError::Scenario(ScenarioError::Missing { .. }) => {
+                ErrorReply::new(ErrorCode::NotFound, format!("{message}; give a path on the map server's machine"))
+            }
+            MapFileError::Scenario(ScenarioError::Map {
+                source: RosMapError::Missing { .. },
+                ..
+            }) => ErrorReply::new(ErrorCode::NotFound, message),
+            MapFileError::Ros(RosMapError::TooLarge { max, actual, .. })
+            | MapFileError::Scenario(ScenarioError::Map {
+                source: RosMapError::TooLarge { max, actual, .. },
+                ..
+            }) => ErrorReply::limit("max_layer_cells", *max, *actual, message),
+            MapFileError::Ros(RosMapError::Io { .. }) | MapFileError::Scenario(ScenarioError::Io { .. }) => {
+                ErrorReply::new(ErrorCode::Internal, message)
+            }
+            _ => ErrorReply::new(ErrorCode::CorruptFile, message),
+        }
+    }
+}
+
+/// Reads a ROS map or a scenario, telling them apart by the ROS `image:` key.
+pub fn read(path: &Path, max_cells: u64) -> Result<MapContent, MapFileError> {
+    let is_ros = std::fs::read_to_string(path)
+        .ok()
+        .and_then(|text| serde_yaml_ng::from_str::<serde_yaml_ng::Value>(&text).ok())
+        .is_some_and(|v| v.get("image").is_some());
+    if is_ros {
+        let map = ros_map::load(path, max_cells)?;
+        return Ok(MapContent {
+            occupancy: map.grid,
+            information: None,
+            robot_radius_m: None,
+        });
+    }
+    let scenario = scenario::load(path, max_cells)?;
+    Ok(from_scenario(scenario))
+}
+
+/// The built-in world.
+pub fn builtin(max_cells: u64) -> Result<MapContent, MapFileError> {
+    let scenario = scenario::parse(&PathBuf::from(BUILTIN_NAME), BUILTIN_SCENARIO, max_cells)?;
+    Ok(from_scenario(scenario))
+}
+
+fn from_scenario(scenario: scenario::Scenario) -> MapContent {
+    MapContent {
+        occupancy: scenario.occupancy,
+        information: Some(scenario.information),
+        robot_radius_m: scenario.file.robot_radius_m,
+    }
+}

@@ -1,0 +1,271 @@
+//! The map server on Zenoh: a thin adapter that turns queries into calls on the
+//! [`LayerStore`] and publishes each changed layer.
+//!
+//! | key | kind | payload |
+//! |---|---|---|
+//! | `<root>/map/layer/<name>` | queryable + publication | [`Layer`](roam_proto::map::Layer) |
+//! | `<root>/map/update/<name>` | queryable | `LayerUpdate` → `UpdateAck` |
+//! | `<root>/map/layers` | queryable | → `LayerList` |
+//! | `<root>/map/load` | queryable | `LoadMap` → `LayerList` |
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use roam_proto::map::{LayerList, LayerUpdate, LoadMap};
+use roam_proto::{encode, keys, ErrorCode, ErrorReply};
+use roam_runtime::{reply, Service, ServiceError};
+use tokio_util::sync::CancellationToken;
+use zenoh::bytes::ZBytes;
+use zenoh::handlers::FifoChannelHandler;
+use zenoh::key_expr::KeyExpr;
+use zenoh::qos::CongestionControl;
+use zenoh::query::{Query, Queryable};
+use zenoh::Session;
+
+use crate::config::MapServerConfig;
+use crate::map_file::{self, MapFileError};
+use crate::persist::{DataDir, PersistError};
+use crate::store::{DerivedParams, LayerStore};
+
+/// The service name in liveliness tokens and logs.
+pub const SERVICE_NAME: &str = "map-server";
+
+/// Why the map server could not start or stopped badly.
+#[derive(Debug, thiserror::Error)]
+pub enum MapServerError {
+    #[error(transparent)]
+    Service(#[from] ServiceError),
+    #[error("the configured map could not be loaded: {0}")]
+    Map(#[from] MapFileError),
+    #[error("the data directory could not be used: {0}")]
+    Persist(#[from] PersistError),
+    #[error("the initial map could not be stored: {0}")]
+    Store(String),
+    #[error("invalid config: {0}")]
+    Config(String),
+}
+
+/// What the query handlers share.
+struct State {
+    root: String,
+    store: Mutex<LayerStore>,
+    /// Each layer encoded once per version, shared by gets and publications.
+    encoded: Mutex<HashMap<String, (u64, ZBytes)>>,
+    robot_radius_override: Option<f64>,
+    session: Session,
+}
+
+impl State {
+    fn store(&self) -> MutexGuard<'_, LayerStore> {
+        // A panic while holding the lock would be a bug; the store is still consistent
+        // because changes are staged and installed at the end.
+        self.store.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// The encoded layer, from the cache when its version is current.
+    fn encoded(&self, name: &str) -> Option<ZBytes> {
+        let store = self.store();
+        let layer = store.get(name)?;
+        let mut cache = self.encoded.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some((version, bytes)) = cache.get(name) {
+            if *version == layer.version {
+                return Some(bytes.clone());
+            }
+        }
+        let bytes = ZBytes::from(encode(layer));
+        cache.insert(name.to_owned(), (layer.version, bytes.clone()));
+        Some(bytes)
+    }
+
+    async fn publish(&self, names: &[String]) {
+        for name in names {
+            let Some(bytes) = self.encoded(name) else { continue };
+            let key = keys::map_layer(&self.root, name);
+            if let Err(e) = self.session.put(&key, bytes).congestion_control(CongestionControl::Block).await {
+                tracing::warn!(%key, "publishing the layer failed: {e}");
+            }
+        }
+    }
+}
+
+/// Builds the store: restores persisted layers, or loads the configured map (the
+/// built-in world when none is configured).
+pub fn open_store(config: &MapServerConfig) -> Result<LayerStore, MapServerError> {
+    if !(config.heuristic_compression > 0.0 && config.heuristic_compression <= 1.0) {
+        return Err(MapServerError::Config(format!(
+            "heuristic_compression must be in (0, 1], got {}",
+            config.heuristic_compression
+        )));
+    }
+    let data = config.data_dir.as_deref().map(DataDir::open).transpose()?;
+    let mut derived = DerivedParams {
+        heuristic_compression: config.heuristic_compression,
+        lethal_threshold: config.lethal_threshold,
+        ..DerivedParams::default()
+    };
+    if let Some(r) = config.robot_radius_m {
+        derived.robot_radius_m = r;
+    }
+    let mut store = LayerStore::new(config.limits, derived, data);
+    if store.restore() {
+        return Ok(store);
+    }
+    let content = match &config.map {
+        Some(path) => map_file::read(path, config.limits.max_layer_cells)?,
+        None => map_file::builtin(config.limits.max_layer_cells)?,
+    };
+    if let (None, Some(r)) = (config.robot_radius_m, content.robot_radius_m) {
+        store.set_robot_radius(r);
+    }
+    store
+        .load_map(content.occupancy, content.information, None)
+        .map_err(|e| MapServerError::Store(e.to_string()))?;
+    Ok(store)
+}
+
+/// Runs the map server until `cancel` is cancelled.
+pub async fn run(config: MapServerConfig, zenoh_config: zenoh::Config, cancel: CancellationToken) -> Result<(), MapServerError> {
+    let store = open_store(&config)?;
+    let service = Service::start(SERVICE_NAME, &config.root, config.instance.as_deref(), zenoh_config, cancel).await?;
+    let state = Arc::new(State {
+        root: config.root.clone(),
+        store: Mutex::new(store),
+        encoded: Mutex::new(HashMap::new()),
+        robot_radius_override: config.robot_radius_m,
+        session: service.session().clone(),
+    });
+    let root = config.root.as_str();
+    let layer_q = service.declare_queryable(&keys::map_layer_any(root)).await?;
+    let update_q = service.declare_queryable(&keys::map_update_any(root)).await?;
+    let index_q = service.declare_queryable(&keys::map_index(root)).await?;
+    let load_q = service.declare_queryable(&keys::map_load(root)).await?;
+
+    let all: Vec<String> = state.store().names().map(str::to_owned).collect();
+    state.publish(&all).await;
+
+    serve(&service, layer_q, state.clone(), |s, q| async move { answer_layer(&s, &q).await });
+    serve(&service, update_q, state.clone(), |s, q| async move { answer_update(s, &q).await });
+    serve(&service, index_q, state.clone(), |s, q| async move {
+        let list = s.store().list();
+        reply::send(&q, &list).await;
+    });
+    serve(&service, load_q, state.clone(), |s, q| async move { answer_load(s, &q).await });
+
+    service.cancelled().await;
+    service.shutdown(roam_runtime::service::DEFAULT_GRACE).await?;
+    Ok(())
+}
+
+/// Runs one queryable's loop on the service: each query is handled in its own tracked
+/// task; after cancellation, queued queries are refused as "unavailable".
+fn serve<F, Fut>(service: &Service, queryable: Queryable<FifoChannelHandler<Query>>, state: Arc<State>, handler: F)
+where
+    F: Fn(Arc<State>, Query) -> Fut + Send + Sync + 'static,
+    Fut: std::future::Future<Output = ()> + Send + 'static,
+{
+    let cancel = service.cancel_token();
+    let tracker = service.tracker();
+    service.spawn(async move {
+        loop {
+            tokio::select! {
+                _ = cancel.cancelled() => break,
+                next = queryable.recv_async() => match next {
+                    Ok(query) => { tracker.spawn(handler(state.clone(), query)); }
+                    Err(_) => break,
+                },
+            }
+        }
+        while let Ok(Some(query)) = queryable.try_recv() {
+            reply::refuse_stopping(&query, SERVICE_NAME).await;
+        }
+    });
+}
+
+/// Answers a layer `get`: every layer whose key matches the query's key expression.
+async fn answer_layer(state: &State, query: &Query) {
+    let names: Vec<String> = state.store().names().map(str::to_owned).collect();
+    let mut answered = 0;
+    for name in &names {
+        let key = keys::map_layer(&state.root, name);
+        let Ok(layer_key) = KeyExpr::try_from(key.as_str()) else { continue };
+        if !query.key_expr().intersects(&layer_key) {
+            continue;
+        }
+        if let Some(bytes) = state.encoded(name) {
+            if let Err(e) = query.reply(layer_key, bytes).await {
+                tracing::warn!(%key, "reply failed: {e}");
+            }
+            answered += 1;
+        }
+    }
+    if answered == 0 {
+        let error = ErrorReply::new(
+            ErrorCode::NotFound,
+            format!("no layer matches '{}'; the map server holds: {}", query.key_expr(), names.join(", ")),
+        );
+        reply::send_error(query, &error).await;
+    }
+}
+
+/// The layer named by the last segment of a concrete key, e.g. `roam/map/update/peb`.
+fn layer_name_of(query: &Query) -> Result<String, ErrorReply> {
+    let key = query.key_expr().as_str();
+    let name = key.rsplit('/').next().unwrap_or_default();
+    keys::check_name("layer name", name).map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, format!("{e}; name one layer in the key, e.g. <root>/map/update/occupancy")))?;
+    Ok(name.to_owned())
+}
+
+async fn answer_update(state: Arc<State>, query: &Query) {
+    let max = state.store().limits().max_request_bytes as usize;
+    let request = layer_name_of(query).and_then(|name| Ok((name, reply::decode_request::<LayerUpdate>(query, max)?)));
+    let (name, update) = match request {
+        Ok(r) => r,
+        Err(e) => return reply::send_error(query, &e).await,
+    };
+    let worker = state.clone();
+    let outcome = tokio::task::spawn_blocking(move || worker.store().apply(&name, &update).map_err(|e| e.to_reply())).await;
+    match outcome {
+        Ok(Ok((ack, changed))) => {
+            reply::send(query, &ack).await;
+            state.publish(&changed).await;
+        }
+        Ok(Err(error)) => reply::send_error(query, &error).await,
+        Err(e) => reply::send_error(query, &ErrorReply::new(ErrorCode::Internal, format!("the update task failed: {e}"))).await,
+    }
+}
+
+async fn answer_load(state: Arc<State>, query: &Query) {
+    let max = state.store().limits().max_request_bytes as usize;
+    let request = match reply::decode_request::<LoadMap>(query, max) {
+        Ok(r) => r,
+        Err(e) => return reply::send_error(query, &e).await,
+    };
+    let worker = state.clone();
+    let outcome = tokio::task::spawn_blocking(move || load(&worker, &request)).await;
+    match outcome {
+        Ok(Ok((list, changed))) => {
+            reply::send(query, &list).await;
+            state.publish(&changed).await;
+        }
+        Ok(Err(error)) => reply::send_error(query, &error).await,
+        Err(e) => reply::send_error(query, &ErrorReply::new(ErrorCode::Internal, format!("the load task failed: {e}"))).await,
+    }
+}
+
+fn load(state: &State, request: &LoadMap) -> Result<(LayerList, Vec<String>), ErrorReply> {
+    let max_cells = state.store().limits().max_layer_cells;
+    let content = map_file::read(Path::new(&request.path), max_cells).map_err(|e| e.to_reply())?;
+    let mut store = state.store();
+    if let (None, Some(r)) = (state.robot_radius_override, content.robot_radius_m) {
+        store.set_robot_radius(r);
+    }
+    let changed = store
+        .load_map(content.occupancy, content.information, request.base_version)
+        .map_err(|e| e.to_reply())?;
+    Ok((store.list(), changed))
+}
+
+/// How long to wait for a map server's first answer by default.
+pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(5);
