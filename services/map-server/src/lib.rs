@@ -12,6 +12,7 @@ pub mod grid;
 pub mod layers;
 pub mod map_file;
 pub mod persist;
+pub mod render;
 pub mod ros_map;
 pub mod scenario;
 pub mod service;

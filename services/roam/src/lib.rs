@@ -1,0 +1,8 @@
+//! The library behind the `roam` binary: the in-process stack, the router role, the
+//! report the stack writes, and the benchmark runners. `main.rs` only parses
+//! arguments and calls in here, so the integration tests boot exactly what users run.
+
+pub mod bench;
+pub mod report;
+pub mod router;
+pub mod stack;

@@ -1,0 +1,175 @@
+//! `roam stack`: every landed service in one process around an in-process router on
+//! loopback, multicast off. The same shape as a compose stack, so what works here works
+//! across machines. Services landed so far: the map server.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use roam_map_server::MapServerConfig;
+use roam_proto::keys;
+use roam_runtime::SessionArgs;
+use tokio::task::JoinSet;
+use tokio_util::sync::CancellationToken;
+
+use crate::router::Router;
+
+/// What the stack runs on.
+#[derive(Debug, Clone, Default)]
+pub struct StackOptions {
+    pub root: Option<String>,
+    /// A ROS map or scenario for the map server; the built-in world when absent.
+    pub map: Option<PathBuf>,
+    /// Where the map server persists its layers; in memory when absent.
+    pub data_dir: Option<PathBuf>,
+    /// The router's endpoint, e.g. `tcp/127.0.0.1:7447`; a free loopback port when absent.
+    pub listen: Option<String>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum StackError {
+    #[error("the in-process router could not start: {0}")]
+    Router(#[from] roam_runtime::SessionError),
+    #[error("{service} did not announce itself within {timeout:?}")]
+    NotUp { service: &'static str, timeout: Duration },
+    #[error("{service} stopped: {reason}")]
+    Failed { service: &'static str, reason: String },
+    #[error("watching liveliness failed: {0}")]
+    Liveliness(String),
+}
+
+/// A running stack.
+#[derive(Debug)]
+pub struct Stack {
+    pub router: Router,
+    pub root: String,
+    cancel: CancellationToken,
+    /// Each service task returns its own name with its outcome.
+    services: JoinSet<(&'static str, Result<(), String>)>,
+}
+
+impl Stack {
+    /// Starts the router and every service, and waits until each holds its liveliness
+    /// token (up to `timeout`).
+    pub async fn start(options: StackOptions, timeout: Duration) -> Result<Stack, StackError> {
+        let router = match &options.listen {
+            Some(endpoint) => Router::start(&SessionArgs::router_on(endpoint), endpoint.clone()).await?,
+            None => Router::on_loopback().await?,
+        };
+        let root = options.root.clone().unwrap_or_else(|| keys::DEFAULT_ROOT.to_owned());
+        let cancel = CancellationToken::new();
+        let client = SessionArgs::client_of(&router.endpoint);
+        let mut services = JoinSet::new();
+
+        let map_config = MapServerConfig {
+            root: root.clone(),
+            map: options.map.clone(),
+            data_dir: options.data_dir.clone(),
+            ..MapServerConfig::default()
+        };
+        let zenoh_config = client.zenoh_config(None)?;
+        let token = cancel.child_token();
+        services.spawn(async move {
+            let outcome = roam_map_server::run(map_config, zenoh_config, token).await;
+            (roam_map_server::SERVICE_NAME, outcome.map_err(|e| e.to_string()))
+        });
+
+        let mut stack = Stack {
+            router,
+            root,
+            cancel,
+            services,
+        };
+        for service in [roam_map_server::SERVICE_NAME] {
+            let (session, root) = (stack.router.session.clone(), stack.root.clone());
+            let live = wait_until_live(&session, &root, service, timeout);
+            tokio::select! {
+                outcome = live => if let Err(e) = outcome {
+                    stack.cancel.cancel();
+                    return Err(e);
+                },
+                // A service that fails at start reports its own reason.
+                Some((name, reason)) = stack.next_stopped() => {
+                    stack.cancel.cancel();
+                    return Err(StackError::Failed { service: name, reason });
+                }
+            }
+        }
+        Ok(stack)
+    }
+
+    /// Resolves when a service stops by itself, with its name and why; `None` when no
+    /// service is left.
+    pub async fn next_stopped(&mut self) -> Option<(&'static str, String)> {
+        let joined = self.services.join_next().await?;
+        Some(match joined {
+            Ok((name, Ok(()))) => (name, "stopped".to_owned()),
+            Ok((name, Err(reason))) => (name, reason),
+            Err(e) => ("a service", format!("panicked: {e}")),
+        })
+    }
+
+    /// Stops every service (each with its own grace period), then the router.
+    pub async fn shutdown(mut self) -> Result<(), StackError> {
+        self.cancel.cancel();
+        let mut first_error = None;
+        let deadline = tokio::time::Instant::now() + Duration::from_secs(5);
+        loop {
+            match tokio::time::timeout_at(deadline, self.services.join_next()).await {
+                Ok(None) => break,
+                Ok(Some(Ok((_, Ok(()))))) => {}
+                Ok(Some(Ok((service, Err(reason))))) => {
+                    first_error.get_or_insert(StackError::Failed { service, reason });
+                }
+                Ok(Some(Err(e))) => {
+                    first_error.get_or_insert(StackError::Failed {
+                        service: "a service",
+                        reason: format!("panicked: {e}"),
+                    });
+                }
+                Err(_) => {
+                    self.services.abort_all();
+                    first_error.get_or_insert(StackError::Failed {
+                        service: "the stack",
+                        reason: "services did not stop within 5 s".into(),
+                    });
+                    break;
+                }
+            }
+        }
+        self.router.close().await;
+        first_error.map_or(Ok(()), Err)
+    }
+}
+
+/// Waits for `<root>/@live/<service>/*` to appear.
+pub async fn wait_until_live(session: &zenoh::Session, root: &str, service: &'static str, timeout: Duration) -> Result<(), StackError> {
+    wait_for_liveliness(session, &keys::liveliness_of(root, service), timeout)
+        .await
+        .map_err(|e| match e {
+            LivelinessWait::Timeout => StackError::NotUp { service, timeout },
+            LivelinessWait::Zenoh(reason) => StackError::Liveliness(reason),
+        })
+}
+
+/// Why waiting for a liveliness token ended without it.
+#[derive(Debug)]
+pub enum LivelinessWait {
+    Timeout,
+    Zenoh(String),
+}
+
+/// Waits until a liveliness token matching `key` exists.
+pub async fn wait_for_liveliness(session: &zenoh::Session, key: &str, timeout: Duration) -> Result<(), LivelinessWait> {
+    let subscriber = session
+        .liveliness()
+        .declare_subscriber(key)
+        .history(true)
+        .await
+        .map_err(|e| LivelinessWait::Zenoh(e.to_string()))?;
+    match tokio::time::timeout(timeout, subscriber.recv_async()).await {
+        Ok(Ok(_)) => Ok(()),
+        Ok(Err(e)) => Err(LivelinessWait::Zenoh(e.to_string())),
+        Err(_) => Err(LivelinessWait::Timeout),
+    }
+}
+
