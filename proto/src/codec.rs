@@ -45,10 +45,15 @@ struct EnvelopeIn<'a> {
 pub enum DecodeError {
     #[error("the payload is not a roam message ({0}); send {{\"v\": {PROTOCOL_VERSION}, \"kind\": ..., \"body\": ...}} as JSON")]
     Envelope(String),
-    #[error("protocol version {found} is not supported; this service speaks version {PROTOCOL_VERSION}")]
+    #[error(
+        "protocol version {found} is not supported; this service speaks version {PROTOCOL_VERSION}"
+    )]
     UnsupportedVersion { found: u32 },
     #[error("expected a '{expected}' message but got '{found}'")]
-    WrongKind { expected: &'static str, found: String },
+    WrongKind {
+        expected: &'static str,
+        found: String,
+    },
     #[error("the '{kind}' message body is invalid: {reason}")]
     Body { kind: &'static str, reason: String },
 }

@@ -22,8 +22,7 @@ pub const MAX_SEGMENT_LEN: usize = 64;
 fn is_segment(s: &str) -> bool {
     !s.is_empty()
         && s.len() <= MAX_SEGMENT_LEN
-        && s
-            .bytes()
+        && s.bytes()
             .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
 }
 
@@ -130,7 +129,10 @@ mod tests {
 
     #[test]
     fn keys_have_the_documented_shape() {
-        assert_eq!(liveliness("roam", "map-server", "a1"), "roam/@live/map-server/a1");
+        assert_eq!(
+            liveliness("roam", "map-server", "a1"),
+            "roam/@live/map-server/a1"
+        );
         assert_eq!(map_layer("r", "occupancy"), "r/map/layer/occupancy");
         assert_eq!(map_update("r", "peb"), "r/map/update/peb");
         assert_eq!(map_index("r"), "r/map/layers");

@@ -14,14 +14,20 @@ fn finite() -> impl Strategy<Value = f64> {
 }
 
 fn meta() -> impl Strategy<Value = GridMeta> {
-    (0u32..5000, 0u32..5000, 0.001..10.0f64, finite(), finite(), -3.2..3.2f64).prop_map(
-        |(width, height, resolution, x, y, yaw)| GridMeta {
+    (
+        0u32..5000,
+        0u32..5000,
+        0.001..10.0f64,
+        finite(),
+        finite(),
+        -3.2..3.2f64,
+    )
+        .prop_map(|(width, height, resolution, x, y, yaw)| GridMeta {
             width,
             height,
             resolution,
             origin: Origin { x, y, yaw },
-        },
-    )
+        })
 }
 
 fn cells() -> impl Strategy<Value = Cells> {
@@ -37,15 +43,20 @@ fn name() -> impl Strategy<Value = String> {
 }
 
 fn layer() -> impl Strategy<Value = Layer> {
-    (name(), any::<u64>(), meta(), prop::option::of(name()), cells()).prop_map(
-        |(name, version, meta, derived_from, cells)| Layer {
+    (
+        name(),
+        any::<u64>(),
+        meta(),
+        prop::option::of(name()),
+        cells(),
+    )
+        .prop_map(|(name, version, meta, derived_from, cells)| Layer {
             name,
             version,
             meta,
             derived_from,
             cells,
-        },
-    )
+        })
 }
 
 fn info() -> impl Strategy<Value = LayerInfo> {
@@ -61,7 +72,11 @@ fn info() -> impl Strategy<Value = LayerInfo> {
 fn change() -> impl Strategy<Value = LayerChange> {
     prop_oneof![
         prop::collection::vec(
-            (any::<u32>(), any::<u32>(), finite()).prop_map(|(x, y, value)| CellWrite { x, y, value }),
+            (any::<u32>(), any::<u32>(), finite()).prop_map(|(x, y, value)| CellWrite {
+                x,
+                y,
+                value
+            }),
             0..50
         )
         .prop_map(|cells| LayerChange::SetCells { cells }),
@@ -82,9 +97,13 @@ fn error_reply() -> impl Strategy<Value = ErrorReply> {
         Just(ErrorCode::Unavailable),
         Just(ErrorCode::Internal),
     ];
-    let limit = prop::option::of((name(), any::<u64>(), any::<u64>()).prop_map(
-        |(name, max, actual)| LimitHit { name, max, actual },
-    ));
+    let limit = prop::option::of(
+        (name(), any::<u64>(), any::<u64>()).prop_map(|(name, max, actual)| LimitHit {
+            name,
+            max,
+            actual,
+        }),
+    );
     (code, ".{0,80}", limit).prop_map(|(code, message, limit)| ErrorReply {
         code,
         message,
@@ -119,14 +138,20 @@ fn refuses_version<T: Message + std::fmt::Debug>(message: &T, version: u32) {
 fn garbage() -> impl Strategy<Value = Vec<u8>> {
     // At least one byte that is not JSON whitespace.
     (prop::collection::vec(any::<u8>(), 0..20), any::<u8>()).prop_map(|(mut tail, first)| {
-        let first = if b" \t\r\n".contains(&first) { b'x' } else { first };
+        let first = if b" \t\r\n".contains(&first) {
+            b'x'
+        } else {
+            first
+        };
         tail.insert(0, first);
         tail
     })
 }
 
 fn other_version() -> impl Strategy<Value = u32> {
-    any::<u32>().prop_filter("not the current version", |v| *v != roam_proto::PROTOCOL_VERSION)
+    any::<u32>().prop_filter("not the current version", |v| {
+        *v != roam_proto::PROTOCOL_VERSION
+    })
 }
 
 proptest! {

@@ -1,1 +1,148 @@
+//! The integration harness: real services in-process around a real router on
+//! loopback, used only through Zenoh, as a client on another machine would.
+//!
+//! Each test gets its own router on a free port, multicast scouting off, and its own
+//! key root, so tests run in parallel without seeing each other. Services are awaited
+//! by liveliness, never by sleeping, and every await has a timeout.
 
+use std::future::IntoFuture;
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::{Duration, Instant};
+
+use roam::router::Router;
+use roam::stack::wait_until_live;
+use roam_map_server::MapServerConfig;
+use roam_proto::keys;
+use roam_runtime::{Requester, SessionArgs};
+use tokio::task::JoinHandle;
+use tokio_util::sync::CancellationToken;
+
+/// How long any single step of a test may take before it fails.
+pub const STEP: Duration = Duration::from_secs(10);
+
+/// Awaits `future` for at most [`STEP`], failing the test with `what` otherwise.
+pub async fn within<F: IntoFuture>(what: &str, future: F) -> F::Output {
+    match tokio::time::timeout(STEP, future).await {
+        Ok(value) => value,
+        Err(_) => panic!("timed out after {STEP:?}: {what}"),
+    }
+}
+
+/// A router and a unique key root for one test.
+#[derive(Debug)]
+pub struct Harness {
+    pub router: Router,
+    pub root: String,
+}
+
+/// A service running in this process.
+#[derive(Debug)]
+pub struct RunningService {
+    cancel: CancellationToken,
+    handle: JoinHandle<Result<(), String>>,
+}
+
+impl RunningService {
+    /// Cancels the service and waits until it has stopped; returns how long that took
+    /// and what the service returned.
+    pub async fn stop(self) -> (Duration, Result<(), String>) {
+        let started = Instant::now();
+        self.cancel.cancel();
+        let outcome = within("service stop", self.handle).await;
+        let outcome = outcome.unwrap_or_else(|e| Err(format!("panicked: {e}")));
+        (started.elapsed(), outcome)
+    }
+}
+
+static NEXT_ROOT: AtomicU32 = AtomicU32::new(0);
+
+impl Harness {
+    /// Starts a router on a free loopback port with a fresh key root.
+    pub async fn start() -> Harness {
+        let _ = tracing_subscriber::fmt()
+            .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
+            .with_test_writer()
+            .try_init();
+        let router = within("router start", Router::on_loopback())
+            .await
+            .expect("router");
+        let root = format!(
+            "test-{}-{}",
+            std::process::id(),
+            NEXT_ROOT.fetch_add(1, Ordering::Relaxed)
+        );
+        Harness { router, root }
+    }
+
+    /// A Zenoh config for a client session connected to this harness's router.
+    pub fn client_config(&self) -> zenoh::Config {
+        SessionArgs::client_of(&self.router.endpoint)
+            .zenoh_config(None)
+            .expect("client config")
+    }
+
+    /// A client session with a request helper.
+    pub async fn client(&self) -> Requester {
+        let session = within(
+            "client open",
+            roam_runtime::session::open(self.client_config()),
+        )
+        .await
+        .expect("client session");
+        Requester::new(session, Duration::from_secs(5))
+    }
+
+    /// A map server config under this harness's root, built-in world, no persistence.
+    pub fn map_server_config(&self) -> MapServerConfig {
+        MapServerConfig {
+            root: self.root.clone(),
+            ..MapServerConfig::default()
+        }
+    }
+
+    /// Starts a map server and waits until its liveliness token is seen.
+    pub async fn start_map_server(&self, config: MapServerConfig) -> RunningService {
+        let cancel = CancellationToken::new();
+        let token = cancel.clone();
+        let zenoh_config = self.client_config();
+        let handle = tokio::spawn(async move {
+            roam_map_server::run(config, zenoh_config, token)
+                .await
+                .map_err(|e| e.to_string())
+        });
+        let live = wait_until_live(
+            &self.router.session,
+            &self.root,
+            roam_map_server::SERVICE_NAME,
+            STEP,
+        );
+        tokio::pin!(live);
+        let mut handle = handle;
+        tokio::select! {
+            outcome = &mut live => outcome.expect("map server up"),
+            finished = &mut handle => panic!("the map server stopped at start: {finished:?}"),
+        }
+        RunningService { cancel, handle }
+    }
+
+    /// Whether any instance of `service` currently holds a liveliness token.
+    pub async fn is_live(&self, service: &str) -> bool {
+        let replies = within(
+            "liveliness get",
+            self.router
+                .session
+                .liveliness()
+                .get(keys::liveliness_of(&self.root, service))
+                .timeout(Duration::from_secs(2)),
+        )
+        .await
+        .expect("liveliness get");
+        within("liveliness replies", replies.recv_async())
+            .await
+            .is_ok()
+    }
+
+    pub async fn close(self) {
+        self.router.close().await;
+    }
+}

@@ -4,7 +4,11 @@
 
 /// Squared distance, in cells², from every cell to the nearest cell where `is_source`
 /// is true. With no source at all every value is `f32::INFINITY`.
-pub fn squared_distance(width: usize, height: usize, is_source: impl Fn(usize) -> bool) -> Vec<f32> {
+pub fn squared_distance(
+    width: usize,
+    height: usize,
+    is_source: impl Fn(usize) -> bool,
+) -> Vec<f32> {
     let mut d: Vec<f32> = (0..width * height)
         .map(|i| if is_source(i) { 0.0 } else { f32::INFINITY })
         .collect();

@@ -80,7 +80,11 @@ mod tests {
             width: 10,
             height: 5,
             resolution: 0.5,
-            origin: Origin { x: -1.0, y: 2.0, yaw: 0.0 },
+            origin: Origin {
+                x: -1.0,
+                y: 2.0,
+                yaw: 0.0,
+            },
         };
         assert_eq!(world_to_cell(&meta, -1.0, 2.0), Some((0, 0)));
         assert_eq!(world_to_cell(&meta, 3.99, 4.49), Some((9, 4)));

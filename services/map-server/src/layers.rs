@@ -62,7 +62,13 @@ pub fn heuristic(information: &Grid<u8>, compression: f64) -> Grid<f32> {
     let cells = sums
         .iter()
         .zip(&counts)
-        .map(|(&s, &n)| if n == 0 { 0.0 } else { (s as f64 / f64::from(n)) as f32 })
+        .map(|(&s, &n)| {
+            if n == 0 {
+                0.0
+            } else {
+                (s as f64 / f64::from(n)) as f32
+            }
+        })
         .collect();
     Grid {
         meta: GridMeta {
@@ -107,7 +113,11 @@ mod tests {
         assert_eq!(inflated.get(13, 11), Some(occupancy::FREE));
         assert_eq!(inflated.get(14, 10), Some(occupancy::FREE));
         assert_eq!(inflated.get(0, 0), Some(occupancy::UNKNOWN));
-        let occupied = inflated.cells.iter().filter(|&&c| c == occupancy::OCCUPIED).count();
+        let occupied = inflated
+            .cells
+            .iter()
+            .filter(|&&c| c == occupancy::OCCUPIED)
+            .count();
         // Lattice points within radius 3: 29.
         assert_eq!(occupied, 29);
     }

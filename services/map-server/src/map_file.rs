@@ -37,9 +37,11 @@ impl MapFileError {
     pub fn to_reply(&self) -> ErrorReply {
         let message = self.to_string();
         match self {
-            MapFileError::Ros(RosMapError::Missing { .. }) | MapFileError::Scenario(ScenarioError::Missing { .. }) => {
-                ErrorReply::new(ErrorCode::NotFound, format!("{message}; give a path on the map server's machine"))
-            }
+            MapFileError::Ros(RosMapError::Missing { .. })
+            | MapFileError::Scenario(ScenarioError::Missing { .. }) => ErrorReply::new(
+                ErrorCode::NotFound,
+                format!("{message}; give a path on the map server's machine"),
+            ),
             MapFileError::Scenario(ScenarioError::Map {
                 source: RosMapError::Missing { .. },
                 ..
@@ -49,7 +51,8 @@ impl MapFileError {
                 source: RosMapError::TooLarge { max, actual, .. },
                 ..
             }) => ErrorReply::limit("max_layer_cells", *max, *actual, message),
-            MapFileError::Ros(RosMapError::Io { .. }) | MapFileError::Scenario(ScenarioError::Io { .. }) => {
+            MapFileError::Ros(RosMapError::Io { .. })
+            | MapFileError::Scenario(ScenarioError::Io { .. }) => {
                 ErrorReply::new(ErrorCode::Internal, message)
             }
             _ => ErrorReply::new(ErrorCode::CorruptFile, message),

@@ -110,7 +110,8 @@ impl DataDir {
         header_line.push(b'\n');
         {
             let mut file = File::create(&tmp).map_err(|e| write_err(&tmp, e))?;
-            file.write_all(&header_line).map_err(|e| write_err(&tmp, e))?;
+            file.write_all(&header_line)
+                .map_err(|e| write_err(&tmp, e))?;
             file.write_all(&body).map_err(|e| write_err(&tmp, e))?;
             file.sync_all().map_err(|e| write_err(&tmp, e))?;
         }
@@ -131,7 +132,9 @@ impl DataDir {
         let entries = match fs::read_dir(&self.layers) {
             Ok(entries) => entries,
             Err(e) => {
-                loaded.warnings.push(format!("cannot list {}: {e}", self.layers.display()));
+                loaded
+                    .warnings
+                    .push(format!("cannot list {}: {e}", self.layers.display()));
                 return loaded;
             }
         };
@@ -149,7 +152,9 @@ impl DataDir {
         for name in names {
             match self.load_one(&name, &mut loaded.warnings) {
                 Some(layer) => loaded.layers.push(layer),
-                None => loaded.warnings.push(format!("layer '{name}' has no readable copy and was not loaded")),
+                None => loaded.warnings.push(format!(
+                    "layer '{name}' has no readable copy and was not loaded"
+                )),
             }
         }
         loaded
@@ -205,20 +210,31 @@ pub fn read_layer(path: &Path) -> Result<Layer, PersistError> {
         .take(MAX_HEADER_BYTES)
         .position(|&b| b == b'\n')
         .ok_or_else(|| corrupt("no header line".into()))?;
-    let header: Header = serde_json::from_slice(&bytes[..newline]).map_err(|e| corrupt(format!("bad header: {e}")))?;
+    let header: Header = serde_json::from_slice(&bytes[..newline])
+        .map_err(|e| corrupt(format!("bad header: {e}")))?;
     if header.format != FORMAT || header.v != FORMAT_VERSION {
         return Err(corrupt(format!("not a {FORMAT} v{FORMAT_VERSION} file")));
     }
     let body = &bytes[newline + 1..];
     if body.len() as u64 != header.bytes {
-        return Err(corrupt(format!("truncated: {} of {} cell bytes", body.len(), header.bytes)));
+        return Err(corrupt(format!(
+            "truncated: {} of {} cell bytes",
+            body.len(),
+            header.bytes
+        )));
     }
     if crc32fast::hash(body) != header.crc32 {
         return Err(corrupt("cell bytes fail their CRC-32".into()));
     }
-    let cells = Cells::from_le_bytes(header.dtype, body).ok_or_else(|| corrupt("cell bytes are not whole cells".into()))?;
+    let cells = Cells::from_le_bytes(header.dtype, body)
+        .ok_or_else(|| corrupt("cell bytes are not whole cells".into()))?;
     if cells.len() as u64 != header.meta.cell_count() {
-        return Err(corrupt(format!("{} cells for a {}x{} grid", cells.len(), header.meta.width, header.meta.height)));
+        return Err(corrupt(format!(
+            "{} cells for a {}x{} grid",
+            cells.len(),
+            header.meta.width,
+            header.meta.height
+        )));
     }
     Ok(Layer {
         name: header.name,
@@ -272,7 +288,10 @@ mod tests {
         let loaded = data.load_all();
         assert_eq!(loaded.layers, vec![layer(1, 0)]);
         let all = loaded.warnings.join("\n");
-        assert!(all.contains("occupancy.layer is corrupt: truncated"), "{all}");
+        assert!(
+            all.contains("occupancy.layer is corrupt: truncated"),
+            "{all}"
+        );
         assert!(all.contains("last good copy"), "{all}");
         assert!(path.with_extension("layer.corrupt").exists());
     }
@@ -291,6 +310,9 @@ mod tests {
         assert!(err.to_string().contains("CRC-32"), "{err}");
         let loaded = data.load_all();
         assert!(loaded.layers.is_empty());
-        assert!(loaded.warnings.iter().any(|w| w.contains("no readable copy")));
+        assert!(loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("no readable copy")));
     }
 }

@@ -14,7 +14,11 @@ pub const INFORMATION: Rgb<u8> = Rgb([240, 120, 0]);
 
 /// Draws occupancy, with the information map tinted over free cells, `scale` pixels
 /// per cell.
-pub fn render_map(occupancy_grid: &Grid<i8>, information: Option<&Grid<u8>>, scale: u32) -> RgbImage {
+pub fn render_map(
+    occupancy_grid: &Grid<i8>,
+    information: Option<&Grid<u8>>,
+    scale: u32,
+) -> RgbImage {
     let scale = scale.max(1);
     let (w, h) = (occupancy_grid.meta.width, occupancy_grid.meta.height);
     let same_size = information.filter(|i| i.meta.width == w && i.meta.height == h);
@@ -49,7 +53,9 @@ pub fn pixel_of(occupancy_grid: &Grid<i8>, x: usize, y: usize, scale: u32) -> (u
 
 fn blend(a: Rgb<u8>, b: Rgb<u8>, t: f32) -> Rgb<u8> {
     let t = t.clamp(0.0, 1.0);
-    Rgb(std::array::from_fn(|k| (f32::from(a.0[k]) * (1.0 - t) + f32::from(b.0[k]) * t).round() as u8))
+    Rgb(std::array::from_fn(|k| {
+        (f32::from(a.0[k]) * (1.0 - t) + f32::from(b.0[k]) * t).round() as u8
+    }))
 }
 
 #[cfg(test)]

@@ -88,7 +88,11 @@ pub enum RosMapError {
     #[error("map image {path} cannot be decoded: {reason}")]
     Image { path: PathBuf, reason: String },
     #[error("map image {path} has {actual} cells; the limit max_layer_cells is {max}")]
-    TooLarge { path: PathBuf, max: u64, actual: u64 },
+    TooLarge {
+        path: PathBuf,
+        max: u64,
+        actual: u64,
+    },
 }
 
 fn io_error(path: &Path, e: std::io::Error) -> RosMapError {
@@ -113,25 +117,39 @@ pub fn load(yaml_path: &Path, max_cells: u64) -> Result<RosMap, RosMapError> {
     };
     let yaml: MapYaml = serde_yaml_ng::from_str(&text).map_err(|e| invalid(e.to_string()))?;
     if !(yaml.resolution.is_finite() && yaml.resolution > 0.0) {
-        return Err(invalid(format!("resolution must be a positive number of metres per cell, got {}", yaml.resolution)));
+        return Err(invalid(format!(
+            "resolution must be a positive number of metres per cell, got {}",
+            yaml.resolution
+        )));
     }
     if yaml.origin.len() != 3 || yaml.origin.iter().any(|v| !v.is_finite()) {
-        return Err(invalid("origin must be [x, y, yaw] with three finite numbers".into()));
+        return Err(invalid(
+            "origin must be [x, y, yaw] with three finite numbers".into(),
+        ));
     }
-    for (name, value) in [("free_thresh", yaml.free_thresh), ("occupied_thresh", yaml.occupied_thresh)] {
+    for (name, value) in [
+        ("free_thresh", yaml.free_thresh),
+        ("occupied_thresh", yaml.occupied_thresh),
+    ] {
         if !(0.0..=1.0).contains(&value) {
-            return Err(invalid(format!("{name} must be between 0 and 1, got {value}")));
+            return Err(invalid(format!(
+                "{name} must be between 0 and 1, got {value}"
+            )));
         }
     }
     if yaml.free_thresh > yaml.occupied_thresh {
-        return Err(invalid("free_thresh must not exceed occupied_thresh".into()));
+        return Err(invalid(
+            "free_thresh must not exceed occupied_thresh".into(),
+        ));
     }
     let negate = match yaml.negate {
         None => false,
         Some(Flag::Bool(b)) => b,
         Some(Flag::Int(0)) => false,
         Some(Flag::Int(1)) => true,
-        Some(Flag::Int(other)) => return Err(invalid(format!("negate must be 0 or 1, got {other}"))),
+        Some(Flag::Int(other)) => {
+            return Err(invalid(format!("negate must be 0 or 1, got {other}")))
+        }
     };
     let image_path = yaml_path
         .parent()
@@ -154,7 +172,12 @@ pub fn load(yaml_path: &Path, max_cells: u64) -> Result<RosMap, RosMapError> {
 }
 
 /// Converts the image into occupancy with Nav2's rules.
-fn load_image(params: &MapParams, resolution: f64, origin: Origin, max_cells: u64) -> Result<Grid<i8>, RosMapError> {
+fn load_image(
+    params: &MapParams,
+    resolution: f64,
+    origin: Origin,
+    max_cells: u64,
+) -> Result<Grid<i8>, RosMapError> {
     let path = &params.image;
     let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
     let image_error = |reason: String| RosMapError::Image {
@@ -164,7 +187,9 @@ fn load_image(params: &MapParams, resolution: f64, origin: Origin, max_cells: u6
     let reader = image::ImageReader::new(std::io::Cursor::new(&bytes))
         .with_guessed_format()
         .map_err(|e| image_error(e.to_string()))?;
-    let (width, height) = reader.into_dimensions().map_err(|e| image_error(e.to_string()))?;
+    let (width, height) = reader
+        .into_dimensions()
+        .map_err(|e| image_error(e.to_string()))?;
     let cells = u64::from(width) * u64::from(height);
     if cells > max_cells {
         return Err(RosMapError::TooLarge {
@@ -205,7 +230,9 @@ fn load_image(params: &MapParams, resolution: f64, origin: Origin, max_cells: u6
                     occupancy::UNKNOWN
                 } else {
                     threshold(occ, params).unwrap_or_else(|| {
-                        let scaled = (occ - params.free_thresh) / (params.occupied_thresh - params.free_thresh) * 100.0;
+                        let scaled = (occ - params.free_thresh)
+                            / (params.occupied_thresh - params.free_thresh)
+                            * 100.0;
                         scaled.round_ties_even() as i8
                     })
                 }
@@ -314,13 +341,18 @@ pub fn save(grid: &Grid<i8>, yaml_path: &Path, params: SaveParams) -> Result<(),
             MapMode::Scale => {
                 return Err(RosMapError::Invalid {
                     path: yaml_path.to_owned(),
-                    reason: "saving in scale mode needs an alpha channel; save as trinary or raw".into(),
+                    reason: "saving in scale mode needs an alpha channel; save as trinary or raw"
+                        .into(),
                 })
             }
         })
     };
     let (w, h) = (grid.width(), grid.height());
-    let mut pgm = format!("P5\n# CREATOR: roam map_saver {:.3} m/pix\n{w} {h}\n255\n", grid.meta.resolution).into_bytes();
+    let mut pgm = format!(
+        "P5\n# CREATOR: roam map_saver {:.3} m/pix\n{w} {h}\n255\n",
+        grid.meta.resolution
+    )
+    .into_bytes();
     pgm.reserve(w * h);
     for image_row in 0..h {
         let row = h - 1 - image_row;

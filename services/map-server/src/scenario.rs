@@ -179,7 +179,9 @@ pub enum ScenarioError {
 pub fn load(path: &Path, max_cells: u64) -> Result<Scenario, ScenarioError> {
     let text = std::fs::read_to_string(path).map_err(|e| {
         if e.kind() == std::io::ErrorKind::NotFound {
-            ScenarioError::Missing { path: path.to_owned() }
+            ScenarioError::Missing {
+                path: path.to_owned(),
+            }
         } else {
             ScenarioError::Io {
                 path: path.to_owned(),
@@ -211,21 +213,30 @@ pub fn parse(path: &Path, text: &str, max_cells: u64) -> Result<Scenario, Scenar
                 })?
                 .grid
         }
-        MapSource::Grid(spec) => build_grid(spec, max_cells).map_err(|reason| field("map.grid", reason))?,
+        MapSource::Grid(spec) => {
+            build_grid(spec, max_cells).map_err(|reason| field("map.grid", reason))?
+        }
     };
     if let Some(r) = file.robot_radius_m {
         if !(r.is_finite() && r >= 0.0) {
-            return Err(field("robot_radius_m", format!("must be a non-negative number of metres, got {r}")));
+            return Err(field(
+                "robot_radius_m",
+                format!("must be a non-negative number of metres, got {r}"),
+            ));
         }
     }
     let information = match &file.information {
         None => Grid::filled(occupancy.meta, 0),
-        Some(spec) => build_information(spec, &occupancy.meta, base, max_cells).map_err(|(f, reason)| field(&f, reason))?,
+        Some(spec) => build_information(spec, &occupancy.meta, base, max_cells)
+            .map_err(|(f, reason)| field(&f, reason))?,
     };
     for (i, place) in file.places.iter().enumerate() {
         let [x, y] = place.at;
         if crate::grid::world_to_cell(&occupancy.meta, x, y).is_none() {
-            return Err(field(&format!("places[{i}].at"), format!("place '{}' at ({x}, {y}) is outside the map", place.name)));
+            return Err(field(
+                &format!("places[{i}].at"),
+                format!("place '{}' at ({x}, {y}) is outside the map", place.name),
+            ));
         }
     }
     Ok(Scenario {
@@ -238,14 +249,25 @@ pub fn parse(path: &Path, text: &str, max_cells: u64) -> Result<Scenario, Scenar
 fn build_grid(spec: &GridSpec, max_cells: u64) -> Result<Grid<i8>, String> {
     let [wm, hm] = spec.size_m;
     if !(spec.resolution.is_finite() && spec.resolution > 0.0) {
-        return Err(format!("resolution must be a positive number of metres per cell, got {}", spec.resolution));
+        return Err(format!(
+            "resolution must be a positive number of metres per cell, got {}",
+            spec.resolution
+        ));
     }
     if !(wm.is_finite() && hm.is_finite() && wm > 0.0 && hm > 0.0) {
-        return Err(format!("size_m must be two positive numbers, got [{wm}, {hm}]"));
+        return Err(format!(
+            "size_m must be two positive numbers, got [{wm}, {hm}]"
+        ));
     }
-    let (w, h) = ((wm / spec.resolution).round(), (hm / spec.resolution).round());
+    let (w, h) = (
+        (wm / spec.resolution).round(),
+        (hm / spec.resolution).round(),
+    );
     if w * h > max_cells as f64 {
-        return Err(format!("the grid has {} cells; the limit max_layer_cells is {max_cells}", w * h));
+        return Err(format!(
+            "the grid has {} cells; the limit max_layer_cells is {max_cells}",
+            w * h
+        ));
     }
     let meta = GridMeta {
         width: w as u32,
@@ -271,15 +293,30 @@ fn build_grid(spec: &GridSpec, max_cells: u64) -> Result<Grid<i8>, String> {
     Ok(grid)
 }
 
-fn build_information(spec: &InformationSpec, meta: &GridMeta, base: &Path, max_cells: u64) -> Result<Grid<u8>, (String, String)> {
+fn build_information(
+    spec: &InformationSpec,
+    meta: &GridMeta,
+    base: &Path,
+    max_cells: u64,
+) -> Result<Grid<u8>, (String, String)> {
     if spec.default_score > 100 {
-        return Err(("information.default_score".into(), format!("scores are 0..=100, got {}", spec.default_score)));
+        return Err((
+            "information.default_score".into(),
+            format!("scores are 0..=100, got {}", spec.default_score),
+        ));
     }
     let mut grid = Grid::filled(*meta, spec.default_score);
     if let Some(image) = &spec.image {
         let image_path = base.join(image);
-        let fail = |reason: String| ("information.image".to_owned(), format!("{}: {reason}", image_path.display()));
-        let decoded = image::open(&image_path).map_err(|e| fail(e.to_string()))?.to_luma8();
+        let fail = |reason: String| {
+            (
+                "information.image".to_owned(),
+                format!("{}: {reason}", image_path.display()),
+            )
+        };
+        let decoded = image::open(&image_path)
+            .map_err(|e| fail(e.to_string()))?
+            .to_luma8();
         if (decoded.width(), decoded.height()) != (meta.width, meta.height) {
             return Err(fail(format!(
                 "the image is {}x{} but the map is {}x{}",
@@ -290,21 +327,33 @@ fn build_information(spec: &InformationSpec, meta: &GridMeta, base: &Path, max_c
             )));
         }
         if u64::from(decoded.width()) * u64::from(decoded.height()) > max_cells {
-            return Err(fail(format!("more than max_layer_cells = {max_cells} cells")));
+            return Err(fail(format!(
+                "more than max_layer_cells = {max_cells} cells"
+            )));
         }
         let h = meta.height as usize;
         for (x, y, p) in decoded.enumerate_pixels() {
             let row = h - 1 - y as usize;
-            grid.cells[row * meta.width as usize + x as usize] = ((f64::from(p.0[0]) * 100.0 / 255.0).round()) as u8;
+            grid.cells[row * meta.width as usize + x as usize] =
+                ((f64::from(p.0[0]) * 100.0 / 255.0).round()) as u8;
         }
     }
     for (i, zone) in spec.zones.iter().enumerate() {
         if zone.score > 100 {
-            return Err((format!("information.zones[{i}].score"), format!("zone '{}': scores are 0..=100, got {}", zone.name, zone.score)));
+            return Err((
+                format!("information.zones[{i}].score"),
+                format!(
+                    "zone '{}': scores are 0..=100, got {}",
+                    zone.name, zone.score
+                ),
+            ));
         }
-        let shape = zone
-            .shape()
-            .ok_or_else(|| (format!("information.zones[{i}]"), format!("zone '{}' needs exactly one of rect or circle", zone.name)))?;
+        let shape = zone.shape().ok_or_else(|| {
+            (
+                format!("information.zones[{i}]"),
+                format!("zone '{}' needs exactly one of rect or circle", zone.name),
+            )
+        })?;
         let (w, h) = (grid.width(), grid.height());
         for y in 0..h {
             for x in 0..w {

@@ -61,7 +61,9 @@ impl State {
     fn store(&self) -> MutexGuard<'_, LayerStore> {
         // A panic while holding the lock would be a bug; the store is still consistent
         // because changes are staged and installed at the end.
-        self.store.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+        self.store
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
     /// The encoded layer, from the cache when its version is current.
@@ -81,9 +83,16 @@ impl State {
 
     async fn publish(&self, names: &[String]) {
         for name in names {
-            let Some(bytes) = self.encoded(name) else { continue };
+            let Some(bytes) = self.encoded(name) else {
+                continue;
+            };
             let key = keys::map_layer(&self.root, name);
-            if let Err(e) = self.session.put(&key, bytes).congestion_control(CongestionControl::Block).await {
+            if let Err(e) = self
+                .session
+                .put(&key, bytes)
+                .congestion_control(CongestionControl::Block)
+                .await
+            {
                 tracing::warn!(%key, "publishing the layer failed: {e}");
             }
         }
@@ -126,9 +135,20 @@ pub fn open_store(config: &MapServerConfig) -> Result<LayerStore, MapServerError
 }
 
 /// Runs the map server until `cancel` is cancelled.
-pub async fn run(config: MapServerConfig, zenoh_config: zenoh::Config, cancel: CancellationToken) -> Result<(), MapServerError> {
+pub async fn run(
+    config: MapServerConfig,
+    zenoh_config: zenoh::Config,
+    cancel: CancellationToken,
+) -> Result<(), MapServerError> {
     let store = open_store(&config)?;
-    let service = Service::start(SERVICE_NAME, &config.root, config.instance.as_deref(), zenoh_config, cancel).await?;
+    let mut service = Service::start(
+        SERVICE_NAME,
+        &config.root,
+        config.instance.as_deref(),
+        zenoh_config,
+        cancel,
+    )
+    .await?;
     let state = Arc::new(State {
         root: config.root.clone(),
         store: Mutex::new(store),
@@ -137,31 +157,48 @@ pub async fn run(config: MapServerConfig, zenoh_config: zenoh::Config, cancel: C
         session: service.session().clone(),
     });
     let root = config.root.as_str();
-    let layer_q = service.declare_queryable(&keys::map_layer_any(root)).await?;
-    let update_q = service.declare_queryable(&keys::map_update_any(root)).await?;
+    let layer_q = service
+        .declare_queryable(&keys::map_layer_any(root))
+        .await?;
+    let update_q = service
+        .declare_queryable(&keys::map_update_any(root))
+        .await?;
     let index_q = service.declare_queryable(&keys::map_index(root)).await?;
     let load_q = service.declare_queryable(&keys::map_load(root)).await?;
 
     let all: Vec<String> = state.store().names().map(str::to_owned).collect();
     state.publish(&all).await;
 
-    serve(&service, layer_q, state.clone(), |s, q| async move { answer_layer(&s, &q).await });
-    serve(&service, update_q, state.clone(), |s, q| async move { answer_update(s, &q).await });
+    serve(&service, layer_q, state.clone(), |s, q| async move {
+        answer_layer(&s, &q).await
+    });
+    serve(&service, update_q, state.clone(), |s, q| async move {
+        answer_update(s, &q).await
+    });
     serve(&service, index_q, state.clone(), |s, q| async move {
         let list = s.store().list();
         reply::send(&q, &list).await;
     });
-    serve(&service, load_q, state.clone(), |s, q| async move { answer_load(s, &q).await });
+    serve(&service, load_q, state.clone(), |s, q| async move {
+        answer_load(s, &q).await
+    });
+    service.announce().await?;
 
     service.cancelled().await;
-    service.shutdown(roam_runtime::service::DEFAULT_GRACE).await?;
+    service
+        .shutdown(roam_runtime::service::DEFAULT_GRACE)
+        .await?;
     Ok(())
 }
 
 /// Runs one queryable's loop on the service: each query is handled in its own tracked
 /// task; after cancellation, queued queries are refused as "unavailable".
-fn serve<F, Fut>(service: &Service, queryable: Queryable<FifoChannelHandler<Query>>, state: Arc<State>, handler: F)
-where
+fn serve<F, Fut>(
+    service: &Service,
+    queryable: Queryable<FifoChannelHandler<Query>>,
+    state: Arc<State>,
+    handler: F,
+) where
     F: Fn(Arc<State>, Query) -> Fut + Send + Sync + 'static,
     Fut: std::future::Future<Output = ()> + Send + 'static,
 {
@@ -189,7 +226,9 @@ async fn answer_layer(state: &State, query: &Query) {
     let mut answered = 0;
     for name in &names {
         let key = keys::map_layer(&state.root, name);
-        let Ok(layer_key) = KeyExpr::try_from(key.as_str()) else { continue };
+        let Ok(layer_key) = KeyExpr::try_from(key.as_str()) else {
+            continue;
+        };
         if !query.key_expr().intersects(&layer_key) {
             continue;
         }
@@ -203,7 +242,11 @@ async fn answer_layer(state: &State, query: &Query) {
     if answered == 0 {
         let error = ErrorReply::new(
             ErrorCode::NotFound,
-            format!("no layer matches '{}'; the map server holds: {}", query.key_expr(), names.join(", ")),
+            format!(
+                "no layer matches '{}'; the map server holds: {}",
+                query.key_expr(),
+                names.join(", ")
+            ),
         );
         reply::send_error(query, &error).await;
     }
@@ -213,26 +256,44 @@ async fn answer_layer(state: &State, query: &Query) {
 fn layer_name_of(query: &Query) -> Result<String, ErrorReply> {
     let key = query.key_expr().as_str();
     let name = key.rsplit('/').next().unwrap_or_default();
-    keys::check_name("layer name", name).map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, format!("{e}; name one layer in the key, e.g. <root>/map/update/occupancy")))?;
+    keys::check_name("layer name", name).map_err(|e| {
+        ErrorReply::new(
+            ErrorCode::InvalidRequest,
+            format!("{e}; name one layer in the key, e.g. <root>/map/update/occupancy"),
+        )
+    })?;
     Ok(name.to_owned())
 }
 
 async fn answer_update(state: Arc<State>, query: &Query) {
     let max = state.store().limits().max_request_bytes as usize;
-    let request = layer_name_of(query).and_then(|name| Ok((name, reply::decode_request::<LayerUpdate>(query, max)?)));
+    let request = layer_name_of(query)
+        .and_then(|name| Ok((name, reply::decode_request::<LayerUpdate>(query, max)?)));
     let (name, update) = match request {
         Ok(r) => r,
         Err(e) => return reply::send_error(query, &e).await,
     };
     let worker = state.clone();
-    let outcome = tokio::task::spawn_blocking(move || worker.store().apply(&name, &update).map_err(|e| e.to_reply())).await;
+    let outcome = tokio::task::spawn_blocking(move || {
+        worker
+            .store()
+            .apply(&name, &update)
+            .map_err(|e| e.to_reply())
+    })
+    .await;
     match outcome {
         Ok(Ok((ack, changed))) => {
             reply::send(query, &ack).await;
             state.publish(&changed).await;
         }
         Ok(Err(error)) => reply::send_error(query, &error).await,
-        Err(e) => reply::send_error(query, &ErrorReply::new(ErrorCode::Internal, format!("the update task failed: {e}"))).await,
+        Err(e) => {
+            reply::send_error(
+                query,
+                &ErrorReply::new(ErrorCode::Internal, format!("the update task failed: {e}")),
+            )
+            .await
+        }
     }
 }
 
@@ -250,7 +311,13 @@ async fn answer_load(state: Arc<State>, query: &Query) {
             state.publish(&changed).await;
         }
         Ok(Err(error)) => reply::send_error(query, &error).await,
-        Err(e) => reply::send_error(query, &ErrorReply::new(ErrorCode::Internal, format!("the load task failed: {e}"))).await,
+        Err(e) => {
+            reply::send_error(
+                query,
+                &ErrorReply::new(ErrorCode::Internal, format!("the load task failed: {e}")),
+            )
+            .await
+        }
     }
 }
 

@@ -15,7 +15,9 @@
 use std::collections::BTreeMap;
 
 use roam_proto::cells::Cells;
-use roam_proto::map::{CellWrite, GridMeta, Layer, LayerChange, LayerInfo, LayerList, LayerUpdate, UpdateAck};
+use roam_proto::map::{
+    CellWrite, GridMeta, Layer, LayerChange, LayerInfo, LayerList, LayerUpdate, UpdateAck,
+};
 use roam_proto::{keys, ErrorCode, ErrorReply};
 
 use crate::grid::{occupancy, Grid};
@@ -79,7 +81,11 @@ impl Default for DerivedParams {
 #[derive(Debug, thiserror::Error)]
 pub enum StoreError {
     #[error("layer '{layer}' is at version {current}, but the update was based on version {base}; get the latest layer and apply your change to it")]
-    Stale { layer: String, base: u64, current: u64 },
+    Stale {
+        layer: String,
+        base: u64,
+        current: u64,
+    },
     #[error("layer '{layer}' is computed from '{source_layer}'; update '{source_layer}' instead")]
     Derived { layer: String, source_layer: String },
     #[error("layer '{0}' does not exist; create it with a replace based on version 0")]
@@ -102,9 +108,13 @@ impl StoreError {
         let message = self.to_string();
         match self {
             StoreError::Stale { .. } => ErrorReply::new(ErrorCode::StaleVersion, message),
-            StoreError::Derived { .. } | StoreError::Invalid(_) => ErrorReply::new(ErrorCode::InvalidRequest, message),
+            StoreError::Derived { .. } | StoreError::Invalid(_) => {
+                ErrorReply::new(ErrorCode::InvalidRequest, message)
+            }
             StoreError::NotFound(_) => ErrorReply::new(ErrorCode::NotFound, message),
-            StoreError::Limit { name, max, actual, .. } => ErrorReply::limit(name, *max, *actual, message),
+            StoreError::Limit {
+                name, max, actual, ..
+            } => ErrorReply::limit(name, *max, *actual, message),
             StoreError::Persist(_) => ErrorReply::new(ErrorCode::Internal, message),
         }
     }
@@ -198,12 +208,22 @@ impl LayerStore {
         self.check_size(&occupancy_grid.meta)?;
         let mut pending = Pending::default();
         let info_cells = information.map(|g| Cells::U8(g.cells));
-        self.stage_source(&mut pending, OCCUPANCY, occupancy_grid.meta, Cells::I8(occupancy_grid.cells), info_cells)?;
+        self.stage_source(
+            &mut pending,
+            OCCUPANCY,
+            occupancy_grid.meta,
+            Cells::I8(occupancy_grid.cells),
+            info_cells,
+        )?;
         self.commit(pending)
     }
 
     /// Applies one update to layer `name`.
-    pub fn apply(&mut self, name: &str, update: &LayerUpdate) -> Result<(UpdateAck, Vec<String>), StoreError> {
+    pub fn apply(
+        &mut self,
+        name: &str,
+        update: &LayerUpdate,
+    ) -> Result<(UpdateAck, Vec<String>), StoreError> {
         keys::check_name("layer name", name).map_err(|e| StoreError::Invalid(e.to_string()))?;
         if let Some(source_layer) = derived_source(name) {
             return Err(StoreError::Derived {
@@ -226,8 +246,15 @@ impl LayerStore {
                         meta.cell_count()
                     )));
                 }
-                if !self.layers.contains_key(name) && self.layers.len() as u64 >= self.limits.max_layers {
-                    return Err(limit("max_layers", self.limits.max_layers, self.layers.len() as u64 + 1, "layers held".into()));
+                if !self.layers.contains_key(name)
+                    && self.layers.len() as u64 >= self.limits.max_layers
+                {
+                    return Err(limit(
+                        "max_layers",
+                        self.limits.max_layers,
+                        self.layers.len() as u64 + 1,
+                        "layers held".into(),
+                    ));
                 }
                 if name == INFORMATION {
                     self.stage_information(&mut pending, *meta, cells.clone())?;
@@ -245,7 +272,10 @@ impl LayerStore {
                         "cells in one set_cells update".into(),
                     ));
                 }
-                let layer = self.layers.get(name).ok_or_else(|| StoreError::NotFound(name.to_owned()))?;
+                let layer = self
+                    .layers
+                    .get(name)
+                    .ok_or_else(|| StoreError::NotFound(name.to_owned()))?;
                 let mut new_cells = layer.cells.clone();
                 for write in cells {
                     set_cell(name, &layer.meta, &mut new_cells, write)?;
@@ -313,18 +343,35 @@ impl LayerStore {
     ) -> Result<(), StoreError> {
         if name == OCCUPANCY {
             let Cells::I8(values) = &cells else {
-                return Err(StoreError::Invalid("occupancy cells must be i8 (ROS values -1, 0..=100)".into()));
+                return Err(StoreError::Invalid(
+                    "occupancy cells must be i8 (ROS values -1, 0..=100)".into(),
+                ));
             };
-            if let Some(bad) = values.iter().find(|&&v| v < occupancy::UNKNOWN || v > occupancy::OCCUPIED) {
-                return Err(StoreError::Invalid(format!("occupancy values are -1 (unknown) or 0..=100, got {bad}")));
+            if let Some(bad) = values
+                .iter()
+                .find(|&&v| v < occupancy::UNKNOWN || v > occupancy::OCCUPIED)
+            {
+                return Err(StoreError::Invalid(format!(
+                    "occupancy values are -1 (unknown) or 0..=100, got {bad}"
+                )));
             }
             let grid = Grid {
                 meta,
                 cells: values.clone(),
             };
-            let inflated = layers::inflate(&grid, self.derived.robot_radius_m, self.derived.lethal_threshold);
+            let inflated = layers::inflate(
+                &grid,
+                self.derived.robot_radius_m,
+                self.derived.lethal_threshold,
+            );
             pending.put(self, name, meta, None, cells);
-            pending.put(self, INFLATED, meta, Some(OCCUPANCY), Cells::I8(inflated.cells));
+            pending.put(
+                self,
+                INFLATED,
+                meta,
+                Some(OCCUPANCY),
+                Cells::I8(inflated.cells),
+            );
             let info_meta = self.layers.get(INFORMATION).map(|l| l.meta);
             match information {
                 Some(info) => self.stage_information(pending, meta, info)?,
@@ -338,20 +385,33 @@ impl LayerStore {
             return Ok(());
         }
         if let Some(bad) = non_finite(&cells) {
-            return Err(StoreError::Invalid(format!("layer '{name}' cells must be finite numbers, got {bad}")));
+            return Err(StoreError::Invalid(format!(
+                "layer '{name}' cells must be finite numbers, got {bad}"
+            )));
         }
         pending.put(self, name, meta, None, cells);
         Ok(())
     }
 
-    fn stage_information(&self, pending: &mut Pending, meta: GridMeta, cells: Cells) -> Result<(), StoreError> {
+    fn stage_information(
+        &self,
+        pending: &mut Pending,
+        meta: GridMeta,
+        cells: Cells,
+    ) -> Result<(), StoreError> {
         let Cells::U8(values) = &cells else {
-            return Err(StoreError::Invalid("information cells must be u8 scores 0..=100".into()));
+            return Err(StoreError::Invalid(
+                "information cells must be u8 scores 0..=100".into(),
+            ));
         };
         if let Some(bad) = values.iter().find(|&&v| v > 100) {
-            return Err(StoreError::Invalid(format!("information scores are 0..=100, got {bad}")));
+            return Err(StoreError::Invalid(format!(
+                "information scores are 0..=100, got {bad}"
+            )));
         }
-        let occupancy_meta = pending.meta_of(OCCUPANCY).or_else(|| self.layers.get(OCCUPANCY).map(|l| l.meta));
+        let occupancy_meta = pending
+            .meta_of(OCCUPANCY)
+            .or_else(|| self.layers.get(OCCUPANCY).map(|l| l.meta));
         if let Some(occ) = occupancy_meta {
             if occ != meta {
                 return Err(StoreError::Invalid(format!(
@@ -371,7 +431,13 @@ impl LayerStore {
                 cells: values.clone(),
             };
             let heuristic = layers::heuristic(&grid, self.derived.heuristic_compression);
-            pending.put(self, HEURISTIC, heuristic.meta, Some(INFORMATION), Cells::F32(heuristic.cells));
+            pending.put(
+                self,
+                HEURISTIC,
+                heuristic.meta,
+                Some(INFORMATION),
+                Cells::F32(heuristic.cells),
+            );
         }
         pending.put(self, INFORMATION, meta, None, cells);
     }
@@ -398,7 +464,14 @@ struct Pending {
 }
 
 impl Pending {
-    fn put(&mut self, store: &LayerStore, name: &str, meta: GridMeta, derived_from: Option<&str>, cells: Cells) {
+    fn put(
+        &mut self,
+        store: &LayerStore,
+        name: &str,
+        meta: GridMeta,
+        derived_from: Option<&str>,
+        cells: Cells,
+    ) {
         self.layers.retain(|l| l.name != name);
         self.layers.push(Layer {
             name: name.to_owned(),
@@ -414,7 +487,10 @@ impl Pending {
     }
 
     fn version_of(&self, name: &str) -> Option<u64> {
-        self.layers.iter().find(|l| l.name == name).map(|l| l.version)
+        self.layers
+            .iter()
+            .find(|l| l.name == name)
+            .map(|l| l.version)
     }
 }
 
@@ -440,7 +516,10 @@ pub fn info(layer: &Layer) -> LayerInfo {
 fn check_meta(meta: &GridMeta) -> Result<(), StoreError> {
     let o = meta.origin;
     if !(meta.resolution.is_finite() && meta.resolution > 0.0) {
-        return Err(StoreError::Invalid(format!("resolution must be a positive number of metres per cell, got {}", meta.resolution)));
+        return Err(StoreError::Invalid(format!(
+            "resolution must be a positive number of metres per cell, got {}",
+            meta.resolution
+        )));
     }
     if !(o.x.is_finite() && o.y.is_finite() && o.yaw.is_finite()) {
         return Err(StoreError::Invalid("the origin must be finite".into()));
@@ -456,7 +535,12 @@ fn non_finite(cells: &Cells) -> Option<f32> {
 }
 
 /// Writes one cell, checking its position and its value against the layer's type.
-fn set_cell(name: &str, meta: &GridMeta, cells: &mut Cells, write: &CellWrite) -> Result<(), StoreError> {
+fn set_cell(
+    name: &str,
+    meta: &GridMeta,
+    cells: &mut Cells,
+    write: &CellWrite,
+) -> Result<(), StoreError> {
     if write.x >= meta.width || write.y >= meta.height {
         return Err(StoreError::Invalid(format!(
             "cell ({}, {}) is outside layer '{name}' ({}x{}); x is the column 0..{}, y the row 0..{}",
@@ -472,7 +556,11 @@ fn set_cell(name: &str, meta: &GridMeta, cells: &mut Cells, write: &CellWrite) -
         (_, Cells::U8(_)) => (0.0, 255.0),
         (_, Cells::F32(_)) => (f64::from(f32::MIN), f64::from(f32::MAX)),
     };
-    let rounded = if matches!(cells, Cells::F32(_)) { value } else { value.round() };
+    let rounded = if matches!(cells, Cells::F32(_)) {
+        value
+    } else {
+        value.round()
+    };
     if !(rounded.is_finite() && (lo..=hi).contains(&rounded)) {
         return Err(StoreError::Invalid(format!(
             "value {value} at ({}, {}) is outside {lo}..={hi} for layer '{name}'",

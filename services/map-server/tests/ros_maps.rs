@@ -22,12 +22,33 @@ const MAX: u64 = DEFAULT_LIMITS.max_layer_cells;
 fn nav2_maps_give_nav2_counts() {
     let depot = ros_map::load(&maps_dir().join("depot.yaml"), MAX).expect("depot");
     assert_eq!((depot.grid.meta.width, depot.grid.meta.height), (604, 307));
-    assert_eq!(count_cells(&depot.grid), CellCounts { occupied: 5947, free: 179_481, unknown: 0 });
+    assert_eq!(
+        count_cells(&depot.grid),
+        CellCounts {
+            occupied: 5947,
+            free: 179_481,
+            unknown: 0
+        }
+    );
     let sandbox = ros_map::load(&maps_dir().join("tb3_sandbox.yaml"), MAX).expect("sandbox");
-    assert_eq!((sandbox.grid.meta.width, sandbox.grid.meta.height), (384, 384));
-    assert_eq!(sandbox.params.mode, MapMode::Trinary, "mode defaults to trinary");
+    assert_eq!(
+        (sandbox.grid.meta.width, sandbox.grid.meta.height),
+        (384, 384)
+    );
+    assert_eq!(
+        sandbox.params.mode,
+        MapMode::Trinary,
+        "mode defaults to trinary"
+    );
     assert_eq!(sandbox.grid.meta.origin.x, -10.0);
-    assert_eq!(count_cells(&sandbox.grid), CellCounts { occupied: 870, free: 7903, unknown: 138_683 });
+    assert_eq!(
+        count_cells(&sandbox.grid),
+        CellCounts {
+            occupied: 870,
+            free: 7903,
+            unknown: 138_683
+        }
+    );
 }
 
 /// Writes a PGM with the given rows (top row first) and a yaml, returns the yaml path.
@@ -59,7 +80,10 @@ fn negate_swaps_black_and_white() {
     let dir = tempfile::tempdir().expect("tmp");
     let yaml = write_map(dir.path(), &[&[0, 254, 205]], "negate: 1\n");
     let map = ros_map::load(&yaml, MAX).expect("load");
-    assert_eq!(map.grid.cells, vec![occupancy::FREE, occupancy::OCCUPIED, occupancy::OCCUPIED]);
+    assert_eq!(
+        map.grid.cells,
+        vec![occupancy::FREE, occupancy::OCCUPIED, occupancy::OCCUPIED]
+    );
 }
 
 #[test]
@@ -68,9 +92,13 @@ fn scale_mode_interpolates_between_the_thresholds() {
     // occ = 1 - v/255: v=128 → 0.498 → rint((0.498-0.196)/(0.65-0.196)*100) = 67.
     let yaml = write_map(dir.path(), &[&[0, 255, 128]], "mode: scale\n");
     let map = ros_map::load(&yaml, MAX).expect("load");
-    let expected = (((1.0 - 128.0 / 255.0) - 0.196) / (0.65 - 0.196) * 100.0f64).round_ties_even() as i8;
+    let expected =
+        (((1.0 - 128.0 / 255.0) - 0.196) / (0.65 - 0.196) * 100.0f64).round_ties_even() as i8;
     assert_eq!(expected, 67);
-    assert_eq!(map.grid.cells, vec![occupancy::OCCUPIED, occupancy::FREE, 67]);
+    assert_eq!(
+        map.grid.cells,
+        vec![occupancy::OCCUPIED, occupancy::FREE, 67]
+    );
 }
 
 #[test]
@@ -91,14 +119,20 @@ fn saved_maps_load_back_identical() {
     assert!(bytes.starts_with(b"P5\n"), "a binary PGM");
     let back = ros_map::load(&out, MAX).expect("reload");
     assert_eq!(back.grid.meta, depot.grid.meta);
-    assert!(back.grid.cells == depot.grid.cells, "cells differ after a round trip");
+    assert!(
+        back.grid.cells == depot.grid.cells,
+        "cells differ after a round trip"
+    );
 }
 
 #[test]
 fn bad_maps_are_refused_naming_the_file() {
     let dir = tempfile::tempdir().expect("tmp");
     let missing = dir.path().join("nope.yaml");
-    assert!(matches!(ros_map::load(&missing, MAX), Err(RosMapError::Missing { .. })));
+    assert!(matches!(
+        ros_map::load(&missing, MAX),
+        Err(RosMapError::Missing { .. })
+    ));
 
     let yaml = write_map(dir.path(), &[&[0, 254]], "");
     std::fs::write(dir.path().join("m.pgm"), b"P5\n2 1\n255\n").expect("truncate");
@@ -110,7 +144,11 @@ fn bad_maps_are_refused_naming_the_file() {
     let err = ros_map::load(&yaml, 3).unwrap_err();
     assert!(err.to_string().contains("max_layer_cells is 3"), "{err}");
 
-    std::fs::write(&yaml, "image: m.pgm\nresolution: -1\norigin: [0,0,0]\noccupied_thresh: 0.65\nfree_thresh: 0.2\n").expect("yaml");
+    std::fs::write(
+        &yaml,
+        "image: m.pgm\nresolution: -1\norigin: [0,0,0]\noccupied_thresh: 0.65\nfree_thresh: 0.2\n",
+    )
+    .expect("yaml");
     let err = ros_map::load(&yaml, MAX).unwrap_err();
     assert!(err.to_string().contains("resolution"), "{err}");
 }

@@ -27,7 +27,8 @@ fn every_shipped_scenario_loads() {
 
 #[test]
 fn the_map_server_config_example_parses() {
-    let config: MapServerConfig = roam_runtime::config_file::load(&config_dir().join("map-server.yaml")).expect("config");
+    let config: MapServerConfig =
+        roam_runtime::config_file::load(&config_dir().join("map-server.yaml")).expect("config");
     assert_eq!(config.root, "roam");
     assert_eq!(config.limits, DEFAULT_LIMITS);
 }
@@ -41,10 +42,20 @@ fn the_builtin_world_has_walls_zones_and_free_places() {
     let info = content.information.expect("information");
     let (lx, ly) = world_to_cell(&info.meta, -5.0, 8.0).expect("in map");
     assert_eq!(info.get(lx, ly), Some(90), "the lab zone");
-    let parsed = scenario::parse(Path::new("builtin"), map_file::BUILTIN_SCENARIO, DEFAULT_LIMITS.max_layer_cells).expect("parse");
+    let parsed = scenario::parse(
+        Path::new("builtin"),
+        map_file::BUILTIN_SCENARIO,
+        DEFAULT_LIMITS.max_layer_cells,
+    )
+    .expect("parse");
     for place in &parsed.file.places {
         let (x, y) = world_to_cell(&occ.meta, place.at[0], place.at[1]).expect("inside");
-        assert_eq!(occ.get(x, y), Some(occupancy::FREE), "{} is free", place.name);
+        assert_eq!(
+            occ.get(x, y),
+            Some(occupancy::FREE),
+            "{} is free",
+            place.name
+        );
     }
 }
 
@@ -55,11 +66,24 @@ fn scenario_errors_name_the_file_and_field() {
     let err = scenario::parse(path, text, DEFAULT_LIMITS.max_layer_cells).unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, ScenarioError::Field { .. }), "{msg}");
-    assert!(msg.contains("/tmp/roam-bad.yaml") && msg.contains("information.zones[0].score"), "{msg}");
+    assert!(
+        msg.contains("/tmp/roam-bad.yaml") && msg.contains("information.zones[0].score"),
+        "{msg}"
+    );
 
-    let err = scenario::parse(path, "name: x\nmap: {grid: {size_m: [1, 1], resolution: 0.1}}\nanchorz: []\n", 1000).unwrap_err();
+    let err = scenario::parse(
+        path,
+        "name: x\nmap: {grid: {size_m: [1, 1], resolution: 0.1}}\nanchorz: []\n",
+        1000,
+    )
+    .unwrap_err();
     assert!(err.to_string().contains("anchorz"), "{err}");
 
-    let err = scenario::parse(path, "name: x\nmap: {grid: {size_m: [100, 100], resolution: 0.1}}\n", 1000).unwrap_err();
+    let err = scenario::parse(
+        path,
+        "name: x\nmap: {grid: {size_m: [100, 100], resolution: 0.1}}\n",
+        1000,
+    )
+    .unwrap_err();
     assert!(err.to_string().contains("max_layer_cells"), "{err}");
 }

@@ -2,7 +2,10 @@
 
 use roam_map_server::grid::{occupancy, Grid};
 use roam_map_server::persist::DataDir;
-use roam_map_server::store::{DerivedParams, LayerStore, Limits, StoreError, DEFAULT_LIMITS, HEURISTIC, INFLATED, INFORMATION, OCCUPANCY};
+use roam_map_server::store::{
+    DerivedParams, LayerStore, Limits, StoreError, DEFAULT_LIMITS, HEURISTIC, INFLATED,
+    INFORMATION, OCCUPANCY,
+};
 use roam_proto::cells::Cells;
 use roam_proto::map::{CellWrite, GridMeta, LayerChange, LayerUpdate, Origin};
 use roam_proto::ErrorCode;
@@ -18,7 +21,9 @@ fn meta(w: u32, h: u32) -> GridMeta {
 
 fn store_with_map(limits: Limits) -> LayerStore {
     let mut store = LayerStore::new(limits, DerivedParams::default(), None);
-    store.load_map(Grid::filled(meta(20, 10), occupancy::FREE), None, None).expect("load");
+    store
+        .load_map(Grid::filled(meta(20, 10), occupancy::FREE), None, None)
+        .expect("load");
     store
 }
 
@@ -26,7 +31,10 @@ fn set(base_version: u64, cells: &[(u32, u32, f64)]) -> LayerUpdate {
     LayerUpdate {
         base_version,
         change: LayerChange::SetCells {
-            cells: cells.iter().map(|&(x, y, value)| CellWrite { x, y, value }).collect(),
+            cells: cells
+                .iter()
+                .map(|&(x, y, value)| CellWrite { x, y, value })
+                .collect(),
         },
     }
 }
@@ -37,15 +45,26 @@ fn loading_a_map_creates_sources_and_derived_layers_at_version_1() {
     for name in [OCCUPANCY, INFLATED, INFORMATION, HEURISTIC] {
         assert_eq!(store.version(name), 1, "{name}");
     }
-    assert_eq!(store.get(INFLATED).and_then(|l| l.derived_from.as_deref()), Some(OCCUPANCY));
+    assert_eq!(
+        store.get(INFLATED).and_then(|l| l.derived_from.as_deref()),
+        Some(OCCUPANCY)
+    );
 }
 
 #[test]
 fn an_update_bumps_the_layer_and_its_derived_layer() {
     let mut store = store_with_map(DEFAULT_LIMITS);
-    let (ack, changed) = store.apply(OCCUPANCY, &set(1, &[(5, 5, 100.0)])).expect("apply");
+    let (ack, changed) = store
+        .apply(OCCUPANCY, &set(1, &[(5, 5, 100.0)]))
+        .expect("apply");
     assert_eq!(ack.version, 2);
-    assert_eq!(ack.derived.iter().map(|d| d.name.as_str()).collect::<Vec<_>>(), vec![INFLATED]);
+    assert_eq!(
+        ack.derived
+            .iter()
+            .map(|d| d.name.as_str())
+            .collect::<Vec<_>>(),
+        vec![INFLATED]
+    );
     assert!(changed.contains(&INFLATED.to_owned()));
     let inflated = store.get(INFLATED).expect("inflated");
     assert_eq!(inflated.version, 2);
@@ -57,28 +76,60 @@ fn an_update_bumps_the_layer_and_its_derived_layer() {
 #[test]
 fn a_stale_update_is_refused_and_changes_nothing() {
     let mut store = store_with_map(DEFAULT_LIMITS);
-    store.apply(OCCUPANCY, &set(1, &[(1, 1, 100.0)])).expect("first writer");
-    let err = store.apply(OCCUPANCY, &set(1, &[(2, 2, 100.0)])).unwrap_err();
-    assert!(matches!(err, StoreError::Stale { base: 1, current: 2, .. }), "{err}");
+    store
+        .apply(OCCUPANCY, &set(1, &[(1, 1, 100.0)]))
+        .expect("first writer");
+    let err = store
+        .apply(OCCUPANCY, &set(1, &[(2, 2, 100.0)]))
+        .unwrap_err();
+    assert!(
+        matches!(
+            err,
+            StoreError::Stale {
+                base: 1,
+                current: 2,
+                ..
+            }
+        ),
+        "{err}"
+    );
     assert_eq!(err.to_reply().code, ErrorCode::StaleVersion);
-    assert_eq!(store.get(OCCUPANCY).and_then(|l| l.cells.get_f64(2 * 20 + 2)), Some(0.0));
+    assert_eq!(
+        store
+            .get(OCCUPANCY)
+            .and_then(|l| l.cells.get_f64(2 * 20 + 2)),
+        Some(0.0)
+    );
 }
 
 #[test]
 fn derived_layers_cannot_be_written() {
     let mut store = store_with_map(DEFAULT_LIMITS);
     let err = store.apply(INFLATED, &set(1, &[(1, 1, 0.0)])).unwrap_err();
-    assert!(err.to_string().contains("update 'occupancy' instead"), "{err}");
+    assert!(
+        err.to_string().contains("update 'occupancy' instead"),
+        "{err}"
+    );
 }
 
 #[test]
 fn bad_cells_are_refused_with_what_to_fix() {
     let mut store = store_with_map(DEFAULT_LIMITS);
-    let err = store.apply(OCCUPANCY, &set(1, &[(20, 0, 0.0)])).unwrap_err();
-    assert!(err.to_string().contains("outside layer 'occupancy' (20x10)"), "{err}");
-    let err = store.apply(OCCUPANCY, &set(1, &[(0, 0, 101.0)])).unwrap_err();
+    let err = store
+        .apply(OCCUPANCY, &set(1, &[(20, 0, 0.0)]))
+        .unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("outside layer 'occupancy' (20x10)"),
+        "{err}"
+    );
+    let err = store
+        .apply(OCCUPANCY, &set(1, &[(0, 0, 101.0)]))
+        .unwrap_err();
     assert!(err.to_string().contains("-1..=100"), "{err}");
-    let err = store.apply(INFORMATION, &set(1, &[(0, 0, f64::NAN)])).unwrap_err();
+    let err = store
+        .apply(INFORMATION, &set(1, &[(0, 0, f64::NAN)]))
+        .unwrap_err();
     assert_eq!(err.to_reply().code, ErrorCode::InvalidRequest);
 }
 
@@ -91,11 +142,16 @@ fn limits_are_named_in_the_error() {
         ..DEFAULT_LIMITS
     };
     let mut store = store_with_map(limits);
-    let err = store.apply(OCCUPANCY, &set(1, &[(0, 0, 0.0), (1, 0, 0.0), (2, 0, 0.0)])).unwrap_err();
+    let err = store
+        .apply(OCCUPANCY, &set(1, &[(0, 0, 0.0), (1, 0, 0.0), (2, 0, 0.0)]))
+        .unwrap_err();
     let reply = err.to_reply();
     assert_eq!(reply.code, ErrorCode::LimitExceeded);
     let hit = reply.limit.expect("limit");
-    assert_eq!((hit.name.as_str(), hit.max, hit.actual), ("max_cells_per_update", 2, 3));
+    assert_eq!(
+        (hit.name.as_str(), hit.max, hit.actual),
+        ("max_cells_per_update", 2, 3)
+    );
 
     let big = LayerUpdate {
         base_version: 0,
@@ -105,7 +161,10 @@ fn limits_are_named_in_the_error() {
         },
     };
     let reply = store.apply("peb", &big).unwrap_err().to_reply();
-    assert_eq!(reply.limit.map(|l| l.name), Some("max_layer_cells".to_owned()));
+    assert_eq!(
+        reply.limit.map(|l| l.name),
+        Some("max_layer_cells".to_owned())
+    );
 }
 
 #[test]
@@ -129,7 +188,11 @@ fn free_layers_are_created_at_version_0_and_owned_by_their_writer() {
             cells: Cells::F32(vec![0.5; 7]),
         },
     };
-    assert!(store.apply("other", &wrong_size).unwrap_err().to_string().contains("7 cells"));
+    assert!(store
+        .apply("other", &wrong_size)
+        .unwrap_err()
+        .to_string()
+        .contains("7 cells"));
 }
 
 #[test]
@@ -150,14 +213,31 @@ fn the_information_map_must_match_the_occupancy_grid() {
 fn persisted_layers_restore_with_their_versions() {
     let dir = tempfile::tempdir().expect("tmp");
     {
-        let mut store = LayerStore::new(DEFAULT_LIMITS, DerivedParams::default(), Some(DataDir::open(dir.path()).expect("dir")));
-        store.load_map(Grid::filled(meta(20, 10), occupancy::FREE), None, None).expect("load");
-        store.apply(OCCUPANCY, &set(1, &[(3, 3, 100.0)])).expect("apply");
+        let mut store = LayerStore::new(
+            DEFAULT_LIMITS,
+            DerivedParams::default(),
+            Some(DataDir::open(dir.path()).expect("dir")),
+        );
+        store
+            .load_map(Grid::filled(meta(20, 10), occupancy::FREE), None, None)
+            .expect("load");
+        store
+            .apply(OCCUPANCY, &set(1, &[(3, 3, 100.0)]))
+            .expect("apply");
     }
-    let mut store = LayerStore::new(DEFAULT_LIMITS, DerivedParams::default(), Some(DataDir::open(dir.path()).expect("dir")));
+    let mut store = LayerStore::new(
+        DEFAULT_LIMITS,
+        DerivedParams::default(),
+        Some(DataDir::open(dir.path()).expect("dir")),
+    );
     assert!(store.restore());
     assert_eq!(store.version(OCCUPANCY), 2);
     assert_eq!(store.version(INFLATED), 2);
     assert_eq!(store.version(HEURISTIC), 1);
-    assert_eq!(store.get(OCCUPANCY).and_then(|l| l.cells.get_f64(3 * 20 + 3)), Some(100.0));
+    assert_eq!(
+        store
+            .get(OCCUPANCY)
+            .and_then(|l| l.cells.get_f64(3 * 20 + 3)),
+        Some(100.0)
+    );
 }

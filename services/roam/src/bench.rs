@@ -102,12 +102,20 @@ pub async fn map(side: u32, iterations: usize, work_dir: &Path) -> Result<MapBen
     result
 }
 
-async fn measure(stack: &Stack, grid: &Grid<i8>, iterations: usize) -> Result<MapBench, BenchError> {
+async fn measure(
+    stack: &Stack,
+    grid: &Grid<i8>,
+    iterations: usize,
+) -> Result<MapBench, BenchError> {
     let open = |endpoint: &str| {
         let args = SessionArgs::client_of(endpoint);
         async move {
-            let config = args.zenoh_config(None).map_err(|e| BenchError::Setup(e.to_string()))?;
-            roam_runtime::session::open(config).await.map_err(|e| BenchError::Setup(e.to_string()))
+            let config = args
+                .zenoh_config(None)
+                .map_err(|e| BenchError::Setup(e.to_string()))?;
+            roam_runtime::session::open(config)
+                .await
+                .map_err(|e| BenchError::Setup(e.to_string()))
         }
     };
     let client = open(&stack.router.endpoint).await?;
@@ -119,7 +127,11 @@ async fn measure(stack: &Stack, grid: &Grid<i8>, iterations: usize) -> Result<Ma
         let layer: Layer = requester.request::<Layer, Layer>(&layer_key, None).await?;
         gets.push(ms(started.elapsed()));
         if layer.cells.len() != grid.cells.len() {
-            return Err(BenchError::Setup(format!("got {} cells, expected {}", layer.cells.len(), grid.cells.len())));
+            return Err(BenchError::Setup(format!(
+                "got {} cells, expected {}",
+                layer.cells.len(),
+                grid.cells.len()
+            )));
         }
     }
 
@@ -156,24 +168,35 @@ async fn measure(stack: &Stack, grid: &Grid<i8>, iterations: usize) -> Result<Ma
         .map_err(|e| BenchError::Setup(e.to_string()))?;
     // Declarations propagate asynchronously: wait until the publisher sees the subscriber.
     let matched = tokio::time::timeout(Duration::from_secs(10), async {
-        while !publisher.matching_status().await.map(|s| s.matching()).unwrap_or(false) {
+        while !publisher
+            .matching_status()
+            .await
+            .map(|s| s.matching())
+            .unwrap_or(false)
+        {
             tokio::time::sleep(Duration::from_millis(10)).await;
         }
     })
     .await;
     if matched.is_err() {
-        return Err(BenchError::Setup("the subscriber never matched the publisher".into()));
+        return Err(BenchError::Setup(
+            "the subscriber never matched the publisher".into(),
+        ));
     }
     let mut publishes = Vec::with_capacity(iterations);
     let wait = Duration::from_secs(10);
     for _ in 0..iterations {
         let started = Instant::now();
-        publisher.put(bytes.clone()).await.map_err(|e| BenchError::Setup(e.to_string()))?;
+        publisher
+            .put(bytes.clone())
+            .await
+            .map_err(|e| BenchError::Setup(e.to_string()))?;
         let sample = tokio::time::timeout(wait, subscriber.recv_async())
             .await
             .map_err(|_| BenchError::Lost(wait))?
             .map_err(|e| BenchError::Setup(e.to_string()))?;
-        let received: Layer = decode(&sample.payload().to_bytes()).map_err(|e| BenchError::Setup(e.to_string()))?;
+        let received: Layer =
+            decode(&sample.payload().to_bytes()).map_err(|e| BenchError::Setup(e.to_string()))?;
         publishes.push(ms(started.elapsed()));
         std::hint::black_box(received);
     }

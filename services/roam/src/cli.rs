@@ -228,17 +228,25 @@ async fn stack(args: StackArgs) -> anyhow::Result<()> {
         listen: args.listen,
     };
     let mut stack = Stack::start(options, Duration::from_secs(30)).await?;
-    eprintln!("roam stack up: router {} (root '{}'); connect with --connect {}", stack.router.endpoint, stack.root, stack.router.endpoint);
+    eprintln!(
+        "roam stack up: router {} (root '{}'); connect with --connect {}",
+        stack.router.endpoint, stack.root, stack.router.endpoint
+    );
     if args.once {
-        let client = roam_runtime::session::open(SessionArgs::client_of(&stack.router.endpoint).zenoh_config(None)?).await?;
+        let client = roam_runtime::session::open(
+            SessionArgs::client_of(&stack.router.endpoint).zenoh_config(None)?,
+        )
+        .await?;
         let requester = Requester::new(client.clone(), Duration::from_secs(10));
-        let outcome = report::build(&requester, &stack.root, &stack.router.endpoint, &args.out).await;
+        let outcome =
+            report::build(&requester, &stack.root, &stack.router.endpoint, &args.out).await;
         let _ = client.close().await;
         stack.shutdown().await?;
         let report = outcome?;
         print!("{report}");
         let json_path = args.out.join("report.json");
-        std::fs::write(&json_path, serde_json::to_vec_pretty(&report)?).with_context(|| format!("writing {}", json_path.display()))?;
+        std::fs::write(&json_path, serde_json::to_vec_pretty(&report)?)
+            .with_context(|| format!("writing {}", json_path.display()))?;
         println!("report: {}", json_path.display());
         return Ok(());
     }
@@ -257,7 +265,8 @@ async fn stack(args: StackArgs) -> anyhow::Result<()> {
 async fn map(command: MapCommand) -> anyhow::Result<()> {
     match command {
         MapCommand::Inspect { map, json } => {
-            let loaded = ros_map::load(&map, roam_map_server::store::DEFAULT_LIMITS.max_layer_cells)?;
+            let loaded =
+                ros_map::load(&map, roam_map_server::store::DEFAULT_LIMITS.max_layer_cells)?;
             let counts = ros_map::count_cells(&loaded.grid);
             let meta = loaded.grid.meta;
             let value = serde_json::json!({
@@ -291,15 +300,22 @@ async fn map(command: MapCommand) -> anyhow::Result<()> {
         }
         MapCommand::Layers(client) => {
             let (requester, session) = connect(&client).await?;
-            let list: Result<LayerList, _> = requester.request::<LayerList, LayerList>(&keys::map_index(&client.root), None).await;
+            let list: Result<LayerList, _> = requester
+                .request::<LayerList, LayerList>(&keys::map_index(&client.root), None)
+                .await;
             let _ = session.close().await;
             println!("{}", serde_json::to_string_pretty(&list?)?);
             Ok(())
         }
         MapCommand::Load { path, client } => {
             let (requester, session) = connect(&client).await?;
-            let request = LoadMap { path, base_version: None };
-            let list: Result<LayerList, _> = requester.request(&keys::map_load(&client.root), Some(&request)).await;
+            let request = LoadMap {
+                path,
+                base_version: None,
+            };
+            let list: Result<LayerList, _> = requester
+                .request(&keys::map_load(&client.root), Some(&request))
+                .await;
             let _ = session.close().await;
             println!("{}", serde_json::to_string_pretty(&list?)?);
             Ok(())
@@ -312,12 +328,19 @@ async fn connect(client: &ClientArgs) -> anyhow::Result<(Requester, zenoh::Sessi
         bail!("--timeout must be a positive number of seconds");
     }
     let session = roam_runtime::session::open(client.session.zenoh_config(None)?).await?;
-    Ok((Requester::new(session.clone(), Duration::from_secs_f64(client.timeout)), session))
+    Ok((
+        Requester::new(session.clone(), Duration::from_secs_f64(client.timeout)),
+        session,
+    ))
 }
 
 async fn bench(command: BenchCommand) -> anyhow::Result<()> {
     match command {
-        BenchCommand::Map { json, side, iterations } => {
+        BenchCommand::Map {
+            json,
+            side,
+            iterations,
+        } => {
             if iterations == 0 || side < 8 {
                 bail!("--iterations must be at least 1 and --side at least 8");
             }

@@ -8,7 +8,10 @@ fn main() -> std::process::ExitCode {
     let cli = cli::Cli::parse();
     roam_runtime::telemetry::init();
     // Zenoh needs tokio's multi-thread runtime.
-    let runtime = match tokio::runtime::Builder::new_multi_thread().enable_all().build() {
+    let runtime = match tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+    {
         Ok(runtime) => runtime,
         Err(e) => {
             eprintln!("error: cannot start the async runtime: {e}");

@@ -46,14 +46,23 @@ pub enum ReportError {
 
 /// Fetches every layer from the map server through Zenoh, and draws the world to
 /// `<out_dir>/world.png` (occupancy with the information map tinted over it).
-pub async fn build(requester: &Requester, root: &str, router: &str, out_dir: &Path) -> Result<StackReport, ReportError> {
-    let list: LayerList = requester.request::<LayerList, LayerList>(&keys::map_index(root), None).await?;
+pub async fn build(
+    requester: &Requester,
+    root: &str,
+    router: &str,
+    out_dir: &Path,
+) -> Result<StackReport, ReportError> {
+    let list: LayerList = requester
+        .request::<LayerList, LayerList>(&keys::map_index(root), None)
+        .await?;
     let mut layers = Vec::new();
     let mut occupancy = None;
     let mut information = None;
     for info in &list.layers {
         let started = Instant::now();
-        let layer: Layer = requester.request::<Layer, Layer>(&keys::map_layer(root, &info.name), None).await?;
+        let layer: Layer = requester
+            .request::<Layer, Layer>(&keys::map_layer(root, &info.name), None)
+            .await?;
         let get_ms = ms(started.elapsed());
         layers.push(LayerSummary {
             name: layer.name.clone(),
@@ -65,8 +74,18 @@ pub async fn build(requester: &Requester, root: &str, router: &str, out_dir: &Pa
             get_ms,
         });
         match (layer.name.as_str(), layer.cells) {
-            (OCCUPANCY, Cells::I8(cells)) => occupancy = Some(Grid { meta: layer.meta, cells }),
-            (INFORMATION, Cells::U8(cells)) => information = Some(Grid { meta: layer.meta, cells }),
+            (OCCUPANCY, Cells::I8(cells)) => {
+                occupancy = Some(Grid {
+                    meta: layer.meta,
+                    cells,
+                })
+            }
+            (INFORMATION, Cells::U8(cells)) => {
+                information = Some(Grid {
+                    meta: layer.meta,
+                    cells,
+                })
+            }
             _ => {}
         }
     }
@@ -107,8 +126,16 @@ pub fn ms(d: Duration) -> f64 {
 
 impl std::fmt::Display for StackReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        writeln!(f, "roam stack under '{}', router {}", self.root, self.router)?;
-        writeln!(f, "{:<14} {:>7} {:>11} {:>10} {:>5} {:>9}", "layer", "version", "cells", "m/cell", "type", "get ms")?;
+        writeln!(
+            f,
+            "roam stack under '{}', router {}",
+            self.root, self.router
+        )?;
+        writeln!(
+            f,
+            "{:<14} {:>7} {:>11} {:>10} {:>5} {:>9}",
+            "layer", "version", "cells", "m/cell", "type", "get ms"
+        )?;
         for l in &self.layers {
             writeln!(
                 f,

@@ -24,7 +24,8 @@ impl Router {
     pub async fn on_loopback() -> Result<Router, SessionError> {
         let mut last = None;
         for _ in 0..5 {
-            let port = free_loopback_port().map_err(|e| SessionError::Open(format!("no free loopback port: {e}")))?;
+            let port = free_loopback_port()
+                .map_err(|e| SessionError::Open(format!("no free loopback port: {e}")))?;
             let endpoint = format!("tcp/127.0.0.1:{port}");
             match Router::start(&SessionArgs::router_on(&endpoint), endpoint.clone()).await {
                 Ok(router) => return Ok(router),

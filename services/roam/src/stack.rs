@@ -30,9 +30,15 @@ pub enum StackError {
     #[error("the in-process router could not start: {0}")]
     Router(#[from] roam_runtime::SessionError),
     #[error("{service} did not announce itself within {timeout:?}")]
-    NotUp { service: &'static str, timeout: Duration },
+    NotUp {
+        service: &'static str,
+        timeout: Duration,
+    },
     #[error("{service} stopped: {reason}")]
-    Failed { service: &'static str, reason: String },
+    Failed {
+        service: &'static str,
+        reason: String,
+    },
     #[error("watching liveliness failed: {0}")]
     Liveliness(String),
 }
@@ -52,10 +58,15 @@ impl Stack {
     /// token (up to `timeout`).
     pub async fn start(options: StackOptions, timeout: Duration) -> Result<Stack, StackError> {
         let router = match &options.listen {
-            Some(endpoint) => Router::start(&SessionArgs::router_on(endpoint), endpoint.clone()).await?,
+            Some(endpoint) => {
+                Router::start(&SessionArgs::router_on(endpoint), endpoint.clone()).await?
+            }
             None => Router::on_loopback().await?,
         };
-        let root = options.root.clone().unwrap_or_else(|| keys::DEFAULT_ROOT.to_owned());
+        let root = options
+            .root
+            .clone()
+            .unwrap_or_else(|| keys::DEFAULT_ROOT.to_owned());
         let cancel = CancellationToken::new();
         let client = SessionArgs::client_of(&router.endpoint);
         let mut services = JoinSet::new();
@@ -70,7 +81,10 @@ impl Stack {
         let token = cancel.child_token();
         services.spawn(async move {
             let outcome = roam_map_server::run(map_config, zenoh_config, token).await;
-            (roam_map_server::SERVICE_NAME, outcome.map_err(|e| e.to_string()))
+            (
+                roam_map_server::SERVICE_NAME,
+                outcome.map_err(|e| e.to_string()),
+            )
         });
 
         let mut stack = Stack {
@@ -142,7 +156,12 @@ impl Stack {
 }
 
 /// Waits for `<root>/@live/<service>/*` to appear.
-pub async fn wait_until_live(session: &zenoh::Session, root: &str, service: &'static str, timeout: Duration) -> Result<(), StackError> {
+pub async fn wait_until_live(
+    session: &zenoh::Session,
+    root: &str,
+    service: &'static str,
+    timeout: Duration,
+) -> Result<(), StackError> {
     wait_for_liveliness(session, &keys::liveliness_of(root, service), timeout)
         .await
         .map_err(|e| match e {
@@ -159,7 +178,11 @@ pub enum LivelinessWait {
 }
 
 /// Waits until a liveliness token matching `key` exists.
-pub async fn wait_for_liveliness(session: &zenoh::Session, key: &str, timeout: Duration) -> Result<(), LivelinessWait> {
+pub async fn wait_for_liveliness(
+    session: &zenoh::Session,
+    key: &str,
+    timeout: Duration,
+) -> Result<(), LivelinessWait> {
     let subscriber = session
         .liveliness()
         .declare_subscriber(key)
@@ -172,4 +195,3 @@ pub async fn wait_for_liveliness(session: &zenoh::Session, key: &str, timeout: D
         Err(_) => Err(LivelinessWait::Timeout),
     }
 }
-

@@ -46,14 +46,22 @@ impl Requester {
     }
 
     /// Sends `request` (or no payload) to `key` and decodes the first reply as `R`.
-    pub async fn request<Q: Message, R: Message>(&self, key: &str, request: Option<&Q>) -> Result<R, ClientError> {
+    pub async fn request<Q: Message, R: Message>(
+        &self,
+        key: &str,
+        request: Option<&Q>,
+    ) -> Result<R, ClientError> {
         let payload = request.map(encode);
         self.request_raw(key, payload).await
     }
 
     /// Sends raw bytes (for clients that build their own payloads, and for tests of
     /// malformed input) and decodes the first reply as `R`.
-    pub async fn request_raw<R: Message>(&self, key: &str, payload: Option<Vec<u8>>) -> Result<R, ClientError> {
+    pub async fn request_raw<R: Message>(
+        &self,
+        key: &str,
+        payload: Option<Vec<u8>>,
+    ) -> Result<R, ClientError> {
         let zenoh_err = |e: zenoh::Error| ClientError::Zenoh {
             key: key.to_owned(),
             reason: e.to_string(),
@@ -64,19 +72,22 @@ impl Requester {
         }
         let replies = get.await.map_err(zenoh_err)?;
         // Zenoh ends the reply stream at its own timeout; ours guards against a hang.
-        let reply = tokio::time::timeout(self.timeout + Duration::from_secs(1), replies.recv_async())
-            .await
-            .ok()
-            .and_then(Result::ok)
-            .ok_or_else(|| ClientError::NoReply {
-                key: key.to_owned(),
-                timeout: self.timeout,
-            })?;
+        let reply =
+            tokio::time::timeout(self.timeout + Duration::from_secs(1), replies.recv_async())
+                .await
+                .ok()
+                .and_then(Result::ok)
+                .ok_or_else(|| ClientError::NoReply {
+                    key: key.to_owned(),
+                    timeout: self.timeout,
+                })?;
         match reply.result() {
-            Ok(sample) => decode(&sample.payload().to_bytes()).map_err(|source| ClientError::Decode {
-                key: key.to_owned(),
-                source,
-            }),
+            Ok(sample) => {
+                decode(&sample.payload().to_bytes()).map_err(|source| ClientError::Decode {
+                    key: key.to_owned(),
+                    source,
+                })
+            }
             Err(error) => {
                 let refusal: ErrorReply =
                     decode(&error.payload().to_bytes()).map_err(|source| ClientError::Decode {

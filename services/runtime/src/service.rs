@@ -2,10 +2,12 @@
 //! all its tasks, and the graceful stop that undoes all of it.
 //!
 //! The life of a service:
-//! 1. [`Service::start`] opens the session and declares `<root>/@live/<service>/<instance>`;
+//! 1. [`Service::start`] opens the session;
 //! 2. the service declares its queryables and subscribers and spawns its loops with
 //!    [`Service::spawn`]; each loop selects on [`Service::cancelled`];
-//! 3. on cancellation (a signal, a test, the stack stopping) [`Service::shutdown`] lets
+//! 3. [`Service::announce`] declares `<root>/@live/<service>/<instance>`. The token comes
+//!    last on purpose: whoever sees it can use every key of the service at once;
+//! 4. on cancellation (a signal, a test, the stack stopping) [`Service::shutdown`] lets
 //!    the loops refuse new work, waits for in-flight work up to a grace period, reports
 //!    the tasks that did not stop, drops the liveliness token and closes the session.
 
@@ -63,8 +65,8 @@ pub struct Service {
 }
 
 impl Service {
-    /// Opens the session and declares the liveliness token. `instance` defaults to the
-    /// session's Zenoh id, which is unique. The service stops when `cancel` is cancelled.
+    /// Opens the session. `instance` defaults to the session's Zenoh id, which is
+    /// unique. The service stops when `cancel` is cancelled.
     pub async fn start(
         name: &'static str,
         root: &str,
@@ -81,8 +83,23 @@ impl Service {
         let instance = instance
             .map(str::to_owned)
             .unwrap_or_else(|| session.zid().to_string());
-        let key = keys::liveliness(root, name, &instance);
-        let token = session
+        Ok(Service {
+            name,
+            root: root.to_owned(),
+            instance,
+            session,
+            token: None,
+            cancel,
+            tasks: TaskTracker::new(),
+        })
+    }
+
+    /// Declares the liveliness token `<root>/@live/<service>/<instance>`: call it once
+    /// every queryable and subscriber is declared, so the token means "ready".
+    pub async fn announce(&mut self) -> Result<(), ServiceError> {
+        let key = keys::liveliness(&self.root, self.name, &self.instance);
+        let token = self
+            .session
             .liveliness()
             .declare_token(&key)
             .await
@@ -91,16 +108,9 @@ impl Service {
                 key: key.clone(),
                 reason: e.to_string(),
             })?;
-        tracing::info!(service = name, %instance, %key, "service started");
-        Ok(Service {
-            name,
-            root: root.to_owned(),
-            instance,
-            session,
-            token: Some(token),
-            cancel,
-            tasks: TaskTracker::new(),
-        })
+        self.token = Some(token);
+        tracing::info!(service = self.name, instance = %self.instance, %key, "service ready");
+        Ok(())
     }
 
     pub fn name(&self) -> &'static str {
@@ -146,7 +156,10 @@ impl Service {
     pub async fn declare_queryable(
         &self,
         key: &str,
-    ) -> Result<zenoh::query::Queryable<zenoh::handlers::FifoChannelHandler<zenoh::query::Query>>, ServiceError> {
+    ) -> Result<
+        zenoh::query::Queryable<zenoh::handlers::FifoChannelHandler<zenoh::query::Query>>,
+        ServiceError,
+    > {
         self.session
             .declare_queryable(key)
             .complete(true)
@@ -164,17 +177,25 @@ impl Service {
     pub async fn shutdown(mut self, grace: Duration) -> Result<(), ServiceError> {
         self.cancel.cancel();
         self.tasks.close();
-        let late = tokio::time::timeout(grace, self.tasks.wait()).await.is_err();
+        let late = tokio::time::timeout(grace, self.tasks.wait())
+            .await
+            .is_err();
         let pending = self.tasks.len();
         if let Some(token) = self.token.take() {
             if let Err(e) = token.undeclare().await {
-                tracing::warn!(service = self.name, "undeclaring the liveliness token failed: {e}");
+                tracing::warn!(
+                    service = self.name,
+                    "undeclaring the liveliness token failed: {e}"
+                );
             }
         }
-        self.session.close().await.map_err(|e| ServiceError::Close {
-            service: self.name,
-            reason: e.to_string(),
-        })?;
+        self.session
+            .close()
+            .await
+            .map_err(|e| ServiceError::Close {
+                service: self.name,
+                reason: e.to_string(),
+            })?;
         tracing::info!(service = self.name, instance = %self.instance, "service stopped");
         if late {
             return Err(ServiceError::StopTimeout {

@@ -82,7 +82,10 @@ impl SessionArgs {
 
     /// Builds the layered Zenoh config; `file_section` is the `zenoh:` section of the
     /// service's config file, if it has one. `ZENOH_CONFIG` is read from the environment.
-    pub fn zenoh_config(&self, file_section: Option<&Value>) -> Result<zenoh::Config, SessionError> {
+    pub fn zenoh_config(
+        &self,
+        file_section: Option<&Value>,
+    ) -> Result<zenoh::Config, SessionError> {
         let env_file = std::env::var_os(ZENOH_CONFIG_ENV).map(PathBuf::from);
         self.zenoh_config_with(file_section, env_file.as_deref())
     }
@@ -93,7 +96,9 @@ impl SessionArgs {
         file_section: Option<&Value>,
         env_file: Option<&Path>,
     ) -> Result<zenoh::Config, SessionError> {
-        let mut merged = file_section.cloned().unwrap_or(Value::Object(Default::default()));
+        let mut merged = file_section
+            .cloned()
+            .unwrap_or(Value::Object(Default::default()));
         if let Some(path) = env_file {
             merge(&mut merged, read_zenoh_file(path)?);
         }
@@ -215,10 +220,19 @@ mod tests {
             .expect("config");
         // The file's listen stays, the env file's mode was overridden by --cfg, the
         // env file's connect was overridden by --connect.
-        assert_eq!(get(&config, "listen/endpoints"), serde_json::json!(["tcp/127.0.0.1:7000"]));
-        assert_eq!(get(&config, "connect/endpoints"), serde_json::json!(["tcp/127.0.0.1:7002"]));
+        assert_eq!(
+            get(&config, "listen/endpoints"),
+            serde_json::json!(["tcp/127.0.0.1:7000"])
+        );
+        assert_eq!(
+            get(&config, "connect/endpoints"),
+            serde_json::json!(["tcp/127.0.0.1:7002"])
+        );
         assert_eq!(get(&config, "mode"), serde_json::json!("peer"));
-        assert_eq!(get(&config, "scouting/multicast/enabled"), serde_json::json!(false));
+        assert_eq!(
+            get(&config, "scouting/multicast/enabled"),
+            serde_json::json!(false)
+        );
 
         let env_only = SessionArgs::default()
             .zenoh_config_with(Some(&file_section), Some(&env_file))
@@ -249,6 +263,9 @@ mod tests {
         let err = SessionArgs::default()
             .zenoh_config_with(None, Some(missing))
             .unwrap_err();
-        assert!(err.to_string().contains("/nonexistent/zenoh.json5"), "{err}");
+        assert!(
+            err.to_string().contains("/nonexistent/zenoh.json5"),
+            "{err}"
+        );
     }
 }

@@ -8,7 +8,8 @@ pub const DEFAULT_FILTER: &str = "info,zenoh=warn,zenoh_transport=warn,zenoh_lin
 /// Installs a tracing subscriber that writes to stderr, filtered by `RUST_LOG` (or
 /// [`DEFAULT_FILTER`]). Calling it twice is harmless: the second call does nothing.
 pub fn init() {
-    let filter = EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new(DEFAULT_FILTER));
+    let filter =
+        EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new(DEFAULT_FILTER));
     let _ = tracing_subscriber::fmt()
         .with_env_filter(filter)
         .with_writer(std::io::stderr)

@@ -1,0 +1,175 @@
+//! The `roam` binary as a user runs it: a process that stops on SIGTERM within 2 s,
+//! `roam stack --once` and its picture, `roam map inspect`.
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use roam::router::free_loopback_port;
+use roam::stack::wait_for_liveliness;
+use roam_runtime::SessionArgs;
+
+const ROAM: &str = env!("CARGO_BIN_EXE_roam");
+
+fn repo(path: &str) -> String {
+    format!("{}/../../{path}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_map_server_process_stops_on_sigterm_within_two_seconds() {
+    let port = free_loopback_port().expect("port");
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let root = format!("sigterm-{}", std::process::id());
+    let mut child = Command::new(ROAM)
+        .args([
+            "map-server",
+            "--mode",
+            "peer",
+            "--no-multicast",
+            "--listen",
+            &endpoint,
+            "--root",
+            &root,
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("spawn roam");
+
+    let client = roam_runtime::session::open(
+        SessionArgs::client_of(&endpoint)
+            .zenoh_config(None)
+            .expect("config"),
+    );
+    // The server may not be listening yet: retry the client until it connects.
+    let session = {
+        let started = Instant::now();
+        let mut opened = client.await;
+        while opened.is_err() && started.elapsed() < Duration::from_secs(20) {
+            tokio::time::sleep(Duration::from_millis(100)).await;
+            opened = roam_runtime::session::open(
+                SessionArgs::client_of(&endpoint)
+                    .zenoh_config(None)
+                    .expect("config"),
+            )
+            .await;
+        }
+        opened.expect("connect to the map server process")
+    };
+    wait_for_liveliness(
+        &session,
+        &format!("{root}/@live/map-server/*"),
+        Duration::from_secs(20),
+    )
+    .await
+    .expect("map server up");
+
+    let started = Instant::now();
+    let status = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(status.success());
+    let exit = loop {
+        if let Some(exit) = child.try_wait().expect("wait") {
+            break exit;
+        }
+        if started.elapsed() > Duration::from_secs(5) {
+            let _ = child.kill();
+            panic!("the map server did not stop within 5 s of SIGTERM");
+        }
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    };
+    let took = started.elapsed();
+    assert!(exit.success(), "exit status {exit:?}");
+    assert!(took < Duration::from_secs(2), "stopping took {took:?}");
+    let _ = session.close().await;
+}
+
+#[test]
+fn stack_once_fetches_every_layer_and_draws_the_world() {
+    let out = tempfile::tempdir().expect("tmp");
+    let output = Command::new(ROAM)
+        .args(["stack", "--once", "--out"])
+        .arg(out.path())
+        .env("ROAM_ROOT", format!("once-{}", std::process::id()))
+        .output()
+        .expect("run roam stack --once");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    for layer in ["occupancy", "inflated", "information", "heuristic"] {
+        assert!(stdout.contains(layer), "{layer} missing from:\n{stdout}");
+    }
+    let report: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(out.path().join("report.json")).expect("report.json"),
+    )
+    .expect("json");
+    assert_eq!(report["layers"].as_array().map(Vec::len), Some(4));
+
+    // The built-in world is 100 × 100 cells drawn at 8 px: the border wall is dark,
+    // the lab (score 90, around (-5, 8) m) is orange, open floor (score 5) near white.
+    let picture = image::open(out.path().join("world.png"))
+        .expect("png")
+        .to_rgb8();
+    assert_eq!(picture.dimensions(), (800, 800));
+    let px = |x_m: f64, y_m: f64| {
+        let (col, row) = (((x_m + 10.0) / 0.2) as u32, ((y_m + 10.0) / 0.2) as u32);
+        *picture.get_pixel(col * 8 + 4, (99 - row) * 8 + 4)
+    };
+    assert_eq!(px(-9.9, 0.0).0, [20, 20, 20], "border wall");
+    let lab = px(-5.0, 8.0).0;
+    assert!(lab[0] > 200 && lab[2] < 60, "lab tinted orange: {lab:?}");
+    let floor = px(5.0, 5.0).0;
+    assert!(
+        floor.iter().all(|&c| c > 230),
+        "floor near white: {floor:?}"
+    );
+}
+
+#[test]
+fn map_inspect_prints_nav2_counts_as_json() {
+    let output = Command::new(ROAM)
+        .args([
+            "map",
+            "inspect",
+            &repo("config/maps/tb3_sandbox.yaml"),
+            "--json",
+        ])
+        .output()
+        .expect("run");
+    assert!(output.status.success());
+    let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
+    assert_eq!(
+        value,
+        serde_json::json!({"width": 384, "height": 384, "resolution": 0.05, "origin": [-10.0, -10.0, 0.0],
+                           "occupied": 870, "free": 7903, "unknown": 138683})
+    );
+    let missing = Command::new(ROAM)
+        .args(["map", "inspect", "/nonexistent/map.yaml"])
+        .output()
+        .expect("run");
+    assert!(!missing.status.success());
+    assert!(
+        String::from_utf8_lossy(&missing.stderr).contains("/nonexistent/map.yaml does not exist")
+    );
+}
+
+#[test]
+fn help_reads_like_a_manual() {
+    let output = Command::new(ROAM).arg("--help").output().expect("run");
+    let text = String::from_utf8_lossy(&output.stdout);
+    for needle in [
+        "map-server",
+        "router",
+        "stack",
+        "ZENOH_CONFIG",
+        "RUST_LOG",
+        "ROAM_ROOT",
+        "CONFIG FILE",
+    ] {
+        assert!(text.contains(needle), "--help lacks {needle}");
+    }
+}

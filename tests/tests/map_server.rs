@@ -1,0 +1,479 @@
+//! The map server through Zenoh: gets, updates, stale refusals, restarts, every error
+//! path, and a graceful stop. Each test boots a real router and a real map server in
+//! process and talks to them only as a Zenoh client.
+
+use std::time::Duration;
+
+use roam_map_server::store::{Limits, DEFAULT_LIMITS};
+use roam_proto::cells::Cells;
+use roam_proto::map::{CellWrite, Layer, LayerChange, LayerList, LayerUpdate, LoadMap, UpdateAck};
+use roam_proto::{encode, keys, ErrorCode, ErrorReply};
+use roam_runtime::{ClientError, Requester};
+use roam_tests::{within, Harness};
+
+async fn get_layer(client: &Requester, root: &str, name: &str) -> Layer {
+    within(
+        "layer get",
+        client.request::<Layer, Layer>(&keys::map_layer(root, name), None),
+    )
+    .await
+    .expect("layer")
+}
+
+fn set(base_version: u64, x: u32, y: u32, value: f64) -> LayerUpdate {
+    LayerUpdate {
+        base_version,
+        change: LayerChange::SetCells {
+            cells: vec![CellWrite { x, y, value }],
+        },
+    }
+}
+
+async fn refusal<T: roam_proto::Message + std::fmt::Debug>(
+    outcome: impl std::future::Future<Output = Result<T, ClientError>>,
+) -> ErrorReply {
+    match within("refused request", outcome).await {
+        Err(ClientError::Refused(reply)) => reply,
+        other => panic!("expected a structured refusal, got {other:?}"),
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_client_gets_every_layer_of_the_builtin_world() {
+    let harness = Harness::start().await;
+    let server = harness.start_map_server(harness.map_server_config()).await;
+    let client = harness.client().await;
+
+    let occupancy = get_layer(&client, &harness.root, "occupancy").await;
+    assert_eq!(
+        (
+            occupancy.meta.width,
+            occupancy.meta.height,
+            occupancy.version
+        ),
+        (100, 100, 1)
+    );
+    assert!(matches!(occupancy.cells, Cells::I8(_)));
+    let heuristic = get_layer(&client, &harness.root, "heuristic").await;
+    assert_eq!(
+        (heuristic.meta.width, heuristic.meta.height),
+        (4, 4),
+        "c_h = 1/4"
+    );
+
+    let list: LayerList = within(
+        "index",
+        client.request::<LayerList, LayerList>(&keys::map_index(&harness.root), None),
+    )
+    .await
+    .expect("list");
+    let names: Vec<&str> = list.layers.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(names, ["heuristic", "inflated", "information", "occupancy"]);
+
+    // A wildcard get answers with every layer.
+    let replies = within(
+        "wildcard get",
+        client.session().get(keys::map_layer_any(&harness.root)),
+    )
+    .await
+    .expect("get");
+    let mut count = 0;
+    while let Ok(reply) = within("reply", replies.recv_async()).await {
+        assert!(reply.result().is_ok());
+        count += 1;
+    }
+    assert_eq!(count, 4);
+
+    let missing =
+        refusal(client.request::<Layer, Layer>(&keys::map_layer(&harness.root, "nope"), None))
+            .await;
+    assert_eq!(missing.code, ErrorCode::NotFound);
+    assert!(
+        missing.message.contains("occupancy"),
+        "names what exists: {}",
+        missing.message
+    );
+
+    let (_, outcome) = server.stop().await;
+    outcome.expect("clean stop");
+    harness.close().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn an_update_is_published_and_a_stale_one_refused() {
+    let harness = Harness::start().await;
+    let server = harness.start_map_server(harness.map_server_config()).await;
+    let client = harness.client().await;
+    let subscriber = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::map_layer(&harness.root, "inflated")),
+    )
+    .await
+    .expect("subscriber");
+
+    let update_key = keys::map_update(&harness.root, "occupancy");
+    let ack: UpdateAck = within(
+        "update",
+        client.request(&update_key, Some(&set(1, 50, 50, 100.0))),
+    )
+    .await
+    .expect("ack");
+    assert_eq!(ack.version, 2);
+    assert_eq!(
+        ack.derived
+            .iter()
+            .map(|d| (d.name.as_str(), d.version))
+            .collect::<Vec<_>>(),
+        [("inflated", 2)]
+    );
+
+    // The derived layer's publication arrives with the new version.
+    let published = loop {
+        let sample = within("publication", subscriber.recv_async())
+            .await
+            .expect("sample");
+        let layer: Layer = roam_proto::decode(&sample.payload().to_bytes()).expect("layer");
+        if layer.version == 2 {
+            break layer;
+        }
+    };
+    assert_eq!(
+        published.cells.get_f64(50 * 100 + 51),
+        Some(100.0),
+        "inflated next to the new obstacle"
+    );
+
+    let occupancy = get_layer(&client, &harness.root, "occupancy").await;
+    assert_eq!(
+        (occupancy.version, occupancy.cells.get_f64(50 * 100 + 50)),
+        (2, Some(100.0))
+    );
+
+    // A second writer that still holds version 1 is refused, and nothing changes.
+    let stale = refusal(
+        client.request::<LayerUpdate, UpdateAck>(&update_key, Some(&set(1, 10, 10, 100.0))),
+    )
+    .await;
+    assert_eq!(stale.code, ErrorCode::StaleVersion);
+    assert!(stale.message.contains("version 2"), "{}", stale.message);
+    assert_eq!(
+        get_layer(&client, &harness.root, "occupancy")
+            .await
+            .cells
+            .get_f64(10 * 100 + 10),
+        Some(0.0)
+    );
+
+    server.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_restarted_server_answers_with_the_same_versions_and_content() {
+    let harness = Harness::start().await;
+    let data = tempfile::tempdir().expect("tmp");
+    let config = roam_map_server::MapServerConfig {
+        data_dir: Some(data.path().to_owned()),
+        ..harness.map_server_config()
+    };
+    let server = harness.start_map_server(config.clone()).await;
+    let client = harness.client().await;
+    let update_key = keys::map_update(&harness.root, "occupancy");
+    within(
+        "update",
+        client.request::<LayerUpdate, UpdateAck>(&update_key, Some(&set(1, 20, 30, 100.0))),
+    )
+    .await
+    .expect("v2");
+    within(
+        "update",
+        client.request::<LayerUpdate, UpdateAck>(&update_key, Some(&set(2, 21, 30, 100.0))),
+    )
+    .await
+    .expect("v3");
+    let before = get_layer(&client, &harness.root, "occupancy").await;
+    let inflated_before = get_layer(&client, &harness.root, "inflated").await;
+    server.stop().await.1.expect("clean stop");
+    assert!(
+        !harness.is_live(roam_map_server::SERVICE_NAME).await,
+        "the liveliness token is gone"
+    );
+
+    let server = harness.start_map_server(config).await;
+    let after = get_layer(&client, &harness.root, "occupancy").await;
+    assert_eq!(after.version, 3);
+    assert_eq!(after, before);
+    assert_eq!(
+        get_layer(&client, &harness.root, "inflated").await,
+        inflated_before
+    );
+    // And it goes on from there.
+    let ack: UpdateAck = within(
+        "update",
+        client.request(&update_key, Some(&set(3, 22, 30, 100.0))),
+    )
+    .await
+    .expect("v4");
+    assert_eq!(ack.version, 4);
+    server.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn malformed_and_wrong_version_payloads_get_structured_errors() {
+    let harness = Harness::start().await;
+    let server = harness.start_map_server(harness.map_server_config()).await;
+    let client = harness.client().await;
+    let key = keys::map_update(&harness.root, "occupancy");
+
+    let malformed =
+        refusal(client.request_raw::<UpdateAck>(&key, Some(b"{not json".to_vec()))).await;
+    assert_eq!(malformed.code, ErrorCode::Malformed);
+
+    let mut value: serde_json::Value =
+        serde_json::from_slice(&encode(&set(1, 0, 0, 0.0))).expect("json");
+    value["v"] = 99.into();
+    let wrong_version = refusal(
+        client.request_raw::<UpdateAck>(&key, Some(serde_json::to_vec(&value).expect("json"))),
+    )
+    .await;
+    assert_eq!(wrong_version.code, ErrorCode::UnsupportedVersion);
+    assert!(
+        wrong_version.message.contains("99"),
+        "{}",
+        wrong_version.message
+    );
+
+    let mut trailing = encode(&set(1, 0, 0, 0.0));
+    trailing.extend_from_slice(b" garbage");
+    assert_eq!(
+        refusal(client.request_raw::<UpdateAck>(&key, Some(trailing)))
+            .await
+            .code,
+        ErrorCode::Malformed
+    );
+
+    let wrong_kind = refusal(client.request::<LoadMap, UpdateAck>(
+        &key,
+        Some(&LoadMap {
+            path: "x".into(),
+            base_version: None,
+        }),
+    ))
+    .await;
+    assert_eq!(wrong_kind.code, ErrorCode::WrongMessage);
+
+    let no_payload = refusal(client.request::<LayerUpdate, UpdateAck>(&key, None)).await;
+    assert_eq!(no_payload.code, ErrorCode::Malformed);
+
+    let derived = refusal(client.request::<LayerUpdate, UpdateAck>(
+        &keys::map_update(&harness.root, "inflated"),
+        Some(&set(1, 0, 0, 0.0)),
+    ))
+    .await;
+    assert_eq!(derived.code, ErrorCode::InvalidRequest);
+
+    let outside =
+        refusal(client.request::<LayerUpdate, UpdateAck>(&key, Some(&set(1, 100, 0, 0.0)))).await;
+    assert!(outside.message.contains("outside"), "{}", outside.message);
+
+    server.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn oversize_updates_are_refused_naming_the_limit() {
+    let harness = Harness::start().await;
+    let config = roam_map_server::MapServerConfig {
+        limits: Limits {
+            max_cells_per_update: 10,
+            max_request_bytes: 4096,
+            ..DEFAULT_LIMITS
+        },
+        ..harness.map_server_config()
+    };
+    let server = harness.start_map_server(config).await;
+    let client = harness.client().await;
+    let key = keys::map_update(&harness.root, "occupancy");
+
+    let many = LayerUpdate {
+        base_version: 1,
+        change: LayerChange::SetCells {
+            cells: (0..11)
+                .map(|x| CellWrite {
+                    x,
+                    y: 1,
+                    value: 100.0,
+                })
+                .collect(),
+        },
+    };
+    let reply = refusal(client.request::<LayerUpdate, UpdateAck>(&key, Some(&many))).await;
+    assert_eq!(reply.code, ErrorCode::LimitExceeded);
+    let limit = reply.limit.expect("limit named");
+    assert_eq!(
+        (limit.name.as_str(), limit.max, limit.actual),
+        ("max_cells_per_update", 10, 11)
+    );
+
+    let huge = LayerUpdate {
+        base_version: 0,
+        change: LayerChange::Replace {
+            meta: roam_proto::map::GridMeta {
+                width: 100,
+                height: 100,
+                resolution: 0.2,
+                origin: Default::default(),
+            },
+            cells: Cells::F32(vec![0.0; 10_000]),
+        },
+    };
+    let reply =
+        refusal(client.request::<LayerUpdate, UpdateAck>(
+            &keys::map_update(&harness.root, "peb"),
+            Some(&huge),
+        ))
+        .await;
+    assert_eq!(
+        reply.limit.map(|l| l.name),
+        Some("max_request_bytes".to_owned())
+    );
+
+    server.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn missing_and_corrupt_files_are_named_in_the_error() {
+    let harness = Harness::start().await;
+    let server = harness.start_map_server(harness.map_server_config()).await;
+    let client = harness.client().await;
+    let key = keys::map_load(&harness.root);
+    let dir = tempfile::tempdir().expect("tmp");
+
+    let missing_path = dir.path().join("missing.yaml");
+    let missing = refusal(client.request::<LoadMap, LayerList>(
+        &key,
+        Some(&LoadMap {
+            path: missing_path.display().to_string(),
+            base_version: None,
+        }),
+    ))
+    .await;
+    assert_eq!(missing.code, ErrorCode::NotFound);
+    assert!(
+        missing.message.contains("missing.yaml"),
+        "{}",
+        missing.message
+    );
+
+    // A map whose image is truncated.
+    std::fs::write(dir.path().join("bad.pgm"), b"P5\n10 10\n255\n\x00\x00").expect("pgm");
+    let yaml = dir.path().join("bad.yaml");
+    std::fs::write(&yaml, "image: bad.pgm\nresolution: 0.05\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.196\n").expect("yaml");
+    let corrupt = refusal(client.request::<LoadMap, LayerList>(
+        &key,
+        Some(&LoadMap {
+            path: yaml.display().to_string(),
+            base_version: None,
+        }),
+    ))
+    .await;
+    assert_eq!(corrupt.code, ErrorCode::CorruptFile);
+    assert!(corrupt.message.contains("bad.pgm"), "{}", corrupt.message);
+
+    // A good map loads, bumps the versions and is served.
+    let depot = concat!(env!("CARGO_MANIFEST_DIR"), "/../config/maps/depot.yaml");
+    let list: LayerList = within(
+        "load",
+        client.request(
+            &key,
+            Some(&LoadMap {
+                path: depot.into(),
+                base_version: Some(1),
+            }),
+        ),
+    )
+    .await
+    .expect("load depot");
+    let occupancy = list
+        .layers
+        .iter()
+        .find(|l| l.name == "occupancy")
+        .expect("occupancy");
+    assert_eq!((occupancy.meta.width, occupancy.version), (604, 2));
+    // A load based on an old version is stale.
+    let stale = refusal(client.request::<LoadMap, LayerList>(
+        &key,
+        Some(&LoadMap {
+            path: depot.into(),
+            base_version: Some(1),
+        }),
+    ))
+    .await;
+    assert_eq!(stale.code, ErrorCode::StaleVersion);
+
+    server.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_corrupt_persisted_layer_is_reported_and_the_last_good_copy_served() {
+    let harness = Harness::start().await;
+    let data = tempfile::tempdir().expect("tmp");
+    let config = roam_map_server::MapServerConfig {
+        data_dir: Some(data.path().to_owned()),
+        ..harness.map_server_config()
+    };
+    let server = harness.start_map_server(config.clone()).await;
+    let client = harness.client().await;
+    let key = keys::map_update(&harness.root, "occupancy");
+    within(
+        "update",
+        client.request::<LayerUpdate, UpdateAck>(&key, Some(&set(1, 5, 5, 100.0))),
+    )
+    .await
+    .expect("v2");
+    server.stop().await.1.expect("clean stop");
+
+    let file = data.path().join("layers/occupancy.layer");
+    let bytes = std::fs::read(&file).expect("layer file");
+    std::fs::write(&file, &bytes[..bytes.len() / 2]).expect("truncate");
+
+    let server = harness.start_map_server(config).await;
+    let list: LayerList = within(
+        "index",
+        client.request::<LayerList, LayerList>(&keys::map_index(&harness.root), None),
+    )
+    .await
+    .expect("list");
+    let warnings = list.warnings.join("\n");
+    assert!(
+        warnings.contains("occupancy.layer is corrupt: truncated"),
+        "{warnings}"
+    );
+    assert!(warnings.contains("last good copy"), "{warnings}");
+    let occupancy = get_layer(&client, &harness.root, "occupancy").await;
+    assert_eq!(occupancy.version, 1, "the previous good copy");
+    assert!(
+        data.path().join("layers/occupancy.layer.corrupt").exists(),
+        "the corrupt file is kept"
+    );
+
+    server.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_service_stops_within_two_seconds_and_drops_its_token() {
+    let harness = Harness::start().await;
+    let server = harness.start_map_server(harness.map_server_config()).await;
+    assert!(harness.is_live(roam_map_server::SERVICE_NAME).await);
+    let (took, outcome) = server.stop().await;
+    outcome.expect("clean stop");
+    assert!(took < Duration::from_secs(2), "stopping took {took:?}");
+    assert!(!harness.is_live(roam_map_server::SERVICE_NAME).await);
+    harness.close().await;
+}
