@@ -85,7 +85,7 @@ impl Cells {
             Dtype::I8 => Some(Cells::I8(bytes.iter().map(|&b| b as i8).collect())),
             Dtype::U8 => Some(Cells::U8(bytes.to_vec())),
             Dtype::F32 => {
-                if bytes.len() % 4 != 0 {
+                if !bytes.len().is_multiple_of(4) {
                     return None;
                 }
                 Some(Cells::F32(

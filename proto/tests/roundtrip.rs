@@ -130,7 +130,7 @@ fn refuses_version<T: Message + std::fmt::Debug>(message: &T, version: u32) {
     value["v"] = version.into();
     let bytes = serde_json::to_vec(&value).expect("json");
     assert_eq!(
-        decode::<T>(&bytes).unwrap_err(),
+        decode::<T>(&bytes).expect_err("must be refused"),
         DecodeError::UnsupportedVersion { found: version }
     );
 }
@@ -206,7 +206,7 @@ fn a_message_sent_to_the_wrong_key_is_refused_by_kind() {
         path: "map.yaml".into(),
         base_version: None,
     });
-    let err = decode::<LayerUpdate>(&bytes).unwrap_err();
+    let err = decode::<LayerUpdate>(&bytes).expect_err("must be refused");
     assert_eq!(err.to_reply().code, ErrorCode::WrongMessage);
     assert!(err.to_string().contains("layer_update"), "{err}");
 }
@@ -214,7 +214,7 @@ fn a_message_sent_to_the_wrong_key_is_refused_by_kind() {
 #[test]
 fn bad_base64_cells_are_a_body_error() {
     let bytes = br#"{"v":1,"kind":"layer_update","body":{"base_version":1,"change":{"op":"replace","meta":{"width":1,"height":1,"resolution":0.1,"origin":{"x":0,"y":0}},"cells":{"dtype":"f32","base64":"AAA="}}}}"#;
-    let err = decode::<LayerUpdate>(bytes).unwrap_err();
+    let err = decode::<LayerUpdate>(bytes).expect_err("must be refused");
     assert_eq!(err.to_reply().code, ErrorCode::Malformed);
     assert!(err.to_string().contains("whole number"), "{err}");
 }

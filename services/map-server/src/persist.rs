@@ -306,7 +306,7 @@ mod tests {
         let last = bytes.len() - 1;
         bytes[last] ^= 0x40;
         fs::write(&path, bytes).expect("write");
-        let err = read_layer(&path).unwrap_err();
+        let err = read_layer(&path).expect_err("must be refused");
         assert!(err.to_string().contains("CRC-32"), "{err}");
         let loaded = data.load_all();
         assert!(loaded.layers.is_empty());

@@ -349,7 +349,7 @@ impl LayerStore {
             };
             if let Some(bad) = values
                 .iter()
-                .find(|&&v| v < occupancy::UNKNOWN || v > occupancy::OCCUPIED)
+                .find(|&&v| !(occupancy::UNKNOWN..=occupancy::OCCUPIED).contains(&v))
             {
                 return Err(StoreError::Invalid(format!(
                     "occupancy values are -1 (unknown) or 0..=100, got {bad}"

@@ -136,12 +136,12 @@ fn bad_maps_are_refused_naming_the_file() {
 
     let yaml = write_map(dir.path(), &[&[0, 254]], "");
     std::fs::write(dir.path().join("m.pgm"), b"P5\n2 1\n255\n").expect("truncate");
-    let err = ros_map::load(&yaml, MAX).unwrap_err();
+    let err = ros_map::load(&yaml, MAX).expect_err("must be refused");
     assert!(matches!(err, RosMapError::Image { .. }), "{err}");
     assert!(err.to_string().contains("m.pgm"), "{err}");
 
     let yaml = write_map(dir.path(), &[&[0, 254], &[0, 0]], "");
-    let err = ros_map::load(&yaml, 3).unwrap_err();
+    let err = ros_map::load(&yaml, 3).expect_err("must be refused");
     assert!(err.to_string().contains("max_layer_cells is 3"), "{err}");
 
     std::fs::write(
@@ -149,6 +149,6 @@ fn bad_maps_are_refused_naming_the_file() {
         "image: m.pgm\nresolution: -1\norigin: [0,0,0]\noccupied_thresh: 0.65\nfree_thresh: 0.2\n",
     )
     .expect("yaml");
-    let err = ros_map::load(&yaml, MAX).unwrap_err();
+    let err = ros_map::load(&yaml, MAX).expect_err("must be refused");
     assert!(err.to_string().contains("resolution"), "{err}");
 }

@@ -63,7 +63,7 @@ fn the_builtin_world_has_walls_zones_and_free_places() {
 fn scenario_errors_name_the_file_and_field() {
     let path = Path::new("/tmp/roam-bad.yaml");
     let text = "name: x\nmap:\n  grid:\n    size_m: [2.0, 2.0]\n    resolution: 0.1\ninformation:\n  zones:\n    - { name: z, score: 120, rect: [0, 0, 1, 1] }\n";
-    let err = scenario::parse(path, text, DEFAULT_LIMITS.max_layer_cells).unwrap_err();
+    let err = scenario::parse(path, text, DEFAULT_LIMITS.max_layer_cells).expect_err("must be refused");
     let msg = err.to_string();
     assert!(matches!(err, ScenarioError::Field { .. }), "{msg}");
     assert!(
@@ -76,7 +76,7 @@ fn scenario_errors_name_the_file_and_field() {
         "name: x\nmap: {grid: {size_m: [1, 1], resolution: 0.1}}\nanchorz: []\n",
         1000,
     )
-    .unwrap_err();
+    .expect_err("must be refused");
     assert!(err.to_string().contains("anchorz"), "{err}");
 
     let err = scenario::parse(
@@ -84,6 +84,6 @@ fn scenario_errors_name_the_file_and_field() {
         "name: x\nmap: {grid: {size_m: [100, 100], resolution: 0.1}}\n",
         1000,
     )
-    .unwrap_err();
+    .expect_err("must be refused");
     assert!(err.to_string().contains("max_layer_cells"), "{err}");
 }

@@ -81,7 +81,7 @@ fn a_stale_update_is_refused_and_changes_nothing() {
         .expect("first writer");
     let err = store
         .apply(OCCUPANCY, &set(1, &[(2, 2, 100.0)]))
-        .unwrap_err();
+        .expect_err("must be refused");
     assert!(
         matches!(
             err,
@@ -105,7 +105,7 @@ fn a_stale_update_is_refused_and_changes_nothing() {
 #[test]
 fn derived_layers_cannot_be_written() {
     let mut store = store_with_map(DEFAULT_LIMITS);
-    let err = store.apply(INFLATED, &set(1, &[(1, 1, 0.0)])).unwrap_err();
+    let err = store.apply(INFLATED, &set(1, &[(1, 1, 0.0)])).expect_err("must be refused");
     assert!(
         err.to_string().contains("update 'occupancy' instead"),
         "{err}"
@@ -117,7 +117,7 @@ fn bad_cells_are_refused_with_what_to_fix() {
     let mut store = store_with_map(DEFAULT_LIMITS);
     let err = store
         .apply(OCCUPANCY, &set(1, &[(20, 0, 0.0)]))
-        .unwrap_err();
+        .expect_err("must be refused");
     assert!(
         err.to_string()
             .contains("outside layer 'occupancy' (20x10)"),
@@ -125,11 +125,11 @@ fn bad_cells_are_refused_with_what_to_fix() {
     );
     let err = store
         .apply(OCCUPANCY, &set(1, &[(0, 0, 101.0)]))
-        .unwrap_err();
+        .expect_err("must be refused");
     assert!(err.to_string().contains("-1..=100"), "{err}");
     let err = store
         .apply(INFORMATION, &set(1, &[(0, 0, f64::NAN)]))
-        .unwrap_err();
+        .expect_err("must be refused");
     assert_eq!(err.to_reply().code, ErrorCode::InvalidRequest);
 }
 
@@ -144,7 +144,7 @@ fn limits_are_named_in_the_error() {
     let mut store = store_with_map(limits);
     let err = store
         .apply(OCCUPANCY, &set(1, &[(0, 0, 0.0), (1, 0, 0.0), (2, 0, 0.0)]))
-        .unwrap_err();
+        .expect_err("must be refused");
     let reply = err.to_reply();
     assert_eq!(reply.code, ErrorCode::LimitExceeded);
     let hit = reply.limit.expect("limit");
@@ -160,7 +160,7 @@ fn limits_are_named_in_the_error() {
             cells: Cells::F32(vec![0.0; 400]),
         },
     };
-    let reply = store.apply("peb", &big).unwrap_err().to_reply();
+    let reply = store.apply("peb", &big).expect_err("must be refused").to_reply();
     assert_eq!(
         reply.limit.map(|l| l.name),
         Some("max_layer_cells".to_owned())
@@ -179,7 +179,7 @@ fn free_layers_are_created_at_version_0_and_owned_by_their_writer() {
     };
     let (ack, _) = store.apply("change_rate", &create).expect("create");
     assert_eq!(ack.version, 1);
-    let again = store.apply("change_rate", &create).unwrap_err();
+    let again = store.apply("change_rate", &create).expect_err("must be refused");
     assert!(matches!(again, StoreError::Stale { .. }));
     let wrong_size = LayerUpdate {
         base_version: 0,
@@ -190,7 +190,7 @@ fn free_layers_are_created_at_version_0_and_owned_by_their_writer() {
     };
     assert!(store
         .apply("other", &wrong_size)
-        .unwrap_err()
+        .expect_err("must be refused")
         .to_string()
         .contains("7 cells"));
 }
@@ -205,7 +205,7 @@ fn the_information_map_must_match_the_occupancy_grid() {
             cells: Cells::U8(vec![10; 25]),
         },
     };
-    let err = store.apply(INFORMATION, &replace).unwrap_err();
+    let err = store.apply(INFORMATION, &replace).expect_err("must be refused");
     assert!(err.to_string().contains("occupancy grid's size"), "{err}");
 }
 

@@ -247,7 +247,7 @@ mod tests {
             cfg: vec!["no-colon".into()],
             ..SessionArgs::default()
         };
-        let err = args.zenoh_config_with(None, None).unwrap_err();
+        let err = args.zenoh_config_with(None, None).expect_err("must be refused");
         assert!(err.to_string().contains("no-colon"), "{err}");
 
         let args = SessionArgs {
@@ -262,7 +262,7 @@ mod tests {
         let missing = Path::new("/nonexistent/zenoh.json5");
         let err = SessionArgs::default()
             .zenoh_config_with(None, Some(missing))
-            .unwrap_err();
+            .expect_err("must be refused");
         assert!(
             err.to_string().contains("/nonexistent/zenoh.json5"),
             "{err}"
