@@ -63,7 +63,8 @@ fn the_builtin_world_has_walls_zones_and_free_places() {
 fn scenario_errors_name_the_file_and_field() {
     let path = Path::new("/tmp/roam-bad.yaml");
     let text = "name: x\nmap:\n  grid:\n    size_m: [2.0, 2.0]\n    resolution: 0.1\ninformation:\n  zones:\n    - { name: z, score: 120, rect: [0, 0, 1, 1] }\n";
-    let err = scenario::parse(path, text, DEFAULT_LIMITS.max_layer_cells).expect_err("must be refused");
+    let err =
+        scenario::parse(path, text, DEFAULT_LIMITS.max_layer_cells).expect_err("must be refused");
     let msg = err.to_string();
     assert!(matches!(err, ScenarioError::Field { .. }), "{msg}");
     assert!(

@@ -105,7 +105,9 @@ fn a_stale_update_is_refused_and_changes_nothing() {
 #[test]
 fn derived_layers_cannot_be_written() {
     let mut store = store_with_map(DEFAULT_LIMITS);
-    let err = store.apply(INFLATED, &set(1, &[(1, 1, 0.0)])).expect_err("must be refused");
+    let err = store
+        .apply(INFLATED, &set(1, &[(1, 1, 0.0)]))
+        .expect_err("must be refused");
     assert!(
         err.to_string().contains("update 'occupancy' instead"),
         "{err}"
@@ -160,7 +162,10 @@ fn limits_are_named_in_the_error() {
             cells: Cells::F32(vec![0.0; 400]),
         },
     };
-    let reply = store.apply("peb", &big).expect_err("must be refused").to_reply();
+    let reply = store
+        .apply("peb", &big)
+        .expect_err("must be refused")
+        .to_reply();
     assert_eq!(
         reply.limit.map(|l| l.name),
         Some("max_layer_cells".to_owned())
@@ -179,7 +184,9 @@ fn free_layers_are_created_at_version_0_and_owned_by_their_writer() {
     };
     let (ack, _) = store.apply("change_rate", &create).expect("create");
     assert_eq!(ack.version, 1);
-    let again = store.apply("change_rate", &create).expect_err("must be refused");
+    let again = store
+        .apply("change_rate", &create)
+        .expect_err("must be refused");
     assert!(matches!(again, StoreError::Stale { .. }));
     let wrong_size = LayerUpdate {
         base_version: 0,
@@ -205,7 +212,9 @@ fn the_information_map_must_match_the_occupancy_grid() {
             cells: Cells::U8(vec![10; 25]),
         },
     };
-    let err = store.apply(INFORMATION, &replace).expect_err("must be refused");
+    let err = store
+        .apply(INFORMATION, &replace)
+        .expect_err("must be refused");
     assert!(err.to_string().contains("occupancy grid's size"), "{err}");
 }
 

@@ -247,7 +247,9 @@ mod tests {
             cfg: vec!["no-colon".into()],
             ..SessionArgs::default()
         };
-        let err = args.zenoh_config_with(None, None).expect_err("must be refused");
+        let err = args
+            .zenoh_config_with(None, None)
+            .expect_err("must be refused");
         assert!(err.to_string().contains("no-colon"), "{err}");
 
         let args = SessionArgs {
