@@ -271,3 +271,25 @@ mod tests {
         );
     }
 }
+
+#[cfg(test)]
+mod shipped_configs {
+    use super::*;
+
+    /// Every Zenoh config shipped in `deploy/` is accepted by Zenoh.
+    #[test]
+    fn deploy_configs_parse() {
+        let deploy = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../deploy");
+        let mut seen = 0;
+        for entry in std::fs::read_dir(&deploy).expect("deploy dir") {
+            let path = entry.expect("entry").path();
+            if path.extension().and_then(|e| e.to_str()) == Some("json5") {
+                SessionArgs::default()
+                    .zenoh_config_with(None, Some(&path))
+                    .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                seen += 1;
+            }
+        }
+        assert!(seen >= 2);
+    }
+}
