@@ -26,8 +26,11 @@ pub enum ErrorCode {
     NotFound,
     /// A file exists but its content is damaged or in the wrong format.
     CorruptFile,
-    /// The service is shutting down or overloaded; try again later or elsewhere.
+    /// The service is shutting down; try again later or elsewhere.
     Unavailable,
+    /// The service has as much work in flight as its limit allows; try another
+    /// instance or later. Never queued: the refusal is immediate.
+    Busy,
     /// A bug or an I/O failure on the service's side; the message says what failed.
     Internal,
 }
@@ -45,6 +48,7 @@ impl ErrorCode {
             ErrorCode::NotFound => "not_found",
             ErrorCode::CorruptFile => "corrupt_file",
             ErrorCode::Unavailable => "unavailable",
+            ErrorCode::Busy => "busy",
             ErrorCode::Internal => "internal",
         }
     }

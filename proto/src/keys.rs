@@ -107,6 +107,37 @@ pub fn map_load(root: &str) -> String {
     format!("{root}/map/load")
 }
 
+/// `<root>/planner/plan`: every planner instance answers a `get` carrying a
+/// [`PlanRequest`](crate::planner::PlanRequest) with a [`Plan`](crate::planner::Plan).
+/// Zenoh sends such a query to one nearest instance (failover, not load sharing); to
+/// share load, pick an instance and use [`planner_plan_at`].
+pub fn planner_plan(root: &str) -> String {
+    format!("{root}/planner/plan")
+}
+
+/// `<root>/planner/instance/<instance>/plan`: the same queryable on one instance's own
+/// key. Clients find instances through `<root>/@live/planner/*` and choose among them.
+pub fn planner_plan_at(root: &str, instance: &str) -> String {
+    format!("{root}/planner/instance/{instance}/plan")
+}
+
+/// `<root>/planner/progress/<request_id>`: the planner working on a request publishes
+/// [`PlanProgress`](crate::planner::PlanProgress) here, at most every 50 ms.
+pub fn planner_progress(root: &str, request_id: &str) -> String {
+    format!("{root}/planner/progress/{request_id}")
+}
+
+/// `<root>/planner/cancel/<request_id>`: put a [`CancelPlan`](crate::planner::CancelPlan)
+/// here to stop a plan in flight; every planner instance listens.
+pub fn planner_cancel(root: &str, request_id: &str) -> String {
+    format!("{root}/planner/cancel/{request_id}")
+}
+
+/// `<root>/planner/cancel/*`: what planner instances subscribe to.
+pub fn planner_cancel_any(root: &str) -> String {
+    format!("{root}/planner/cancel/*")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -11,6 +11,7 @@ pub mod codec;
 pub mod error;
 pub mod keys;
 pub mod map;
+pub mod planner;
 
 pub use codec::{decode, encode, DecodeError, Message, PROTOCOL_VERSION};
 pub use error::{ErrorCode, ErrorReply, LimitHit};

@@ -95,6 +95,7 @@ fn error_reply() -> impl Strategy<Value = ErrorReply> {
         Just(ErrorCode::NotFound),
         Just(ErrorCode::CorruptFile),
         Just(ErrorCode::Unavailable),
+        Just(ErrorCode::Busy),
         Just(ErrorCode::Internal),
     ];
     let limit = prop::option::of(
@@ -217,4 +218,166 @@ fn bad_base64_cells_are_a_body_error() {
     let err = decode::<LayerUpdate>(bytes).expect_err("must be refused");
     assert_eq!(err.to_reply().code, ErrorCode::Malformed);
     assert!(err.to_string().contains("whole number"), "{err}");
+}
+
+mod planner_messages {
+    use super::*;
+    use roam_proto::planner::{
+        CancelPlan, FitnessTerms, GaOverrides, MapVersion, Plan, PlanProgress, PlanRequest,
+        PlannerModel, StopReason,
+    };
+
+    fn model() -> impl Strategy<Value = PlannerModel> {
+        prop_oneof![
+            Just(PlannerModel::Shortest),
+            Just(PlannerModel::Model0),
+            Just(PlannerModel::Model1),
+            Just(PlannerModel::Model2),
+        ]
+    }
+
+    fn version() -> impl Strategy<Value = MapVersion> {
+        (any::<u64>(), any::<u64>()).prop_map(|(inflated, information)| MapVersion {
+            inflated,
+            information,
+        })
+    }
+
+    fn overrides() -> impl Strategy<Value = GaOverrides> {
+        (
+            prop::option::of(1u32..1000),
+            prop::option::of(1u32..5000),
+            prop::option::of(0.0..1.0f64),
+            prop::option::of(finite()),
+            prop::option::of(1u32..9),
+        )
+            .prop_map(
+                |(population, max_generations, crossover_ratio, w1, perception_diameter)| {
+                    GaOverrides {
+                        population,
+                        max_generations,
+                        crossover_ratio,
+                        w1,
+                        perception_diameter,
+                        ..GaOverrides::default()
+                    }
+                },
+            )
+    }
+
+    fn request() -> impl Strategy<Value = PlanRequest> {
+        (
+            prop::option::of(name()),
+            [finite(), finite()],
+            [finite(), finite()],
+            (finite(), finite()),
+            model(),
+            overrides(),
+            any::<u64>(),
+            prop::option::of(version()),
+        )
+            .prop_map(
+                |(
+                    request_id,
+                    start,
+                    goal,
+                    (t_exec_s, deadline_s),
+                    model,
+                    params,
+                    seed,
+                    map_version,
+                )| PlanRequest {
+                    request_id,
+                    start,
+                    goal,
+                    t_exec_s,
+                    deadline_s,
+                    model,
+                    params,
+                    seed,
+                    map_version,
+                },
+            )
+    }
+
+    fn plan() -> impl Strategy<Value = Plan> {
+        (
+            name(),
+            model(),
+            prop::collection::vec([any::<u32>(), any::<u32>()], 0..40),
+            (finite(), any::<bool>(), any::<bool>()),
+            [finite(), finite(), finite(), finite(), finite(), finite()],
+            (finite(), finite(), finite(), any::<u32>(), finite()),
+            prop_oneof![
+                Just(StopReason::MaxGenerations),
+                Just(StopReason::Deadline),
+                Just(StopReason::Cancelled),
+                Just(StopReason::Complete)
+            ],
+            (any::<u64>(), version(), name()),
+        )
+            .prop_map(
+                |(
+                    request_id,
+                    model,
+                    cells,
+                    (t_eta_s, reaches_goal, within_budget),
+                    f,
+                    (u_ges, density, distinct_information, generations, planning_ms),
+                    stop_reason,
+                    (seed, map_version, instance),
+                )| {
+                    let points = cells
+                        .iter()
+                        .map(|c| [f64::from(c[0]) * 0.2, f64::from(c[1]) * 0.2])
+                        .collect();
+                    Plan {
+                        request_id,
+                        model,
+                        cells,
+                        points,
+                        t_eta_s,
+                        reaches_goal,
+                        within_budget,
+                        fitness: FitnessTerms {
+                            f1_information: f[0],
+                            f2_on_time: f[1],
+                            f3_goal: f[2],
+                            f4_overtime: f[3],
+                            f5_idle: f[4],
+                            total: f[5],
+                        },
+                        u_ges,
+                        density,
+                        distinct_information,
+                        generations,
+                        planning_ms,
+                        stop_reason,
+                        seed,
+                        map_version,
+                        instance,
+                    }
+                },
+            )
+    }
+
+    proptest! {
+        #[test]
+        fn plan_request_round_trips(m in request()) { round_trips(&m); }
+
+        #[test]
+        fn plan_round_trips(m in plan()) { round_trips(&m); }
+
+        #[test]
+        fn progress_and_cancel_round_trip(id in name(), best in prop::collection::vec((any::<u32>(), finite()), 0..20), done in any::<bool>()) {
+            round_trips(&PlanProgress { request_id: id.clone(), best_fitness: best, done });
+            round_trips(&CancelPlan { request_id: id });
+        }
+
+        #[test]
+        fn planner_messages_refuse_garbage_and_versions(m in request(), g in garbage(), v in other_version()) {
+            refuses_trailing(&m, &g);
+            refuses_version(&m, v);
+        }
+    }
 }

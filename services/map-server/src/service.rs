@@ -18,10 +18,9 @@ use roam_proto::{encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::{reply, Service, ServiceError};
 use tokio_util::sync::CancellationToken;
 use zenoh::bytes::ZBytes;
-use zenoh::handlers::FifoChannelHandler;
 use zenoh::key_expr::KeyExpr;
 use zenoh::qos::CongestionControl;
-use zenoh::query::{Query, Queryable};
+use zenoh::query::Query;
 use zenoh::Session;
 
 use crate::config::MapServerConfig;
@@ -169,17 +168,17 @@ pub async fn run(
     let all: Vec<String> = state.store().names().map(str::to_owned).collect();
     state.publish(&all).await;
 
-    serve(&service, layer_q, state.clone(), |s, q| async move {
+    service.serve(layer_q, state.clone(), |s, q| async move {
         answer_layer(&s, &q).await
     });
-    serve(&service, update_q, state.clone(), |s, q| async move {
+    service.serve(update_q, state.clone(), |s, q| async move {
         answer_update(s, &q).await
     });
-    serve(&service, index_q, state.clone(), |s, q| async move {
+    service.serve(index_q, state.clone(), |s, q| async move {
         let list = s.store().list();
         reply::send(&q, &list).await;
     });
-    serve(&service, load_q, state.clone(), |s, q| async move {
+    service.serve(load_q, state.clone(), |s, q| async move {
         answer_load(s, &q).await
     });
     service.announce().await?;
@@ -189,35 +188,6 @@ pub async fn run(
         .shutdown(roam_runtime::service::DEFAULT_GRACE)
         .await?;
     Ok(())
-}
-
-/// Runs one queryable's loop on the service: each query is handled in its own tracked
-/// task; after cancellation, queued queries are refused as "unavailable".
-fn serve<F, Fut>(
-    service: &Service,
-    queryable: Queryable<FifoChannelHandler<Query>>,
-    state: Arc<State>,
-    handler: F,
-) where
-    F: Fn(Arc<State>, Query) -> Fut + Send + Sync + 'static,
-    Fut: std::future::Future<Output = ()> + Send + 'static,
-{
-    let cancel = service.cancel_token();
-    let tracker = service.tracker();
-    service.spawn(async move {
-        loop {
-            tokio::select! {
-                _ = cancel.cancelled() => break,
-                next = queryable.recv_async() => match next {
-                    Ok(query) => { tracker.spawn(handler(state.clone(), query)); }
-                    Err(_) => break,
-                },
-            }
-        }
-        while let Ok(Some(query)) = queryable.try_recv() {
-            reply::refuse_stopping(&query, SERVICE_NAME).await;
-        }
-    });
 }
 
 /// Answers a layer `get`: every layer whose key matches the query's key expression.

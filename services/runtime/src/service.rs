@@ -12,15 +12,23 @@
 //!    the tasks that did not stop, drops the liveliness token and closes the session.
 
 use std::future::Future;
+use std::sync::Arc;
 use std::time::Duration;
 
 use roam_proto::keys;
+use tokio::sync::Semaphore;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
+use zenoh::handlers::FifoChannelHandler;
 use zenoh::liveliness::LivelinessToken;
+use zenoh::query::{Query, Queryable};
 use zenoh::Session;
 
+use crate::reply;
 use crate::session::{self, SessionError};
+
+/// Queries one queryable handles at once (see [`Service::serve`]).
+pub const MAX_IN_FLIGHT: usize = 32;
 
 /// How long [`Service::shutdown`] waits for in-flight work by default.
 pub const DEFAULT_GRACE: Duration = Duration::from_millis(1500);
@@ -169,6 +177,53 @@ impl Service {
                 key: key.to_owned(),
                 reason: e.to_string(),
             })
+    }
+
+    /// Runs a queryable's loop: each query is handled by `handler(state, query)` in
+    /// its own tracked task, at most [`MAX_IN_FLIGHT`] at once (further queries wait in
+    /// Zenoh's channel, which pushes back on senders instead of growing memory). After
+    /// cancellation, queries still queued are refused as `unavailable`.
+    pub fn serve<S, F, Fut>(
+        &self,
+        queryable: Queryable<FifoChannelHandler<Query>>,
+        state: S,
+        handler: F,
+    ) where
+        S: Clone + Send + Sync + 'static,
+        F: Fn(S, Query) -> Fut + Send + Sync + 'static,
+        Fut: Future<Output = ()> + Send + 'static,
+    {
+        let cancel = self.cancel.clone();
+        let tracker = self.tasks.clone();
+        let name = self.name;
+        let permits = Arc::new(Semaphore::new(MAX_IN_FLIGHT));
+        self.tasks.spawn(async move {
+            loop {
+                let permit = tokio::select! {
+                    _ = cancel.cancelled() => break,
+                    permit = permits.clone().acquire_owned() => match permit {
+                        Ok(permit) => permit,
+                        Err(_) => break,
+                    },
+                };
+                tokio::select! {
+                    _ = cancel.cancelled() => break,
+                    next = queryable.recv_async() => match next {
+                        Ok(query) => {
+                            let work = handler(state.clone(), query);
+                            tracker.spawn(async move {
+                                work.await;
+                                drop(permit);
+                            });
+                        }
+                        Err(_) => break,
+                    },
+                }
+            }
+            while let Ok(Some(query)) = queryable.try_recv() {
+                reply::refuse_stopping(&query, name).await;
+            }
+        });
     }
 
     /// Stops the service: cancels its loops, waits up to `grace` for in-flight work,

@@ -1,0 +1,175 @@
+//! Messages of the GA planner (paper 000): plan requests, plans, progress.
+
+use serde::{Deserialize, Serialize};
+
+use crate::codec::Message;
+
+/// Which planner answers: the curious GA with one of the paper's models, or a baseline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlannerModel {
+    /// Shortest path by distance (A*, octile heuristic): the information-blind baseline.
+    Shortest,
+    /// GA with Model 0, coverage: a constant gain per newly perceived cell (Eq. 8).
+    Model0,
+    /// GA with Model I, novelty of stimuli with time and amount decay (Eq. 9).
+    Model1,
+    /// GA with Model II, heterogeneity |H − I| against the heuristic map (Eq. 10).
+    Model2,
+}
+
+impl PlannerModel {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            PlannerModel::Shortest => "shortest",
+            PlannerModel::Model0 => "model0",
+            PlannerModel::Model1 => "model1",
+            PlannerModel::Model2 => "model2",
+        }
+    }
+}
+
+/// The map a plan was made on: the versions of the two layers the planner reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapVersion {
+    pub inflated: u64,
+    pub information: u64,
+}
+
+/// Overrides of the GA parameters (paper 000 Table I); every field is optional.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GaOverrides {
+    pub population: Option<u32>,
+    pub max_generations: Option<u32>,
+    pub crossover_ratio: Option<f64>,
+    pub mutation_ratio: Option<f64>,
+    pub mutation_percentage: Option<f64>,
+    pub v_lin: Option<f64>,
+    pub v_ang: Option<f64>,
+    pub w1: Option<f64>,
+    pub w2: Option<f64>,
+    pub w3: Option<f64>,
+    pub w4: Option<f64>,
+    pub w5: Option<f64>,
+    pub w_t: Option<f64>,
+    pub w_n: Option<f64>,
+    pub heuristic_compression: Option<f64>,
+    pub perception_diameter: Option<u32>,
+    pub coverage_gain: Option<f64>,
+}
+
+/// Ask for a plan: from `start` to `goal` (world metres) within `t_exec_s` seconds of
+/// driving, planned within `deadline_s` seconds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanRequest {
+    /// Names the plan's progress key and lets a client cancel it; the planner makes one
+    /// up when absent. Characters a-z, A-Z, 0-9, '_' and '-'.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub request_id: Option<String>,
+    pub start: [f64; 2],
+    pub goal: [f64; 2],
+    /// Seconds the robot has to drive (paper 000: t_exec).
+    pub t_exec_s: f64,
+    /// Seconds the planner may take (paper 000: t_plan); the best path so far is returned.
+    pub deadline_s: f64,
+    pub model: PlannerModel,
+    #[serde(default)]
+    pub params: GaOverrides,
+    #[serde(default)]
+    pub seed: u64,
+    /// Plan on this map version; refused when the planner no longer has it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub map_version: Option<MapVersion>,
+}
+
+impl Message for PlanRequest {
+    const KIND: &'static str = "plan_request";
+}
+
+/// The fitness terms of paper 000 Eqs. 1 and 3–7 for the returned path.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitnessTerms {
+    pub f1_information: f64,
+    pub f2_on_time: f64,
+    pub f3_goal: f64,
+    pub f4_overtime: f64,
+    pub f5_idle: f64,
+    pub total: f64,
+}
+
+/// Why the GA stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopReason {
+    MaxGenerations,
+    Deadline,
+    Cancelled,
+    /// Baselines that are not iterative.
+    Complete,
+}
+
+/// A plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Plan {
+    pub request_id: String,
+    pub model: PlannerModel,
+    /// Grid cells `[x, y]` from start to end, 8-connected.
+    pub cells: Vec<[u32; 2]>,
+    /// The cells' centres in world metres.
+    pub points: Vec<[f64; 2]>,
+    /// Estimated driving time (paper 000 Eq. 2), seconds.
+    pub t_eta_s: f64,
+    pub reaches_goal: bool,
+    pub within_budget: bool,
+    pub fitness: FitnessTerms,
+    /// Unbiased information U_ges (Eq. 11): window sums along the path, cells counted
+    /// each time they are in view.
+    pub u_ges: f64,
+    /// Information density D = U_ges / L (Eq. 12).
+    pub density: f64,
+    /// Information of the distinct cells seen along the path.
+    pub distinct_information: f64,
+    pub generations: u32,
+    pub planning_ms: f64,
+    pub stop_reason: StopReason,
+    pub seed: u64,
+    pub map_version: MapVersion,
+    /// The planner instance that answered.
+    pub instance: String,
+}
+
+impl Message for Plan {
+    const KIND: &'static str = "plan";
+}
+
+/// Progress of a plan in flight, published on `<root>/planner/progress/<request_id>`:
+/// the best fitness of each generation since the previous message.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlanProgress {
+    pub request_id: String,
+    /// `[generation, best fitness]` pairs, in order.
+    pub best_fitness: Vec<(u32, f64)>,
+    pub done: bool,
+}
+
+impl Message for PlanProgress {
+    const KIND: &'static str = "plan_progress";
+}
+
+/// Cancel a plan in flight: put on `<root>/planner/cancel/<request_id>`. The planner
+/// stops and replies with the best path found so far (`stop_reason: cancelled`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CancelPlan {
+    pub request_id: String,
+}
+
+impl Message for CancelPlan {
+    const KIND: &'static str = "cancel_plan";
+}
