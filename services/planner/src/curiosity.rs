@@ -1,0 +1,214 @@
+//! The fitness of a path (paper 000 Eqs. 1, 3–7) under the three curiosity models
+//! (Eqs. 8–10).
+//!
+//! Walking the path gene by gene, the evaluator perceives the window around each cell
+//! (Eq. 3, see [`GaParams::window`]). A cell counts once per path: every model "holds
+//! internal information maps, marking cells that have been visited ... as not
+//! containing more useful information" (§II.B), so cells already perceived along the
+//! same path are masked. The masking uses a stamp per cell, so evaluating a path costs
+//! O(L · window) with no clearing between paths.
+//!
+//! - Model 0 (Eq. 8): I_0 per newly perceived cell, whatever its score.
+//! - Model I (Eq. 9): `M = max(I · (1 − w_t / (t_s + 1) − w_n · (n_I − 1)), 0)`.
+//!   Ambiguity: roam counts one experience of stimulus I per gene that newly perceives
+//!   at least one cell of score I (not one per cell), n_I being the number of such
+//!   genes so far including this one, and t_s the path time (Eq. 2) since the previous
+//!   gene that experienced I (t_s = ∞ for the first, so the time term vanishes).
+//!   Score 0 carries no stimulus.
+//! - Model II (Eq. 10): `M = |H − I|` with H the mean of the cell's heuristic block.
+//!   Both maps are updated along the path (§II.B.3): a perceived cell's I becomes 0 and
+//!   its block's mean drops accordingly. The paper recomputed block averages, which
+//!   made Model II slow; roam keeps each block's sum and count and updates the sum in
+//!   O(1) per perceived cell, so Model II costs about what Model I does.
+
+use roam_proto::planner::{FitnessTerms, PlannerModel};
+
+use crate::eta::step_time;
+use crate::params::GaParams;
+use crate::world::{Cell, World};
+
+/// The curiosity model that scores information (the GA's F_1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Model {
+    Coverage,
+    Novelty,
+    Heterogeneity,
+}
+
+impl Model {
+    /// The model of a planner choice; `None` for the shortest-path baseline.
+    pub fn of(choice: PlannerModel) -> Option<Model> {
+        match choice {
+            PlannerModel::Shortest => None,
+            PlannerModel::Model0 => Some(Model::Coverage),
+            PlannerModel::Model1 => Some(Model::Novelty),
+            PlannerModel::Model2 => Some(Model::Heterogeneity),
+        }
+    }
+}
+
+/// What evaluating one path gives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Evaluation {
+    pub fitness: FitnessTerms,
+    /// Σ M_n before the weight W_1.
+    pub model_information: f64,
+    pub t_eta: f64,
+    pub reaches_goal: bool,
+}
+
+/// Scores paths; holds the scratch state so that evaluating allocates nothing.
+#[derive(Debug)]
+pub struct Evaluator<'a> {
+    world: &'a World,
+    params: &'a GaParams,
+    model: Model,
+    goal: Cell,
+    t_exec: f64,
+    window: Vec<(i32, i32)>,
+    stamp: Vec<u32>,
+    current: u32,
+    // Model I: per score value, experiences so far, time of the last, gene of the last.
+    experiences: [u32; 101],
+    last_time: [f64; 101],
+    last_gene: [u32; 101],
+    factor: [f64; 101],
+    // Model II: block sums as this path has changed them.
+    block_sums: Vec<f64>,
+}
+
+impl<'a> Evaluator<'a> {
+    pub fn new(
+        world: &'a World,
+        params: &'a GaParams,
+        model: Model,
+        goal: Cell,
+        t_exec: f64,
+    ) -> Self {
+        Evaluator {
+            world,
+            params,
+            model,
+            goal,
+            t_exec,
+            window: params.window(),
+            stamp: vec![0; world.cell_count()],
+            current: 0,
+            experiences: [0; 101],
+            last_time: [f64::NEG_INFINITY; 101],
+            last_gene: [u32::MAX; 101],
+            factor: [0.0; 101],
+            block_sums: Vec::new(),
+        }
+    }
+
+    fn next_stamp(&mut self) {
+        self.current = self.current.wrapping_add(1);
+        if self.current == 0 {
+            self.stamp.fill(0);
+            self.current = 1;
+        }
+    }
+
+    /// The fitness of `path` (Eqs. 1–7).
+    pub fn evaluate(&mut self, path: &[Cell]) -> Evaluation {
+        self.next_stamp();
+        match self.model {
+            Model::Novelty => {
+                self.experiences = [0; 101];
+                self.last_time = [f64::NEG_INFINITY; 101];
+                self.last_gene = [u32::MAX; 101];
+            }
+            Model::Heterogeneity => {
+                self.block_sums.clear();
+                self.block_sums.extend_from_slice(&self.world.block_sums);
+            }
+            Model::Coverage => {}
+        }
+        let (w, h) = (self.world.width() as i32, self.world.height() as i32);
+        let mut t = 0.0;
+        let mut prev_dir = None;
+        let mut information = 0.0;
+        for (gene, pair) in path.iter().enumerate() {
+            let cell = *pair;
+            if gene > 0 {
+                if let Some(dir) = self.world.direction(path[gene - 1], cell) {
+                    t += step_time(self.world, self.params, prev_dir, dir);
+                    prev_dir = Some(dir);
+                }
+            }
+            let (x, y) = self.world.xy(cell);
+            let (x, y) = (x as i32, y as i32);
+            for k in 0..self.window.len() {
+                let (dx, dy) = self.window[k];
+                let (nx, ny) = (x + dx, y + dy);
+                if nx < 0 || ny < 0 || nx >= w || ny >= h {
+                    continue;
+                }
+                let idx = (ny * w + nx) as usize;
+                if self.stamp[idx] == self.current {
+                    continue;
+                }
+                self.stamp[idx] = self.current;
+                information += self.gain(idx, gene as u32, t);
+            }
+        }
+        let reaches_goal = path.last() == Some(&self.goal);
+        let p = self.params;
+        let f1 = p.w1 * information;
+        let f2 = if t < self.t_exec { p.w2 } else { 0.0 };
+        let f3 = if reaches_goal { p.w3 } else { 0.0 };
+        let f4 = -p.w4 * (t - self.t_exec).max(0.0);
+        let f5 = -p.w5 * (self.t_exec - t).max(0.0);
+        Evaluation {
+            fitness: FitnessTerms {
+                f1_information: f1,
+                f2_on_time: f2,
+                f3_goal: f3,
+                f4_overtime: f4,
+                f5_idle: f5,
+                total: f1 + f2 + f3 + f4 + f5,
+            },
+            model_information: information,
+            t_eta: t,
+            reaches_goal,
+        }
+    }
+
+    /// M_xy of a newly perceived cell (Eqs. 8–10).
+    #[inline]
+    fn gain(&mut self, idx: usize, gene: u32, t: f64) -> f64 {
+        match self.model {
+            Model::Coverage => self.params.coverage_gain,
+            Model::Novelty => {
+                let score = self.world.information[idx] as usize;
+                if score == 0 {
+                    return 0.0;
+                }
+                if self.last_gene[score] != gene {
+                    // A new experience of stimulus `score` at this gene (Eq. 9).
+                    self.experiences[score] += 1;
+                    let t_s = t - self.last_time[score];
+                    let n = f64::from(self.experiences[score]);
+                    let time_term = if t_s.is_finite() {
+                        self.params.w_t / (t_s + 1.0)
+                    } else {
+                        0.0
+                    };
+                    self.factor[score] = (1.0 - time_term - self.params.w_n * (n - 1.0)).max(0.0);
+                    self.last_time[score] = t;
+                    self.last_gene[score] = gene;
+                }
+                score as f64 * self.factor[score]
+            }
+            Model::Heterogeneity => {
+                let score = f64::from(self.world.information[idx]);
+                let block = self.world.block_of[idx] as usize;
+                let mean = self.block_sums[block] / f64::from(self.world.block_cells[block]);
+                // Perceiving the cell sets its I to 0 in both maps (§II.B.3).
+                self.block_sums[block] -= score;
+                (mean - score).abs()
+            }
+        }
+    }
+}

@@ -1,0 +1,421 @@
+//! The genetic algorithm of paper 000 §II.A.
+//!
+//! - Chromosomes are 8-connected paths of cells starting at S.
+//! - Initialisation (§II.A.1): random walks from S over legal moves, of a length drawn
+//!   between the Manhattan distance and a cap, stopping early at G. roam's choices
+//!   (both parameters of [`GaOptions`]): the cap is the number of cells the time budget
+//!   allows (t_exec / (resolution · v_lin)) rather than every cell of the map, since
+//!   longer walks can never fit the budget; and a walk that has not reached G is
+//!   finished along the shortest route to G, so that the first population already
+//!   reaches the goal and the GA spends its generations on information and time.
+//! - Selection (§II.A.3): "layered selection" after Li et al. is not spelled out in the
+//!   paper. roam sorts by fitness and splits the population into three layers: the top
+//!   third enters the next generation twice, the middle third once, the bottom third
+//!   not at all. The best chromosome so far is kept unchanged (elitism).
+//! - Crossover (§II.A.4): a share r_c of chromosomes is paired at random; a pair is
+//!   crossed only at a gene both share besides S and G (picked at random among them),
+//!   so children need no repair.
+//! - Mutation (§II.A.4): in a share r_m of chromosomes, a share p_m of genes moves to a
+//!   random legal 8-neighbour; a gap this opens to the previous or next gene is closed
+//!   with the one cell between them (the mutation is dropped if no legal cell closes it).
+//! - Stop at the maximum generations, the deadline, or a cancellation, whichever comes
+//!   first; the best path found is returned.
+//!
+//! Every random choice draws from one ChaCha8 generator seeded by the request, and
+//! nothing iterates a hash map, so the same seed and request give the same path bit for
+//! bit (when the plan ends by its generation count, not by its wall-clock deadline).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use roam_proto::planner::StopReason;
+
+use crate::curiosity::{Evaluation, Evaluator, Model};
+use crate::params::GaParams;
+use crate::search::descend_to_goal;
+use crate::world::{Cell, World, MOVES};
+
+/// How a GA run starts and when it stops, beyond the paper's parameters.
+#[derive(Debug, Clone)]
+pub struct GaOptions {
+    pub seed: u64,
+    /// Wall-clock limit; `None` runs to `max_generations`.
+    pub deadline: Option<Instant>,
+    /// Cap initial walk lengths at the cells the budget allows (roam) instead of the
+    /// map's cell count (the paper).
+    pub cap_walks_by_budget: bool,
+    /// Finish initial walks at the goal along the shortest route.
+    pub complete_walks_to_goal: bool,
+    /// Longest chromosome, in cells: crossovers and mutations that would exceed it are
+    /// dropped, so memory stays bounded.
+    pub max_path_cells: usize,
+}
+
+/// What a GA run returns.
+#[derive(Debug, Clone)]
+pub struct GaResult {
+    pub best: Vec<Cell>,
+    pub evaluation: Evaluation,
+    pub generations: u32,
+    pub evaluations: u64,
+    pub stop_reason: StopReason,
+}
+
+#[derive(Debug, Clone)]
+struct Chromosome {
+    genes: Vec<Cell>,
+    fitness: Option<f64>,
+}
+
+/// The inputs of one GA run.
+#[derive(Debug)]
+pub struct Problem<'a> {
+    pub world: &'a World,
+    pub params: &'a GaParams,
+    pub model: Model,
+    pub start: Cell,
+    pub goal: Cell,
+    pub t_exec: f64,
+    /// Cost-to-goal from every cell (see [`crate::search::distance_field`]).
+    pub goal_field: &'a [u32],
+}
+
+/// Runs the GA. `progress` gets each generation's number and best fitness, and
+/// `cancel` stops the run at the next generation.
+pub fn run(
+    problem: &Problem<'_>,
+    options: &GaOptions,
+    cancel: &AtomicBool,
+    mut progress: impl FnMut(u32, f64),
+) -> GaResult {
+    let params = problem.params;
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let mut evaluator = Evaluator::new(
+        problem.world,
+        params,
+        problem.model,
+        problem.goal,
+        problem.t_exec,
+    );
+    let mut population: Vec<Chromosome> = (0..params.population)
+        .map(|_| Chromosome {
+            genes: initial_walk(problem, options, &mut rng),
+            fitness: None,
+        })
+        .collect();
+    let mut scratch = Scratch::new(problem.world.cell_count());
+    let mut best: Option<(Chromosome, Evaluation)> = None;
+    let mut evaluations = 0u64;
+    let mut generation = 0u32;
+    let stop_reason = loop {
+        // Evaluate what changed.
+        for chromosome in &mut population {
+            if chromosome.fitness.is_none() {
+                let evaluation = evaluator.evaluate(&chromosome.genes);
+                evaluations += 1;
+                chromosome.fitness = Some(evaluation.fitness.total);
+                if best
+                    .as_ref()
+                    .is_none_or(|(_, b)| evaluation.fitness.total > b.fitness.total)
+                {
+                    best = Some((chromosome.clone(), evaluation));
+                }
+            }
+        }
+        generation += 1;
+        let best_fitness = best
+            .as_ref()
+            .map_or(f64::NEG_INFINITY, |(_, e)| e.fitness.total);
+        progress(generation, best_fitness);
+        if generation >= params.max_generations {
+            break StopReason::MaxGenerations;
+        }
+        if cancel.load(Ordering::Relaxed) {
+            break StopReason::Cancelled;
+        }
+        if options.deadline.is_some_and(|d| Instant::now() >= d) {
+            break StopReason::Deadline;
+        }
+        population = layered_selection(population, best.as_ref().map(|(c, _)| c));
+        // Index 0 is the elite: never crossed or mutated.
+        let n = population.len();
+        let mut order: Vec<usize> = (1..n).collect();
+        order.shuffle(&mut rng);
+        let crossed = ((params.crossover_ratio * n as f64).round() as usize).min(order.len()) & !1;
+        for pair in order[..crossed].chunks_exact(2) {
+            crossover(
+                &mut population,
+                pair[0],
+                pair[1],
+                problem,
+                options,
+                &mut scratch,
+                &mut rng,
+            );
+        }
+        order.shuffle(&mut rng);
+        let mutated = ((params.mutation_ratio * n as f64).round() as usize).min(order.len());
+        for &i in &order[..mutated] {
+            mutate(&mut population[i], problem, options, &mut rng);
+        }
+    };
+    let (chromosome, evaluation) = match best {
+        Some(b) => b,
+        None => {
+            let genes = vec![problem.start];
+            let evaluation = evaluator.evaluate(&genes);
+            (
+                Chromosome {
+                    genes,
+                    fitness: None,
+                },
+                evaluation,
+            )
+        }
+    };
+    GaResult {
+        best: chromosome.genes,
+        evaluation,
+        generations: generation,
+        evaluations,
+        stop_reason,
+    }
+}
+
+/// A random walk from S (§II.A.1), see the module doc for roam's two choices.
+fn initial_walk(problem: &Problem<'_>, options: &GaOptions, rng: &mut ChaCha8Rng) -> Vec<Cell> {
+    let world = problem.world;
+    let manhattan = world.manhattan(problem.start, problem.goal).max(1);
+    let map_cap = world.traversable_count().max(manhattan);
+    let cap = if options.cap_walks_by_budget {
+        let per_cell = world.meta.resolution * problem.params.v_lin;
+        let budget_cells = if per_cell > 0.0 {
+            (problem.t_exec / per_cell).ceil() as usize
+        } else {
+            map_cap
+        };
+        budget_cells.clamp(manhattan, map_cap)
+    } else {
+        map_cap
+    };
+    let cap = cap.min(options.max_path_cells.saturating_sub(1).max(manhattan));
+    let length = rng.random_range(manhattan..=cap);
+    let mut walk = Vec::with_capacity(length + 1);
+    walk.push(problem.start);
+    let mut cell = problem.start;
+    let mut moves = [0 as Cell; 8];
+    while walk.len() < length && cell != problem.goal {
+        let mut count = 0;
+        for dir in 0..MOVES.len() {
+            if let Some(next) = world.step(cell, dir) {
+                moves[count] = next;
+                count += 1;
+            }
+        }
+        if count == 0 {
+            break;
+        }
+        cell = moves[rng.random_range(0..count)];
+        walk.push(cell);
+    }
+    if options.complete_walks_to_goal && cell != problem.goal {
+        descend_to_goal(world, problem.goal_field, &mut walk);
+    }
+    walk
+}
+
+/// Layered selection: top third twice, middle third once, bottom third dropped; the
+/// best so far first.
+fn layered_selection(
+    mut population: Vec<Chromosome>,
+    best: Option<&Chromosome>,
+) -> Vec<Chromosome> {
+    let n = population.len();
+    // Stable sort on fitness, best first; ties keep their order (determinism).
+    population.sort_by(|a, b| {
+        b.fitness
+            .unwrap_or(f64::NEG_INFINITY)
+            .total_cmp(&a.fitness.unwrap_or(f64::NEG_INFINITY))
+    });
+    let third = n.div_ceil(3);
+    let mut next = Vec::with_capacity(n);
+    if let Some(best) = best {
+        next.push(best.clone());
+    }
+    for c in population.iter().take(third) {
+        next.push(c.clone());
+        next.push(c.clone());
+    }
+    for c in population.iter().skip(third) {
+        if next.len() >= n {
+            break;
+        }
+        next.push(c.clone());
+    }
+    next.truncate(n);
+    next
+}
+
+/// Reusable buffers for crossover: the position of each cell in the first parent.
+struct Scratch {
+    position: Vec<u32>,
+    stamp: Vec<u32>,
+    current: u32,
+    shared: Vec<(usize, usize)>,
+}
+
+impl Scratch {
+    fn new(cells: usize) -> Self {
+        Scratch {
+            position: vec![0; cells],
+            stamp: vec![0; cells],
+            current: 0,
+            shared: Vec::new(),
+        }
+    }
+
+    fn next(&mut self) {
+        self.current = self.current.wrapping_add(1);
+        if self.current == 0 {
+            self.stamp.fill(0);
+            self.current = 1;
+        }
+    }
+}
+
+/// Crosses chromosomes `a` and `b` at a shared gene other than S and G (§II.A.4).
+fn crossover(
+    population: &mut [Chromosome],
+    a: usize,
+    b: usize,
+    problem: &Problem<'_>,
+    options: &GaOptions,
+    scratch: &mut Scratch,
+    rng: &mut ChaCha8Rng,
+) {
+    let (pa, pb) = (&population[a].genes, &population[b].genes);
+    if pa.len() < 3 || pb.len() < 3 {
+        return;
+    }
+    scratch.next();
+    let cur = scratch.current;
+    for (i, &cell) in pa.iter().enumerate().take(pa.len() - 1).skip(1) {
+        if cell == problem.goal {
+            continue;
+        }
+        scratch.stamp[cell as usize] = cur;
+        scratch.position[cell as usize] = i as u32;
+    }
+    scratch.shared.clear();
+    for (j, &cell) in pb.iter().enumerate().take(pb.len() - 1).skip(1) {
+        if scratch.stamp[cell as usize] == cur {
+            scratch
+                .shared
+                .push((scratch.position[cell as usize] as usize, j));
+        }
+    }
+    if scratch.shared.is_empty() {
+        return;
+    }
+    let (i, j) = scratch.shared[rng.random_range(0..scratch.shared.len())];
+    let child_a: Vec<Cell> = pa[..=i].iter().chain(&pb[j + 1..]).copied().collect();
+    let child_b: Vec<Cell> = pb[..=j].iter().chain(&pa[i + 1..]).copied().collect();
+    if child_a.len() > options.max_path_cells || child_b.len() > options.max_path_cells {
+        return;
+    }
+    population[a] = Chromosome {
+        genes: child_a,
+        fitness: None,
+    };
+    population[b] = Chromosome {
+        genes: child_b,
+        fitness: None,
+    };
+}
+
+/// Mutates a share p_m of the genes of one chromosome (§II.A.4).
+fn mutate(
+    chromosome: &mut Chromosome,
+    problem: &Problem<'_>,
+    options: &GaOptions,
+    rng: &mut ChaCha8Rng,
+) {
+    let world = problem.world;
+    let len = chromosome.genes.len();
+    if len < 2 {
+        return;
+    }
+    let count = ((problem.params.mutation_percentage * len as f64).round() as usize).max(1);
+    let mut changed = false;
+    for _ in 0..count {
+        let genes = &mut chromosome.genes;
+        if genes.len() >= options.max_path_cells || genes.len() < 2 {
+            break;
+        }
+        // Any gene but S; the last gene only when it is not G.
+        let last_movable = if *genes.last().unwrap_or(&problem.goal) == problem.goal {
+            genes.len() - 1
+        } else {
+            genes.len()
+        };
+        if last_movable <= 1 {
+            break;
+        }
+        let i = rng.random_range(1..last_movable);
+        let dir = rng.random_range(0..MOVES.len());
+        let Some(moved) = world.step(genes[i], dir) else {
+            continue;
+        };
+        let prev = genes[i - 1];
+        let next = genes.get(i + 1).copied();
+        if moved == prev || Some(moved) == next {
+            continue;
+        }
+        let Some(before) = bridge(world, prev, moved) else {
+            continue;
+        };
+        let after = match next {
+            Some(n) => match bridge(world, moved, n) {
+                Some(b) => b,
+                None => continue,
+            },
+            None => Bridge::Direct,
+        };
+        let mut replacement = Vec::with_capacity(3);
+        if let Bridge::Via(c) = before {
+            replacement.push(c);
+        }
+        replacement.push(moved);
+        if let Bridge::Via(c) = after {
+            replacement.push(c);
+        }
+        genes.splice(i..=i, replacement);
+        changed = true;
+    }
+    if changed {
+        chromosome.fitness = None;
+    }
+}
+
+enum Bridge {
+    Direct,
+    Via(Cell),
+}
+
+/// How to get from `a` to `b` (at most two cells apart): directly, or through the one
+/// legal cell between them.
+fn bridge(world: &World, a: Cell, b: Cell) -> Option<Bridge> {
+    if world.is_legal_move(a, b) {
+        return Some(Bridge::Direct);
+    }
+    if world.chebyshev(a, b) != 2 {
+        return None;
+    }
+    (0..MOVES.len())
+        .filter_map(|d| world.step(a, d))
+        .find(|&c| world.is_legal_move(c, b))
+        .map(Bridge::Via)
+}

@@ -1,0 +1,24 @@
+//! roam's curious planner (Spielbauer et al., "Roaming with Robots", paper 000).
+//!
+//! A robot with downtime asks for a path from where it stands to its next task that
+//! gathers the most information and still arrives within the time it has. The
+//! algorithm side is plain Rust over plain types:
+//! - [`world`]: the planning grid (traversable cells, information, heuristic blocks);
+//! - [`params`]: the GA parameters, Table I's values as defaults;
+//! - [`eta`]: the travel-time estimate t_ETA (Eq. 2);
+//! - [`curiosity`]: the fitness (Eqs. 1, 3–7) with Models 0 / I / II (Eqs. 8–10);
+//! - [`metrics`]: U_ges, D (Eqs. 11–12) and the information of distinct cells;
+//! - [`ga`]: initialisation, layered selection, crossover, mutation (§II.A);
+//! - [`search`]: the shortest-path baseline (A*, octile) and the distance field;
+//! - [`plan`]: one request end to end, with the checks that refuse bad requests.
+//!
+//! [`service`] is the thin Zenoh adapter.
+
+pub mod curiosity;
+pub mod eta;
+pub mod ga;
+pub mod metrics;
+pub mod params;
+pub mod plan;
+pub mod search;
+pub mod world;

@@ -1,0 +1,243 @@
+//! The GA's parameters: paper 000 Table I's values are the defaults, and every one can
+//! be overridden per request. Ranges are checked, and an out-of-range value is refused
+//! with its name and range.
+
+use roam_proto::planner::GaOverrides;
+
+/// The parameters of one plan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GaParams {
+    /// N_p: chromosomes per population (Table I: 200).
+    pub population: usize,
+    /// N: maximum generations (Table I: 2000).
+    pub max_generations: u32,
+    /// r_c: share of chromosomes crossed per generation (Table I: 0.7).
+    pub crossover_ratio: f64,
+    /// r_m: share of chromosomes mutated per generation (Table I: 0.3).
+    pub mutation_ratio: f64,
+    /// p_m: share of genes mutated in a mutated chromosome (Table I: 0.1).
+    pub mutation_percentage: f64,
+    /// v_lin (Table I: 2.0). Ambiguity: Table I calls it a velocity in m/s, but Eq. 2
+    /// multiplies it by distance, so it acts as seconds per metre. roam follows Eq. 2:
+    /// 2.0 s/m, i.e. a robot averaging 0.5 m/s.
+    pub v_lin: f64,
+    /// v_ang (Table I: 1.0), seconds per radian of turning, by the same reading of Eq. 2.
+    pub v_ang: f64,
+    /// W_1: weight of the curiosity model's information (Table I: 3).
+    pub w1: f64,
+    /// W_2: reward when t_ETA < t_exec (Table I: 500000).
+    pub w2: f64,
+    /// W_3: reward when the last gene is the goal (Table I: 1000000).
+    pub w3: f64,
+    /// W_4: penalty per second of overtime. Table I lists -200 while Eq. 6 already
+    /// subtracts it; roam stores the magnitude (200) and subtracts, as Eq. 6 does.
+    pub w4: f64,
+    /// W_5: penalty per second of unused time, magnitude (Table I: -10; see `w4`).
+    pub w5: f64,
+    /// w_t: Model I decay for the time between similar stimuli (Table I: 0.4).
+    pub w_t: f64,
+    /// w_n: Model I decay for the number of similar stimuli (Table I: 0.01).
+    pub w_n: f64,
+    /// c_h: heuristic compression for Model II (Table I: 0.25).
+    pub heuristic_compression: f64,
+    /// d: perception diameter in cells (paper 000 §III: 3). Eq. 3 sums x and y from
+    /// [-d/2] to [d/2]; roam reads the brackets as floor, which gives -2..=1 for d = 3:
+    /// the paper's "16-cell neighbourhood" (4 × 4, one cell wider behind than ahead).
+    pub perception_diameter: u32,
+    /// I_0: Model 0's gain per newly perceived cell (Eq. 8). Not in Table I; 1.0 here.
+    pub coverage_gain: f64,
+}
+
+impl Default for GaParams {
+    fn default() -> Self {
+        GaParams {
+            population: 200,
+            max_generations: 2000,
+            crossover_ratio: 0.7,
+            mutation_ratio: 0.3,
+            mutation_percentage: 0.1,
+            v_lin: 2.0,
+            v_ang: 1.0,
+            w1: 3.0,
+            w2: 500_000.0,
+            w3: 1_000_000.0,
+            w4: 200.0,
+            w5: 10.0,
+            w_t: 0.4,
+            w_n: 0.01,
+            heuristic_compression: 0.25,
+            perception_diameter: 3,
+            coverage_gain: 1.0,
+        }
+    }
+}
+
+/// The largest population a request may ask for.
+pub const MAX_POPULATION: usize = 2000;
+/// The most generations a request may ask for.
+pub const MAX_GENERATIONS: u32 = 100_000;
+/// The widest perception diameter, in cells.
+pub const MAX_PERCEPTION_DIAMETER: u32 = 15;
+
+/// A parameter outside its range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("parameter {name} = {value} is out of range; use {range}")]
+pub struct ParamError {
+    pub name: &'static str,
+    pub value: f64,
+    pub range: &'static str,
+}
+
+fn check(name: &'static str, value: f64, ok: bool, range: &'static str) -> Result<(), ParamError> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(ParamError { name, value, range })
+    }
+}
+
+impl GaParams {
+    /// Table I's values with the request's overrides applied, then checked.
+    pub fn with_overrides(overrides: &GaOverrides) -> Result<GaParams, ParamError> {
+        let mut p = GaParams::default();
+        let o = overrides;
+        if let Some(v) = o.population {
+            p.population = v as usize;
+        }
+        if let Some(v) = o.max_generations {
+            p.max_generations = v;
+        }
+        macro_rules! take {
+            ($($field:ident),*) => { $( if let Some(v) = o.$field { p.$field = v; } )* };
+        }
+        take!(
+            crossover_ratio,
+            mutation_ratio,
+            mutation_percentage,
+            v_lin,
+            v_ang,
+            w1,
+            w2,
+            w3,
+            w4,
+            w5,
+            w_t,
+            w_n,
+            heuristic_compression,
+            coverage_gain
+        );
+        if let Some(v) = o.perception_diameter {
+            p.perception_diameter = v;
+        }
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// Checks every parameter's range.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let pop = self.population as f64;
+        check(
+            "population",
+            pop,
+            (2..=MAX_POPULATION).contains(&self.population),
+            "2..=2000",
+        )?;
+        check(
+            "max_generations",
+            f64::from(self.max_generations),
+            (1..=MAX_GENERATIONS).contains(&self.max_generations),
+            "1..=100000",
+        )?;
+        for (name, v) in [
+            ("crossover_ratio", self.crossover_ratio),
+            ("mutation_ratio", self.mutation_ratio),
+            ("mutation_percentage", self.mutation_percentage),
+        ] {
+            check(name, v, (0.0..=1.0).contains(&v), "0..=1")?;
+        }
+        for (name, v) in [("v_lin", self.v_lin), ("v_ang", self.v_ang)] {
+            check(
+                name,
+                v,
+                v >= 0.0 && v <= 1000.0,
+                "0..=1000 seconds per metre / radian",
+            )?;
+        }
+        for (name, v) in [
+            ("w1", self.w1),
+            ("w2", self.w2),
+            ("w3", self.w3),
+            ("w4", self.w4),
+            ("w5", self.w5),
+            ("w_t", self.w_t),
+            ("w_n", self.w_n),
+            ("coverage_gain", self.coverage_gain),
+        ] {
+            check(
+                name,
+                v,
+                (0.0..=1e12).contains(&v),
+                "a magnitude in 0..=1e12 (penalties are subtracted)",
+            )?;
+        }
+        check(
+            "heuristic_compression",
+            self.heuristic_compression,
+            self.heuristic_compression > 0.0 && self.heuristic_compression <= 1.0,
+            "(0, 1]",
+        )?;
+        check(
+            "perception_diameter",
+            f64::from(self.perception_diameter),
+            (1..=MAX_PERCEPTION_DIAMETER).contains(&self.perception_diameter),
+            "1..=15 cells",
+        )?;
+        Ok(())
+    }
+
+    /// The perception window's offsets, Eq. 3 with floor brackets (see
+    /// [`GaParams::perception_diameter`]).
+    pub fn window(&self) -> Vec<(i32, i32)> {
+        let d = self.perception_diameter as i32;
+        let lo = (-d).div_euclid(2);
+        let hi = d.div_euclid(2);
+        let mut offsets = Vec::new();
+        for y in lo..=hi {
+            for x in lo..=hi {
+                offsets.push((x, y));
+            }
+        }
+        offsets
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_one_is_the_default_and_d3_sees_16_cells() {
+        let p = GaParams::default();
+        assert_eq!((p.population, p.max_generations), (200, 2000));
+        assert_eq!(p.window().len(), 16);
+        assert!(p.validate().is_ok());
+    }
+
+    #[test]
+    fn overrides_apply_and_ranges_are_named() {
+        let p = GaParams::with_overrides(&GaOverrides {
+            population: Some(50),
+            w1: Some(5.0),
+            ..GaOverrides::default()
+        })
+        .expect("valid");
+        assert_eq!((p.population, p.w1), (50, 5.0));
+        let err = GaParams::with_overrides(&GaOverrides {
+            crossover_ratio: Some(1.5),
+            ..GaOverrides::default()
+        })
+        .expect_err("must be refused");
+        assert_eq!(err.name, "crossover_ratio");
+        assert!(err.to_string().contains("0..=1"));
+    }
+}

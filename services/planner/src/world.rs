@@ -1,0 +1,207 @@
+//! The planning grid: which cells the robot may occupy, their information scores, and
+//! the heuristic blocks of Model II.
+
+use roam_map_server::grid::{cell_center, world_to_cell, Grid};
+use roam_map_server::layers::block_size;
+use roam_proto::map::GridMeta;
+
+/// A cell index, `y * width + x`.
+pub type Cell = u32;
+
+/// The eight moves, counter-clockwise from east; the index is the heading in units of 45°.
+pub const MOVES: [(i32, i32); 8] = [
+    (1, 0),
+    (1, 1),
+    (0, 1),
+    (-1, 1),
+    (-1, 0),
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+];
+
+/// The grid the planner works on.
+#[derive(Debug, Clone)]
+pub struct World {
+    pub meta: GridMeta,
+    width: usize,
+    height: usize,
+    /// A cell is traversable when the inflated occupancy is free (0). Unknown cells
+    /// are not: a plan never counts on space nobody has seen.
+    traversable: Vec<bool>,
+    /// Information scores I_xy, 0..=100.
+    pub information: Vec<u8>,
+    /// Model II: the heuristic block of each cell and each block's cell count and
+    /// initial sum of scores (paper 000 §II.B.3).
+    pub block_of: Vec<u32>,
+    pub block_cells: Vec<u32>,
+    pub block_sums: Vec<f64>,
+    /// The c_h the blocks were cut for.
+    pub heuristic_compression: f64,
+}
+
+/// Why a world could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum WorldError {
+    #[error("the inflated map is {0}x{1} but the information map is {2}x{3}; both must cover the same cells")]
+    SizeMismatch(u32, u32, u32, u32),
+    #[error("the map has no cells")]
+    Empty,
+}
+
+impl World {
+    /// Builds the planning grid from the inflated occupancy and the information map,
+    /// with heuristic blocks at compression `c_h`.
+    pub fn new(
+        inflated: &Grid<i8>,
+        information: &Grid<u8>,
+        heuristic_compression: f64,
+    ) -> Result<World, WorldError> {
+        let (w, h) = (inflated.width(), inflated.height());
+        if (information.width(), information.height()) != (w, h) {
+            return Err(WorldError::SizeMismatch(
+                inflated.meta.width,
+                inflated.meta.height,
+                information.meta.width,
+                information.meta.height,
+            ));
+        }
+        if w == 0 || h == 0 {
+            return Err(WorldError::Empty);
+        }
+        let traversable = inflated.cells.iter().map(|&c| c == 0).collect();
+        let mut world = World {
+            meta: inflated.meta,
+            width: w,
+            height: h,
+            traversable,
+            information: information.cells.clone(),
+            block_of: Vec::new(),
+            block_cells: Vec::new(),
+            block_sums: Vec::new(),
+            heuristic_compression,
+        };
+        world.set_heuristic_compression(heuristic_compression);
+        Ok(world)
+    }
+
+    /// Recomputes the heuristic blocks for compression `c_h` (see
+    /// [`roam_map_server::layers::heuristic`] for how blocks are cut).
+    pub fn set_heuristic_compression(&mut self, compression: f64) {
+        let (w, h) = (self.width, self.height);
+        self.heuristic_compression = compression;
+        let block = block_size(w, h, compression);
+        let bw = w.div_ceil(block);
+        let blocks = bw * h.div_ceil(block);
+        self.block_of = vec![0; w * h];
+        self.block_cells = vec![0; blocks];
+        self.block_sums = vec![0.0; blocks];
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                let b = (y / block) * bw + x / block;
+                self.block_of[i] = b as u32;
+                self.block_cells[b] += 1;
+                self.block_sums[b] += f64::from(self.information[i]);
+            }
+        }
+    }
+
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    pub fn cell_count(&self) -> usize {
+        self.width * self.height
+    }
+
+    pub fn cell(&self, x: usize, y: usize) -> Cell {
+        (y * self.width + x) as Cell
+    }
+
+    pub fn xy(&self, cell: Cell) -> (usize, usize) {
+        let c = cell as usize;
+        (c % self.width, c / self.width)
+    }
+
+    pub fn is_traversable(&self, cell: Cell) -> bool {
+        self.traversable
+            .get(cell as usize)
+            .copied()
+            .unwrap_or(false)
+    }
+
+    pub fn traversable_count(&self) -> usize {
+        self.traversable.iter().filter(|&&t| t).count()
+    }
+
+    /// The cell at a world point, if it is on the map.
+    pub fn cell_at(&self, x: f64, y: f64) -> Option<Cell> {
+        world_to_cell(&self.meta, x, y).map(|(cx, cy)| self.cell(cx, cy))
+    }
+
+    /// The world point at the centre of a cell.
+    pub fn center(&self, cell: Cell) -> (f64, f64) {
+        let (x, y) = self.xy(cell);
+        cell_center(&self.meta, x, y)
+    }
+
+    /// The cell one move away in direction `dir` (an index into [`MOVES`]), if that
+    /// move is legal: on the map, onto a traversable cell, and for a diagonal move,
+    /// not cutting a corner (both orthogonal neighbours traversable).
+    #[inline]
+    pub fn step(&self, from: Cell, dir: usize) -> Option<Cell> {
+        let (dx, dy) = MOVES[dir];
+        let (x, y) = self.xy(from);
+        let (nx, ny) = (x as i64 + i64::from(dx), y as i64 + i64::from(dy));
+        if nx < 0 || ny < 0 || nx >= self.width as i64 || ny >= self.height as i64 {
+            return None;
+        }
+        let to = self.cell(nx as usize, ny as usize);
+        if !self.traversable[to as usize] {
+            return None;
+        }
+        if dx != 0 && dy != 0 {
+            let side_a = self.cell(nx as usize, y);
+            let side_b = self.cell(x, ny as usize);
+            if !self.traversable[side_a as usize] || !self.traversable[side_b as usize] {
+                return None;
+            }
+        }
+        Some(to)
+    }
+
+    /// The direction index of the move from `a` to `b` if they are 8-neighbours.
+    #[inline]
+    pub fn direction(&self, a: Cell, b: Cell) -> Option<usize> {
+        let (ax, ay) = self.xy(a);
+        let (bx, by) = self.xy(b);
+        let (dx, dy) = (bx as i64 - ax as i64, by as i64 - ay as i64);
+        MOVES
+            .iter()
+            .position(|&(mx, my)| i64::from(mx) == dx && i64::from(my) == dy)
+    }
+
+    /// Whether moving from `a` to `b` is one legal step.
+    pub fn is_legal_move(&self, a: Cell, b: Cell) -> bool {
+        self.direction(a, b).and_then(|d| self.step(a, d)) == Some(b)
+    }
+
+    /// Chebyshev distance in cells.
+    pub fn chebyshev(&self, a: Cell, b: Cell) -> usize {
+        let (ax, ay) = self.xy(a);
+        let (bx, by) = self.xy(b);
+        ax.abs_diff(bx).max(ay.abs_diff(by))
+    }
+
+    /// Manhattan distance in cells.
+    pub fn manhattan(&self, a: Cell, b: Cell) -> usize {
+        let (ax, ay) = self.xy(a);
+        let (bx, by) = self.xy(b);
+        ax.abs_diff(bx) + ay.abs_diff(by)
+    }
+}

@@ -1,0 +1,264 @@
+//! Properties of every plan: geometry, budgets, determinism, the paper's claims in
+//! miniature, and the refusals.
+
+mod common;
+
+use std::sync::atomic::AtomicBool;
+
+use proptest::prelude::*;
+use roam_planner::eta::path_eta;
+use roam_planner::params::GaParams;
+use roam_planner::plan::{plan, PlanError, PlanOutcome, PlanSpec};
+use roam_planner::world::World;
+use roam_proto::planner::PlannerModel;
+
+fn spec(
+    model: PlannerModel,
+    start: [f64; 2],
+    goal: [f64; 2],
+    t_exec_s: f64,
+    seed: u64,
+    generations: u32,
+) -> PlanSpec {
+    PlanSpec {
+        start,
+        goal,
+        t_exec_s,
+        deadline_s: 600.0,
+        model,
+        params: GaParams {
+            max_generations: generations,
+            population: 60,
+            ..GaParams::default()
+        },
+        seed,
+    }
+}
+
+fn run(world: &World, spec: &PlanSpec) -> PlanOutcome {
+    plan(world, spec, &AtomicBool::new(false), |_, _| {}).expect("plan")
+}
+
+/// The geometry every returned path must have, checked independently of the planner.
+fn check_geometry(world: &World, spec: &PlanSpec, outcome: &PlanOutcome) {
+    let path = &outcome.path;
+    assert_eq!(
+        path.first().copied(),
+        world.cell_at(spec.start[0], spec.start[1]),
+        "starts at S"
+    );
+    for &cell in path {
+        assert!(
+            world.is_traversable(cell),
+            "cell {:?} is not free",
+            world.xy(cell)
+        );
+    }
+    for pair in path.windows(2) {
+        let ((ax, ay), (bx, by)) = (world.xy(pair[0]), world.xy(pair[1]));
+        assert_eq!(
+            ax.abs_diff(bx).max(ay.abs_diff(by)),
+            1,
+            "8-connected step {:?} → {:?}",
+            (ax, ay),
+            (bx, by)
+        );
+        if ax != bx && ay != by {
+            // No corner cutting: both orthogonal neighbours are free.
+            assert!(
+                world.is_traversable(world.cell(bx, ay))
+                    && world.is_traversable(world.cell(ax, by))
+            );
+        }
+    }
+    // An independent recomputation of the claims: the goal and the budget.
+    let goal = world.cell_at(spec.goal[0], spec.goal[1]);
+    assert_eq!(outcome.reaches_goal, path.last().copied() == goal);
+    let eta = path_eta(world, &spec.params, path);
+    assert!(
+        (eta - outcome.t_eta_s).abs() < 1e-9,
+        "eta {eta} vs {}",
+        outcome.t_eta_s
+    );
+    assert_eq!(outcome.within_budget, eta <= spec.t_exec_s);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    #[test]
+    fn every_plan_is_a_legal_path_from_s(
+        seed in any::<u64>(),
+        model in prop_oneof![Just(PlannerModel::Model0), Just(PlannerModel::Model1), Just(PlannerModel::Model2), Just(PlannerModel::Shortest)],
+        sx in -9.0..9.0f64, sy in -9.0..9.0f64, gx in -9.0..9.0f64, gy in -9.0..9.0f64,
+        slack in 1.0..3.0f64,
+    ) {
+        let world = common::builtin_world();
+        let mut s = spec(model, [sx, sy], [gx, gy], 1.0, seed, 30);
+        // Find the shortest ETA by asking with a huge budget first.
+        s.t_exec_s = 86_400.0;
+        let needed = match plan(&world, &PlanSpec { model: PlannerModel::Shortest, ..s.clone() }, &AtomicBool::new(false), |_, _| {}) {
+            Ok(outcome) => outcome.t_eta_s,
+            Err(PlanError::Blocked { .. }) | Err(PlanError::NoPath) => return Ok(()),
+            Err(e) => panic!("{e}"),
+        };
+        s.t_exec_s = (needed * slack).max(1.0);
+        let outcome = run(&world, &s);
+        check_geometry(&world, &s, &outcome);
+    }
+}
+
+#[test]
+fn the_same_seed_gives_the_same_path_bit_for_bit() {
+    let world = common::builtin_world();
+    for model in [
+        PlannerModel::Model0,
+        PlannerModel::Model1,
+        PlannerModel::Model2,
+    ] {
+        let s = spec(model, [-8.0, -8.0], [6.0, -7.0], 80.0, 42, 100);
+        let a = run(&world, &s);
+        let b = run(&world, &s);
+        assert_eq!(a.path, b.path, "{model:?}");
+        assert_eq!(a.fitness.total.to_bits(), b.fitness.total.to_bits());
+        let c = run(&world, &PlanSpec { seed: 43, ..s });
+        assert_ne!(
+            a.path, c.path,
+            "another seed explores differently ({model:?})"
+        );
+    }
+}
+
+#[test]
+fn curious_plans_reach_the_goal_in_budget_and_gather_more_than_the_shortest_path() {
+    let world = common::builtin_world();
+    let shortest = run(
+        &world,
+        &spec(
+            PlannerModel::Shortest,
+            [-8.0, -8.0],
+            [-2.0, 4.0],
+            600.0,
+            1,
+            1,
+        ),
+    );
+    let budget = shortest.t_eta_s * 2.0;
+    for model in [
+        PlannerModel::Model0,
+        PlannerModel::Model1,
+        PlannerModel::Model2,
+    ] {
+        let s = spec(model, [-8.0, -8.0], [-2.0, 4.0], budget, 7, 400);
+        let outcome = run(&world, &s);
+        check_geometry(&world, &s, &outcome);
+        assert!(
+            outcome.reaches_goal && outcome.within_budget,
+            "{model:?}: eta {} of {budget}",
+            outcome.t_eta_s
+        );
+        assert!(
+            outcome.metrics.distinct_information > shortest.metrics.distinct_information,
+            "{model:?} saw {} vs shortest {}",
+            outcome.metrics.distinct_information,
+            shortest.metrics.distinct_information
+        );
+    }
+}
+
+#[test]
+fn refusals_say_what_to_change() {
+    let world = common::builtin_world();
+    let off = plan(
+        &world,
+        &spec(PlannerModel::Model1, [50.0, 0.0], [0.0, 0.0], 100.0, 1, 5),
+        &AtomicBool::new(false),
+        |_, _| {},
+    );
+    assert!(
+        matches!(off, Err(PlanError::OffMap { which: "start", .. })),
+        "{off:?}"
+    );
+    let wall = plan(
+        &world,
+        &spec(PlannerModel::Model1, [-8.0, -8.0], [-9.9, 0.0], 100.0, 1, 5),
+        &AtomicBool::new(false),
+        |_, _| {},
+    );
+    assert!(
+        matches!(wall, Err(PlanError::Blocked { which: "goal", .. })),
+        "{wall:?}"
+    );
+    let short = plan(
+        &world,
+        &spec(PlannerModel::Model1, [-8.0, -8.0], [6.0, -7.0], 5.0, 1, 5),
+        &AtomicBool::new(false),
+        |_, _| {},
+    );
+    match short {
+        Err(PlanError::BudgetTooShort {
+            given_s,
+            needed_s,
+            short_by_s,
+        }) => {
+            assert_eq!(given_s, 5.0);
+            assert!((needed_s - given_s - short_by_s).abs() < 1e-9);
+        }
+        other => panic!("{other:?}"),
+    }
+    let deadline = plan(
+        &world,
+        &PlanSpec {
+            deadline_s: 0.0,
+            ..spec(PlannerModel::Model1, [-8.0, -8.0], [6.0, -7.0], 100.0, 1, 5)
+        },
+        &AtomicBool::new(false),
+        |_, _| {},
+    );
+    assert!(matches!(
+        deadline,
+        Err(PlanError::OutOfRange {
+            name: "deadline_s",
+            ..
+        })
+    ));
+}
+
+#[test]
+fn a_walled_in_goal_has_no_path() {
+    let mut world = common::open_world(30, 30);
+    // Rebuild with a ring of walls around the goal cell (15, 15).
+    let meta = world.meta;
+    let mut occupancy = roam_map_server::grid::Grid::filled(meta, 0i8);
+    for (x, y) in [
+        (13, 13),
+        (14, 13),
+        (15, 13),
+        (16, 13),
+        (17, 13),
+        (13, 17),
+        (14, 17),
+        (15, 17),
+        (16, 17),
+        (17, 17),
+        (13, 14),
+        (13, 15),
+        (13, 16),
+        (17, 14),
+        (17, 15),
+        (17, 16),
+    ] {
+        occupancy.cells[y * 30 + x] = 100;
+    }
+    let information = roam_map_server::grid::Grid {
+        meta,
+        cells: world.information.clone(),
+    };
+    world = World::new(&occupancy, &information, 0.25).expect("world");
+    let outcome = plan(
+        &world,
+        &spec(PlannerModel::Model1, [0.5, 0.5], [3.1, 3.1], 100.0, 1, 5),
+        &AtomicBool::new(false),
+        |_, _| {},
+    );
+    assert_eq!(outcome.expect_err("must be refused"), PlanError::NoPath);
+}
