@@ -87,6 +87,12 @@ impl ErrorReply {
         }
     }
 
+    /// The same reply with another code (e.g. `busy` for a limit on work in flight).
+    pub fn with_code(mut self, code: ErrorCode) -> Self {
+        self.code = code;
+        self
+    }
+
     /// A [`ErrorCode::LimitExceeded`] reply naming the limit.
     pub fn limit(name: &str, max: u64, actual: u64, message: impl Into<String>) -> Self {
         ErrorReply {

@@ -85,3 +85,72 @@ mod tests {
         assert_eq!(pixel_of(&occ, 1, 0, 2), (2, 2));
     }
 }
+
+/// Colour of a planned path.
+pub const PATH: Rgb<u8> = Rgb([0, 90, 220]);
+/// Colour of a second path (a baseline) drawn for comparison.
+pub const BASELINE: Rgb<u8> = Rgb([200, 0, 160]);
+/// Colour of the start and goal markers.
+pub const MARKER: Rgb<u8> = Rgb([0, 170, 60]);
+
+/// Draws a path of grid cells `[x, y]` over a picture from [`render_map`] (same
+/// `scale` and grid height): each cell filled in the middle, consecutive cells joined.
+pub fn draw_path(
+    image: &mut RgbImage,
+    grid_height: u32,
+    cells: &[[u32; 2]],
+    scale: u32,
+    colour: Rgb<u8>,
+) {
+    let scale = scale.max(1);
+    let centre = |c: [u32; 2]| -> (f64, f64) {
+        let top = (grid_height.saturating_sub(1).saturating_sub(c[1])) * scale;
+        (
+            f64::from(c[0] * scale) + f64::from(scale) / 2.0,
+            f64::from(top) + f64::from(scale) / 2.0,
+        )
+    };
+    let thickness = (scale / 3).max(1) as i64;
+    let mut dot = |x: f64, y: f64| {
+        for dy in -thickness / 2..=thickness / 2 {
+            for dx in -thickness / 2..=thickness / 2 {
+                let (px, py) = (x as i64 + dx, y as i64 + dy);
+                if px >= 0 && py >= 0 && (px as u32) < image.width() && (py as u32) < image.height()
+                {
+                    image.put_pixel(px as u32, py as u32, colour);
+                }
+            }
+        }
+    };
+    for pair in cells.windows(2) {
+        let (a, b) = (centre(pair[0]), centre(pair[1]));
+        let steps = (f64::from(scale) * 2.0).ceil() as usize;
+        for k in 0..=steps {
+            let t = k as f64 / steps as f64;
+            dot(a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t);
+        }
+    }
+    if let [only] = cells {
+        let (x, y) = centre(*only);
+        dot(x, y);
+    }
+}
+
+/// Marks a cell with a filled square of `colour`, the cell's size plus a border.
+pub fn draw_marker(
+    image: &mut RgbImage,
+    grid_height: u32,
+    cell: [u32; 2],
+    scale: u32,
+    colour: Rgb<u8>,
+) {
+    let scale = scale.max(1);
+    let top = (grid_height.saturating_sub(1).saturating_sub(cell[1])) * scale;
+    let left = cell[0] * scale;
+    let border = scale;
+    for y in top.saturating_sub(border)..(top + scale + border).min(image.height()) {
+        for x in left.saturating_sub(border)..(left + scale + border).min(image.width()) {
+            image.put_pixel(x, y, colour);
+        }
+    }
+}

@@ -14,11 +14,18 @@
 //!
 //! [`service`] is the thin Zenoh adapter.
 
+pub mod client;
+pub mod config;
 pub mod curiosity;
 pub mod eta;
 pub mod ga;
+pub mod maps;
 pub mod metrics;
 pub mod params;
 pub mod plan;
 pub mod search;
+pub mod service;
 pub mod world;
+
+pub use config::PlannerConfig;
+pub use service::{run, SERVICE_NAME};

@@ -91,6 +91,7 @@ pub async fn map(side: u32, iterations: usize, work_dir: &Path) -> Result<MapBen
         StackOptions {
             root: Some("roam-bench".into()),
             map: Some(yaml),
+            planners: 1,
             ..StackOptions::default()
         },
         Duration::from_secs(30),

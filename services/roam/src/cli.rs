@@ -6,12 +6,18 @@ use std::time::Duration;
 use anyhow::{bail, Context};
 use clap::{Args, Parser, Subcommand};
 use roam::bench;
-use roam::report;
+use roam::report::{self, Mission};
 use roam::router::Router;
 use roam::stack::{Stack, StackOptions};
-use roam_map_server::{ros_map, MapServerConfig};
+use roam_map_server::grid::Grid;
+use roam_map_server::{map_file, render, ros_map, MapServerConfig};
+use roam_planner::client::PlannerClient;
+use roam_planner::PlannerConfig;
+use roam_proto::cells::Cells;
 use roam_proto::keys;
+use roam_proto::map::Layer;
 use roam_proto::map::{LayerList, LoadMap};
+use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
 use roam_runtime::{config_file, signals, Requester, SessionArgs};
 
 const ABOUT: &str = "roam: curious, time-aware robot navigation as Zenoh services.";
@@ -25,11 +31,15 @@ Zenoh; this one binary runs every role.
 ROLES
   map-server   Holds the occupancy, inflated, information and heuristic layers (and the
                layers other services publish), versioned and optionally persisted.
+  planner      The curious GA planner (paper 000): a path from here to the next task
+               that gathers the most information and still arrives within the budget.
+               Run several; clients spread plans over the live instances.
   router       A Zenoh router: run one per site or fleet; services connect to it.
   stack        Every landed service in one process around an in-process router on
                loopback, multicast off. The embedded default world needs no files.
 
 CLIENTS AND TOOLS
+  plan         Ask a running planner for a path; --png draws it.
   map          Inspect map files offline; list, load and fetch layers of a running stack.
   bench        Benchmarks that print JSON.
 
@@ -50,6 +60,7 @@ EXAMPLES
   roam router --listen tcp/0.0.0.0:7447      on the site server
   roam map-server --mode client --connect tcp/10.0.0.5:7447 --map config/maps/depot.yaml
   roam map layers --connect tcp/10.0.0.5:7447
+  roam plan --connect tcp/10.0.0.5:7447 --start -8,-8 --goal 6,-7 --budget 60 --png plan.png
   roam map inspect config/maps/depot.yaml --json";
 
 #[derive(Debug, Parser)]
@@ -63,6 +74,10 @@ pub struct Cli {
 enum Command {
     /// Run the map server: layers, versions, persistence.
     MapServer(MapServerArgs),
+    /// Run a curious GA planner instance (paper 000).
+    Planner(PlannerArgs),
+    /// Ask a running planner for a curious path (a client).
+    Plan(PlanArgs),
     /// Run a Zenoh router (no separate zenohd needed).
     Router(RouterArgs),
     /// Run every landed service in one process around an in-process router.
@@ -103,6 +118,69 @@ struct MapServerArgs {
 }
 
 #[derive(Debug, Args)]
+struct PlannerArgs {
+    #[command(flatten)]
+    service: ServiceArgs,
+    /// Plans computed at once; more are refused with `busy`.
+    #[arg(long)]
+    max_concurrent_plans: Option<usize>,
+}
+
+#[derive(Debug, Args)]
+struct PlanArgs {
+    /// Start, world metres: X,Y.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    start: [f64; 2],
+    /// Goal, world metres: X,Y.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    goal: [f64; 2],
+    /// Seconds the robot has to drive (t_exec).
+    #[arg(long)]
+    budget: f64,
+    /// Curiosity model: 0, 1, 2 or shortest.
+    #[arg(long, default_value = "1", value_parser = parse_model)]
+    model: PlannerModel,
+    /// Seconds the planner may take (t_plan).
+    #[arg(long, default_value_t = 5.0)]
+    deadline: f64,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// GA generations (Table I: 2000).
+    #[arg(long)]
+    generations: Option<u32>,
+    /// Draw the map, the information layer and the path to this PNG.
+    #[arg(long, value_name = "FILE")]
+    png: Option<PathBuf>,
+    /// Print the whole plan as JSON.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    client: ClientArgs,
+}
+
+fn parse_point(text: &str) -> Result<[f64; 2], String> {
+    let (x, y) = text
+        .split_once(',')
+        .ok_or_else(|| format!("'{text}' is not X,Y (e.g. -8,-8)"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .map_err(|e| format!("'{v}' in '{text}': {e}"))
+    };
+    Ok([parse(x)?, parse(y)?])
+}
+
+fn parse_model(text: &str) -> Result<PlannerModel, String> {
+    match text {
+        "0" | "model0" => Ok(PlannerModel::Model0),
+        "1" | "model1" => Ok(PlannerModel::Model1),
+        "2" | "model2" => Ok(PlannerModel::Model2),
+        "shortest" => Ok(PlannerModel::Shortest),
+        other => Err(format!("'{other}' is not a model; use 0, 1, 2 or shortest")),
+    }
+}
+
+#[derive(Debug, Args)]
 struct RouterArgs {
     #[command(flatten)]
     session: SessionArgs,
@@ -122,6 +200,9 @@ struct StackArgs {
     /// The in-process router's endpoint (default: a free port on 127.0.0.1).
     #[arg(long, value_name = "ENDPOINT")]
     listen: Option<String>,
+    /// Planner instances to run.
+    #[arg(long, default_value_t = 1)]
+    planners: usize,
     /// Boot, fetch every layer through Zenoh, write the report and stop.
     #[arg(long)]
     once: bool,
@@ -177,6 +258,8 @@ enum BenchCommand {
 pub async fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::MapServer(args) => map_server(args).await,
+        Command::Planner(args) => planner(args).await,
+        Command::Plan(args) => plan(args).await,
         Command::Router(args) => router(args).await,
         Command::Stack(args) => stack(args).await,
         Command::Map(command) => map(command).await,
@@ -207,6 +290,155 @@ async fn map_server(args: MapServerArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+async fn planner(args: PlannerArgs) -> anyhow::Result<()> {
+    let mut config: PlannerConfig = match &args.service.config {
+        Some(path) => config_file::load(path)?,
+        None => PlannerConfig::default(),
+    };
+    if let Some(root) = args.service.root {
+        config.root = root;
+    }
+    if args.service.instance.is_some() {
+        config.instance = args.service.instance;
+    }
+    if let Some(n) = args.max_concurrent_plans {
+        config.max_concurrent_plans = n;
+    }
+    let zenoh = args.service.session.zenoh_config(config.zenoh.as_ref())?;
+    roam_planner::run(config, zenoh, signals::cancel_on_signal()).await?;
+    Ok(())
+}
+
+async fn plan(args: PlanArgs) -> anyhow::Result<()> {
+    let (requester, session) = connect(&args.client).await?;
+    let planner = PlannerClient::new(session.clone(), &args.client.root);
+    let request = PlanRequest {
+        request_id: None,
+        start: args.start,
+        goal: args.goal,
+        t_exec_s: args.budget,
+        deadline_s: args.deadline,
+        model: args.model,
+        params: GaOverrides {
+            max_generations: args.generations,
+            ..GaOverrides::default()
+        },
+        seed: args.seed,
+        map_version: None,
+    };
+    let outcome = planner.plan(&request).await;
+    let picture = match (&outcome, &args.png) {
+        (Ok(plan), Some(path)) => Some(draw_plan(&requester, &args.client.root, plan, path).await),
+        _ => None,
+    };
+    let _ = session.close().await;
+    let plan = outcome?;
+    if let Some(result) = picture {
+        result?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&plan)?);
+    } else {
+        println!(
+            "{} plan {} by {}: {} cells, ETA {:.1} s of {:.1} s ({}), {} the goal\n  U_ges {:.0}, D {:.1}, distinct information {:.0}, fitness {:.0}, {} generations in {:.0} ms ({:?})",
+            plan.model.as_str(),
+            plan.request_id,
+            plan.instance,
+            plan.cells.len(),
+            plan.t_eta_s,
+            args.budget,
+            if plan.within_budget { "within budget" } else { "OVER budget" },
+            if plan.reaches_goal { "reaches" } else { "does NOT reach" },
+            plan.u_ges,
+            plan.density,
+            plan.distinct_information,
+            plan.fitness.total,
+            plan.generations,
+            plan.planning_ms,
+            plan.stop_reason
+        );
+    }
+    if let Some(path) = &args.png {
+        println!("picture: {}", path.display());
+    }
+    Ok(())
+}
+
+/// Fetches occupancy and information from the map server and draws the plan over them.
+async fn draw_plan(
+    requester: &Requester,
+    root: &str,
+    plan: &Plan,
+    path: &std::path::Path,
+) -> anyhow::Result<()> {
+    let occupancy: Layer = requester
+        .request::<Layer, Layer>(&keys::map_layer(root, "occupancy"), None)
+        .await?;
+    let information: Layer = requester
+        .request::<Layer, Layer>(&keys::map_layer(root, "information"), None)
+        .await?;
+    let (Cells::I8(occ), Cells::U8(info)) = (occupancy.cells, information.cells) else {
+        bail!("the map server's occupancy or information layer has an unexpected type");
+    };
+    let occ = Grid {
+        meta: occupancy.meta,
+        cells: occ,
+    };
+    let info = Grid {
+        meta: information.meta,
+        cells: info,
+    };
+    let scale = (800 / occ.meta.width.max(occ.meta.height)).clamp(1, 8);
+    let mut image = render::render_map(&occ, Some(&info), scale);
+    render::draw_path(
+        &mut image,
+        occ.meta.height,
+        &plan.cells,
+        scale,
+        render::PATH,
+    );
+    for end in [plan.cells.first(), plan.cells.last()]
+        .into_iter()
+        .flatten()
+    {
+        render::draw_marker(&mut image, occ.meta.height, *end, scale, render::MARKER);
+    }
+    image
+        .save(path)
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
+}
+
+/// The missions of a scenario: from its `start` place to each other place.
+fn scenario_missions(map: Option<&std::path::Path>) -> Vec<Mission> {
+    let max = roam_map_server::store::DEFAULT_LIMITS.max_layer_cells;
+    let parsed = match map {
+        None => roam_map_server::scenario::parse(
+            std::path::Path::new(map_file::BUILTIN_NAME),
+            map_file::BUILTIN_SCENARIO,
+            max,
+        )
+        .ok(),
+        Some(path) => roam_map_server::scenario::load(path, max).ok(),
+    };
+    let Some(scenario) = parsed else {
+        return Vec::new();
+    };
+    let places = &scenario.file.places;
+    let Some(start) = places.iter().find(|p| p.name == "start") else {
+        return Vec::new();
+    };
+    places
+        .iter()
+        .filter(|p| p.name != "start")
+        .map(|p| Mission {
+            name: format!("start->{}", p.name),
+            start: start.at,
+            goal: p.at,
+        })
+        .collect()
+}
+
 async fn router(args: RouterArgs) -> anyhow::Result<()> {
     let mut session = args.session;
     if session.listen.is_empty() {
@@ -221,11 +453,13 @@ async fn router(args: RouterArgs) -> anyhow::Result<()> {
 }
 
 async fn stack(args: StackArgs) -> anyhow::Result<()> {
+    let missions = scenario_missions(args.map.as_deref());
     let options = StackOptions {
         root: args.root,
         map: args.map,
         data_dir: args.data_dir,
         listen: args.listen,
+        planners: args.planners,
     };
     let mut stack = Stack::start(options, Duration::from_secs(30)).await?;
     eprintln!(
@@ -238,8 +472,14 @@ async fn stack(args: StackArgs) -> anyhow::Result<()> {
         )
         .await?;
         let requester = Requester::new(client.clone(), Duration::from_secs(10));
-        let outcome =
-            report::build(&requester, &stack.root, &stack.router.endpoint, &args.out).await;
+        let outcome = report::build(
+            &requester,
+            &stack.root,
+            &stack.router.endpoint,
+            &missions,
+            &args.out,
+        )
+        .await;
         let _ = client.close().await;
         stack.shutdown().await?;
         let report = outcome?;

@@ -5,11 +5,13 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use roam_map_server::grid::Grid;
-use roam_map_server::render::render_map;
+use roam_map_server::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, PATH};
 use roam_map_server::store::{INFORMATION, OCCUPANCY};
+use roam_planner::client::PlannerClient;
 use roam_proto::cells::Cells;
 use roam_proto::keys;
 use roam_proto::map::{Layer, LayerList};
+use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
 use roam_runtime::{ClientError, Requester};
 use serde::Serialize;
 
@@ -26,12 +28,38 @@ pub struct LayerSummary {
     pub get_ms: f64,
 }
 
+/// A downtime trip to plan: from `start` to `goal` (world metres).
+#[derive(Debug, Clone, Serialize)]
+pub struct Mission {
+    pub name: String,
+    pub start: [f64; 2],
+    pub goal: [f64; 2],
+}
+
+/// One mission's outcome: the curious plan against the shortest path in the same
+/// downtime (twice the shortest path's ETA).
+#[derive(Debug, Clone, Serialize)]
+pub struct MissionReport {
+    pub name: String,
+    pub budget_s: f64,
+    pub shortest_eta_s: f64,
+    pub shortest_information: f64,
+    pub curious_eta_s: f64,
+    pub curious_information: f64,
+    pub curious_reaches_goal: bool,
+    pub curious_within_budget: bool,
+    pub generations: u32,
+    pub planning_ms: f64,
+    pub instance: String,
+}
+
 /// The report of a stack run.
 #[derive(Debug, Clone, Serialize)]
 pub struct StackReport {
     pub root: String,
     pub router: String,
     pub layers: Vec<LayerSummary>,
+    pub missions: Vec<MissionReport>,
     pub warnings: Vec<String>,
     pub picture: Option<PathBuf>,
 }
@@ -44,12 +72,14 @@ pub enum ReportError {
     Write { path: PathBuf, reason: String },
 }
 
-/// Fetches every layer from the map server through Zenoh, and draws the world to
-/// `<out_dir>/world.png` (occupancy with the information map tinted over it).
+/// Fetches every layer from the map server through Zenoh, plans each mission with the
+/// planner (Model I against the shortest path), and draws the world with the paths to
+/// `<out_dir>/world.png`.
 pub async fn build(
     requester: &Requester,
     root: &str,
     router: &str,
+    missions: &[Mission],
     out_dir: &Path,
 ) -> Result<StackReport, ReportError> {
     let list: LayerList = requester
@@ -89,17 +119,40 @@ pub async fn build(
             _ => {}
         }
     }
+    let planner = PlannerClient::new(requester.session().clone(), root);
+    let mut mission_reports = Vec::new();
+    let mut drawn: Vec<(Plan, Plan)> = Vec::new();
+    for mission in missions {
+        let (report, shortest, curious) = plan_mission(&planner, mission).await?;
+        mission_reports.push(report);
+        drawn.push((shortest, curious));
+    }
     let picture = match &occupancy {
         Some(occ) => {
             std::fs::create_dir_all(out_dir).map_err(|e| write_error(out_dir, e))?;
             let path = out_dir.join("world.png");
             let scale = (800 / occ.meta.width.max(occ.meta.height)).clamp(1, 8);
-            render_map(occ, information.as_ref(), scale)
-                .save(&path)
-                .map_err(|e| ReportError::Write {
-                    path: path.clone(),
-                    reason: e.to_string(),
-                })?;
+            let mut image = render_map(occ, information.as_ref(), scale);
+            for (shortest, curious) in &drawn {
+                draw_path(
+                    &mut image,
+                    occ.meta.height,
+                    &shortest.cells,
+                    scale,
+                    BASELINE,
+                );
+                draw_path(&mut image, occ.meta.height, &curious.cells, scale, PATH);
+                for end in [curious.cells.first(), curious.cells.last()]
+                    .into_iter()
+                    .flatten()
+                {
+                    draw_marker(&mut image, occ.meta.height, *end, scale, MARKER);
+                }
+            }
+            image.save(&path).map_err(|e| ReportError::Write {
+                path: path.clone(),
+                reason: e.to_string(),
+            })?;
             Some(path)
         }
         None => None,
@@ -108,9 +161,50 @@ pub async fn build(
         root: root.to_owned(),
         router: router.to_owned(),
         layers,
+        missions: mission_reports,
         warnings: list.warnings,
         picture,
     })
+}
+
+/// The seed every report plan uses, so the report is the same run after run.
+pub const REPORT_SEED: u64 = 2024;
+
+async fn plan_mission(
+    planner: &PlannerClient,
+    mission: &Mission,
+) -> Result<(MissionReport, Plan, Plan), ReportError> {
+    let mut request = PlanRequest {
+        request_id: None,
+        start: mission.start,
+        goal: mission.goal,
+        t_exec_s: 86_400.0,
+        deadline_s: 5.0,
+        model: PlannerModel::Shortest,
+        params: GaOverrides::default(),
+        seed: REPORT_SEED,
+        map_version: None,
+    };
+    let shortest = planner.plan(&request).await?;
+    request.t_exec_s = 2.0 * shortest.t_eta_s;
+    request.model = PlannerModel::Model1;
+    request.params.max_generations = Some(1000);
+    request.map_version = Some(shortest.map_version);
+    let curious = planner.plan(&request).await?;
+    let report = MissionReport {
+        name: mission.name.clone(),
+        budget_s: request.t_exec_s,
+        shortest_eta_s: shortest.t_eta_s,
+        shortest_information: shortest.distinct_information,
+        curious_eta_s: curious.t_eta_s,
+        curious_information: curious.distinct_information,
+        curious_reaches_goal: curious.reaches_goal,
+        curious_within_budget: curious.within_budget,
+        generations: curious.generations,
+        planning_ms: curious.planning_ms,
+        instance: curious.instance.clone(),
+    };
+    Ok((report, shortest, curious))
 }
 
 fn write_error(path: &Path, e: std::io::Error) -> ReportError {
@@ -147,6 +241,48 @@ impl std::fmt::Display for StackReport {
                 l.dtype,
                 l.get_ms
             )?;
+        }
+        if !self.missions.is_empty() {
+            writeln!(
+                f,
+                "\ndowntime missions (Model I vs the shortest path, budget = 2 x shortest ETA):"
+            )?;
+            writeln!(
+                f,
+                "{:<16} {:>8} {:>10} {:>10} {:>10} {:>10} {:>6} {:>9}",
+                "mission",
+                "budget s",
+                "short. s",
+                "short. I",
+                "curious s",
+                "curious I",
+                "gain",
+                "plan ms"
+            )?;
+            for m in &self.missions {
+                let gain = if m.shortest_information > 0.0 {
+                    (m.curious_information / m.shortest_information - 1.0) * 100.0
+                } else {
+                    0.0
+                };
+                writeln!(
+                    f,
+                    "{:<16} {:>8.1} {:>10.1} {:>10.0} {:>10.1} {:>10.0} {:>5.0}% {:>9.0}{}",
+                    m.name,
+                    m.budget_s,
+                    m.shortest_eta_s,
+                    m.shortest_information,
+                    m.curious_eta_s,
+                    m.curious_information,
+                    gain,
+                    m.planning_ms,
+                    if m.curious_reaches_goal && m.curious_within_budget {
+                        ""
+                    } else {
+                        "  (misses goal or budget)"
+                    }
+                )?;
+            }
         }
         for w in &self.warnings {
             writeln!(f, "warning: {w}")?;

@@ -1,11 +1,12 @@
 //! `roam stack`: every landed service in one process around an in-process router on
 //! loopback, multicast off. The same shape as a compose stack, so what works here works
-//! across machines. Services landed so far: the map server.
+//! across machines. Services landed so far: the map server and the planner.
 
 use std::path::PathBuf;
 use std::time::Duration;
 
 use roam_map_server::MapServerConfig;
+use roam_planner::PlannerConfig;
 use roam_proto::keys;
 use roam_runtime::SessionArgs;
 use tokio::task::JoinSet;
@@ -23,7 +24,12 @@ pub struct StackOptions {
     pub data_dir: Option<PathBuf>,
     /// The router's endpoint, e.g. `tcp/127.0.0.1:7447`; a free loopback port when absent.
     pub listen: Option<String>,
+    /// Planner instances to run (default 1).
+    pub planners: usize,
 }
+
+/// The services `Stack::start` runs, in start order.
+pub const SERVICES: [&str; 2] = [roam_map_server::SERVICE_NAME, roam_planner::SERVICE_NAME];
 
 #[derive(Debug, thiserror::Error)]
 pub enum StackError {
@@ -87,13 +93,30 @@ impl Stack {
             )
         });
 
+        for index in 0..options.planners.max(1) {
+            let planner_config = PlannerConfig {
+                root: root.clone(),
+                instance: Some(format!("planner-{index}")),
+                ..PlannerConfig::default()
+            };
+            let zenoh_config = client.zenoh_config(None)?;
+            let token = cancel.child_token();
+            services.spawn(async move {
+                let outcome = roam_planner::run(planner_config, zenoh_config, token).await;
+                (
+                    roam_planner::SERVICE_NAME,
+                    outcome.map_err(|e| e.to_string()),
+                )
+            });
+        }
+
         let mut stack = Stack {
             router,
             root,
             cancel,
             services,
         };
-        for service in [roam_map_server::SERVICE_NAME] {
+        for service in SERVICES {
             let (session, root) = (stack.router.session.clone(), stack.root.clone());
             let live = wait_until_live(&session, &root, service, timeout);
             tokio::select! {

@@ -1,0 +1,102 @@
+//! The maps the planner plans on: the latest `inflated` and `information` layers from
+//! the map server, and a few earlier versions for requests that name one.
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+use roam_map_server::grid::Grid;
+use roam_proto::cells::Cells;
+use roam_proto::map::Layer;
+use roam_proto::planner::MapVersion;
+
+use crate::world::World;
+
+/// The layer names the planner reads.
+pub const INFLATED: &str = "inflated";
+pub const INFORMATION: &str = "information";
+
+/// Heuristic compression the cached worlds are built with (Table I); requests with
+/// another c_h get their blocks recut.
+pub const DEFAULT_COMPRESSION: f64 = 0.25;
+
+/// Latest layers and the worlds built from them.
+#[derive(Debug, Default)]
+pub struct MapCache {
+    inflated: Option<Layer>,
+    information: Option<Layer>,
+    worlds: VecDeque<(MapVersion, Arc<World>)>,
+    history: usize,
+}
+
+impl MapCache {
+    pub fn new(history: usize) -> Self {
+        MapCache {
+            history: history.max(1),
+            ..MapCache::default()
+        }
+    }
+
+    /// Takes a new layer; rebuilds the world when both layers are present and agree in
+    /// size. Returns the new version when a world was built.
+    pub fn update(&mut self, layer: Layer) -> Option<MapVersion> {
+        let slot = match layer.name.as_str() {
+            INFLATED => &mut self.inflated,
+            INFORMATION => &mut self.information,
+            _ => return None,
+        };
+        if slot
+            .as_ref()
+            .is_some_and(|old| old.version >= layer.version)
+        {
+            return None;
+        }
+        *slot = Some(layer);
+        let (Some(inflated), Some(information)) = (&self.inflated, &self.information) else {
+            return None;
+        };
+        let version = MapVersion {
+            inflated: inflated.version,
+            information: information.version,
+        };
+        if self.worlds.iter().any(|(v, _)| *v == version) {
+            return None;
+        }
+        let (Cells::I8(occ), Cells::U8(info)) = (&inflated.cells, &information.cells) else {
+            tracing::warn!("the map server's layers have unexpected types; not planning on them");
+            return None;
+        };
+        let occ = Grid {
+            meta: inflated.meta,
+            cells: occ.clone(),
+        };
+        let info = Grid {
+            meta: information.meta,
+            cells: info.clone(),
+        };
+        match World::new(&occ, &info, DEFAULT_COMPRESSION) {
+            Ok(world) => {
+                self.worlds.push_back((version, Arc::new(world)));
+                while self.worlds.len() > self.history {
+                    self.worlds.pop_front();
+                }
+                Some(version)
+            }
+            Err(e) => {
+                tracing::warn!("cannot plan on map {version:?}: {e}");
+                None
+            }
+        }
+    }
+
+    /// The world for a version, or the latest.
+    pub fn world(&self, version: Option<MapVersion>) -> Option<(MapVersion, Arc<World>)> {
+        match version {
+            None => self.worlds.back().cloned(),
+            Some(v) => self.worlds.iter().find(|(k, _)| *k == v).cloned(),
+        }
+    }
+
+    pub fn versions(&self) -> Vec<MapVersion> {
+        self.worlds.iter().map(|(v, _)| *v).collect()
+    }
+}

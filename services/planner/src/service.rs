@@ -1,0 +1,414 @@
+//! The planner on Zenoh: a thin adapter around [`crate::plan::plan`].
+//!
+//! | key | kind | payload |
+//! |---|---|---|
+//! | `<root>/planner/plan` | queryable (every instance) | `plan_request` → `plan` |
+//! | `<root>/planner/instance/<instance>/plan` | queryable (this instance) | `plan_request` → `plan` |
+//! | `<root>/planner/progress/<request_id>` | publication | `plan_progress`, at most every 50 ms |
+//! | `<root>/planner/cancel/*` | subscription | `cancel_plan` |
+//! | `<root>/map/layer/{inflated,information}` | subscription + get | `layer` |
+
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+use roam_proto::map::Layer;
+use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest};
+use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply};
+use roam_runtime::{reply, Requester, Service, ServiceError};
+use tokio_util::sync::CancellationToken;
+use zenoh::query::Query;
+use zenoh::Wait;
+
+use crate::config::PlannerConfig;
+use crate::maps::{MapCache, INFLATED, INFORMATION};
+use crate::params::GaParams;
+use crate::plan::{plan, PlanOutcome, PlanSpec};
+use crate::world::World;
+
+pub const SERVICE_NAME: &str = "planner";
+
+/// Largest plan request accepted, in bytes.
+pub const MAX_REQUEST_BYTES: usize = 64 * 1024;
+
+/// How often progress is published at most.
+pub const PROGRESS_PERIOD: Duration = Duration::from_millis(50);
+
+#[derive(Debug, thiserror::Error)]
+pub enum PlannerError {
+    #[error(transparent)]
+    Service(#[from] ServiceError),
+    #[error("invalid config: {0}")]
+    Config(String),
+}
+
+struct State {
+    root: String,
+    instance: String,
+    session: zenoh::Session,
+    maps: Mutex<MapCache>,
+    in_flight: AtomicUsize,
+    max_in_flight: usize,
+    cancels: Mutex<HashMap<String, Arc<AtomicBool>>>,
+    next_id: AtomicU64,
+}
+
+impl State {
+    fn maps(&self) -> MutexGuard<'_, MapCache> {
+        self.maps.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn cancels(&self) -> MutexGuard<'_, HashMap<String, Arc<AtomicBool>>> {
+        self.cancels.lock().unwrap_or_else(|p| p.into_inner())
+    }
+}
+
+/// Frees a plan slot and its cancel entry however the plan ends.
+struct Slot<'a> {
+    state: &'a State,
+    request_id: Option<String>,
+}
+
+impl Drop for Slot<'_> {
+    fn drop(&mut self) {
+        if let Some(id) = &self.request_id {
+            self.state.cancels().remove(id);
+        }
+        self.state.in_flight.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+/// Runs a planner instance until `cancel` is cancelled.
+pub async fn run(
+    config: PlannerConfig,
+    zenoh_config: zenoh::Config,
+    cancel: CancellationToken,
+) -> Result<(), PlannerError> {
+    if config.max_concurrent_plans == 0 {
+        return Err(PlannerError::Config(
+            "max_concurrent_plans must be at least 1".into(),
+        ));
+    }
+    let mut service = Service::start(
+        SERVICE_NAME,
+        &config.root,
+        config.instance.as_deref(),
+        zenoh_config,
+        cancel,
+    )
+    .await?;
+    let state = Arc::new(State {
+        root: config.root.clone(),
+        instance: service.instance().to_owned(),
+        session: service.session().clone(),
+        maps: Mutex::new(MapCache::new(config.map_history)),
+        in_flight: AtomicUsize::new(0),
+        max_in_flight: config.max_concurrent_plans,
+        cancels: Mutex::new(HashMap::new()),
+        next_id: AtomicU64::new(1),
+    });
+    let root = config.root.as_str();
+
+    // Maps: follow publications, and fetch the current layers until we have them.
+    for layer in [INFLATED, INFORMATION] {
+        let key = keys::map_layer(root, layer);
+        let subscriber = service
+            .session()
+            .declare_subscriber(&key)
+            .await
+            .map_err(|e| ServiceError::Declare {
+                what: "subscriber",
+                key: key.clone(),
+                reason: e.to_string(),
+            })?;
+        let (state, cancel) = (state.clone(), service.cancel_token());
+        service.spawn(async move {
+            loop {
+                tokio::select! {
+                    _ = cancel.cancelled() => break,
+                    sample = subscriber.recv_async() => match sample {
+                        Ok(sample) => match decode::<Layer>(&sample.payload().to_bytes()) {
+                            Ok(layer) => take_layer(&state, layer),
+                            Err(e) => tracing::warn!(key = %sample.key_expr(), "ignoring a layer that does not decode: {e}"),
+                        },
+                        Err(_) => break,
+                    },
+                }
+            }
+        });
+    }
+    {
+        let (state, cancel) = (state.clone(), service.cancel_token());
+        let requester = Requester::new(service.session().clone(), Duration::from_secs(5));
+        service.spawn(async move { fetch_maps(state, requester, cancel).await });
+    }
+
+    let cancel_key = keys::planner_cancel_any(root);
+    let cancels = service
+        .session()
+        .declare_subscriber(&cancel_key)
+        .await
+        .map_err(|e| ServiceError::Declare {
+            what: "subscriber",
+            key: cancel_key.clone(),
+            reason: e.to_string(),
+        })?;
+    {
+        let (state, cancel) = (state.clone(), service.cancel_token());
+        service.spawn(async move {
+            loop {
+                tokio::select! {
+                    _ = cancel.cancelled() => break,
+                    sample = cancels.recv_async() => match sample {
+                        Ok(sample) => {
+                            if let Ok(request) = decode::<CancelPlan>(&sample.payload().to_bytes()) {
+                                if let Some(flag) = state.cancels().get(&request.request_id) {
+                                    flag.store(true, Ordering::Relaxed);
+                                }
+                            }
+                        }
+                        Err(_) => break,
+                    },
+                }
+            }
+        });
+    }
+
+    let shared = service.declare_queryable(&keys::planner_plan(root)).await?;
+    let own = service
+        .declare_queryable(&keys::planner_plan_at(root, service.instance()))
+        .await?;
+    service.serve(shared, state.clone(), |s, q| async move {
+        answer_plan(s, q).await
+    });
+    service.serve(
+        own,
+        state.clone(),
+        |s, q| async move { answer_plan(s, q).await },
+    );
+    // The liveliness token means "ready to plan", so it waits for the first map.
+    loop {
+        if state.maps().world(None).is_some() {
+            break;
+        }
+        tokio::select! {
+            _ = service.cancelled() => break,
+            _ = tokio::time::sleep(Duration::from_millis(20)) => {}
+        }
+    }
+    if !service.cancel_token().is_cancelled() {
+        service.announce().await?;
+    }
+
+    service.cancelled().await;
+    // Stop every plan in flight: each returns its best path so far.
+    for flag in state.cancels().values() {
+        flag.store(true, Ordering::Relaxed);
+    }
+    service
+        .shutdown(roam_runtime::service::DEFAULT_GRACE)
+        .await?;
+    Ok(())
+}
+
+fn take_layer(state: &State, layer: Layer) {
+    if let Some(version) = state.maps().update(layer) {
+        tracing::info!(
+            inflated = version.inflated,
+            information = version.information,
+            "planning on a new map"
+        );
+    }
+}
+
+/// Gets the two layers from the map server, retrying until both arrive.
+async fn fetch_maps(state: Arc<State>, requester: Requester, cancel: CancellationToken) {
+    loop {
+        for name in [INFLATED, INFORMATION] {
+            match requester
+                .request::<Layer, Layer>(&keys::map_layer(&state.root, name), None)
+                .await
+            {
+                Ok(layer) => take_layer(&state, layer),
+                Err(e) => tracing::debug!("map layer {name} not available yet: {e}"),
+            }
+        }
+        if state.maps().world(None).is_some() {
+            return;
+        }
+        tokio::select! {
+            _ = cancel.cancelled() => return,
+            _ = tokio::time::sleep(Duration::from_millis(500)) => {}
+        }
+    }
+}
+
+async fn answer_plan(state: Arc<State>, query: Query) {
+    let request = match reply::decode_request::<PlanRequest>(&query, MAX_REQUEST_BYTES) {
+        Ok(r) => r,
+        Err(e) => return reply::send_error(&query, &e).await,
+    };
+    let result = tokio::task::spawn_blocking({
+        let state = state.clone();
+        move || plan_request(&state, request)
+    })
+    .await
+    .unwrap_or_else(|e| {
+        Err(ErrorReply::new(
+            ErrorCode::Internal,
+            format!("the planning task failed: {e}"),
+        ))
+    });
+    reply::send_result(&query, result).await;
+}
+
+/// Checks a request against this instance's state, plans, and builds the reply.
+fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply> {
+    // A bounded number of plans at once; the next is refused now, never queued.
+    let running = state.in_flight.fetch_add(1, Ordering::AcqRel);
+    let mut slot = Slot {
+        state,
+        request_id: None,
+    };
+    if running >= state.max_in_flight {
+        return Err(ErrorReply::limit(
+            "max_concurrent_plans",
+            state.max_in_flight as u64,
+            running as u64 + 1,
+            format!(
+                "planner {} is busy with {running} plans; ask another instance or retry",
+                state.instance
+            ),
+        )
+        .with_code(ErrorCode::Busy));
+    }
+    let request_id = match &request.request_id {
+        Some(id) => {
+            keys::check_name("request id", id)
+                .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
+            id.clone()
+        }
+        None => format!(
+            "{}-{}",
+            state.instance,
+            state.next_id.fetch_add(1, Ordering::Relaxed)
+        ),
+    };
+    let flag = Arc::new(AtomicBool::new(false));
+    {
+        let mut cancels = state.cancels();
+        if cancels.contains_key(&request_id) {
+            return Err(ErrorReply::new(
+                ErrorCode::InvalidRequest,
+                format!("request id '{request_id}' is already being planned; use a fresh id"),
+            ));
+        }
+        cancels.insert(request_id.clone(), flag.clone());
+    }
+    slot.request_id = Some(request_id.clone());
+
+    let (map_version, world) = {
+        let maps = state.maps();
+        match maps.world(request.map_version) {
+            Some(w) => w,
+            None => {
+                let have = maps.versions();
+                return Err(match request.map_version {
+                    Some(v) => ErrorReply::new(
+                        ErrorCode::NotFound,
+                        format!("map version {v:?} is unknown to this planner; it has {have:?}; omit map_version to plan on the latest"),
+                    ),
+                    None => ErrorReply::new(ErrorCode::Unavailable, "the planner has no map yet; is the map server running under the same root?"),
+                });
+            }
+        }
+    };
+    let params = GaParams::with_overrides(&request.params)
+        .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
+    let spec = PlanSpec {
+        start: request.start,
+        goal: request.goal,
+        t_exec_s: request.t_exec_s,
+        deadline_s: request.deadline_s,
+        model: request.model,
+        params,
+        seed: request.seed,
+    };
+    let progress_key = keys::planner_progress(&state.root, &request_id);
+    let mut batch = Vec::new();
+    let mut last_sent = Instant::now();
+    let publish = |batch: &mut Vec<(u32, f64)>, done: bool| {
+        let message = PlanProgress {
+            request_id: request_id.clone(),
+            best_fitness: std::mem::take(batch),
+            done,
+        };
+        if let Err(e) = state.session.put(&progress_key, encode(&message)).wait() {
+            tracing::debug!("progress publication failed: {e}");
+        }
+    };
+    let outcome = plan(&world, &spec, &flag, |generation, best| {
+        batch.push((generation, best));
+        if last_sent.elapsed() >= PROGRESS_PERIOD {
+            publish(&mut batch, false);
+            last_sent = Instant::now();
+        }
+    })
+    .map_err(|e| e.to_reply())?;
+    publish(&mut batch, true);
+    Ok(to_message(
+        &world,
+        &request,
+        request_id.clone(),
+        map_version,
+        &state.instance,
+        outcome,
+    ))
+}
+
+/// The reply message of an outcome.
+pub fn to_message(
+    world: &World,
+    request: &PlanRequest,
+    request_id: String,
+    map_version: roam_proto::planner::MapVersion,
+    instance: &str,
+    outcome: PlanOutcome,
+) -> Plan {
+    let cells = outcome
+        .path
+        .iter()
+        .map(|&c| {
+            let (x, y) = world.xy(c);
+            [x as u32, y as u32]
+        })
+        .collect();
+    let points = outcome
+        .path
+        .iter()
+        .map(|&c| {
+            let (x, y) = world.center(c);
+            [x, y]
+        })
+        .collect();
+    Plan {
+        request_id,
+        model: request.model,
+        cells,
+        points,
+        t_eta_s: outcome.t_eta_s,
+        reaches_goal: outcome.reaches_goal,
+        within_budget: outcome.within_budget,
+        fitness: outcome.fitness,
+        u_ges: outcome.metrics.u_ges,
+        density: outcome.metrics.density,
+        distinct_information: outcome.metrics.distinct_information,
+        generations: outcome.generations,
+        planning_ms: outcome.planning.as_secs_f64() * 1000.0,
+        stop_reason: outcome.stop_reason,
+        seed: request.seed,
+        map_version,
+        instance: instance.to_owned(),
+    }
+}
