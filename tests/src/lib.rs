@@ -10,8 +10,9 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
 use roam::router::Router;
-use roam::stack::wait_until_live;
+use roam::stack::{wait_for_liveliness, wait_until_live};
 use roam_map_server::MapServerConfig;
+use roam_planner::PlannerConfig;
 use roam_proto::keys;
 use roam_runtime::{Requester, SessionArgs};
 use tokio::task::JoinHandle;
@@ -121,6 +122,38 @@ impl Harness {
         tokio::select! {
             outcome = &mut live => outcome.expect("map server up"),
             finished = &mut handle => panic!("the map server stopped at start: {finished:?}"),
+        }
+        RunningService { cancel, handle }
+    }
+
+    /// A planner config under this harness's root with the given instance name.
+    pub fn planner_config(&self, instance: &str) -> PlannerConfig {
+        PlannerConfig {
+            root: self.root.clone(),
+            instance: Some(instance.to_owned()),
+            ..PlannerConfig::default()
+        }
+    }
+
+    /// Starts a planner and waits for its own liveliness token (it announces itself
+    /// once it has a map, so start the map server first).
+    pub async fn start_planner(&self, config: PlannerConfig) -> RunningService {
+        let cancel = CancellationToken::new();
+        let token = cancel.clone();
+        let zenoh_config = self.client_config();
+        let instance = config.instance.clone().unwrap_or_default();
+        let handle = tokio::spawn(async move {
+            roam_planner::run(config, zenoh_config, token)
+                .await
+                .map_err(|e| e.to_string())
+        });
+        let key = keys::liveliness(&self.root, roam_planner::SERVICE_NAME, &instance);
+        let live = wait_for_liveliness(&self.router.session, &key, STEP);
+        tokio::pin!(live);
+        let mut handle = handle;
+        tokio::select! {
+            outcome = &mut live => outcome.expect("planner up"),
+            finished = &mut handle => panic!("the planner stopped at start: {finished:?}"),
         }
         RunningService { cancel, handle }
     }

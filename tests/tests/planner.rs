@@ -1,0 +1,500 @@
+//! The planner through Zenoh: plans, determinism against the in-process planner, every
+//! refusal, progress, cancel, busy, and two instances sharing load and surviving one's
+//! death. Real map server and planners in process, used only as a Zenoh client.
+
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
+
+use roam_map_server::layers::inflate;
+use roam_map_server::map_file;
+use roam_map_server::store::DEFAULT_LIMITS;
+use roam_planner::client::PlannerClient;
+use roam_planner::params::GaParams;
+use roam_planner::plan::{plan, PlanSpec};
+use roam_planner::world::World;
+use roam_proto::planner::{
+    CancelPlan, GaOverrides, MapVersion, Plan, PlanProgress, PlanRequest, PlannerModel, StopReason,
+};
+use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply};
+use roam_runtime::{ClientError, Requester};
+use roam_tests::{within, Harness, RunningService};
+
+fn request(start: [f64; 2], goal: [f64; 2], t_exec_s: f64, generations: u32) -> PlanRequest {
+    PlanRequest {
+        request_id: None,
+        start,
+        goal,
+        t_exec_s,
+        deadline_s: 60.0,
+        model: PlannerModel::Model1,
+        params: GaOverrides {
+            max_generations: Some(generations),
+            population: Some(60),
+            ..GaOverrides::default()
+        },
+        seed: 11,
+        map_version: None,
+    }
+}
+
+async fn ask(client: &Requester, root: &str, request: &PlanRequest) -> Result<Plan, ClientError> {
+    within(
+        "plan",
+        client.request(&keys::planner_plan(root), Some(request)),
+    )
+    .await
+}
+
+async fn refusal(client: &Requester, root: &str, request: &PlanRequest) -> ErrorReply {
+    match ask(client, root, request).await {
+        Err(ClientError::Refused(reply)) => reply,
+        other => panic!("expected a refusal, got {other:?}"),
+    }
+}
+
+struct Running {
+    harness: Harness,
+    map_server: RunningService,
+    planners: Vec<RunningService>,
+}
+
+async fn boot(planners: &[(&str, usize)]) -> Running {
+    let harness = Harness::start().await;
+    let map_server = harness.start_map_server(harness.map_server_config()).await;
+    let mut started = Vec::new();
+    for (name, concurrent) in planners {
+        let config = roam_planner::PlannerConfig {
+            max_concurrent_plans: *concurrent,
+            ..harness.planner_config(name)
+        };
+        started.push(harness.start_planner(config).await);
+    }
+    Running {
+        harness,
+        map_server,
+        planners: started,
+    }
+}
+
+impl Running {
+    async fn stop(self) {
+        for planner in self.planners {
+            planner.stop().await.1.expect("planner stops cleanly");
+        }
+        self.map_server
+            .stop()
+            .await
+            .1
+            .expect("map server stops cleanly");
+        self.harness.close().await;
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
+    let running = boot(&[("solo", 2)]).await;
+    let client = running.harness.client().await;
+    let req = request([-8.0, -8.0], [6.0, -7.0], 80.0, 80);
+    let remote = ask(&client, &running.harness.root, &req)
+        .await
+        .expect("plan");
+    assert!(remote.reaches_goal && remote.within_budget, "{remote:?}");
+    assert_eq!(remote.generations, 80);
+    assert_eq!(remote.stop_reason, StopReason::MaxGenerations);
+    assert_eq!(
+        remote.map_version,
+        MapVersion {
+            inflated: 1,
+            information: 1
+        }
+    );
+    assert_eq!(remote.points.len(), remote.cells.len());
+
+    // The same request in process, on the same world built from the same scenario.
+    let content = map_file::builtin(DEFAULT_LIMITS.max_layer_cells).expect("builtin");
+    let inflated = inflate(
+        &content.occupancy,
+        content.robot_radius_m.unwrap_or(0.2),
+        65,
+    );
+    let world = World::new(&inflated, &content.information.expect("info"), 0.25).expect("world");
+    let spec = PlanSpec {
+        start: req.start,
+        goal: req.goal,
+        t_exec_s: req.t_exec_s,
+        deadline_s: req.deadline_s,
+        model: req.model,
+        params: GaParams::with_overrides(&req.params).expect("params"),
+        seed: req.seed,
+    };
+    let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local plan");
+    let local_cells: Vec<[u32; 2]> = local
+        .path
+        .iter()
+        .map(|&c| {
+            let (x, y) = world.xy(c);
+            [x as u32, y as u32]
+        })
+        .collect();
+    assert_eq!(remote.cells, local_cells);
+    assert_eq!(
+        remote.fitness.total.to_bits(),
+        local.fitness.total.to_bits()
+    );
+    assert_eq!(remote.u_ges.to_bits(), local.metrics.u_ges.to_bits());
+
+    // And again through the service: the same answer.
+    let again = ask(&client, &running.harness.root, &req)
+        .await
+        .expect("plan");
+    assert_eq!(again.cells, remote.cells);
+    running.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn every_refusal_is_structured_and_says_what_to_change() {
+    let running = boot(&[("solo", 2)]).await;
+    let client = running.harness.client().await;
+    let root = running.harness.root.clone();
+    let ok = request([-8.0, -8.0], [6.0, -7.0], 80.0, 5);
+
+    let off = refusal(
+        &client,
+        &root,
+        &PlanRequest {
+            start: [40.0, 0.0],
+            ..ok.clone()
+        },
+    )
+    .await;
+    assert_eq!(off.code, ErrorCode::InvalidRequest);
+    assert!(off.message.contains("off the map"), "{}", off.message);
+
+    let blocked = refusal(
+        &client,
+        &root,
+        &PlanRequest {
+            goal: [-9.9, 0.0],
+            ..ok.clone()
+        },
+    )
+    .await;
+    assert!(
+        blocked.message.contains("inside an obstacle"),
+        "{}",
+        blocked.message
+    );
+
+    let short = refusal(
+        &client,
+        &root,
+        &PlanRequest {
+            t_exec_s: 10.0,
+            ..ok.clone()
+        },
+    )
+    .await;
+    assert_eq!(short.code, ErrorCode::InvalidRequest);
+    assert!(
+        short
+            .message
+            .contains("shorter than the shortest path's ETA"),
+        "{}",
+        short.message
+    );
+
+    let deadline = refusal(
+        &client,
+        &root,
+        &PlanRequest {
+            deadline_s: 5000.0,
+            ..ok.clone()
+        },
+    )
+    .await;
+    assert_eq!(deadline.code, ErrorCode::LimitExceeded);
+    assert_eq!(
+        deadline.limit.map(|l| l.name),
+        Some("deadline_s".to_owned())
+    );
+
+    let params = refusal(
+        &client,
+        &root,
+        &PlanRequest {
+            params: GaOverrides {
+                mutation_ratio: Some(2.0),
+                ..GaOverrides::default()
+            },
+            ..ok.clone()
+        },
+    )
+    .await;
+    assert!(
+        params.message.contains("mutation_ratio"),
+        "{}",
+        params.message
+    );
+
+    let version = refusal(
+        &client,
+        &root,
+        &PlanRequest {
+            map_version: Some(MapVersion {
+                inflated: 99,
+                information: 1,
+            }),
+            ..ok.clone()
+        },
+    )
+    .await;
+    assert_eq!(version.code, ErrorCode::NotFound);
+    assert!(version.message.contains("unknown"), "{}", version.message);
+
+    let malformed = match within(
+        "raw",
+        client.request_raw::<Plan>(&keys::planner_plan(&root), Some(b"[1,2".to_vec())),
+    )
+    .await
+    {
+        Err(ClientError::Refused(r)) => r,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(malformed.code, ErrorCode::Malformed);
+
+    // No path: wall the goal in through the map server, then plan on the new map.
+    let mut cells = Vec::new();
+    for x in 30..=36u32 {
+        cells.push(roam_proto::map::CellWrite {
+            x,
+            y: 30,
+            value: 100.0,
+        });
+        cells.push(roam_proto::map::CellWrite {
+            x,
+            y: 36,
+            value: 100.0,
+        });
+    }
+    for y in 31..=35u32 {
+        cells.push(roam_proto::map::CellWrite {
+            x: 30,
+            y,
+            value: 100.0,
+        });
+        cells.push(roam_proto::map::CellWrite {
+            x: 36,
+            y,
+            value: 100.0,
+        });
+    }
+    let update = roam_proto::map::LayerUpdate {
+        base_version: 1,
+        change: roam_proto::map::LayerChange::SetCells { cells },
+    };
+    let _: roam_proto::map::UpdateAck = within(
+        "wall",
+        client.request(&keys::map_update(&root, "occupancy"), Some(&update)),
+    )
+    .await
+    .expect("wall in");
+    // Cell (33, 33) is the world point (-3.3, -3.3); wait until the planner has map v2.
+    let walled = PlanRequest {
+        goal: [-3.3, -3.3],
+        map_version: Some(MapVersion {
+            inflated: 2,
+            information: 1,
+        }),
+        ..ok.clone()
+    };
+    let no_path = loop {
+        let reply = refusal(&client, &root, &walled).await;
+        if reply.code != ErrorCode::NotFound || !reply.message.contains("unknown") {
+            break reply;
+        }
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    };
+    assert_eq!(no_path.code, ErrorCode::NotFound);
+    assert!(no_path.message.contains("no path"), "{}", no_path.message);
+    running.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn progress_is_published_and_a_plan_can_be_cancelled() {
+    let running = boot(&[("solo", 2)]).await;
+    let client = running.harness.client().await;
+    let root = running.harness.root.clone();
+    let id = "long-plan";
+    let subscriber = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::planner_progress(&root, id)),
+    )
+    .await
+    .expect("sub");
+    let long = PlanRequest {
+        request_id: Some(id.into()),
+        params: GaOverrides {
+            max_generations: Some(100_000),
+            ..GaOverrides::default()
+        },
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
+    };
+    let pending = {
+        let client = client.clone();
+        let root = root.clone();
+        tokio::spawn(async move {
+            client
+                .request::<PlanRequest, Plan>(&keys::planner_plan(&root), Some(&long))
+                .await
+        })
+    };
+    // Progress arrives while it plans: generations in order, best fitness never worse.
+    let mut seen: Vec<(u32, f64)> = Vec::new();
+    while seen.len() < 5 {
+        let sample = within("progress", subscriber.recv_async())
+            .await
+            .expect("sample");
+        let progress: PlanProgress = decode(&sample.payload().to_bytes()).expect("progress");
+        assert_eq!(progress.request_id, id);
+        seen.extend(progress.best_fitness);
+    }
+    assert!(
+        seen.windows(2)
+            .all(|w| w[1].0 == w[0].0 + 1 && w[1].1 >= w[0].1),
+        "{seen:?}"
+    );
+
+    within(
+        "cancel",
+        client.session().put(
+            keys::planner_cancel(&root, id),
+            encode(&CancelPlan {
+                request_id: id.into(),
+            }),
+        ),
+    )
+    .await
+    .expect("put");
+    let plan = within("cancelled plan", pending)
+        .await
+        .expect("join")
+        .expect("plan");
+    assert_eq!(plan.stop_reason, StopReason::Cancelled);
+    assert!(plan.generations < 100_000);
+    assert!(plan.reaches_goal, "the best path so far is returned");
+    // The last progress message says done.
+    let done = loop {
+        let sample = within("final progress", subscriber.recv_async())
+            .await
+            .expect("sample");
+        let progress: PlanProgress = decode(&sample.payload().to_bytes()).expect("progress");
+        if progress.done {
+            break progress;
+        }
+    };
+    assert!(done.done);
+    running.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_full_planner_refuses_at_once_with_busy() {
+    let running = boot(&[("tiny", 1)]).await;
+    let client = running.harness.client().await;
+    let root = running.harness.root.clone();
+    let id = "hog";
+    let subscriber = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::planner_progress(&root, id)),
+    )
+    .await
+    .expect("sub");
+    let hog = PlanRequest {
+        request_id: Some(id.into()),
+        params: GaOverrides {
+            max_generations: Some(100_000),
+            ..GaOverrides::default()
+        },
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
+    };
+    let pending = {
+        let client = client.clone();
+        let root = root.clone();
+        tokio::spawn(async move {
+            client
+                .request::<PlanRequest, Plan>(&keys::planner_plan(&root), Some(&hog))
+                .await
+        })
+    };
+    within("hog progress", subscriber.recv_async())
+        .await
+        .expect("the hog is planning");
+    let started = std::time::Instant::now();
+    let busy = refusal(&client, &root, &request([-8.0, -8.0], [6.0, -7.0], 80.0, 5)).await;
+    assert_eq!(busy.code, ErrorCode::Busy);
+    assert!(
+        started.elapsed() < Duration::from_secs(2),
+        "refused at once, not queued"
+    );
+    assert_eq!(
+        busy.limit.map(|l| l.name),
+        Some("max_concurrent_plans".to_owned())
+    );
+    within(
+        "cancel",
+        client.session().put(
+            keys::planner_cancel(&root, id),
+            encode(&CancelPlan {
+                request_id: id.into(),
+            }),
+        ),
+    )
+    .await
+    .expect("put");
+    within("hog", pending).await.expect("join").expect("plan");
+    running.stop().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn two_instances_share_the_load_and_survive_one_death() {
+    let mut running = boot(&[("alpha", 2), ("beta", 2)]).await;
+    let session = running.harness.client().await.session().clone();
+    let planner = PlannerClient::new(session, &running.harness.root);
+    assert_eq!(
+        within("instances", planner.live_instances())
+            .await
+            .expect("live"),
+        ["alpha", "beta"]
+    );
+    let mut answered_by = Vec::new();
+    for _ in 0..4 {
+        let plan = within(
+            "plan",
+            planner.plan(&request([-8.0, -8.0], [-2.0, 4.0], 60.0, 10)),
+        )
+        .await
+        .expect("plan");
+        answered_by.push(plan.instance);
+    }
+    assert!(
+        answered_by.contains(&"alpha".to_owned()) && answered_by.contains(&"beta".to_owned()),
+        "{answered_by:?}"
+    );
+
+    // Kill alpha: plans keep coming, from beta.
+    let alpha = running.planners.remove(0);
+    alpha.stop().await.1.expect("alpha stops");
+    for _ in 0..3 {
+        let plan = within(
+            "plan",
+            planner.plan(&request([-8.0, -8.0], [-2.0, 4.0], 60.0, 10)),
+        )
+        .await
+        .expect("plan after a death");
+        assert_eq!(plan.instance, "beta");
+    }
+    running.stop().await;
+}
