@@ -126,6 +126,7 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         model: req.model,
         params: GaParams::with_overrides(&req.params).expect("params"),
         seed: req.seed,
+        threads: roam_planner::ga::default_threads(),
     };
     let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local plan");
     let local_cells: Vec<[u32; 2]> = local

@@ -58,34 +58,6 @@ fn blend(a: Rgb<u8>, b: Rgb<u8>, t: f32) -> Rgb<u8> {
     }))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use roam_proto::map::{GridMeta, Origin};
-
-    #[test]
-    fn cells_are_drawn_north_up_with_information_tint() {
-        let meta = GridMeta {
-            width: 3,
-            height: 2,
-            resolution: 1.0,
-            origin: Origin::default(),
-        };
-        let mut occ = Grid::filled(meta, occupancy::FREE);
-        occ.cells[0] = occupancy::OCCUPIED; // (0, 0): bottom-left
-        occ.cells[5] = occupancy::UNKNOWN; // (2, 1): top-right
-        let mut info = Grid::filled(meta, 0u8);
-        info.cells[1] = 100; // (1, 0)
-        let image = render_map(&occ, Some(&info), 2);
-        assert_eq!(image.dimensions(), (6, 4));
-        assert_eq!(*image.get_pixel(0, 3), OCCUPIED);
-        assert_eq!(*image.get_pixel(5, 0), UNKNOWN);
-        assert_eq!(*image.get_pixel(2, 2), INFORMATION);
-        assert_eq!(*image.get_pixel(0, 0), FREE);
-        assert_eq!(pixel_of(&occ, 1, 0, 2), (2, 2));
-    }
-}
-
 /// Colour of a planned path.
 pub const PATH: Rgb<u8> = Rgb([0, 90, 220]);
 /// Colour of a second path (a baseline) drawn for comparison.
@@ -152,5 +124,33 @@ pub fn draw_marker(
         for x in left.saturating_sub(border)..(left + scale + border).min(image.width()) {
             image.put_pixel(x, y, colour);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roam_proto::map::{GridMeta, Origin};
+
+    #[test]
+    fn cells_are_drawn_north_up_with_information_tint() {
+        let meta = GridMeta {
+            width: 3,
+            height: 2,
+            resolution: 1.0,
+            origin: Origin::default(),
+        };
+        let mut occ = Grid::filled(meta, occupancy::FREE);
+        occ.cells[0] = occupancy::OCCUPIED; // (0, 0): bottom-left
+        occ.cells[5] = occupancy::UNKNOWN; // (2, 1): top-right
+        let mut info = Grid::filled(meta, 0u8);
+        info.cells[1] = 100; // (1, 0)
+        let image = render_map(&occ, Some(&info), 2);
+        assert_eq!(image.dimensions(), (6, 4));
+        assert_eq!(*image.get_pixel(0, 3), OCCUPIED);
+        assert_eq!(*image.get_pixel(5, 0), UNKNOWN);
+        assert_eq!(*image.get_pixel(2, 2), INFORMATION);
+        assert_eq!(*image.get_pixel(0, 0), FREE);
+        assert_eq!(pixel_of(&occ, 1, 0, 2), (2, 2));
     }
 }

@@ -6,7 +6,9 @@
 //! internal information maps, marking cells that have been visited ... as not
 //! containing more useful information" (§II.B), so cells already perceived along the
 //! same path are masked. The masking uses a stamp per cell, so evaluating a path costs
-//! O(L · window) with no clearing between paths.
+//! O(L · window) with no clearing between paths. After a move, only the cells that
+//! enter the window need a look: every cell of the previous window is already stamped,
+//! so for d = 3 a straight move checks 4 cells and a diagonal 7 instead of 16.
 //!
 //! - Model 0 (Eq. 8): I_0 per newly perceived cell, whatever its score.
 //! - Model I (Eq. 9): `M = max(I · (1 − w_t / (t_s + 1) − w_n · (n_I − 1)), 0)`.
@@ -25,7 +27,7 @@ use roam_proto::planner::{FitnessTerms, PlannerModel};
 
 use crate::eta::step_time;
 use crate::params::GaParams;
-use crate::world::{Cell, World};
+use crate::world::{Cell, World, MOVES};
 
 /// The curiosity model that scores information (the GA's F_1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -57,6 +59,19 @@ pub struct Evaluation {
     pub reaches_goal: bool,
 }
 
+/// For each of the eight moves, the offsets `o` of `window` whose cell is new after
+/// the move: `o + move` is not an offset of the window.
+pub fn entering_offsets(window: &[(i32, i32)]) -> [Vec<(i32, i32)>; 8] {
+    std::array::from_fn(|dir| {
+        let (mx, my) = MOVES[dir];
+        window
+            .iter()
+            .copied()
+            .filter(|&(ox, oy)| !window.contains(&(ox + mx, oy + my)))
+            .collect()
+    })
+}
+
 /// Scores paths; holds the scratch state so that evaluating allocates nothing.
 #[derive(Debug)]
 pub struct Evaluator<'a> {
@@ -66,6 +81,10 @@ pub struct Evaluator<'a> {
     goal: Cell,
     t_exec: f64,
     window: Vec<(i32, i32)>,
+    /// Per move direction, the window offsets whose cells are new after that move.
+    entering: [Vec<(i32, i32)>; 8],
+    /// Eq. 2 time of a move, by previous direction (8: none) and direction.
+    step_times: [[f64; 8]; 9],
     stamp: Vec<u32>,
     current: u32,
     // Model I: per score value, experiences so far, time of the last, gene of the last.
@@ -92,6 +111,10 @@ impl<'a> Evaluator<'a> {
             goal,
             t_exec,
             window: params.window(),
+            entering: entering_offsets(&params.window()),
+            step_times: std::array::from_fn(|prev| {
+                std::array::from_fn(|dir| step_time(world, params, (prev < 8).then_some(prev), dir))
+            }),
             stamp: vec![0; world.cell_count()],
             current: 0,
             experiences: [0; 101],
@@ -127,20 +150,31 @@ impl<'a> Evaluator<'a> {
         }
         let (w, h) = (self.world.width() as i32, self.world.height() as i32);
         let mut t = 0.0;
-        let mut prev_dir = None;
+        let mut prev_dir = 8;
         let mut information = 0.0;
-        for (gene, pair) in path.iter().enumerate() {
-            let cell = *pair;
+        // The position is tracked move by move: no division per gene.
+        let (mut cx, mut cy) = path.first().map_or((0, 0), |&c| self.world.xy(c));
+        for (gene, &cell) in path.iter().enumerate() {
+            let mut moved = None;
             if gene > 0 {
-                if let Some(dir) = self.world.direction(path[gene - 1], cell) {
-                    t += step_time(self.world, self.params, prev_dir, dir);
-                    prev_dir = Some(dir);
+                match self.world.move_between(path[gene - 1], cell, cx, cy) {
+                    Some(dir) => {
+                        t += self.step_times[prev_dir][dir];
+                        prev_dir = dir;
+                        moved = Some(dir);
+                        cx = (cx as i64 + i64::from(MOVES[dir].0)) as usize;
+                        cy = (cy as i64 + i64::from(MOVES[dir].1)) as usize;
+                    }
+                    None => (cx, cy) = self.world.xy(cell),
                 }
             }
-            let (x, y) = self.world.xy(cell);
-            let (x, y) = (x as i32, y as i32);
-            for k in 0..self.window.len() {
-                let (dx, dy) = self.window[k];
+            let (x, y) = (cx as i32, cy as i32);
+            let count = moved.map_or(self.window.len(), |dir| self.entering[dir].len());
+            for k in 0..count {
+                let (dx, dy) = match moved {
+                    Some(dir) => self.entering[dir][k],
+                    None => self.window[k],
+                };
                 let (nx, ny) = (x + dx, y + dy);
                 if nx < 0 || ny < 0 || nx >= w || ny >= h {
                     continue;
@@ -209,6 +243,23 @@ impl<'a> Evaluator<'a> {
                 self.block_sums[block] -= score;
                 (mean - score).abs()
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_straight_move_brings_4_new_cells_and_a_diagonal_7_for_d3() {
+        let entering = entering_offsets(&GaParams::default().window());
+        for (dir, offsets) in entering.iter().enumerate() {
+            assert_eq!(
+                offsets.len(),
+                if dir % 2 == 0 { 4 } else { 7 },
+                "direction {dir}"
+            );
         }
     }
 }

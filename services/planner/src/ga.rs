@@ -52,6 +52,57 @@ pub struct GaOptions {
     /// Longest chromosome, in cells: crossovers and mutations that would exceed it are
     /// dropped, so memory stays bounded.
     pub max_path_cells: usize,
+    /// Threads that evaluate a generation's new chromosomes. Evaluation is a pure
+    /// function of the path and the best is picked in population order afterwards, so
+    /// the result is the same for any thread count.
+    pub threads: usize,
+}
+
+/// The default evaluation threads: the machine's cores, at most 4.
+pub fn default_threads() -> usize {
+    std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .clamp(1, 4)
+}
+
+/// Below this many new chromosomes a generation is evaluated on one thread: spawning
+/// would cost more than it saves.
+const PARALLEL_MIN: usize = 32;
+
+/// Evaluates the chromosomes at `dirty`, in order, on up to `evaluators.len()` threads.
+fn evaluate_dirty(
+    evaluators: &mut [Evaluator<'_>],
+    population: &[Chromosome],
+    dirty: &[usize],
+) -> Vec<Evaluation> {
+    if evaluators.len() <= 1 || dirty.len() < PARALLEL_MIN {
+        let evaluator = &mut evaluators[0];
+        return dirty
+            .iter()
+            .map(|&i| evaluator.evaluate(&population[i].genes))
+            .collect();
+    }
+    let chunk = dirty.len().div_ceil(evaluators.len());
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = evaluators
+            .iter_mut()
+            .zip(dirty.chunks(chunk))
+            .map(|(evaluator, part)| {
+                scope.spawn(move || {
+                    part.iter()
+                        .map(|&i| evaluator.evaluate(&population[i].genes))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| {
+                h.join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            })
+            .collect()
+    })
 }
 
 /// What a GA run returns.
@@ -93,13 +144,17 @@ pub fn run(
 ) -> GaResult {
     let params = problem.params;
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    let mut evaluator = Evaluator::new(
-        problem.world,
-        params,
-        problem.model,
-        problem.goal,
-        problem.t_exec,
-    );
+    let mut evaluators: Vec<Evaluator<'_>> = (0..options.threads.max(1))
+        .map(|_| {
+            Evaluator::new(
+                problem.world,
+                params,
+                problem.model,
+                problem.goal,
+                problem.t_exec,
+            )
+        })
+        .collect();
     let mut population: Vec<Chromosome> = (0..params.population)
         .map(|_| Chromosome {
             genes: initial_walk(problem, options, &mut rng),
@@ -111,18 +166,20 @@ pub fn run(
     let mut evaluations = 0u64;
     let mut generation = 0u32;
     let stop_reason = loop {
-        // Evaluate what changed.
-        for chromosome in &mut population {
-            if chromosome.fitness.is_none() {
-                let evaluation = evaluator.evaluate(&chromosome.genes);
-                evaluations += 1;
-                chromosome.fitness = Some(evaluation.fitness.total);
-                if best
-                    .as_ref()
-                    .is_none_or(|(_, b)| evaluation.fitness.total > b.fitness.total)
-                {
-                    best = Some((chromosome.clone(), evaluation));
-                }
+        // Evaluate what changed, then take the best in population order.
+        let dirty: Vec<usize> = (0..population.len())
+            .filter(|&i| population[i].fitness.is_none())
+            .collect();
+        let results = evaluate_dirty(&mut evaluators, &population, &dirty);
+        evaluations += results.len() as u64;
+        for (&i, evaluation) in dirty.iter().zip(results) {
+            let chromosome = &mut population[i];
+            chromosome.fitness = Some(evaluation.fitness.total);
+            if best
+                .as_ref()
+                .is_none_or(|(_, b)| evaluation.fitness.total > b.fitness.total)
+            {
+                best = Some((chromosome.clone(), evaluation));
             }
         }
         generation += 1;
@@ -166,7 +223,7 @@ pub fn run(
         Some(b) => b,
         None => {
             let genes = vec![problem.start];
-            let evaluation = evaluator.evaluate(&genes);
+            let evaluation = evaluators[0].evaluate(&genes);
             (
                 Chromosome {
                     genes,
@@ -245,16 +302,14 @@ fn layered_selection(
     if let Some(best) = best {
         next.push(best.clone());
     }
-    for c in population.iter().take(third) {
+    // Chromosomes are moved, not copied, except the top layer's second copies.
+    let mut ranked = population.into_iter();
+    for c in ranked.by_ref().take(third) {
         next.push(c.clone());
-        next.push(c.clone());
+        next.push(c);
     }
-    for c in population.iter().skip(third) {
-        if next.len() >= n {
-            break;
-        }
-        next.push(c.clone());
-    }
+    let room = n.saturating_sub(next.len());
+    next.extend(ranked.take(room));
     next.truncate(n);
     next
 }

@@ -159,7 +159,7 @@ impl GaParams {
             check(
                 name,
                 v,
-                v >= 0.0 && v <= 1000.0,
+                (0.0..=1000.0).contains(&v),
                 "0..=1000 seconds per metre / radian",
             )?;
         }

@@ -30,6 +30,8 @@ pub struct PlanSpec {
     pub model: PlannerModel,
     pub params: GaParams,
     pub seed: u64,
+    /// Evaluation threads (see [`GaOptions::threads`]); the result does not depend on it.
+    pub threads: usize,
 }
 
 /// A plan before it becomes a message.
@@ -212,6 +214,7 @@ pub fn plan(
                 cap_walks_by_budget: true,
                 complete_walks_to_goal: true,
                 max_path_cells: max_path_cells(world, params, spec.t_exec_s),
+                threads: spec.threads,
             };
             let result = ga::run(&problem, &options, cancel, progress);
             (

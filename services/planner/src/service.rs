@@ -334,6 +334,7 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
         model: request.model,
         params,
         seed: request.seed,
+        threads: crate::ga::default_threads(),
     };
     let progress_key = keys::planner_progress(&state.root, &request_id);
     let mut batch = Vec::new();

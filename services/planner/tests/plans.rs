@@ -32,6 +32,7 @@ fn spec(
             ..GaParams::default()
         },
         seed,
+        threads: 2,
     }
 }
 
@@ -120,6 +121,17 @@ fn the_same_seed_gives_the_same_path_bit_for_bit() {
         let b = run(&world, &s);
         assert_eq!(a.path, b.path, "{model:?}");
         assert_eq!(a.fitness.total.to_bits(), b.fitness.total.to_bits());
+        let single = run(
+            &world,
+            &PlanSpec {
+                threads: 1,
+                ..s.clone()
+            },
+        );
+        assert_eq!(
+            single.path, a.path,
+            "the thread count does not change the plan ({model:?})"
+        );
         let c = run(&world, &PlanSpec { seed: 43, ..s });
         assert_ne!(
             a.path, c.path,

@@ -253,6 +253,14 @@ enum BenchCommand {
         #[arg(long, default_value_t = 20)]
         iterations: usize,
     },
+    /// The GA per curiosity model (2000 generations, population 200) and the service overhead.
+    Planner {
+        #[arg(long)]
+        json: bool,
+        /// Plans per model.
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+    },
 }
 
 pub async fn run(cli: Cli) -> anyhow::Result<()> {
@@ -589,12 +597,23 @@ async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             let result = bench::map(side, iterations, &dir).await;
             let _ = std::fs::remove_dir_all(&dir);
             let result = result?;
-            if json {
-                println!("{}", serde_json::to_string(&result)?);
-            } else {
-                println!("{}", serde_json::to_string_pretty(&result)?);
+            print_json(&result, json)
+        }
+        BenchCommand::Planner { json, runs } => {
+            if runs == 0 {
+                bail!("--runs must be at least 1");
             }
-            Ok(())
+            let result = roam::bench_planner::planner(runs).await?;
+            print_json(&result, json)
         }
     }
+}
+
+fn print_json<T: serde::Serialize>(value: &T, compact: bool) -> anyhow::Result<()> {
+    if compact {
+        println!("{}", serde_json::to_string(value)?);
+    } else {
+        println!("{}", serde_json::to_string_pretty(value)?);
+    }
+    Ok(())
 }

@@ -3,6 +3,7 @@
 //! arguments and calls in here, so the integration tests boot exactly what users run.
 
 pub mod bench;
+pub mod bench_planner;
 pub mod report;
 pub mod router;
 pub mod stack;
