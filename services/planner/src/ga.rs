@@ -8,6 +8,10 @@
 //!   longer walks can never fit the budget; and a walk that has not reached G is
 //!   finished along the shortest route to G, so that the first population already
 //!   reaches the goal and the GA spends its generations on information and time.
+//!   One more choice: the shortest path (which the request was checked against, so it
+//!   fits the budget) joins the first population. The GA therefore always holds a path
+//!   that reaches the goal in time, and a tight budget cannot end in an over-budget
+//!   plan just because no random walk happened to fit.
 //! - Selection (§II.A.3): "layered selection" after Li et al. is not spelled out in the
 //!   paper. roam sorts by fitness and splits the population into three layers: the top
 //!   third enters the next generation twice, the middle third once, the bottom third
@@ -132,6 +136,9 @@ pub struct Problem<'a> {
     pub t_exec: f64,
     /// Cost-to-goal from every cell (see [`crate::search::distance_field`]).
     pub goal_field: &'a [u32],
+    /// Paths placed in the first population as they are (roam seeds the shortest path,
+    /// see the module doc); the rest of the population is random walks.
+    pub seed_paths: &'a [Vec<Cell>],
 }
 
 /// Runs the GA. `progress` gets each generation's number and best fitness, and
@@ -155,12 +162,18 @@ pub fn run(
             )
         })
         .collect();
-    let mut population: Vec<Chromosome> = (0..params.population)
-        .map(|_| Chromosome {
-            genes: initial_walk(problem, options, &mut rng),
+    let seeded = problem.seed_paths.len().min(params.population);
+    let mut population: Vec<Chromosome> = problem.seed_paths[..seeded]
+        .iter()
+        .map(|genes| Chromosome {
+            genes: genes.clone(),
             fitness: None,
         })
         .collect();
+    population.extend((seeded..params.population).map(|_| Chromosome {
+        genes: initial_walk(problem, options, &mut rng),
+        fitness: None,
+    }));
     let mut scratch = Scratch::new(problem.world.cell_count());
     let mut best: Option<(Chromosome, Evaluation)> = None;
     let mut evaluations = 0u64;

@@ -207,6 +207,7 @@ pub fn plan(
                 goal,
                 t_exec: spec.t_exec_s,
                 goal_field: &field,
+                seed_paths: std::slice::from_ref(&shortest),
             };
             let options = GaOptions {
                 seed: spec.seed,

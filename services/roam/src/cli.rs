@@ -88,6 +88,31 @@ enum Command {
     /// Benchmarks; each prints JSON with --json.
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Reproduce a paper's evaluation and print ours next to its figures.
+    #[command(subcommand)]
+    Reproduce(ReproduceCommand),
+}
+
+#[derive(Debug, Subcommand)]
+enum ReproduceCommand {
+    /// Paper 000 §III: Models 0 / I / II, two goals, three t_plan/t_exec ratios.
+    Planner {
+        /// Print {"rows": [...], "comparisons": [...], "pictures": [...]} as JSON.
+        #[arg(long)]
+        json: bool,
+        /// Runs per goal, ratio and model (the paper: 20).
+        #[arg(long, default_value_t = 20)]
+        runs: usize,
+        /// Total time T = t_plan + t_exec, seconds.
+        #[arg(long, default_value_t = 100.0)]
+        total: f64,
+        /// Generations that all of T would buy; t_plan = r·T buys r times this.
+        #[arg(long, default_value_t = 2500.0)]
+        generations_per_t: f64,
+        /// Where the per-model pictures go.
+        #[arg(long, default_value = "roam-reproduce/planner")]
+        out: PathBuf,
+    },
 }
 
 #[derive(Debug, Args)]
@@ -272,6 +297,32 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Stack(args) => stack(args).await,
         Command::Map(command) => map(command).await,
         Command::Bench(command) => bench(command).await,
+        Command::Reproduce(ReproduceCommand::Planner {
+            json,
+            runs,
+            total,
+            generations_per_t,
+            out,
+        }) => {
+            if runs == 0 || !(total.is_finite() && total > 0.0) || !(generations_per_t >= 1.0) {
+                bail!("--runs must be at least 1, --total positive and --generations-per-t at least 1");
+            }
+            let options = roam::reproduce_planner::ReproduceOptions {
+                runs,
+                total_s: total,
+                generations_per_t,
+                out_dir: out,
+            };
+            let result =
+                tokio::task::spawn_blocking(move || roam::reproduce_planner::run(&options))
+                    .await??;
+            if json {
+                println!("{}", serde_json::to_string(&result)?);
+            } else {
+                print!("{result}");
+            }
+            Ok(())
+        }
     }
 }
 

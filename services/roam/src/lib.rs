@@ -5,5 +5,6 @@
 pub mod bench;
 pub mod bench_planner;
 pub mod report;
+pub mod reproduce_planner;
 pub mod router;
 pub mod stack;

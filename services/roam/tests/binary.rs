@@ -108,6 +108,23 @@ fn stack_once_fetches_every_layer_and_draws_the_world() {
     )
     .expect("json");
     assert_eq!(report["layers"].as_array().map(Vec::len), Some(4));
+    let missions = report["missions"].as_array().expect("missions");
+    assert_eq!(missions.len(), 2, "start to goal1 and goal2");
+    for mission in missions {
+        assert_eq!(mission["curious_reaches_goal"], true, "{mission}");
+        assert_eq!(mission["curious_within_budget"], true, "{mission}");
+        assert!(
+            mission["curious_information"].as_f64() > mission["shortest_information"].as_f64(),
+            "{mission}"
+        );
+    }
+    assert!(
+        count_colour(
+            &out.path().join("world.png"),
+            roam_map_server::render::PATH.0
+        ) > 100,
+        "planned paths drawn"
+    );
 
     // The built-in world is 100 × 100 cells drawn at 8 px: the border wall is dark,
     // the lab (score 90, around (-5, 8) m) is orange, open floor (score 5) near white.
@@ -172,4 +189,174 @@ fn help_reads_like_a_manual() {
     ] {
         assert!(text.contains(needle), "--help lacks {needle}");
     }
+}
+
+/// Counts pixels of exactly `colour` in a PNG.
+fn count_colour(path: &std::path::Path, colour: [u8; 3]) -> usize {
+    let picture = image::open(path).expect("png").to_rgb8();
+    picture.pixels().filter(|p| p.0 == colour).count()
+}
+
+#[test]
+fn reproduce_planner_prints_every_row_and_draws_each_model() {
+    let out = tempfile::tempdir().expect("tmp");
+    let output = Command::new(ROAM)
+        .args([
+            "reproduce",
+            "planner",
+            "--json",
+            "--runs",
+            "1",
+            "--generations-per-t",
+            "40",
+            "--out",
+        ])
+        .arg(out.path())
+        .output()
+        .expect("run");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
+    let rows = value["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 2 * 3 * 3, "2 goals × 3 ratios × 3 models");
+    for row in rows {
+        for field in [
+            "goal",
+            "ratio",
+            "model",
+            "u_ges_median",
+            "u_ges_mean",
+            "d_median",
+            "within_budget",
+            "reached_goal",
+        ] {
+            assert!(!row[field].is_null(), "{field} missing in {row}");
+        }
+        assert!(row["u_ges_median"].as_f64().expect("number") > 0.0);
+    }
+    assert!(!value["comparisons"]
+        .as_array()
+        .expect("comparisons")
+        .is_empty());
+    for model in ["model0", "model1", "model2"] {
+        let png = out.path().join(format!("{model}.png"));
+        assert!(
+            count_colour(&png, roam_map_server::render::PATH.0) > 50,
+            "{model}: the path is drawn"
+        );
+        assert!(
+            count_colour(&png, roam_map_server::render::MARKER.0) > 50,
+            "{model}: start and goal marked"
+        );
+    }
+}
+
+/// A guard that stops a child process however the test ends.
+struct Child(std::process::Child);
+
+impl Drop for Child {
+    fn drop(&mut self) {
+        let _ = Command::new("kill")
+            .args(["-TERM", &self.0.id().to_string()])
+            .status();
+        let started = Instant::now();
+        while started.elapsed() < Duration::from_secs(5) {
+            if let Ok(Some(_)) = self.0.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+#[test]
+fn roam_plan_asks_a_running_stack_and_draws_the_path() {
+    use std::io::{BufRead, BufReader};
+    let port = free_loopback_port().expect("port");
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let root = format!("plan-cli-{}", std::process::id());
+    let mut child = Command::new(ROAM)
+        .args(["stack", "--listen", &endpoint, "--root", &root])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn stack");
+    let stderr = child.stderr.take().expect("stderr");
+    let stack = Child(child);
+    // Wait for "roam stack up" (bounded), then keep draining stderr.
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            if line.contains("roam stack up") {
+                let _ = tx.send(());
+            }
+        }
+    });
+    rx.recv_timeout(Duration::from_secs(60))
+        .expect("the stack comes up");
+
+    let out = tempfile::tempdir().expect("tmp");
+    let png = out.path().join("plan.png");
+    let output = Command::new(ROAM)
+        .args([
+            "plan",
+            "--mode",
+            "client",
+            "--connect",
+            &endpoint,
+            "--root",
+            &root,
+            "--start=-8,-8",
+            "--goal=-2,4",
+            "--budget",
+            "60",
+            "--generations",
+            "50",
+            "--json",
+            "--png",
+        ])
+        .arg(&png)
+        .output()
+        .expect("run roam plan");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let text = String::from_utf8_lossy(&output.stdout);
+    let json_end = text.rfind('}').expect("json");
+    let plan: serde_json::Value = serde_json::from_str(&text[..=json_end]).expect("plan json");
+    assert_eq!(plan["reaches_goal"], true);
+    assert_eq!(plan["within_budget"], true);
+    assert!(
+        count_colour(&png, roam_map_server::render::PATH.0) > 50,
+        "the path is drawn"
+    );
+
+    let refused = Command::new(ROAM)
+        .args([
+            "plan",
+            "--mode",
+            "client",
+            "--connect",
+            &endpoint,
+            "--root",
+            &root,
+            "--start=-8,-8",
+            "--goal=-2,4",
+            "--budget",
+            "5",
+        ])
+        .output()
+        .expect("run roam plan");
+    assert!(!refused.status.success());
+    assert!(
+        String::from_utf8_lossy(&refused.stderr).contains("shorter than the shortest path's ETA")
+    );
+    drop(stack);
 }
