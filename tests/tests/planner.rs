@@ -52,6 +52,41 @@ async fn refusal(client: &Requester, root: &str, request: &PlanRequest) -> Error
     }
 }
 
+/// Starts a plan that runs until it is cancelled (100,000 generations), with a
+/// subscriber to its progress.
+async fn start_endless_plan(
+    client: &Requester,
+    root: &str,
+    id: &str,
+) -> (
+    zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
+    tokio::task::JoinHandle<Result<Plan, ClientError>>,
+) {
+    let subscriber = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::planner_progress(root, id)),
+    )
+    .await
+    .expect("progress subscriber");
+    let endless = PlanRequest {
+        request_id: Some(id.into()),
+        params: GaOverrides {
+            max_generations: Some(100_000),
+            ..GaOverrides::default()
+        },
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
+    };
+    let (client, root) = (client.clone(), root.to_owned());
+    let pending = tokio::spawn(async move {
+        client
+            .request::<PlanRequest, Plan>(&keys::planner_plan(&root), Some(&endless))
+            .await
+    });
+    (subscriber, pending)
+}
+
 struct Running {
     harness: Harness,
     map_server: RunningService,
@@ -129,14 +164,7 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         threads: roam_planner::ga::default_threads(),
     };
     let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local plan");
-    let local_cells: Vec<[u32; 2]> = local
-        .path
-        .iter()
-        .map(|&c| {
-            let (x, y) = world.xy(c);
-            [x as u32, y as u32]
-        })
-        .collect();
+    let local_cells = world.grid_cells(&local.path);
     assert_eq!(remote.cells, local_cells);
     assert_eq!(
         remote.fitness.total.to_bits(),
@@ -326,31 +354,7 @@ async fn progress_is_published_and_a_plan_can_be_cancelled() {
     let client = running.harness.client().await;
     let root = running.harness.root.clone();
     let id = "long-plan";
-    let subscriber = within(
-        "subscribe",
-        client
-            .session()
-            .declare_subscriber(keys::planner_progress(&root, id)),
-    )
-    .await
-    .expect("sub");
-    let long = PlanRequest {
-        request_id: Some(id.into()),
-        params: GaOverrides {
-            max_generations: Some(100_000),
-            ..GaOverrides::default()
-        },
-        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
-    };
-    let pending = {
-        let client = client.clone();
-        let root = root.clone();
-        tokio::spawn(async move {
-            client
-                .request::<PlanRequest, Plan>(&keys::planner_plan(&root), Some(&long))
-                .await
-        })
-    };
+    let (subscriber, pending) = start_endless_plan(&client, &root, id).await;
     // Progress arrives while it plans: generations in order, best fitness never worse.
     let mut seen: Vec<(u32, f64)> = Vec::new();
     while seen.len() < 5 {
@@ -405,31 +409,7 @@ async fn a_full_planner_refuses_at_once_with_busy() {
     let client = running.harness.client().await;
     let root = running.harness.root.clone();
     let id = "hog";
-    let subscriber = within(
-        "subscribe",
-        client
-            .session()
-            .declare_subscriber(keys::planner_progress(&root, id)),
-    )
-    .await
-    .expect("sub");
-    let hog = PlanRequest {
-        request_id: Some(id.into()),
-        params: GaOverrides {
-            max_generations: Some(100_000),
-            ..GaOverrides::default()
-        },
-        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
-    };
-    let pending = {
-        let client = client.clone();
-        let root = root.clone();
-        tokio::spawn(async move {
-            client
-                .request::<PlanRequest, Plan>(&keys::planner_plan(&root), Some(&hog))
-                .await
-        })
-    };
+    let (subscriber, pending) = start_endless_plan(&client, &root, id).await;
     within("hog progress", subscriber.recv_async())
         .await
         .expect("the hog is planning");

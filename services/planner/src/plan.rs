@@ -34,6 +34,34 @@ pub struct PlanSpec {
     pub threads: usize,
 }
 
+impl PlanSpec {
+    /// A batch-experiment spec: Table I's parameters with `max_generations`, a deadline
+    /// far enough away that the generation count ends the run (so results repeat bit
+    /// for bit), and the default evaluation threads.
+    pub fn batch(
+        start: [f64; 2],
+        goal: [f64; 2],
+        t_exec_s: f64,
+        model: PlannerModel,
+        max_generations: u32,
+        seed: u64,
+    ) -> PlanSpec {
+        PlanSpec {
+            start,
+            goal,
+            t_exec_s,
+            deadline_s: MAX_DEADLINE_S,
+            model,
+            params: GaParams {
+                max_generations,
+                ..GaParams::default()
+            },
+            seed,
+            threads: crate::ga::default_threads(),
+        }
+    }
+}
+
 /// A plan before it becomes a message.
 #[derive(Debug, Clone)]
 pub struct PlanOutcome {

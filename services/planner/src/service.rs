@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use roam_proto::map::Layer;
 use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest};
-use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply};
+use roam_proto::{encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::{reply, Requester, Service, ServiceError};
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
@@ -112,68 +112,30 @@ pub async fn run(
 
     // Maps: follow publications, and fetch the current layers until we have them.
     for layer in [INFLATED, INFORMATION] {
-        let key = keys::map_layer(root, layer);
-        let subscriber = service
-            .session()
-            .declare_subscriber(&key)
-            .await
-            .map_err(|e| ServiceError::Declare {
-                what: "subscriber",
-                key: key.clone(),
-                reason: e.to_string(),
-            })?;
-        let (state, cancel) = (state.clone(), service.cancel_token());
-        service.spawn(async move {
-            loop {
-                tokio::select! {
-                    _ = cancel.cancelled() => break,
-                    sample = subscriber.recv_async() => match sample {
-                        Ok(sample) => match decode::<Layer>(&sample.payload().to_bytes()) {
-                            Ok(layer) => take_layer(&state, layer),
-                            Err(e) => tracing::warn!(key = %sample.key_expr(), "ignoring a layer that does not decode: {e}"),
-                        },
-                        Err(_) => break,
-                    },
-                }
-            }
-        });
+        service
+            .subscribe(
+                &keys::map_layer(root, layer),
+                state.clone(),
+                |state: &Arc<State>, layer: Layer| take_layer(state, layer),
+            )
+            .await?;
     }
     {
         let (state, cancel) = (state.clone(), service.cancel_token());
         let requester = Requester::new(service.session().clone(), Duration::from_secs(5));
         service.spawn(async move { fetch_maps(state, requester, cancel).await });
     }
-
-    let cancel_key = keys::planner_cancel_any(root);
-    let cancels = service
-        .session()
-        .declare_subscriber(&cancel_key)
-        .await
-        .map_err(|e| ServiceError::Declare {
-            what: "subscriber",
-            key: cancel_key.clone(),
-            reason: e.to_string(),
-        })?;
-    {
-        let (state, cancel) = (state.clone(), service.cancel_token());
-        service.spawn(async move {
-            loop {
-                tokio::select! {
-                    _ = cancel.cancelled() => break,
-                    sample = cancels.recv_async() => match sample {
-                        Ok(sample) => {
-                            if let Ok(request) = decode::<CancelPlan>(&sample.payload().to_bytes()) {
-                                if let Some(flag) = state.cancels().get(&request.request_id) {
-                                    flag.store(true, Ordering::Relaxed);
-                                }
-                            }
-                        }
-                        Err(_) => break,
-                    },
+    service
+        .subscribe(
+            &keys::planner_cancel_any(root),
+            state.clone(),
+            |state: &Arc<State>, request: CancelPlan| {
+                if let Some(flag) = state.cancels().get(&request.request_id) {
+                    flag.store(true, Ordering::Relaxed);
                 }
-            }
-        });
-    }
+            },
+        )
+        .await?;
 
     let shared = service.declare_queryable(&keys::planner_plan(root)).await?;
     let own = service
@@ -377,14 +339,7 @@ pub fn to_message(
     instance: &str,
     outcome: PlanOutcome,
 ) -> Plan {
-    let cells = outcome
-        .path
-        .iter()
-        .map(|&c| {
-            let (x, y) = world.xy(c);
-            [x as u32, y as u32]
-        })
-        .collect();
+    let cells = world.grid_cells(&outcome.path);
     let points = outcome
         .path
         .iter()

@@ -149,6 +149,16 @@ impl World {
         world_to_cell(&self.meta, x, y).map(|(cx, cy)| self.cell(cx, cy))
     }
 
+    /// A path as `[x, y]` grid cells, as plans carry them on the wire.
+    pub fn grid_cells(&self, path: &[Cell]) -> Vec<[u32; 2]> {
+        path.iter()
+            .map(|&c| {
+                let (x, y) = self.xy(c);
+                [x as u32, y as u32]
+            })
+            .collect()
+    }
+
     /// The world point at the centre of a cell.
     pub fn center(&self, cell: Cell) -> (f64, f64) {
         let (x, y) = self.xy(cell);

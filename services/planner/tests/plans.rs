@@ -7,7 +7,6 @@ use std::sync::atomic::AtomicBool;
 
 use proptest::prelude::*;
 use roam_planner::eta::path_eta;
-use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanError, PlanOutcome, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
@@ -20,20 +19,10 @@ fn spec(
     seed: u64,
     generations: u32,
 ) -> PlanSpec {
-    PlanSpec {
-        start,
-        goal,
-        t_exec_s,
-        deadline_s: 600.0,
-        model,
-        params: GaParams {
-            max_generations: generations,
-            population: 60,
-            ..GaParams::default()
-        },
-        seed,
-        threads: 2,
-    }
+    let mut spec = PlanSpec::batch(start, goal, t_exec_s, model, generations, seed);
+    spec.params.population = 60;
+    spec.threads = 2;
+    spec
 }
 
 fn run(world: &World, spec: &PlanSpec) -> PlanOutcome {

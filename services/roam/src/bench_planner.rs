@@ -15,7 +15,6 @@ use roam_map_server::layers::inflate;
 use roam_map_server::map_file;
 use roam_map_server::store::DEFAULT_LIMITS;
 use roam_planner::client::PlannerClient;
-use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::{GaOverrides, PlanRequest, PlannerModel};
@@ -66,19 +65,7 @@ fn median(values: &mut [f64]) -> f64 {
 }
 
 fn spec(model: PlannerModel, t_exec_s: f64, seed: u64, generations: u32) -> PlanSpec {
-    PlanSpec {
-        start: START,
-        goal: GOAL,
-        t_exec_s,
-        deadline_s: 600.0,
-        model,
-        params: GaParams {
-            max_generations: generations,
-            ..GaParams::default()
-        },
-        seed,
-        threads: roam_planner::ga::default_threads(),
-    }
+    PlanSpec::batch(START, GOAL, t_exec_s, model, generations, seed)
 }
 
 pub async fn planner(runs: usize) -> Result<PlannerBench, BenchError> {

@@ -304,7 +304,10 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
             generations_per_t,
             out,
         }) => {
-            if runs == 0 || !(total.is_finite() && total > 0.0) || !(generations_per_t.is_finite() && generations_per_t >= 1.0) {
+            if runs == 0
+                || !(total.is_finite() && total > 0.0)
+                || !(generations_per_t.is_finite() && generations_per_t >= 1.0)
+            {
                 bail!("--runs must be at least 1, --total positive and --generations-per-t at least 1");
             }
             let options = roam::reproduce_planner::ReproduceOptions {

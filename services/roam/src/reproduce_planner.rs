@@ -19,7 +19,6 @@ use std::sync::atomic::AtomicBool;
 use roam_map_server::map_file;
 use roam_map_server::render::{draw_marker, draw_path, render_map, MARKER, PATH};
 use roam_map_server::store::DEFAULT_LIMITS;
-use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
@@ -111,19 +110,7 @@ pub fn run(options: &ReproduceOptions) -> Result<Reproduction, BenchError> {
                 let (mut u, mut d, mut info) = (Vec::new(), Vec::new(), Vec::new());
                 let (mut within, mut reached) = (0usize, 0usize);
                 for seed in 0..options.runs as u64 {
-                    let spec = PlanSpec {
-                        start: START,
-                        goal,
-                        t_exec_s,
-                        deadline_s: 600.0,
-                        model,
-                        params: GaParams {
-                            max_generations: generations,
-                            ..GaParams::default()
-                        },
-                        seed,
-                        threads: roam_planner::ga::default_threads(),
-                    };
+                    let spec = PlanSpec::batch(START, goal, t_exec_s, model, generations, seed);
                     let outcome = plan(&world, &spec, &never, |_, _| {}).map_err(|e| {
                         BenchError::Setup(format!(
                             "{goal_name} {ratio_name} {}: {e}",
@@ -280,13 +267,7 @@ fn draw(
     let mut written = Vec::new();
     for (model, path) in paths {
         let mut image = render_map(&content.occupancy, info, scale);
-        let cells: Vec<[u32; 2]> = path
-            .iter()
-            .map(|&c| {
-                let (x, y) = world.xy(c);
-                [x as u32, y as u32]
-            })
-            .collect();
+        let cells = world.grid_cells(path);
         draw_path(&mut image, world.meta.height, &cells, scale, PATH);
         for end in [cells.first(), cells.last()].into_iter().flatten() {
             draw_marker(&mut image, world.meta.height, *end, scale, MARKER);

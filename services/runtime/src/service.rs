@@ -226,6 +226,48 @@ impl Service {
         });
     }
 
+    /// Subscribes to `key` and hands every sample that decodes as `T` to
+    /// `handler(&state, message)` on a tracked task, until the service stops. Samples
+    /// that do not decode are logged and dropped: a subscriber has no one to answer.
+    /// Handlers run inline, so keep them light.
+    pub async fn subscribe<T, S, F>(
+        &self,
+        key: &str,
+        state: S,
+        handler: F,
+    ) -> Result<(), ServiceError>
+    where
+        T: roam_proto::Message,
+        S: Send + Sync + 'static,
+        F: Fn(&S, T) + Send + 'static,
+    {
+        let subscriber =
+            self.session
+                .declare_subscriber(key)
+                .await
+                .map_err(|e| ServiceError::Declare {
+                    what: "subscriber",
+                    key: key.to_owned(),
+                    reason: e.to_string(),
+                })?;
+        let cancel = self.cancel.clone();
+        self.tasks.spawn(async move {
+            loop {
+                tokio::select! {
+                    _ = cancel.cancelled() => break,
+                    sample = subscriber.recv_async() => match sample {
+                        Ok(sample) => match roam_proto::decode::<T>(&sample.payload().to_bytes()) {
+                            Ok(message) => handler(&state, message),
+                            Err(e) => tracing::warn!(key = %sample.key_expr(), "ignoring a sample that does not decode: {e}"),
+                        },
+                        Err(_) => break,
+                    },
+                }
+            }
+        });
+        Ok(())
+    }
+
     /// Stops the service: cancels its loops, waits up to `grace` for in-flight work,
     /// drops the liveliness token and closes the session. Returns an error naming how
     /// many tasks did not stop in time (the session is closed all the same).
