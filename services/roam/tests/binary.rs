@@ -360,3 +360,83 @@ fn roam_plan_asks_a_running_stack_and_draws_the_path() {
     );
     drop(stack);
 }
+
+/// Waits (bounded) until `roam map layers` through `endpoint` answers, and returns its
+/// output.
+fn layers_through(endpoint: &str, root: &str) -> serde_json::Value {
+    let started = Instant::now();
+    loop {
+        let output = Command::new(ROAM)
+            .args([
+                "map",
+                "layers",
+                "--mode",
+                "client",
+                "--connect",
+                endpoint,
+                "--root",
+                root,
+                "--timeout",
+                "2",
+            ])
+            .output()
+            .expect("run roam map layers");
+        if output.status.success() {
+            return serde_json::from_slice(&output.stdout).expect("layer list json");
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "no answer: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}
+
+/// The README's recipe for running a service on another machine: a router, a map
+/// server connected to it in client mode, and a client that asks through the router.
+#[test]
+fn a_router_process_connects_a_map_server_and_a_client() {
+    let port = free_loopback_port().expect("port");
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let root = format!("router-{}", std::process::id());
+    let _router = Child(
+        Command::new(ROAM)
+            .args(["router", "--no-multicast", "--listen", &endpoint])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawn router"),
+    );
+    let _map_server = Child(
+        Command::new(ROAM)
+            .args([
+                "map-server",
+                "--mode",
+                "client",
+                "--no-multicast",
+                "--connect",
+                &endpoint,
+                "--root",
+                &root,
+                "--map",
+                &repo("config/maps/depot.yaml"),
+            ])
+            .arg("--cfg")
+            .arg("connect/timeout_ms:-1")
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawn map server"),
+    );
+    let list = layers_through(&endpoint, &root);
+    let occupancy = list["layers"]
+        .as_array()
+        .expect("layers")
+        .iter()
+        .find(|l| l["name"] == "occupancy")
+        .expect("occupancy layer")
+        .clone();
+    assert_eq!(occupancy["meta"]["width"], 604);
+    assert_eq!(occupancy["version"], 1);
+}
