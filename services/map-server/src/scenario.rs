@@ -1,10 +1,13 @@
-//! roam's scenario file, the parts the map server reads: the map (a ROS map or shapes
-//! on an empty grid), the robot radius for inflation, the zones of interest that make
-//! the information map, and named places (start, goals, tasks).
+//! roam's scenario file: the map (a ROS map or shapes on an empty grid), the robot
+//! radius for inflation, the zones of interest that make the information map, named
+//! places (start, goals, tasks), and the sim world's sections: anchors, sensing, motion,
+//! robots, scripted blocks, random walkers, mission waypoints and the sim clock.
 //!
-//! A scenario is YAML; paths inside it are relative to the scenario file. The sim world
-//! adds its own sections (anchors, robots, blocks); every field is documented in the
-//! README's "Scenario files" section. Unknown fields are refused so a typo is caught.
+//! A scenario is YAML; paths inside it are relative to the scenario file. The map server
+//! reads the map and information sections; the sim world (`roam-sim`) reads the rest.
+//! Every sim section is optional and has defaults (paper 002 §4's parameters). Unknown
+//! fields are refused so a typo is caught, and every value is checked here, at load
+//! time, with an error that names the file and the field.
 //!
 //! ```yaml
 //! name: downtime-20x20
@@ -24,6 +27,20 @@
 //!     - { name: lab, score: 80, rect: [-9.0, 5.0, -3.0, 9.0] }
 //! places:
 //!   - { name: start, at: [0.0, 0.0] }
+//! # The sim world's sections (all optional):
+//! anchors:                     # TOA beacons, metres; may stand on walls
+//!   - { name: a1, at: [-9.5, -9.5] }
+//! sensing: { range_m: 30.0, sigma_toa_m: 0.10, d0_m: 15.0, k: 2.0, observation_radius_m: 5.0 }
+//! motion: { step_mu: 0.2, sigma_tr_m: 0.01, max_speed_m_per_step: 0.2 }
+//! robots:                      # start positions, metres, on free cells
+//!   - { name: r1, at: [-8.0, -8.0] }
+//! blocks:                      # scripted moving obstacles
+//!   - { name: b1, size_cells: [2, 2], period_steps: 7, path: [[1.0, 1.0], [3.0, 1.0]] }
+//! walkers:                     # random walkers
+//!   - { name: w1, at: [2.0, -5.0], size_m: 0.4, step_m: 0.2, every_steps: 3 }
+//! waypoints:                   # a mission, in order
+//!   - { name: A, at: [-8.0, -8.0] }
+//! time: { step_s: 0.4 }
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -51,6 +68,187 @@ pub struct ScenarioFile {
     pub information: Option<InformationSpec>,
     #[serde(default)]
     pub places: Vec<Place>,
+    /// Sim world: the anchors (paper 002 §2), fixed beacons at known positions that a
+    /// robot measures its TOA range to. World metres; an anchor may stand on a wall.
+    #[serde(default)]
+    pub anchors: Vec<Place>,
+    /// Sim world: the range sensor and the local grid observation.
+    #[serde(default)]
+    pub sensing: SensingSpec,
+    /// Sim world: the robots' motion model (paper 002 Eq. 1).
+    #[serde(default)]
+    pub motion: MotionSpec,
+    /// Sim world: the robots and where each starts (world metres, on a free cell).
+    #[serde(default)]
+    pub robots: Vec<Place>,
+    /// Sim world: scripted moving obstacles (paper 004 §5's two blocks).
+    #[serde(default)]
+    pub blocks: Vec<BlockSpec>,
+    /// Sim world: obstacles that wander at random.
+    #[serde(default)]
+    pub walkers: Vec<WalkerSpec>,
+    /// A mission's waypoints in the order they are visited (paper 002 ES2: A, B, C, D).
+    #[serde(default)]
+    pub waypoints: Vec<Place>,
+    /// Sim world: the clock.
+    #[serde(default)]
+    pub time: TimeSpec,
+}
+
+/// Paper 002 §4's sensing range: 30 m.
+pub const DEFAULT_RANGE_M: f64 = 30.0;
+/// Paper 002 §4's σ_TOA: 0.10 m.
+pub const DEFAULT_SIGMA_TOA_M: f64 = 0.10;
+/// Paper 002 §4's d0: 15 m.
+pub const DEFAULT_D0_M: f64 = 15.0;
+/// Paper 002 §4's K: 2.
+pub const DEFAULT_K: f64 = 2.0;
+/// roam's choice (no paper gives one for a laser-like grid observation): 5 m, about what
+/// covers one of the 6 × 6 m rooms of paper 004's Stage world from inside it.
+pub const DEFAULT_OBSERVATION_RADIUS_M: f64 = 5.0;
+/// Paper 002 §4's step size μ: 0.2.
+pub const DEFAULT_STEP_MU: f64 = 0.2;
+/// Paper 002 §4's σ_tr: 0.01 m.
+pub const DEFAULT_SIGMA_TR_M: f64 = 0.01;
+/// 0.2 m per step, μ times a unit command: paper 002's ES1 robot covers 59.56 m in 296
+/// steps (0.201 m per step), so its commands have unit length at most.
+pub const DEFAULT_MAX_SPEED_M_PER_STEP: f64 = 0.2;
+/// 0.4 s per step: with the default 0.2 m per step a robot drives at 0.5 m/s, the speed
+/// paper 000's Table I implies (v_lin = 2.0 s/m) and the planner's t_ETA assumes. Paper
+/// 002 counts steps, not seconds.
+pub const DEFAULT_STEP_S: f64 = 0.4;
+/// The largest observation radius, in cells: the line-of-sight table grows with the
+/// cube of the radius (128 cells: about 50 k cells in view and a 25 MB table).
+pub const MAX_OBSERVATION_RADIUS_CELLS: f64 = 128.0;
+/// Occupancy values from which a cell blocks motion and sight in the sim world: the map
+/// server's default `lethal_threshold`. Unknown cells (-1) block too: the sim needs a
+/// definite ground truth, and a robot must not drive into space nobody mapped.
+pub const BLOCKED_THRESHOLD: i8 = 65;
+
+/// Whether an occupancy value blocks a robot and its sensors in the sim world.
+pub fn is_blocked(value: i8) -> bool {
+    value < 0 || value >= BLOCKED_THRESHOLD
+}
+
+/// Which ranges a robot receives (paper 002 §2.1 says both `d ≤ s_r` and `d̂ ≤ s_r`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RangeGate {
+    /// Anchors whose true distance is within the range (§2.1's first reading): which
+    /// anchors a robot hears depends on geometry alone, as the Fisher information does.
+    #[default]
+    TrueDistance,
+    /// Measurements whose noisy value is within the range (§2.1's second reading).
+    Measured,
+}
+
+/// The TOA range sensor (paper 002 §2.1, §4) and the local grid observation.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SensingSpec {
+    /// Sensing range s_r, metres (paper 002: 30).
+    pub range_m: f64,
+    /// Range noise standard deviation σ_TOA up to d0, metres (paper 002: 0.10).
+    pub sigma_toa_m: f64,
+    /// Distance d0 beyond which the noise grows, metres (paper 002: 15).
+    pub d0_m: f64,
+    /// Exponent K of the variance σ²((d/d0)^K + 1) beyond d0 (paper 002: 2), unitless.
+    pub k: f64,
+    /// Which ranges are delivered: by true distance (default) or by measured distance.
+    pub range_gate: RangeGate,
+    /// Radius of the local grid observation with line of sight, metres; 0 turns it off.
+    pub observation_radius_m: f64,
+}
+
+impl Default for SensingSpec {
+    fn default() -> Self {
+        SensingSpec {
+            range_m: DEFAULT_RANGE_M,
+            sigma_toa_m: DEFAULT_SIGMA_TOA_M,
+            d0_m: DEFAULT_D0_M,
+            k: DEFAULT_K,
+            range_gate: RangeGate::default(),
+            observation_radius_m: DEFAULT_OBSERVATION_RADIUS_M,
+        }
+    }
+}
+
+/// The motion model `p ← p + μ·u + ν`, ν ~ N(0, σ_tr²) per axis (paper 002 Eq. 1).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MotionSpec {
+    /// Step size μ, metres per unit of command per step (paper 002: 0.2).
+    pub step_mu: f64,
+    /// Transition noise standard deviation σ_tr per axis, metres (paper 002: 0.01); 0
+    /// makes motion deterministic (paper 004's grid world).
+    pub sigma_tr_m: f64,
+    /// The longest commanded move μ·|u| in one step, metres; longer commands are
+    /// clipped to this length.
+    pub max_speed_m_per_step: f64,
+}
+
+impl Default for MotionSpec {
+    fn default() -> Self {
+        MotionSpec {
+            step_mu: DEFAULT_STEP_MU,
+            sigma_tr_m: DEFAULT_SIGMA_TR_M,
+            max_speed_m_per_step: DEFAULT_MAX_SPEED_M_PER_STEP,
+        }
+    }
+}
+
+/// The sim clock.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TimeSpec {
+    /// Sim time per step, seconds.
+    pub step_s: f64,
+}
+
+impl Default for TimeSpec {
+    fn default() -> Self {
+        TimeSpec {
+            step_s: DEFAULT_STEP_S,
+        }
+    }
+}
+
+/// A scripted moving obstacle: it holds each position of `path` for `period_steps`
+/// steps, then moves to the next, and starts over after the last (paper 004 §5: "changes
+/// position every 7 time steps and moves over 6 positions").
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlockSpec {
+    pub name: String,
+    /// Width and height in cells: give this or `size_m`.
+    #[serde(default)]
+    pub size_cells: Option<[u32; 2]>,
+    /// Width and height in metres, rounded to whole cells (at least one): give this or
+    /// `size_cells`.
+    #[serde(default)]
+    pub size_m: Option<[f64; 2]>,
+    /// The positions, world metres: each point picks the cell the block is centred on
+    /// (for an even size the extra column or row is on the +x or +y side).
+    pub path: Vec<[f64; 2]>,
+    /// Steps the block holds each position, at least 1.
+    pub period_steps: u32,
+}
+
+/// An obstacle that wanders: every `every_steps` steps it tries one move of `step_m` in
+/// one of the four axis directions, drawn at random, and stays put when the place is
+/// taken (a wall, a block, another walker, a robot) or off the map.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WalkerSpec {
+    pub name: String,
+    /// Start position, world metres, on a free cell.
+    pub at: [f64; 2],
+    /// Side of the square it covers, metres, rounded to whole cells (at least one).
+    pub size_m: f64,
+    /// Length of one move, metres.
+    pub step_m: f64,
+    /// Steps between two moves, at least 1.
+    pub every_steps: u32,
 }
 
 /// Where the occupancy grid comes from.
@@ -239,11 +437,272 @@ pub fn parse(path: &Path, text: &str, max_cells: u64) -> Result<Scenario, Scenar
             ));
         }
     }
+    validate_sim(&file, &occupancy).map_err(|(f, reason)| field(&f, reason))?;
     Ok(Scenario {
         file,
         occupancy,
         information,
     })
+}
+
+/// A field's name and what is wrong with it.
+type FieldError = (String, String);
+
+/// Checks the sim world's sections against the map.
+fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldError> {
+    let meta = &occupancy.meta;
+    let on_map = |f: String, what: &str, [x, y]: [f64; 2]| -> Result<(usize, usize), FieldError> {
+        if !(x.is_finite() && y.is_finite()) {
+            return Err((
+                f,
+                format!("{what}: coordinates must be numbers, got ({x}, {y})"),
+            ));
+        }
+        crate::grid::world_to_cell(meta, x, y).ok_or_else(|| {
+            let (x0, y0) = (meta.origin.x, meta.origin.y);
+            let x1 = x0 + f64::from(meta.width) * meta.resolution;
+            let y1 = y0 + f64::from(meta.height) * meta.resolution;
+            (
+                f,
+                format!("{what} at ({x}, {y}) is outside the map, which spans x {x0}..{x1} and y {y0}..{y1} m"),
+            )
+        })
+    };
+    let on_free_cell = |f: String, what: &str, at: [f64; 2]| -> Result<(), FieldError> {
+        let (cx, cy) = on_map(f.clone(), what, at)?;
+        match occupancy.get(cx, cy) {
+            Some(v) if !is_blocked(v) => Ok(()),
+            v => Err((
+                f,
+                format!(
+                    "{what} at ({}, {}) is on an occupied or unknown cell (value {}); it must start on a free cell",
+                    at[0],
+                    at[1],
+                    v.unwrap_or(occupancy::UNKNOWN)
+                ),
+            )),
+        }
+    };
+    let unique = |list: &str, names: Vec<&str>| -> Result<(), FieldError> {
+        for (i, name) in names.iter().enumerate() {
+            if name.is_empty() {
+                return Err((
+                    format!("{list}[{i}].name"),
+                    "a name must not be empty".into(),
+                ));
+            }
+            if names[..i].contains(name) {
+                return Err((
+                    format!("{list}[{i}].name"),
+                    format!("the name '{name}' is used twice in {list}"),
+                ));
+            }
+        }
+        Ok(())
+    };
+
+    unique(
+        "anchors",
+        file.anchors.iter().map(|a| a.name.as_str()).collect(),
+    )?;
+    for (i, anchor) in file.anchors.iter().enumerate() {
+        on_map(
+            format!("anchors[{i}].at"),
+            &format!("anchor '{}'", anchor.name),
+            anchor.at,
+        )?;
+    }
+    validate_sensing(&file.sensing, meta.resolution)?;
+    validate_motion(&file.motion)?;
+    if !(file.time.step_s.is_finite() && file.time.step_s > 0.0) {
+        return Err((
+            "time.step_s".into(),
+            format!(
+                "must be a positive number of seconds, got {}",
+                file.time.step_s
+            ),
+        ));
+    }
+    unique(
+        "robots",
+        file.robots.iter().map(|r| r.name.as_str()).collect(),
+    )?;
+    for (i, robot) in file.robots.iter().enumerate() {
+        on_free_cell(
+            format!("robots[{i}].at"),
+            &format!("robot '{}'", robot.name),
+            robot.at,
+        )?;
+    }
+    unique(
+        "blocks",
+        file.blocks.iter().map(|b| b.name.as_str()).collect(),
+    )?;
+    for (i, block) in file.blocks.iter().enumerate() {
+        let f = |sub: &str| format!("blocks[{i}].{sub}");
+        match (block.size_cells, block.size_m) {
+            (Some([w, h]), None) if w >= 1 && h >= 1 => {}
+            (Some(size), None) => {
+                return Err((
+                    f("size_cells"),
+                    format!(
+                        "block '{}': both sizes must be at least 1 cell, got {size:?}",
+                        block.name
+                    ),
+                ));
+            }
+            (None, Some([w, h])) if w.is_finite() && h.is_finite() && w > 0.0 && h > 0.0 => {}
+            (None, Some(size)) => {
+                return Err((
+                    f("size_m"),
+                    format!(
+                        "block '{}': both sizes must be positive metres, got {size:?}",
+                        block.name
+                    ),
+                ));
+            }
+            _ => {
+                return Err((
+                    format!("blocks[{i}]"),
+                    format!(
+                        "block '{}' needs exactly one of size_cells or size_m",
+                        block.name
+                    ),
+                ));
+            }
+        }
+        if block.path.is_empty() {
+            return Err((
+                f("path"),
+                format!("block '{}' needs at least one position", block.name),
+            ));
+        }
+        for (j, &at) in block.path.iter().enumerate() {
+            on_map(
+                f(&format!("path[{j}]")),
+                &format!("block '{}' position {j}", block.name),
+                at,
+            )?;
+        }
+        if block.period_steps == 0 {
+            return Err((
+                f("period_steps"),
+                format!("block '{}': must be at least 1 step", block.name),
+            ));
+        }
+    }
+    unique(
+        "walkers",
+        file.walkers.iter().map(|w| w.name.as_str()).collect(),
+    )?;
+    for (i, walker) in file.walkers.iter().enumerate() {
+        let f = |sub: &str| format!("walkers[{i}].{sub}");
+        on_free_cell(f("at"), &format!("walker '{}'", walker.name), walker.at)?;
+        if !(walker.size_m.is_finite() && walker.size_m > 0.0) {
+            return Err((
+                f("size_m"),
+                format!(
+                    "walker '{}': must be a positive number of metres, got {}",
+                    walker.name, walker.size_m
+                ),
+            ));
+        }
+        if !(walker.step_m.is_finite() && walker.step_m > 0.0) {
+            return Err((
+                f("step_m"),
+                format!(
+                    "walker '{}': must be a positive number of metres, got {}",
+                    walker.name, walker.step_m
+                ),
+            ));
+        }
+        if walker.every_steps == 0 {
+            return Err((
+                f("every_steps"),
+                format!("walker '{}': must be at least 1 step", walker.name),
+            ));
+        }
+    }
+    unique(
+        "waypoints",
+        file.waypoints.iter().map(|w| w.name.as_str()).collect(),
+    )?;
+    for (i, waypoint) in file.waypoints.iter().enumerate() {
+        on_map(
+            format!("waypoints[{i}].at"),
+            &format!("waypoint '{}'", waypoint.name),
+            waypoint.at,
+        )?;
+    }
+    Ok(())
+}
+
+fn validate_sensing(s: &SensingSpec, resolution: f64) -> Result<(), FieldError> {
+    let positive = |f: &str, v: f64, unit: &str| {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err((
+                format!("sensing.{f}"),
+                format!("must be a positive number of {unit}, got {v}"),
+            ))
+        }
+    };
+    let non_negative = |f: &str, v: f64, unit: &str| {
+        if v.is_finite() && v >= 0.0 {
+            Ok(())
+        } else {
+            Err((
+                format!("sensing.{f}"),
+                format!("must be a non-negative number of {unit}, got {v}"),
+            ))
+        }
+    };
+    positive("range_m", s.range_m, "metres")?;
+    non_negative("sigma_toa_m", s.sigma_toa_m, "metres")?;
+    positive("d0_m", s.d0_m, "metres")?;
+    non_negative("k", s.k, "(a unitless exponent)")?;
+    non_negative("observation_radius_m", s.observation_radius_m, "metres")?;
+    let cells = s.observation_radius_m / resolution;
+    if cells > MAX_OBSERVATION_RADIUS_CELLS {
+        return Err((
+            "sensing.observation_radius_m".into(),
+            format!(
+                "{} m is {cells:.0} cells of {resolution} m; the limit is {MAX_OBSERVATION_RADIUS_CELLS} cells ({} m on this map)",
+                s.observation_radius_m,
+                MAX_OBSERVATION_RADIUS_CELLS * resolution
+            ),
+        ));
+    }
+    Ok(())
+}
+
+fn validate_motion(m: &MotionSpec) -> Result<(), FieldError> {
+    if !(m.step_mu.is_finite() && m.step_mu > 0.0) {
+        return Err((
+            "motion.step_mu".into(),
+            format!("must be a positive number, got {}", m.step_mu),
+        ));
+    }
+    if !(m.sigma_tr_m.is_finite() && m.sigma_tr_m >= 0.0) {
+        return Err((
+            "motion.sigma_tr_m".into(),
+            format!(
+                "must be a non-negative number of metres, got {}",
+                m.sigma_tr_m
+            ),
+        ));
+    }
+    if !(m.max_speed_m_per_step.is_finite() && m.max_speed_m_per_step > 0.0) {
+        return Err((
+            "motion.max_speed_m_per_step".into(),
+            format!(
+                "must be a positive number of metres per step, got {}",
+                m.max_speed_m_per_step
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn build_grid(spec: &GridSpec, max_cells: u64) -> Result<Grid<i8>, String> {

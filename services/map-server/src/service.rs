@@ -11,7 +11,6 @@
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard};
-use std::time::Duration;
 
 use roam_proto::map::{LayerList, LayerUpdate, LoadMap};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
@@ -303,6 +302,3 @@ fn load(state: &State, request: &LoadMap) -> Result<(LayerList, Vec<String>), Er
         .map_err(|e| e.to_reply())?;
     Ok((store.list(), changed))
 }
-
-/// How long to wait for a map server's first answer by default.
-pub const DEFAULT_TIMEOUT: Duration = Duration::from_secs(5);
