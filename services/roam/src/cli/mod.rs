@@ -1,0 +1,143 @@
+//! Command-line interface: one subcommand per role, client commands, benchmarks and
+//! experiment runners. Each submodule holds one group of commands.
+
+mod map;
+mod plan;
+mod roles;
+mod tools;
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::bail;
+use clap::{Args, Parser, Subcommand};
+use roam_proto::keys;
+use roam_runtime::{Requester, SessionArgs};
+
+use map::MapCommand;
+use plan::PlanArgs;
+use roles::{MapServerArgs, PlannerArgs, RouterArgs, StackArgs};
+use tools::{BenchCommand, ReproduceCommand};
+
+const ABOUT: &str = "roam: curious, time-aware robot navigation as Zenoh services.";
+
+const LONG_ABOUT: &str = "\
+roam turns a robot's downtime between fixed tasks into information: it plans curious \
+paths that still arrive on time, drives them while keeping localization uncertainty low, \
+and learns where the world changes. Each part is an independent service speaking over \
+Zenoh; this one binary runs every role.
+
+ROLES
+  map-server   Holds the occupancy, inflated, information and heuristic layers (and the
+               layers other services publish), versioned and optionally persisted.
+  planner      The curious GA planner (paper 000): a path from here to the next task
+               that gathers the most information and still arrives within the budget.
+               Run several; clients spread plans over the live instances.
+  router       A Zenoh router: run one per site or fleet; services connect to it.
+  stack        Every landed service in one process around an in-process router on
+               loopback, multicast off. The embedded default world needs no files.
+
+CLIENTS AND TOOLS
+  plan         Ask a running planner for a path; --png draws it.
+  map          Inspect map files offline; list, load and fetch layers of a running stack.
+  bench        Benchmarks that print JSON.
+
+CONFIG FILE
+  A service reads its own YAML config with --config (see config/map-server.yaml). Its
+  `zenoh:` section is a Zenoh config fragment. Zenoh settings are layered, lowest first:
+  the config file's `zenoh:` section, the file named by ZENOH_CONFIG, the flags --mode,
+  --connect, --listen, --no-multicast, then each --cfg KEY:VALUE.
+
+ENVIRONMENT
+  ZENOH_CONFIG  A Zenoh JSON5 or YAML config file for every session of the process.
+  RUST_LOG      Log filter (default: info, Zenoh at warn), e.g. RUST_LOG=debug.
+  ROAM_ROOT     The key root (default `roam`); two stacks with different roots never
+                see each other.
+
+EXAMPLES
+  roam stack --once                          boot the stack, fetch every layer, report
+  roam router --listen tcp/0.0.0.0:7447      on the site server
+  roam map-server --mode client --connect tcp/10.0.0.5:7447 --map config/maps/depot.yaml
+  roam map layers --connect tcp/10.0.0.5:7447
+  roam plan --connect tcp/10.0.0.5:7447 --start -8,-8 --goal 6,-7 --budget 60 --png plan.png
+  roam map inspect config/maps/depot.yaml --json";
+
+#[derive(Debug, Parser)]
+#[command(name = "roam", version, about = ABOUT, long_about = LONG_ABOUT)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run the map server: layers, versions, persistence.
+    MapServer(MapServerArgs),
+    /// Run a curious GA planner instance (paper 000).
+    Planner(PlannerArgs),
+    /// Ask a running planner for a curious path (a client).
+    Plan(PlanArgs),
+    /// Run a Zenoh router (no separate zenohd needed).
+    Router(RouterArgs),
+    /// Run every landed service in one process around an in-process router.
+    Stack(StackArgs),
+    /// Map files and the map server's layers.
+    #[command(subcommand)]
+    Map(MapCommand),
+    /// Benchmarks; each prints JSON with --json.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+    /// Reproduce a paper's evaluation and print ours next to its figures.
+    #[command(subcommand)]
+    Reproduce(ReproduceCommand),
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct ServiceArgs {
+    /// The service's YAML config file.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) config: Option<PathBuf>,
+    /// Key root for every key expression.
+    #[arg(long, env = "ROAM_ROOT")]
+    pub(crate) root: Option<String>,
+    /// Instance name in the liveliness token (default: the Zenoh session id).
+    #[arg(long)]
+    pub(crate) instance: Option<String>,
+    #[command(flatten)]
+    pub(crate) session: SessionArgs,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct ClientArgs {
+    #[arg(long, env = "ROAM_ROOT", default_value = keys::DEFAULT_ROOT)]
+    pub(crate) root: String,
+    /// Seconds to wait for an answer.
+    #[arg(long, default_value_t = 5.0)]
+    pub(crate) timeout: f64,
+    #[command(flatten)]
+    pub(crate) session: SessionArgs,
+}
+
+pub async fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::MapServer(args) => roles::map_server(args).await,
+        Command::Planner(args) => roles::planner(args).await,
+        Command::Plan(args) => plan::plan(args).await,
+        Command::Router(args) => roles::router(args).await,
+        Command::Stack(args) => roles::stack(args).await,
+        Command::Map(command) => map::map(command).await,
+        Command::Bench(command) => tools::bench(command).await,
+        Command::Reproduce(command) => tools::reproduce(command).await,
+    }
+}
+
+pub(crate) async fn connect(client: &ClientArgs) -> anyhow::Result<(Requester, zenoh::Session)> {
+    if !(client.timeout.is_finite() && client.timeout > 0.0) {
+        bail!("--timeout must be a positive number of seconds");
+    }
+    let session = roam_runtime::session::open(client.session.zenoh_config(None)?).await?;
+    Ok((
+        Requester::new(session.clone(), Duration::from_secs_f64(client.timeout)),
+        session,
+    ))
+}

@@ -1,0 +1,202 @@
+//! The service roles: map server, planner, router, and the whole stack in one process.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::{bail, Context};
+use clap::Args;
+use roam::report::{self, Mission};
+use roam::router::Router;
+use roam::stack::{Stack, StackOptions};
+use roam_map_server::{map_file, MapServerConfig};
+use roam_planner::PlannerConfig;
+use roam_runtime::{config_file, signals, Requester, SessionArgs};
+
+use super::ServiceArgs;
+
+#[derive(Debug, Args)]
+pub(crate) struct MapServerArgs {
+    #[command(flatten)]
+    service: ServiceArgs,
+    /// A ROS map.yaml or a roam scenario (default: the config's, else the built-in world).
+    #[arg(long, value_name = "PATH")]
+    map: Option<PathBuf>,
+    /// Persist layers and versions in this directory.
+    #[arg(long, value_name = "DIR")]
+    data_dir: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct PlannerArgs {
+    #[command(flatten)]
+    service: ServiceArgs,
+    /// Plans computed at once; more are refused with `busy`.
+    #[arg(long)]
+    max_concurrent_plans: Option<usize>,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct RouterArgs {
+    #[command(flatten)]
+    session: SessionArgs,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct StackArgs {
+    /// Key root.
+    #[arg(long, env = "ROAM_ROOT")]
+    root: Option<String>,
+    /// A ROS map.yaml or roam scenario for the map server (default: the built-in world).
+    #[arg(long, value_name = "PATH")]
+    map: Option<PathBuf>,
+    /// Persist the map server's layers here.
+    #[arg(long, value_name = "DIR")]
+    data_dir: Option<PathBuf>,
+    /// The in-process router's endpoint (default: a free port on 127.0.0.1).
+    #[arg(long, value_name = "ENDPOINT")]
+    listen: Option<String>,
+    /// Planner instances to run.
+    #[arg(long, default_value_t = 1)]
+    planners: usize,
+    /// Boot, fetch every layer through Zenoh, write the report and stop.
+    #[arg(long)]
+    once: bool,
+    /// Where --once writes its report.
+    #[arg(long, value_name = "DIR", default_value = "roam-report")]
+    out: PathBuf,
+}
+
+pub(crate) async fn map_server(args: MapServerArgs) -> anyhow::Result<()> {
+    let mut config: MapServerConfig = match &args.service.config {
+        Some(path) => config_file::load(path)?,
+        None => MapServerConfig::default(),
+    };
+    if let Some(root) = args.service.root {
+        config.root = root;
+    }
+    if args.service.instance.is_some() {
+        config.instance = args.service.instance;
+    }
+    if args.map.is_some() {
+        config.map = args.map;
+    }
+    if args.data_dir.is_some() {
+        config.data_dir = args.data_dir;
+    }
+    let zenoh = args.service.session.zenoh_config(config.zenoh.as_ref())?;
+    let cancel = signals::cancel_on_signal();
+    roam_map_server::run(config, zenoh, cancel).await?;
+    Ok(())
+}
+
+pub(crate) async fn planner(args: PlannerArgs) -> anyhow::Result<()> {
+    let mut config: PlannerConfig = match &args.service.config {
+        Some(path) => config_file::load(path)?,
+        None => PlannerConfig::default(),
+    };
+    if let Some(root) = args.service.root {
+        config.root = root;
+    }
+    if args.service.instance.is_some() {
+        config.instance = args.service.instance;
+    }
+    if let Some(n) = args.max_concurrent_plans {
+        config.max_concurrent_plans = n;
+    }
+    let zenoh = args.service.session.zenoh_config(config.zenoh.as_ref())?;
+    roam_planner::run(config, zenoh, signals::cancel_on_signal()).await?;
+    Ok(())
+}
+
+/// The missions of a scenario: from its `start` place to each other place.
+pub(crate) fn scenario_missions(map: Option<&std::path::Path>) -> Vec<Mission> {
+    let max = roam_map_server::store::DEFAULT_LIMITS.max_layer_cells;
+    let parsed = match map {
+        None => roam_map_server::scenario::parse(
+            std::path::Path::new(map_file::BUILTIN_NAME),
+            map_file::BUILTIN_SCENARIO,
+            max,
+        )
+        .ok(),
+        Some(path) => roam_map_server::scenario::load(path, max).ok(),
+    };
+    let Some(scenario) = parsed else {
+        return Vec::new();
+    };
+    let places = &scenario.file.places;
+    let Some(start) = places.iter().find(|p| p.name == "start") else {
+        return Vec::new();
+    };
+    places
+        .iter()
+        .filter(|p| p.name != "start")
+        .map(|p| Mission {
+            name: format!("start->{}", p.name),
+            start: start.at,
+            goal: p.at,
+        })
+        .collect()
+}
+
+pub(crate) async fn router(args: RouterArgs) -> anyhow::Result<()> {
+    let mut session = args.session;
+    if session.listen.is_empty() {
+        session.listen.push("tcp/0.0.0.0:7447".into());
+    }
+    let endpoint = session.listen.join(", ");
+    let router = Router::start(&session, endpoint).await?;
+    tracing::info!(listen = %router.endpoint, "router running; stop with Ctrl-C or SIGTERM");
+    signals::wait_for_stop_signal().await;
+    router.close().await;
+    Ok(())
+}
+
+pub(crate) async fn stack(args: StackArgs) -> anyhow::Result<()> {
+    let missions = scenario_missions(args.map.as_deref());
+    let options = StackOptions {
+        root: args.root,
+        map: args.map,
+        data_dir: args.data_dir,
+        listen: args.listen,
+        planners: args.planners,
+    };
+    let mut stack = Stack::start(options, Duration::from_secs(30)).await?;
+    eprintln!(
+        "roam stack up: router {} (root '{}'); connect with --connect {}",
+        stack.router.endpoint, stack.root, stack.router.endpoint
+    );
+    if args.once {
+        let client = roam_runtime::session::open(
+            SessionArgs::client_of(&stack.router.endpoint).zenoh_config(None)?,
+        )
+        .await?;
+        let requester = Requester::new(client.clone(), Duration::from_secs(10));
+        let outcome = report::build(
+            &requester,
+            &stack.root,
+            &stack.router.endpoint,
+            &missions,
+            &args.out,
+        )
+        .await;
+        let _ = client.close().await;
+        stack.shutdown().await?;
+        let report = outcome?;
+        print!("{report}");
+        let json_path = args.out.join("report.json");
+        std::fs::write(&json_path, serde_json::to_vec_pretty(&report)?)
+            .with_context(|| format!("writing {}", json_path.display()))?;
+        println!("report: {}", json_path.display());
+        return Ok(());
+    }
+    let cancel = signals::cancel_on_signal();
+    tokio::select! {
+        _ = cancel.cancelled() => {}
+        Some((service, reason)) = stack.next_stopped() => {
+            stack.shutdown().await.ok();
+            bail!("{service} stopped: {reason}");
+        }
+    }
+    stack.shutdown().await?;
+    Ok(())
+}
