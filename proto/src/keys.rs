@@ -138,6 +138,55 @@ pub fn planner_cancel_any(root: &str) -> String {
     format!("{root}/planner/cancel/*")
 }
 
+/// `<root>/sim/control`: the sim answers a `get` carrying a
+/// [`SimControl`](crate::sim::SimControl) with a [`SimStatus`](crate::sim::SimStatus).
+pub fn sim_control(root: &str) -> String {
+    format!("{root}/sim/control")
+}
+
+/// `<root>/sim/clock`: the sim publishes a [`SimClock`](crate::sim::SimClock) after
+/// every step. Rate: the sim's step rate.
+pub fn sim_clock(root: &str) -> String {
+    format!("{root}/sim/clock")
+}
+
+/// `<root>/robot/<robot>/cmd`: a controller puts a
+/// [`RobotCommand`](crate::sim::RobotCommand); the sim applies it at its next step.
+pub fn robot_command(root: &str, robot: &str) -> String {
+    format!("{root}/robot/{robot}/cmd")
+}
+
+/// `<root>/robot/*/cmd`: what the sim subscribes to.
+pub fn robot_command_any(root: &str) -> String {
+    format!("{root}/robot/*/cmd")
+}
+
+/// `<root>/robot/<robot>/ranges`: the sim publishes a
+/// [`RangeScan`](crate::sim::RangeScan) every step.
+pub fn robot_ranges(root: &str, robot: &str) -> String {
+    format!("{root}/robot/{robot}/ranges")
+}
+
+/// `<root>/robot/<robot>/observation`: the sim publishes a
+/// [`LocalObservation`](crate::sim::LocalObservation) every step when the scenario's
+/// observation radius is above 0.
+pub fn robot_observation(root: &str, robot: &str) -> String {
+    format!("{root}/robot/{robot}/observation")
+}
+
+/// `<root>/robot/<robot>/truth`: the sim publishes the true position
+/// ([`GroundTruth`](crate::sim::GroundTruth)) every step, for evaluation only.
+pub fn robot_truth(root: &str, robot: &str) -> String {
+    format!("{root}/robot/{robot}/truth")
+}
+
+/// `<root>/robot/<robot>/events`: the sim publishes
+/// [`RobotEvents`](crate::sim::RobotEvents) in the steps that have some (collisions,
+/// clipped speed, displacement).
+pub fn robot_events(root: &str, robot: &str) -> String {
+    format!("{root}/robot/{robot}/events")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,6 +12,7 @@ pub mod error;
 pub mod keys;
 pub mod map;
 pub mod planner;
+pub mod sim;
 
 pub use codec::{decode, encode, DecodeError, Message, PROTOCOL_VERSION};
 pub use error::{ErrorCode, ErrorReply, LimitHit};
