@@ -127,7 +127,7 @@ pub const BLOCKED_THRESHOLD: i8 = 65;
 
 /// Whether an occupancy value blocks a robot and its sensors in the sim world.
 pub fn is_blocked(value: i8) -> bool {
-    value < 0 || value >= BLOCKED_THRESHOLD
+    !(0..BLOCKED_THRESHOLD).contains(&value)
 }
 
 /// Which ranges a robot receives (paper 002 §2.1 says both `d ≤ s_r` and `d̂ ≤ s_r`).
@@ -437,7 +437,7 @@ pub fn parse(path: &Path, text: &str, max_cells: u64) -> Result<Scenario, Scenar
             ));
         }
     }
-    validate_sim(&file, &occupancy).map_err(|(f, reason)| field(&f, reason))?;
+    validate_sim(&file, &occupancy).map_err(|i| field(&i.field, i.reason))?;
     Ok(Scenario {
         file,
         occupancy,
@@ -445,54 +445,90 @@ pub fn parse(path: &Path, text: &str, max_cells: u64) -> Result<Scenario, Scenar
     })
 }
 
-/// A field's name and what is wrong with it.
-type FieldError = (String, String);
+/// A field of a scenario's sections and what is wrong with it, for callers that check
+/// a section outside a file (the sim checks parameters given in code the same way).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FieldIssue {
+    /// The field, e.g. `sensing.sigma_toa_m`.
+    pub field: String,
+    /// What is wrong and what is allowed.
+    pub reason: String,
+}
+
+impl FieldIssue {
+    pub fn new(field: impl Into<String>, reason: impl Into<String>) -> FieldIssue {
+        FieldIssue {
+            field: field.into(),
+            reason: reason.into(),
+        }
+    }
+}
+
+/// The cell a sim item stands in, or why it cannot stand there.
+fn cell_on_map(
+    meta: &GridMeta,
+    field: String,
+    what: &str,
+    [x, y]: [f64; 2],
+) -> Result<(usize, usize), FieldIssue> {
+    if !(x.is_finite() && y.is_finite()) {
+        return Err(FieldIssue::new(
+            field,
+            format!("{what}: coordinates must be numbers, got ({x}, {y})"),
+        ));
+    }
+    crate::grid::world_to_cell(meta, x, y).ok_or_else(|| {
+        let (x0, y0) = (meta.origin.x, meta.origin.y);
+        let x1 = x0 + f64::from(meta.width) * meta.resolution;
+        let y1 = y0 + f64::from(meta.height) * meta.resolution;
+        FieldIssue::new(
+            field,
+            format!(
+                "{what} at ({x}, {y}) is outside the map, which spans x {x0}..{x1} and \
+                 y {y0}..{y1} m"
+            ),
+        )
+    })
+}
+
+/// Checks that a sim item starts on a free cell of the static map.
+fn on_free_cell(
+    occupancy: &Grid<i8>,
+    field: String,
+    what: &str,
+    at: [f64; 2],
+) -> Result<(), FieldIssue> {
+    let (cx, cy) = cell_on_map(&occupancy.meta, field.clone(), what, at)?;
+    match occupancy.get(cx, cy) {
+        Some(v) if !is_blocked(v) => Ok(()),
+        v => Err(FieldIssue::new(
+            field,
+            format!(
+                "{what} at ({}, {}) is on an occupied or unknown cell (value {}); it must \
+                 start on a free cell",
+                at[0],
+                at[1],
+                v.unwrap_or(occupancy::UNKNOWN)
+            ),
+        )),
+    }
+}
 
 /// Checks the sim world's sections against the map.
-fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldError> {
+fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldIssue> {
     let meta = &occupancy.meta;
-    let on_map = |f: String, what: &str, [x, y]: [f64; 2]| -> Result<(usize, usize), FieldError> {
-        if !(x.is_finite() && y.is_finite()) {
-            return Err((
-                f,
-                format!("{what}: coordinates must be numbers, got ({x}, {y})"),
-            ));
-        }
-        crate::grid::world_to_cell(meta, x, y).ok_or_else(|| {
-            let (x0, y0) = (meta.origin.x, meta.origin.y);
-            let x1 = x0 + f64::from(meta.width) * meta.resolution;
-            let y1 = y0 + f64::from(meta.height) * meta.resolution;
-            (
-                f,
-                format!("{what} at ({x}, {y}) is outside the map, which spans x {x0}..{x1} and y {y0}..{y1} m"),
-            )
-        })
-    };
-    let on_free_cell = |f: String, what: &str, at: [f64; 2]| -> Result<(), FieldError> {
-        let (cx, cy) = on_map(f.clone(), what, at)?;
-        match occupancy.get(cx, cy) {
-            Some(v) if !is_blocked(v) => Ok(()),
-            v => Err((
-                f,
-                format!(
-                    "{what} at ({}, {}) is on an occupied or unknown cell (value {}); it must start on a free cell",
-                    at[0],
-                    at[1],
-                    v.unwrap_or(occupancy::UNKNOWN)
-                ),
-            )),
-        }
-    };
-    let unique = |list: &str, names: Vec<&str>| -> Result<(), FieldError> {
+    let on_map = |f: String, what: &str, at: [f64; 2]| cell_on_map(meta, f, what, at);
+    let on_free_cell = |f: String, what: &str, at: [f64; 2]| on_free_cell(occupancy, f, what, at);
+    let unique = |list: &str, names: Vec<&str>| -> Result<(), FieldIssue> {
         for (i, name) in names.iter().enumerate() {
             if name.is_empty() {
-                return Err((
+                return Err(FieldIssue::new(
                     format!("{list}[{i}].name"),
-                    "a name must not be empty".into(),
+                    "a name must not be empty",
                 ));
             }
             if names[..i].contains(name) {
-                return Err((
+                return Err(FieldIssue::new(
                     format!("{list}[{i}].name"),
                     format!("the name '{name}' is used twice in {list}"),
                 ));
@@ -512,17 +548,9 @@ fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldEr
             anchor.at,
         )?;
     }
-    validate_sensing(&file.sensing, meta.resolution)?;
-    validate_motion(&file.motion)?;
-    if !(file.time.step_s.is_finite() && file.time.step_s > 0.0) {
-        return Err((
-            "time.step_s".into(),
-            format!(
-                "must be a positive number of seconds, got {}",
-                file.time.step_s
-            ),
-        ));
-    }
+    file.sensing.check(meta.resolution)?;
+    file.motion.check()?;
+    file.time.check()?;
     unique(
         "robots",
         file.robots.iter().map(|r| r.name.as_str()).collect(),
@@ -543,7 +571,7 @@ fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldEr
         match (block.size_cells, block.size_m) {
             (Some([w, h]), None) if w >= 1 && h >= 1 => {}
             (Some(size), None) => {
-                return Err((
+                return Err(FieldIssue::new(
                     f("size_cells"),
                     format!(
                         "block '{}': both sizes must be at least 1 cell, got {size:?}",
@@ -553,7 +581,7 @@ fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldEr
             }
             (None, Some([w, h])) if w.is_finite() && h.is_finite() && w > 0.0 && h > 0.0 => {}
             (None, Some(size)) => {
-                return Err((
+                return Err(FieldIssue::new(
                     f("size_m"),
                     format!(
                         "block '{}': both sizes must be positive metres, got {size:?}",
@@ -562,7 +590,7 @@ fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldEr
                 ));
             }
             _ => {
-                return Err((
+                return Err(FieldIssue::new(
                     format!("blocks[{i}]"),
                     format!(
                         "block '{}' needs exactly one of size_cells or size_m",
@@ -572,7 +600,7 @@ fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldEr
             }
         }
         if block.path.is_empty() {
-            return Err((
+            return Err(FieldIssue::new(
                 f("path"),
                 format!("block '{}' needs at least one position", block.name),
             ));
@@ -585,7 +613,7 @@ fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldEr
             )?;
         }
         if block.period_steps == 0 {
-            return Err((
+            return Err(FieldIssue::new(
                 f("period_steps"),
                 format!("block '{}': must be at least 1 step", block.name),
             ));
@@ -599,7 +627,7 @@ fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldEr
         let f = |sub: &str| format!("walkers[{i}].{sub}");
         on_free_cell(f("at"), &format!("walker '{}'", walker.name), walker.at)?;
         if !(walker.size_m.is_finite() && walker.size_m > 0.0) {
-            return Err((
+            return Err(FieldIssue::new(
                 f("size_m"),
                 format!(
                     "walker '{}': must be a positive number of metres, got {}",
@@ -608,7 +636,7 @@ fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldEr
             ));
         }
         if !(walker.step_m.is_finite() && walker.step_m > 0.0) {
-            return Err((
+            return Err(FieldIssue::new(
                 f("step_m"),
                 format!(
                     "walker '{}': must be a positive number of metres, got {}",
@@ -617,7 +645,7 @@ fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldEr
             ));
         }
         if walker.every_steps == 0 {
-            return Err((
+            return Err(FieldIssue::new(
                 f("every_steps"),
                 format!("walker '{}': must be at least 1 step", walker.name),
             ));
@@ -637,72 +665,92 @@ fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldEr
     Ok(())
 }
 
-fn validate_sensing(s: &SensingSpec, resolution: f64) -> Result<(), FieldError> {
-    let positive = |f: &str, v: f64, unit: &str| {
-        if v.is_finite() && v > 0.0 {
-            Ok(())
-        } else {
-            Err((
-                format!("sensing.{f}"),
-                format!("must be a positive number of {unit}, got {v}"),
-            ))
+impl SensingSpec {
+    /// Checks every field; `resolution` (metres per cell) bounds the observation radius.
+    pub fn check(&self, resolution: f64) -> Result<(), FieldIssue> {
+        let positive = |f: &str, v: f64, unit: &str| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(FieldIssue::new(
+                    format!("sensing.{f}"),
+                    format!("must be a positive number of {unit}, got {v}"),
+                ))
+            }
+        };
+        let non_negative = |f: &str, v: f64, unit: &str| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(FieldIssue::new(
+                    format!("sensing.{f}"),
+                    format!("must be a non-negative number of {unit}, got {v}"),
+                ))
+            }
+        };
+        positive("range_m", self.range_m, "metres")?;
+        non_negative("sigma_toa_m", self.sigma_toa_m, "metres")?;
+        positive("d0_m", self.d0_m, "metres")?;
+        non_negative("k", self.k, "(a unitless exponent)")?;
+        non_negative("observation_radius_m", self.observation_radius_m, "metres")?;
+        let cells = self.observation_radius_m / resolution;
+        if cells > MAX_OBSERVATION_RADIUS_CELLS {
+            return Err(FieldIssue::new(
+                "sensing.observation_radius_m",
+                format!(
+                    "{} m is {cells:.0} cells of {resolution} m; the limit is \
+                     {MAX_OBSERVATION_RADIUS_CELLS} cells ({} m on this map)",
+                    self.observation_radius_m,
+                    MAX_OBSERVATION_RADIUS_CELLS * resolution
+                ),
+            ));
         }
-    };
-    let non_negative = |f: &str, v: f64, unit: &str| {
-        if v.is_finite() && v >= 0.0 {
-            Ok(())
-        } else {
-            Err((
-                format!("sensing.{f}"),
-                format!("must be a non-negative number of {unit}, got {v}"),
-            ))
-        }
-    };
-    positive("range_m", s.range_m, "metres")?;
-    non_negative("sigma_toa_m", s.sigma_toa_m, "metres")?;
-    positive("d0_m", s.d0_m, "metres")?;
-    non_negative("k", s.k, "(a unitless exponent)")?;
-    non_negative("observation_radius_m", s.observation_radius_m, "metres")?;
-    let cells = s.observation_radius_m / resolution;
-    if cells > MAX_OBSERVATION_RADIUS_CELLS {
-        return Err((
-            "sensing.observation_radius_m".into(),
-            format!(
-                "{} m is {cells:.0} cells of {resolution} m; the limit is {MAX_OBSERVATION_RADIUS_CELLS} cells ({} m on this map)",
-                s.observation_radius_m,
-                MAX_OBSERVATION_RADIUS_CELLS * resolution
-            ),
-        ));
+        Ok(())
     }
-    Ok(())
 }
 
-fn validate_motion(m: &MotionSpec) -> Result<(), FieldError> {
-    if !(m.step_mu.is_finite() && m.step_mu > 0.0) {
-        return Err((
-            "motion.step_mu".into(),
-            format!("must be a positive number, got {}", m.step_mu),
-        ));
+impl MotionSpec {
+    /// Checks every field.
+    pub fn check(&self) -> Result<(), FieldIssue> {
+        if !(self.step_mu.is_finite() && self.step_mu > 0.0) {
+            return Err(FieldIssue::new(
+                "motion.step_mu",
+                format!("must be a positive number, got {}", self.step_mu),
+            ));
+        }
+        if !(self.sigma_tr_m.is_finite() && self.sigma_tr_m >= 0.0) {
+            return Err(FieldIssue::new(
+                "motion.sigma_tr_m",
+                format!(
+                    "must be a non-negative number of metres, got {}",
+                    self.sigma_tr_m
+                ),
+            ));
+        }
+        if !(self.max_speed_m_per_step.is_finite() && self.max_speed_m_per_step > 0.0) {
+            return Err(FieldIssue::new(
+                "motion.max_speed_m_per_step",
+                format!(
+                    "must be a positive number of metres per step, got {}",
+                    self.max_speed_m_per_step
+                ),
+            ));
+        }
+        Ok(())
     }
-    if !(m.sigma_tr_m.is_finite() && m.sigma_tr_m >= 0.0) {
-        return Err((
-            "motion.sigma_tr_m".into(),
-            format!(
-                "must be a non-negative number of metres, got {}",
-                m.sigma_tr_m
-            ),
-        ));
+}
+
+impl TimeSpec {
+    /// Checks every field.
+    pub fn check(&self) -> Result<(), FieldIssue> {
+        if !(self.step_s.is_finite() && self.step_s > 0.0) {
+            return Err(FieldIssue::new(
+                "time.step_s",
+                format!("must be a positive number of seconds, got {}", self.step_s),
+            ));
+        }
+        Ok(())
     }
-    if !(m.max_speed_m_per_step.is_finite() && m.max_speed_m_per_step > 0.0) {
-        return Err((
-            "motion.max_speed_m_per_step".into(),
-            format!(
-                "must be a positive number of metres per step, got {}",
-                m.max_speed_m_per_step
-            ),
-        ));
-    }
-    Ok(())
 }
 
 fn build_grid(spec: &GridSpec, max_cells: u64) -> Result<Grid<i8>, String> {

@@ -88,3 +88,139 @@ fn scenario_errors_name_the_file_and_field() {
     .expect_err("must be refused");
     assert!(err.to_string().contains("max_layer_cells"), "{err}");
 }
+
+/// A 10 x 10 m map of 0.5 m cells with border walls and a wall at x = 5, for the sim
+/// sections' checks; `extra` is appended.
+fn sim_scenario(extra: &str) -> Result<scenario::Scenario, ScenarioError> {
+    let text = format!(
+        "name: sim\nmap:\n  grid:\n    size_m: [10.0, 10.0]\n    resolution: 0.5\n    border_walls: true\n    obstacles: [ {{ rect: [5.0, 0.0, 5.4, 10.0] }} ]\n{extra}"
+    );
+    scenario::parse(
+        Path::new("/tmp/roam-sim.yaml"),
+        &text,
+        DEFAULT_LIMITS.max_layer_cells,
+    )
+}
+
+#[test]
+fn sim_sections_parse_with_the_papers_defaults() {
+    let parsed = sim_scenario(
+        "anchors: [ { name: a, at: [5.2, 5.0] } ]\nrobots: [ { name: r, at: [2.0, 2.0] } ]\nblocks: [ { name: b, size_m: [1.0, 0.5], period_steps: 7, path: [[7.0, 7.0], [8.0, 7.0]] } ]\nwalkers: [ { name: w, at: [7.0, 3.0], size_m: 0.5, step_m: 0.5, every_steps: 2 } ]\nwaypoints: [ { name: A, at: [1.0, 1.0] }, { name: B, at: [9.0, 9.0] } ]\nsensing: { k: 3.0 }\n",
+    )
+    .expect("valid");
+    let file = &parsed.file;
+    assert_eq!(file.anchors.len(), 1, "an anchor may stand on a wall");
+    assert_eq!(file.sensing.range_m, scenario::DEFAULT_RANGE_M);
+    assert_eq!(file.sensing.sigma_toa_m, 0.10);
+    assert_eq!(file.sensing.d0_m, 15.0);
+    assert_eq!(file.sensing.k, 3.0);
+    assert_eq!(file.sensing.range_gate, scenario::RangeGate::TrueDistance);
+    assert_eq!(file.motion.step_mu, 0.2);
+    assert_eq!(file.motion.sigma_tr_m, 0.01);
+    assert_eq!(file.time.step_s, scenario::DEFAULT_STEP_S);
+    assert_eq!(file.blocks[0].size_m, Some([1.0, 0.5]));
+    assert_eq!(file.waypoints[1].name, "B");
+}
+
+#[test]
+fn sim_section_errors_name_the_file_and_field() {
+    let cases: &[(&str, &str, &str)] = &[
+        (
+            "robots: [ { name: r, at: [12.0, 2.0] } ]\n",
+            "robots[0].at",
+            "outside the map",
+        ),
+        (
+            "robots: [ { name: r, at: [5.2, 2.0] } ]\n",
+            "robots[0].at",
+            "free cell",
+        ),
+        (
+            "robots: [ { name: r, at: [2.0, 2.0] }, { name: r, at: [3.0, 2.0] } ]\n",
+            "robots[1].name",
+            "used twice",
+        ),
+        (
+            "anchors: [ { name: a, at: [1.0, 1.0] }, { name: b, at: [1.0, -3.0] } ]\n",
+            "anchors[1].at",
+            "outside the map",
+        ),
+        (
+            "sensing: { sigma_toa_m: -0.1 }\n",
+            "sensing.sigma_toa_m",
+            "non-negative",
+        ),
+        ("sensing: { d0_m: 0.0 }\n", "sensing.d0_m", "positive"),
+        ("sensing: { range_m: .nan }\n", "sensing.range_m", "positive"),
+        (
+            "sensing: { observation_radius_m: 100.0 }\n",
+            "sensing.observation_radius_m",
+            "limit",
+        ),
+        (
+            "motion: { sigma_tr_m: -0.01 }\n",
+            "motion.sigma_tr_m",
+            "non-negative",
+        ),
+        (
+            "motion: { max_speed_m_per_step: 0.0 }\n",
+            "motion.max_speed_m_per_step",
+            "positive",
+        ),
+        ("time: { step_s: -1.0 }\n", "time.step_s", "positive"),
+        (
+            "blocks: [ { name: b, size_cells: [2, 2], period_steps: 7, path: [[7.0, 7.0], [7.0, 11.0]] } ]\n",
+            "blocks[0].path[1]",
+            "outside the map",
+        ),
+        (
+            "blocks: [ { name: b, period_steps: 7, path: [[7.0, 7.0]] } ]\n",
+            "blocks[0]",
+            "exactly one of size_cells or size_m",
+        ),
+        (
+            "blocks: [ { name: b, size_cells: [0, 2], period_steps: 7, path: [[7.0, 7.0]] } ]\n",
+            "blocks[0].size_cells",
+            "at least 1",
+        ),
+        (
+            "blocks: [ { name: b, size_cells: [1, 1], period_steps: 0, path: [[7.0, 7.0]] } ]\n",
+            "blocks[0].period_steps",
+            "at least 1",
+        ),
+        (
+            "blocks: [ { name: b, size_cells: [1, 1], period_steps: 2, path: [] } ]\n",
+            "blocks[0].path",
+            "at least one position",
+        ),
+        (
+            "walkers: [ { name: w, at: [7.0, 3.0], size_m: 0.5, step_m: 0.0, every_steps: 2 } ]\n",
+            "walkers[0].step_m",
+            "positive",
+        ),
+        (
+            "walkers: [ { name: w, at: [7.0, 3.0], size_m: 0.5, step_m: 0.5, every_steps: 0 } ]\n",
+            "walkers[0].every_steps",
+            "at least 1",
+        ),
+        (
+            "waypoints: [ { name: A, at: [1.0, 1.0] }, { name: B, at: [-1.0, 1.0] } ]\n",
+            "waypoints[1].at",
+            "outside the map",
+        ),
+    ];
+    for (extra, field, says) in cases {
+        let err = sim_scenario(extra).expect_err(extra);
+        let msg = err.to_string();
+        assert!(matches!(err, ScenarioError::Field { .. }), "{extra}: {msg}");
+        assert!(
+            msg.contains("/tmp/roam-sim.yaml")
+                && msg.contains(&format!("field {field}:"))
+                && msg.contains(says),
+            "{extra}: {msg}"
+        );
+    }
+    // A typo inside a sim section is refused by name.
+    let err = sim_scenario("sensing: { sigma_toa: 0.1 }\n").expect_err("typo");
+    assert!(err.to_string().contains("sigma_toa"), "{err}");
+}

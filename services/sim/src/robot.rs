@@ -1,0 +1,149 @@
+//! A robot: where it is, its own random stream, and paper 002's motion model (Eq. 1)
+//! with a top speed and collisions.
+
+use rand_chacha::ChaCha8Rng;
+use roam_map_server::scenario::MotionSpec;
+use serde::Serialize;
+
+use crate::event::Event;
+use crate::noise;
+use crate::raster;
+use crate::world::World;
+
+/// How far (in cells) a clipped move stops short of the cell it would have entered:
+/// enough that rounding never puts the stopping point inside that cell.
+const BACKOFF_CELLS: f64 = 1e-6;
+
+/// A robot in the sim: a point that moves on the plane (paper 002 models no heading).
+#[derive(Debug, Clone)]
+pub struct Robot {
+    name: String,
+    start: [f64; 2],
+    at: [f64; 2],
+    /// The robot's own stream: its transition noise and its range noise.
+    rng: ChaCha8Rng,
+    /// Events that happened between steps (a reset put it on a free cell), reported
+    /// with the next step.
+    pub(crate) pending: Vec<Event>,
+}
+
+impl Robot {
+    /// A robot at its start, its stream derived from the sim's seed and its name.
+    pub(crate) fn new(name: &str, start: [f64; 2], seed: u64) -> Robot {
+        Robot {
+            name: name.to_owned(),
+            start,
+            at: start,
+            rng: stream(seed, name),
+            pending: Vec::new(),
+        }
+    }
+
+    /// Back to its start with its stream restarted from `seed`.
+    pub(crate) fn reset(&mut self, seed: u64) {
+        self.at = self.start;
+        self.rng = stream(seed, &self.name);
+        self.pending.clear();
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Where it started (and returns to on a reset), world metres.
+    pub fn start(&self) -> [f64; 2] {
+        self.start
+    }
+
+    /// Where it is: the ground truth, world metres.
+    pub fn position(&self) -> [f64; 2] {
+        self.at
+    }
+
+    pub(crate) fn set_position(&mut self, at: [f64; 2]) {
+        self.at = at;
+    }
+
+    pub(crate) fn rng(&mut self) -> &mut ChaCha8Rng {
+        &mut self.rng
+    }
+}
+
+/// The robot's stream: `"robot/<name>"` under the sim's seed.
+fn stream(seed: u64, name: &str) -> ChaCha8Rng {
+    noise::stream(seed, &format!("robot/{name}"))
+}
+
+/// The result of one move.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Moved {
+    /// Where the robot ends, world metres.
+    pub at: [f64; 2],
+    /// What happened on the way (speed clipped, collision).
+    pub events: Vec<Event>,
+}
+
+/// Paper 002 Eq. 1, `p ← p + μ·u + ν`, for a robot at `at` given command `u` and the
+/// transition noise `nu` already drawn, against the world as it is now.
+///
+/// - **Top speed.** The commanded move μ·u is clipped to `max_speed_m_per_step` (its
+///   direction kept) before the noise is added; the event says by how much.
+/// - **No command, no noise.** A zero command leaves the robot where it is: ν models
+///   the drive's error, which a drive at rest does not make. (The caller draws ν every
+///   step anyway, so a robot's stream does not depend on when it was commanded.)
+/// - **Collisions.** The robot is a point and never enters a cell it may not be in
+///   (a wall, an unknown cell, a block, a walker, off the map). The move, noise
+///   included, is walked cell by cell along the straight segment; at the first such
+///   cell the robot stops just short of it and a `Collision` event names the cell and
+///   what is in it. Robots are not obstacles to each other (paper 002's robots are
+///   points that share the plane).
+pub fn step_motion(
+    at: [f64; 2],
+    u: [f64; 2],
+    nu: [f64; 2],
+    motion: &MotionSpec,
+    world: &World,
+) -> Moved {
+    let mut events = Vec::new();
+    if u == [0.0, 0.0] {
+        return Moved { at, events };
+    }
+    let mut step = [motion.step_mu * u[0], motion.step_mu * u[1]];
+    let length = step[0].hypot(step[1]);
+    if length > motion.max_speed_m_per_step {
+        let scale = motion.max_speed_m_per_step / length;
+        step = [step[0] * scale, step[1] * scale];
+        events.push(Event::SpeedClipped {
+            requested_m: length,
+            allowed_m: motion.max_speed_m_per_step,
+        });
+    }
+    let target = [at[0] + step[0] + nu[0], at[1] + step[1] + nu[1]];
+    let (from, to) = (world.to_cell_units(at), world.to_cell_units(target));
+    let Some((t, cell)) = raster::first_blocked(from, to, |c| world.is_blocked(c)) else {
+        return Moved { at: target, events };
+    };
+    let cells_long = (to[0] - from[0]).hypot(to[1] - from[1]);
+    let t_stop = (t - BACKOFF_CELLS / cells_long.max(f64::MIN_POSITIVE)).max(0.0);
+    let mut stopped = [
+        at[0] + (target[0] - at[0]) * t_stop,
+        at[1] + (target[1] - at[1]) * t_stop,
+    ];
+    // The stopping point must be on a free cell; rounding could still tip it over the
+    // edge of a tiny last step, and then the robot simply stays put.
+    if world.cell_of(stopped).is_none_or(|c| world.is_blocked(c)) {
+        stopped = at;
+    }
+    events.push(Event::Collision {
+        target,
+        stopped_at: stopped,
+        cell: [cell.0, cell.1],
+        obstacle: world
+            .obstacle_at(cell)
+            .unwrap_or(crate::world::Obstacle::Wall),
+    });
+    Moved {
+        at: stopped,
+        events,
+    }
+}
