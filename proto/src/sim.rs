@@ -53,6 +53,13 @@ pub struct SimStatus {
     /// The real-time factor when running; 0 means as fast as possible.
     pub rate: f64,
     pub step_s: f64,
+    /// Free-running steps that finished after the next one was due (since the last
+    /// load, reset or resume).
+    #[serde(default)]
+    pub late_steps: u64,
+    /// Free-running steps since the last load, reset or resume.
+    #[serde(default)]
+    pub free_steps: u64,
     /// Robots at their true positions.
     pub robots: Vec<NamedPoint>,
     pub anchors: Vec<NamedPoint>,

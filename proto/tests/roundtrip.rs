@@ -438,7 +438,7 @@ mod sim_messages {
         #[test]
         fn status_and_clock_round_trip(scenario in name(), seed in any::<u64>(), step in any::<u64>(), time_s in finite(), running in any::<bool>(), robots in prop::collection::vec((name(), point()), 0..4)) {
             let robots: Vec<NamedPoint> = robots.into_iter().map(|(name, at)| NamedPoint { name, at }).collect();
-            round_trips(&SimStatus { scenario, seed, step, time_s, running, rate: 1.0, step_s: 0.1, anchors: robots.clone(), robots });
+            round_trips(&SimStatus { scenario, seed, step, time_s, running, rate: 1.0, step_s: 0.1, late_steps: 1, free_steps: 9, anchors: robots.clone(), robots });
             round_trips(&SimClock { step, time_s });
         }
 

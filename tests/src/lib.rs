@@ -15,6 +15,7 @@ use roam_map_server::MapServerConfig;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
 use roam_runtime::{Requester, SessionArgs};
+use roam_sim::service::SimConfig;
 use tokio::task::JoinHandle;
 use tokio_util::sync::CancellationToken;
 
@@ -154,6 +155,46 @@ impl Harness {
         tokio::select! {
             outcome = &mut live => outcome.expect("planner up"),
             finished = &mut handle => panic!("the planner stopped at start: {finished:?}"),
+        }
+        RunningService { cancel, handle }
+    }
+
+    /// A sim config under this harness's root: `scenario` (the built-in world when
+    /// `None`), paused for lock-step.
+    pub fn sim_config(&self, scenario: Option<&str>) -> SimConfig {
+        SimConfig {
+            root: self.root.clone(),
+            scenario: scenario.map(|s| {
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("..")
+                    .join(s)
+            }),
+            rate: None,
+            ..SimConfig::default()
+        }
+    }
+
+    /// Starts the sim world and waits for its liveliness token.
+    pub async fn start_sim(&self, config: SimConfig) -> RunningService {
+        let cancel = CancellationToken::new();
+        let token = cancel.clone();
+        let zenoh_config = self.client_config();
+        let handle = tokio::spawn(async move {
+            roam_sim::service::run(config, zenoh_config, token)
+                .await
+                .map_err(|e| e.to_string())
+        });
+        let live = wait_until_live(
+            &self.router.session,
+            &self.root,
+            roam_sim::service::SERVICE_NAME,
+            STEP,
+        );
+        tokio::pin!(live);
+        let mut handle = handle;
+        tokio::select! {
+            outcome = &mut live => outcome.expect("sim up"),
+            finished = &mut handle => panic!("the sim stopped at start: {finished:?}"),
         }
         RunningService { cancel, handle }
     }

@@ -1,6 +1,7 @@
 //! `roam stack`: every landed service in one process around an in-process router on
 //! loopback, multicast off. The same shape as a compose stack, so what works here works
-//! across machines. Services landed so far: the map server and the planner.
+//! across machines. Services landed so far: the map server, the planner and the sim
+//! world (free-running at 1x on the built-in world).
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -9,6 +10,7 @@ use roam_map_server::MapServerConfig;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
 use roam_runtime::SessionArgs;
+use roam_sim::service::SimConfig;
 use tokio::task::JoinSet;
 use tokio_util::sync::CancellationToken;
 
@@ -29,7 +31,11 @@ pub struct StackOptions {
 }
 
 /// The services `Stack::start` runs, in start order.
-pub const SERVICES: [&str; 2] = [roam_map_server::SERVICE_NAME, roam_planner::SERVICE_NAME];
+pub const SERVICES: [&str; 3] = [
+    roam_map_server::SERVICE_NAME,
+    roam_planner::SERVICE_NAME,
+    roam_sim::service::SERVICE_NAME,
+];
 
 #[derive(Debug, thiserror::Error)]
 pub enum StackError {
@@ -109,6 +115,20 @@ impl Stack {
                 )
             });
         }
+
+        let sim_config = SimConfig {
+            root: root.clone(),
+            ..SimConfig::default()
+        };
+        let zenoh_config = client.zenoh_config(None)?;
+        let token = cancel.child_token();
+        services.spawn(async move {
+            let outcome = roam_sim::service::run(sim_config, zenoh_config, token).await;
+            (
+                roam_sim::service::SERVICE_NAME,
+                outcome.map_err(|e| e.to_string()),
+            )
+        });
 
         let mut stack = Stack {
             router,

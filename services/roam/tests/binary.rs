@@ -440,3 +440,46 @@ fn a_router_process_connects_a_map_server_and_a_client() {
     assert_eq!(occupancy["meta"]["width"], 604);
     assert_eq!(occupancy["version"], 1);
 }
+
+#[test]
+fn every_shipped_scenario_renders_and_es1_shows_anchor_wall_and_robot() {
+    let out = tempfile::tempdir().expect("tmp");
+    for entry in std::fs::read_dir(repo("config/scenarios")).expect("scenarios") {
+        let path = entry.expect("entry").path();
+        if path.extension().and_then(|e| e.to_str()) != Some("yaml") {
+            continue;
+        }
+        let png = out.path().join(format!(
+            "{}.png",
+            path.file_stem().and_then(|s| s.to_str()).unwrap_or("x")
+        ));
+        let status = Command::new(ROAM)
+            .args(["sim", "render"])
+            .arg(&path)
+            .arg("--png")
+            .arg(&png)
+            .output()
+            .expect("run");
+        assert!(
+            status.status.success(),
+            "{}: {}",
+            path.display(),
+            String::from_utf8_lossy(&status.stderr)
+        );
+        assert!(png.exists());
+    }
+    // es1: 70 x 50 m at 0.5 m, drawn at 5 px per cell (800 / 140), north up.
+    let picture = image::open(out.path().join("es1.png"))
+        .expect("png")
+        .to_rgb8();
+    let px = |x: f64, y: f64| {
+        *picture.get_pixel((x / 0.5 * 5.0) as u32, ((50.0 - y) / 0.5 * 5.0) as u32)
+    };
+    assert_eq!(px(4.0, 44.0), roam_sim::render::ANCHOR, "anchor a1");
+    assert_eq!(px(10.0, 16.0), roam_sim::render::ROBOT, "the robot at A");
+    assert_eq!(
+        px(0.1, 25.0),
+        roam_map_server::render::OCCUPIED,
+        "the west wall"
+    );
+}

@@ -24,10 +24,13 @@
 
 pub mod event;
 pub mod los;
+pub mod messages;
 pub mod noise;
 pub mod raster;
+pub mod render;
 pub mod robot;
 pub mod sensors;
+pub mod service;
 pub mod sim;
 pub mod world;
 

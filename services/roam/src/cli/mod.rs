@@ -4,6 +4,7 @@
 mod map;
 mod plan;
 mod roles;
+mod sim;
 mod tools;
 
 use std::path::PathBuf;
@@ -33,6 +34,9 @@ ROLES
   planner      The curious GA planner (paper 000): a path from here to the next task
                that gathers the most information and still arrives within the budget.
                Run several; clients spread plans over the live instances.
+  sim          The sim world: robots (paper 002's motion model), anchors and TOA
+               ranges, moving blocks (paper 004), line-of-sight observations, a clock;
+               free-running or in lock-step. `roam sim render` draws a scenario.
   router       A Zenoh router: run one per site or fleet; services connect to it.
   stack        Every landed service in one process around an in-process router on
                loopback, multicast off. The embedded default world needs no files.
@@ -75,6 +79,8 @@ enum Command {
     MapServer(MapServerArgs),
     /// Run a curious GA planner instance (paper 000).
     Planner(PlannerArgs),
+    /// Run the sim world (papers 002 and 004), or `sim render` a scenario to a PNG.
+    Sim(sim::SimArgs),
     /// Ask a running planner for a curious path (a client).
     Plan(PlanArgs),
     /// Run a Zenoh router (no separate zenohd needed).
@@ -122,6 +128,7 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::MapServer(args) => roles::map_server(args).await,
         Command::Planner(args) => roles::planner(args).await,
+        Command::Sim(args) => sim::sim(args).await,
         Command::Plan(args) => plan::plan(args).await,
         Command::Router(args) => roles::router(args).await,
         Command::Stack(args) => roles::stack(args).await,

@@ -1,0 +1,99 @@
+//! `roam sim`: the sim world service, and `roam sim render` for a picture of a scenario.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use roam_runtime::{config_file, signals};
+use roam_sim::service::{load_scenario, SimConfig};
+use roam_sim::Sim;
+
+use super::ServiceArgs;
+
+#[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
+pub(crate) struct SimArgs {
+    #[command(subcommand)]
+    command: Option<SimCommand>,
+    #[command(flatten)]
+    run: SimRunArgs,
+}
+
+#[derive(Debug, Subcommand)]
+enum SimCommand {
+    /// Draw a scenario: map, zones of interest, anchors with range circles, blocks, robots.
+    Render {
+        scenario: PathBuf,
+        #[arg(long, value_name = "FILE")]
+        png: PathBuf,
+        /// Pixels per cell (default: about 800 pixels on the longer side).
+        #[arg(long)]
+        scale: Option<u32>,
+    },
+}
+
+#[derive(Debug, Args)]
+struct SimRunArgs {
+    #[command(flatten)]
+    service: ServiceArgs,
+    /// A scenario file (default: the config's, else the built-in world).
+    #[arg(long, value_name = "PATH")]
+    scenario: Option<PathBuf>,
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Free-run at this real-time factor (0: as fast as possible).
+    #[arg(long, conflicts_with = "paused")]
+    rate: Option<f64>,
+    /// Start paused: step only on `step` requests (lock-step).
+    #[arg(long)]
+    paused: bool,
+}
+
+pub(crate) async fn sim(args: SimArgs) -> anyhow::Result<()> {
+    match args.command {
+        Some(SimCommand::Render {
+            scenario,
+            png,
+            scale,
+        }) => render(scenario, png, scale),
+        None => run(args.run).await,
+    }
+}
+
+async fn run(args: SimRunArgs) -> anyhow::Result<()> {
+    let mut config: SimConfig = match &args.service.config {
+        Some(path) => config_file::load(path)?,
+        None => SimConfig::default(),
+    };
+    if let Some(root) = args.service.root {
+        config.root = root;
+    }
+    if args.service.instance.is_some() {
+        config.instance = args.service.instance;
+    }
+    if args.scenario.is_some() {
+        config.scenario = args.scenario;
+    }
+    if let Some(seed) = args.seed {
+        config.seed = seed;
+    }
+    if args.paused {
+        config.rate = None;
+    } else if args.rate.is_some() {
+        config.rate = args.rate;
+    }
+    let zenoh = args.service.session.zenoh_config(config.zenoh.as_ref())?;
+    roam_sim::service::run(config, zenoh, signals::cancel_on_signal()).await?;
+    Ok(())
+}
+
+fn render(scenario: PathBuf, png: PathBuf, scale: Option<u32>) -> anyhow::Result<()> {
+    let (_, loaded) = load_scenario(Some(&scenario))?;
+    let sim = Sim::new(&loaded, 0)?;
+    let scale = scale.unwrap_or_else(|| roam_sim::render::auto_scale(&sim));
+    roam_sim::render::render(&sim, scale)
+        .save(&png)
+        .with_context(|| format!("writing {}", png.display()))?;
+    println!("picture: {}", png.display());
+    Ok(())
+}

@@ -1,0 +1,441 @@
+//! The sim world on Zenoh: a thin adapter around [`Sim`].
+//!
+//! | key | kind | payload |
+//! |---|---|---|
+//! | `<root>/sim/control` | queryable | `sim_control` → `sim_status` |
+//! | `<root>/sim/clock` | publication, every step | `sim_clock` |
+//! | `<root>/robot/*/cmd` | subscription | `robot_command` (applies to the next step) |
+//! | `<root>/robot/<id>/{ranges,observation,truth,events}` | publications, every step | `range_scan`, `observation`, `ground_truth`, `robot_events` |
+//!
+//! Two ways to run: free at a real-time factor (`resume`), or in lock-step, where each
+//! `step` request runs n steps and answers once their messages are published. Commands
+//! are taken by a callback subscriber the moment they arrive, so a command put before
+//! a `step` request from the same session is in that step: lock-step runs are
+//! reproducible through the service, bit for bit.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use roam_map_server::map_file::{BUILTIN_NAME, BUILTIN_SCENARIO};
+use roam_map_server::scenario::{self, Scenario, ScenarioError};
+use roam_map_server::store::DEFAULT_LIMITS;
+use roam_proto::sim::{RobotCommand, SimClock, SimControl, SimStatus};
+use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply, Message};
+use roam_runtime::{reply, Service, ServiceError};
+use serde::Deserialize;
+use tokio::time::Instant;
+use tokio_util::sync::CancellationToken;
+use zenoh::qos::CongestionControl;
+use zenoh::query::Query;
+
+use crate::messages::{points, robot_messages, RobotMessages};
+use crate::sim::{Command, Sim, SimError};
+
+pub const SERVICE_NAME: &str = "sim";
+/// Steps one `step` request may ask for.
+pub const MAX_STEPS_PER_REQUEST: u32 = 100_000;
+/// The fastest real-time factor `resume` accepts (0 means as fast as possible).
+pub const MAX_RATE: f64 = 1000.0;
+/// Largest control request, bytes.
+pub const MAX_REQUEST_BYTES: usize = 64 * 1024;
+
+/// The sim service's config file (YAML).
+///
+/// ```yaml
+/// root: roam
+/// scenario: config/scenarios/es1.yaml   # default: the built-in downtime world
+/// seed: 0
+/// rate: 1.0                             # free-run at 1x; absent: start paused (lock-step)
+/// ```
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimConfig {
+    pub root: String,
+    pub instance: Option<String>,
+    pub scenario: Option<PathBuf>,
+    pub seed: u64,
+    pub rate: Option<f64>,
+    pub zenoh: Option<serde_json::Value>,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        SimConfig {
+            root: keys::DEFAULT_ROOT.to_owned(),
+            instance: None,
+            scenario: None,
+            seed: 0,
+            rate: Some(1.0),
+            zenoh: None,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SimServiceError {
+    #[error(transparent)]
+    Service(#[from] ServiceError),
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    #[error("the scenario cannot be simulated: {0}")]
+    Sim(#[from] SimError),
+    #[error("invalid config: {0}")]
+    Config(String),
+}
+
+/// What control requests change.
+struct Control {
+    sim: Sim,
+    scenario: String,
+    running: bool,
+    rate: f64,
+    /// The latest command per robot, taken by the next step.
+    pending: BTreeMap<String, [f64; 2]>,
+    late_steps: u64,
+    free_steps: u64,
+}
+
+struct State {
+    root: String,
+    session: zenoh::Session,
+    control: Mutex<Control>,
+}
+
+impl State {
+    fn control(&self) -> MutexGuard<'_, Control> {
+        self.control.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn status(&self) -> SimStatus {
+        let c = self.control();
+        let (robots, anchors) = points(&c.sim);
+        SimStatus {
+            scenario: c.scenario.clone(),
+            seed: c.sim.seed(),
+            step: c.sim.steps(),
+            time_s: c.sim.time_s(),
+            running: c.running,
+            rate: c.rate,
+            step_s: c.sim.params().time.step_s,
+            late_steps: c.late_steps,
+            free_steps: c.free_steps,
+            robots,
+            anchors,
+        }
+    }
+}
+
+/// Reads a scenario file, or the built-in world.
+pub fn load_scenario(path: Option<&Path>) -> Result<(String, Scenario), ScenarioError> {
+    let max = DEFAULT_LIMITS.max_layer_cells;
+    match path {
+        Some(p) => Ok((p.display().to_string(), scenario::load(p, max)?)),
+        None => Ok((
+            BUILTIN_NAME.to_owned(),
+            scenario::parse(Path::new(BUILTIN_NAME), BUILTIN_SCENARIO, max)?,
+        )),
+    }
+}
+
+fn check_rate(rate: f64) -> Result<(), ErrorReply> {
+    if rate.is_finite() && (0.0..=MAX_RATE).contains(&rate) {
+        Ok(())
+    } else {
+        Err(ErrorReply::new(
+            ErrorCode::InvalidRequest,
+            format!("rate {rate} is out of range; use 0 (as fast as possible) to {MAX_RATE} times real time"),
+        ))
+    }
+}
+
+/// Runs the sim until `cancel` is cancelled.
+pub async fn run(
+    config: SimConfig,
+    zenoh_config: zenoh::Config,
+    cancel: CancellationToken,
+) -> Result<(), SimServiceError> {
+    if let Some(rate) = config.rate {
+        check_rate(rate).map_err(|e| SimServiceError::Config(e.message))?;
+    }
+    let (name, scenario) = load_scenario(config.scenario.as_deref())?;
+    let sim = Sim::new(&scenario, config.seed)?;
+    let mut service = Service::start(
+        SERVICE_NAME,
+        &config.root,
+        config.instance.as_deref(),
+        zenoh_config,
+        cancel,
+    )
+    .await?;
+    let state = Arc::new(State {
+        root: config.root.clone(),
+        session: service.session().clone(),
+        control: Mutex::new(Control {
+            sim,
+            scenario: name,
+            running: config.rate.is_some(),
+            rate: config.rate.unwrap_or(1.0),
+            pending: BTreeMap::new(),
+            late_steps: 0,
+            free_steps: 0,
+        }),
+    });
+
+    // Commands: a callback, so a command is pending before any later query is handled.
+    let command_key = keys::robot_command_any(&config.root);
+    let commands = {
+        let state = state.clone();
+        service
+            .session()
+            .declare_subscriber(&command_key)
+            .callback(move |sample| {
+                take_command(
+                    &state,
+                    sample.key_expr().as_str(),
+                    &sample.payload().to_bytes(),
+                )
+            })
+            .await
+            .map_err(|e| ServiceError::Declare {
+                what: "subscriber",
+                key: command_key.clone(),
+                reason: e.to_string(),
+            })?
+    };
+
+    let control = service
+        .declare_queryable(&keys::sim_control(&config.root))
+        .await?;
+    service.serve(control, state.clone(), |s, q| async move {
+        answer_control(s, q).await
+    });
+    {
+        let (state, cancel) = (state.clone(), service.cancel_token());
+        service.spawn(async move { free_run(state, cancel).await });
+    }
+    service.announce().await?;
+    service.cancelled().await;
+    drop(commands);
+    service
+        .shutdown(roam_runtime::service::DEFAULT_GRACE)
+        .await?;
+    Ok(())
+}
+
+/// Stores a command for the next step; commands for unknown robots or with non-finite
+/// values are dropped (logged), so the pending map never outgrows the robots.
+fn take_command(state: &State, key: &str, payload: &[u8]) {
+    let robot = key.rsplit('/').nth(1).unwrap_or_default();
+    let command = match decode::<RobotCommand>(payload) {
+        Ok(c) if c.u.iter().all(|v| v.is_finite()) => c,
+        Ok(c) => return tracing::warn!(%robot, u = ?c.u, "dropping a command that is not finite"),
+        Err(e) => return tracing::warn!(%robot, "dropping a command that does not decode: {e}"),
+    };
+    let mut control = state.control();
+    if control.sim.robot(robot).is_some() {
+        control.pending.insert(robot.to_owned(), command.u);
+    } else {
+        tracing::debug!(%robot, "dropping a command for a robot the sim does not have");
+    }
+}
+
+/// One step under the lock; returns the messages to publish after it is released.
+fn step_once(state: &State) -> Result<(SimClock, Vec<RobotMessages>), ErrorReply> {
+    let mut control = state.control();
+    let commands: Vec<Command> = std::mem::take(&mut control.pending)
+        .into_iter()
+        .map(|(robot, u)| Command { robot, u })
+        .collect();
+    let report = control.sim.step(&commands).map_err(|e| sim_error(&e))?;
+    let clock = SimClock {
+        step: report.step,
+        time_s: report.time_s,
+    };
+    let messages = report
+        .robots
+        .iter()
+        .map(|r| robot_messages(&control.sim, report.step, report.time_s, r))
+        .collect();
+    Ok((clock, messages))
+}
+
+async fn put<T: Message>(state: &State, key: &str, message: &T) {
+    if let Err(e) = state
+        .session
+        .put(key, encode(message))
+        .congestion_control(CongestionControl::Block)
+        .await
+    {
+        tracing::warn!(%key, "publication failed: {e}");
+    }
+}
+
+async fn publish(state: &State, clock: SimClock, robots: Vec<RobotMessages>) {
+    let root = &state.root;
+    for m in robots {
+        let robot = m.truth.robot.clone();
+        put(state, &keys::robot_ranges(root, &robot), &m.ranges).await;
+        put(state, &keys::robot_truth(root, &robot), &m.truth).await;
+        if let Some(o) = &m.observation {
+            put(state, &keys::robot_observation(root, &robot), o).await;
+        }
+        if let Some(e) = &m.events {
+            put(state, &keys::robot_events(root, &robot), e).await;
+        }
+    }
+    put(state, &keys::sim_clock(root), &clock).await;
+}
+
+/// Steps while running: every `step_s / rate` seconds of wall time, or back to back at
+/// rate 0. A step whose messages are not out before the next one is due counts as late.
+async fn free_run(state: Arc<State>, cancel: CancellationToken) {
+    let mut next = Instant::now();
+    loop {
+        let (running, period) = {
+            let c = state.control();
+            let step_s = c.sim.params().time.step_s;
+            let period = if c.rate > 0.0 {
+                Duration::from_secs_f64(step_s / c.rate)
+            } else {
+                Duration::ZERO
+            };
+            (c.running, period)
+        };
+        if !running {
+            tokio::select! {
+                _ = cancel.cancelled() => return,
+                _ = tokio::time::sleep(Duration::from_millis(10)) => {}
+            }
+            next = Instant::now();
+            continue;
+        }
+        match step_once(&state) {
+            Ok((clock, messages)) => publish(&state, clock, messages).await,
+            Err(e) => tracing::warn!("step failed: {e}"),
+        }
+        next += period;
+        let now = Instant::now();
+        {
+            let mut c = state.control();
+            c.free_steps += 1;
+            if now > next {
+                c.late_steps += 1;
+            }
+        }
+        if now > next + period * 4 {
+            // Far behind (a pause of the machine): catch up from now, not in a burst.
+            next = now;
+        }
+        tokio::select! {
+            _ = cancel.cancelled() => return,
+            _ = tokio::time::sleep_until(next) => {}
+            _ = tokio::task::yield_now(), if period.is_zero() => {}
+        }
+    }
+}
+
+fn sim_error(e: &SimError) -> ErrorReply {
+    let message = e.to_string();
+    match e {
+        SimError::UnknownRobot(_) => ErrorReply::new(ErrorCode::NotFound, message),
+        SimError::TooManyRobots { max } => {
+            ErrorReply::limit("max_robots", *max as u64, *max as u64 + 1, message)
+        }
+        _ => ErrorReply::new(ErrorCode::InvalidRequest, message),
+    }
+}
+
+fn scenario_error(e: &ScenarioError) -> ErrorReply {
+    let message = e.to_string();
+    match e {
+        ScenarioError::Missing { .. } => ErrorReply::new(ErrorCode::NotFound, message),
+        ScenarioError::Io { .. } => ErrorReply::new(ErrorCode::Internal, message),
+        ScenarioError::Map { .. } => ErrorReply::new(ErrorCode::CorruptFile, message),
+        _ => ErrorReply::new(ErrorCode::InvalidRequest, message),
+    }
+}
+
+async fn answer_control(state: Arc<State>, query: Query) {
+    let request = match reply::decode_request::<SimControl>(&query, MAX_REQUEST_BYTES) {
+        Ok(r) => r,
+        Err(e) => return reply::send_error(&query, &e).await,
+    };
+    let outcome = control(&state, request).await;
+    reply::send_result(&query, outcome.map(|()| state.status())).await;
+}
+
+async fn control(state: &Arc<State>, request: SimControl) -> Result<(), ErrorReply> {
+    match request {
+        SimControl::Load { path, seed } => {
+            let loaded = tokio::task::spawn_blocking(move || {
+                let (name, scenario) =
+                    load_scenario(Some(Path::new(&path))).map_err(|e| scenario_error(&e))?;
+                let sim = Sim::new(&scenario, seed).map_err(|e| sim_error(&e))?;
+                Ok::<_, ErrorReply>((name, sim))
+            })
+            .await
+            .map_err(|e| ErrorReply::new(ErrorCode::Internal, format!("loading failed: {e}")))??;
+            let mut c = state.control();
+            c.scenario = loaded.0;
+            c.sim = loaded.1;
+            c.running = false;
+            c.pending.clear();
+            c.late_steps = 0;
+            c.free_steps = 0;
+        }
+        SimControl::Reset { seed } => {
+            let mut c = state.control();
+            c.sim.reset(seed);
+            c.pending.clear();
+            c.late_steps = 0;
+            c.free_steps = 0;
+        }
+        SimControl::Step { n } => {
+            if n > MAX_STEPS_PER_REQUEST {
+                return Err(ErrorReply::limit(
+                    "max_steps_per_request",
+                    u64::from(MAX_STEPS_PER_REQUEST),
+                    u64::from(n),
+                    format!("ask for at most {MAX_STEPS_PER_REQUEST} steps per request"),
+                ));
+            }
+            if state.control().running {
+                return Err(ErrorReply::new(
+                    ErrorCode::InvalidRequest,
+                    "the sim is free-running; pause it before stepping it in lock-step",
+                ));
+            }
+            for _ in 0..n {
+                let (clock, messages) = step_once(state)?;
+                publish(state, clock, messages).await;
+            }
+        }
+        SimControl::Pause => state.control().running = false,
+        SimControl::Resume { rate } => {
+            check_rate(rate)?;
+            let mut c = state.control();
+            c.running = true;
+            c.rate = rate;
+            c.late_steps = 0;
+            c.free_steps = 0;
+        }
+        SimControl::AddRobot { name, at } => {
+            keys::check_name("robot name", &name)
+                .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
+            state
+                .control()
+                .sim
+                .add_robot(&name, at)
+                .map_err(|e| sim_error(&e))?;
+        }
+        SimControl::RemoveRobot { name } => {
+            let mut c = state.control();
+            c.sim.remove_robot(&name).map_err(|e| sim_error(&e))?;
+            c.pending.remove(&name);
+        }
+        SimControl::Status => {}
+    }
+    Ok(())
+}
