@@ -4,6 +4,7 @@
 
 pub mod bench;
 pub mod bench_planner;
+pub mod bench_sim;
 pub mod report;
 pub mod reproduce_planner;
 pub mod router;

@@ -18,6 +18,19 @@ pub(crate) enum BenchCommand {
         #[arg(long, default_value_t = 20)]
         iterations: usize,
     },
+    /// Many robots at a fixed sim rate publishing their sensors over Zenoh.
+    Sim {
+        #[arg(long)]
+        json: bool,
+        #[arg(long, default_value_t = 100)]
+        robots: usize,
+        /// Steps per second.
+        #[arg(long, default_value_t = 10.0)]
+        rate_hz: f64,
+        /// How long to run, seconds.
+        #[arg(long, default_value_t = 10.0)]
+        seconds: f64,
+    },
     /// The GA per curiosity model (2000 generations, population 200) and the service overhead.
     Planner {
         #[arg(long)]
@@ -65,6 +78,22 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             let result = bench::map(side, iterations, &dir).await;
             let _ = std::fs::remove_dir_all(&dir);
             let result = result?;
+            print_json(&result, json)
+        }
+        BenchCommand::Sim {
+            json,
+            robots,
+            rate_hz,
+            seconds,
+        } => {
+            if robots == 0
+                || robots > roam_sim::sim::MAX_ROBOTS
+                || !(rate_hz.is_finite() && rate_hz > 0.0)
+                || !(seconds.is_finite() && seconds > 0.0)
+            {
+                bail!("--robots must be 1..=1000, --rate-hz and --seconds positive");
+            }
+            let result = roam::bench_sim::sim(robots, rate_hz, seconds).await?;
             print_json(&result, json)
         }
         BenchCommand::Planner { json, runs } => {
