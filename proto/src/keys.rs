@@ -187,6 +187,24 @@ pub fn robot_events(root: &str, robot: &str) -> String {
     format!("{root}/robot/{robot}/events")
 }
 
+/// `<root>/robot/<robot>/estimate`: the localization service publishes a
+/// [`PositionEstimate`](crate::localization::PositionEstimate) for every range scan.
+pub fn robot_estimate(root: &str, robot: &str) -> String {
+    format!("{root}/robot/{robot}/estimate")
+}
+
+/// `<root>/robot/*/ranges`: what the localization service subscribes to.
+pub fn robot_ranges_any(root: &str) -> String {
+    format!("{root}/robot/*/ranges")
+}
+
+/// `<root>/localization/peb`: the localization service answers a `get` carrying a
+/// [`PebQuery`](crate::localization::PebQuery) with a
+/// [`PebReply`](crate::localization::PebReply).
+pub fn localization_peb(root: &str) -> String {
+    format!("{root}/localization/peb")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

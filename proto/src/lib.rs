@@ -10,6 +10,7 @@ pub mod cells;
 pub mod codec;
 pub mod error;
 pub mod keys;
+pub mod localization;
 pub mod map;
 pub mod planner;
 pub mod sim;
