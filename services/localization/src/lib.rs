@@ -1,0 +1,25 @@
+//! roam's localization algorithm (paper 002 §2, Lite & Rinner): TOA ranging with
+//! distance-dependent noise, the weighted least-squares position estimate, the Fisher
+//! information matrix, the Cramér–Rao bound and the position error bound, at a point,
+//! at a list of points and over a grid region.
+//!
+//! Plain Rust over plain types: no Zenoh, no async. The service adapter, the controller's
+//! experiments and the benchmark runner call the same entry points:
+//! [`estimate`] (one position fix) and [`peb_field`] (a PEB layer).
+
+pub mod error;
+pub mod field;
+pub mod fim;
+pub mod model;
+pub mod wls;
+
+pub use error::LocalizationError;
+pub use field::{
+    bounds_at, crb_field, peb_field, peb_gradient, CrbField, GridRegion, PebField,
+    DEFAULT_GRADIENT_STEP_M,
+};
+pub use fim::{bound, bound_from_fim, fim, Bound, FimOptions};
+pub use model::RangingModel;
+pub use nalgebra;
+pub use roam_sim::noise::ToaNoise;
+pub use wls::{estimate, Degraded, Estimate, Range, WlsOptions};
