@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 
 use roam::router::Router;
 use roam::stack::{wait_for_liveliness, wait_until_live};
+use roam_localization::service::LocalizationConfig;
 use roam_map_server::MapServerConfig;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
@@ -195,6 +196,40 @@ impl Harness {
         tokio::select! {
             outcome = &mut live => outcome.expect("sim up"),
             finished = &mut handle => panic!("the sim stopped at start: {finished:?}"),
+        }
+        RunningService { cancel, handle }
+    }
+
+    /// Starts the localization service on a scenario's sensing model and constellation.
+    pub async fn start_localization(&self, scenario: Option<&str>) -> RunningService {
+        let config = LocalizationConfig {
+            root: self.root.clone(),
+            scenario: scenario.map(|s| {
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("..")
+                    .join(s)
+            }),
+            ..LocalizationConfig::default()
+        };
+        let cancel = CancellationToken::new();
+        let token = cancel.clone();
+        let zenoh_config = self.client_config();
+        let handle = tokio::spawn(async move {
+            roam_localization::service::run(config, zenoh_config, token)
+                .await
+                .map_err(|e| e.to_string())
+        });
+        let live = wait_until_live(
+            &self.router.session,
+            &self.root,
+            roam_localization::service::SERVICE_NAME,
+            STEP,
+        );
+        tokio::pin!(live);
+        let mut handle = handle;
+        tokio::select! {
+            outcome = &mut live => outcome.expect("localization up"),
+            finished = &mut handle => panic!("localization stopped at start: {finished:?}"),
         }
         RunningService { cancel, handle }
     }

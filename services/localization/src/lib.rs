@@ -11,6 +11,7 @@ pub mod error;
 pub mod field;
 pub mod fim;
 pub mod model;
+pub mod service;
 pub mod wls;
 
 pub use error::LocalizationError;

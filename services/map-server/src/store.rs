@@ -384,9 +384,9 @@ impl LayerStore {
             }
             return Ok(());
         }
-        if let Some(bad) = non_finite(&cells) {
+        if let Some(bad) = not_a_number(&cells) {
             return Err(StoreError::Invalid(format!(
-                "layer '{name}' cells must be finite numbers, got {bad}"
+                "layer '{name}' cells must be numbers (infinity is allowed), got {bad}"
             )));
         }
         pending.put(self, name, meta, None, cells);
@@ -527,9 +527,11 @@ fn check_meta(meta: &GridMeta) -> Result<(), StoreError> {
     Ok(())
 }
 
-fn non_finite(cells: &Cells) -> Option<f32> {
+/// The first NaN of an f32 layer. Infinity is a value (an unbounded PEB, say); NaN is
+/// never one.
+fn not_a_number(cells: &Cells) -> Option<f32> {
     match cells {
-        Cells::F32(v) => v.iter().copied().find(|c| !c.is_finite()),
+        Cells::F32(v) => v.iter().copied().find(|c| c.is_nan()),
         _ => None,
     }
 }

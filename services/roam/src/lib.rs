@@ -3,8 +3,10 @@
 //! arguments and calls in here, so the integration tests boot exactly what users run.
 
 pub mod bench;
+pub mod bench_localization;
 pub mod bench_planner;
 pub mod bench_sim;
+pub mod peb_picture;
 pub mod report;
 pub mod reproduce_planner;
 pub mod router;

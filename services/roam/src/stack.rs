@@ -1,11 +1,12 @@
 //! `roam stack`: every landed service in one process around an in-process router on
 //! loopback, multicast off. The same shape as a compose stack, so what works here works
 //! across machines. Services landed so far: the map server, the planner and the sim
-//! world (free-running at 1x on the built-in world).
+//! world (free-running at 1x on the built-in world) and localization.
 
 use std::path::PathBuf;
 use std::time::Duration;
 
+use roam_localization::service::LocalizationConfig;
 use roam_map_server::MapServerConfig;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
@@ -31,10 +32,11 @@ pub struct StackOptions {
 }
 
 /// The services `Stack::start` runs, in start order.
-pub const SERVICES: [&str; 3] = [
+pub const SERVICES: [&str; 4] = [
     roam_map_server::SERVICE_NAME,
     roam_planner::SERVICE_NAME,
     roam_sim::service::SERVICE_NAME,
+    roam_localization::service::SERVICE_NAME,
 ];
 
 #[derive(Debug, thiserror::Error)]
@@ -126,6 +128,21 @@ impl Stack {
             let outcome = roam_sim::service::run(sim_config, zenoh_config, token).await;
             (
                 roam_sim::service::SERVICE_NAME,
+                outcome.map_err(|e| e.to_string()),
+            )
+        });
+
+        let localization_config = LocalizationConfig {
+            root: root.clone(),
+            ..LocalizationConfig::default()
+        };
+        let zenoh_config = client.zenoh_config(None)?;
+        let token = cancel.child_token();
+        services.spawn(async move {
+            let outcome =
+                roam_localization::service::run(localization_config, zenoh_config, token).await;
+            (
+                roam_localization::service::SERVICE_NAME,
                 outcome.map_err(|e| e.to_string()),
             )
         });

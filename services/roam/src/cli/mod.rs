@@ -34,6 +34,8 @@ ROLES
   planner      The curious GA planner (paper 000): a path from here to the next task
                that gathers the most information and still arrives within the budget.
                Run several; clients spread plans over the live instances.
+  localization Position estimates from TOA ranges (weighted least squares) with their
+               Cramér-Rao bound and PEB; PEB at points or over a region; a PEB layer.
   sim          The sim world: robots (paper 002's motion model), anchors and TOA
                ranges, moving blocks (paper 004), line-of-sight observations, a clock;
                free-running or in lock-step. `roam sim render` draws a scenario.
@@ -79,6 +81,8 @@ enum Command {
     MapServer(MapServerArgs),
     /// Run a curious GA planner instance (paper 000).
     Planner(PlannerArgs),
+    /// Run the localization / CRB service (paper 002 §2).
+    Localization(roles::LocalizationArgs),
     /// Run the sim world (papers 002 and 004), or `sim render` a scenario to a PNG.
     Sim(sim::SimArgs),
     /// Ask a running planner for a curious path (a client).
@@ -129,6 +133,7 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
         Command::MapServer(args) => roles::map_server(args).await,
         Command::Planner(args) => roles::planner(args).await,
         Command::Sim(args) => sim::sim(args).await,
+        Command::Localization(args) => roles::localization(args).await,
         Command::Plan(args) => plan::plan(args).await,
         Command::Router(args) => roles::router(args).await,
         Command::Stack(args) => roles::stack(args).await,

@@ -200,3 +200,31 @@ pub(crate) async fn stack(args: StackArgs) -> anyhow::Result<()> {
     stack.shutdown().await?;
     Ok(())
 }
+
+#[derive(Debug, Args)]
+pub(crate) struct LocalizationArgs {
+    #[command(flatten)]
+    service: ServiceArgs,
+    /// The scenario whose sensing model and anchors to use (default: the built-in world).
+    #[arg(long, value_name = "PATH")]
+    scenario: Option<PathBuf>,
+}
+
+pub(crate) async fn localization(args: LocalizationArgs) -> anyhow::Result<()> {
+    let mut config: roam_localization::service::LocalizationConfig = match &args.service.config {
+        Some(path) => config_file::load(path)?,
+        None => roam_localization::service::LocalizationConfig::default(),
+    };
+    if let Some(root) = args.service.root {
+        config.root = root;
+    }
+    if args.service.instance.is_some() {
+        config.instance = args.service.instance;
+    }
+    if args.scenario.is_some() {
+        config.scenario = args.scenario;
+    }
+    let zenoh = args.service.session.zenoh_config(config.zenoh.as_ref())?;
+    roam_localization::service::run(config, zenoh, signals::cancel_on_signal()).await?;
+    Ok(())
+}

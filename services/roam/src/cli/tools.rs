@@ -18,6 +18,13 @@ pub(crate) enum BenchCommand {
         #[arg(long, default_value_t = 20)]
         iterations: usize,
     },
+    /// WLS estimates per second with 7 anchors and a 500 x 500 PEB field.
+    Localization {
+        #[arg(long)]
+        json: bool,
+        #[arg(long, default_value_t = 200_000)]
+        estimates: usize,
+    },
     /// Many robots at a fixed sim rate publishing their sensors over Zenoh.
     Sim {
         #[arg(long)]
@@ -78,6 +85,16 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             let result = bench::map(side, iterations, &dir).await;
             let _ = std::fs::remove_dir_all(&dir);
             let result = result?;
+            print_json(&result, json)
+        }
+        BenchCommand::Localization { json, estimates } => {
+            if estimates == 0 {
+                bail!("--estimates must be at least 1");
+            }
+            let result = tokio::task::spawn_blocking(move || {
+                roam::bench_localization::localization(estimates)
+            })
+            .await??;
             print_json(&result, json)
         }
         BenchCommand::Sim {

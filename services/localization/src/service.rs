@@ -1,0 +1,371 @@
+//! The localization service on Zenoh: a thin adapter around [`estimate`] and the PEB
+//! fields.
+//!
+//! | key | kind | payload |
+//! |---|---|---|
+//! | `<root>/robot/*/ranges` | subscription | `range_scan` (from the sim or a robot) |
+//! | `<root>/robot/<id>/estimate` | publication, one per scan | `position_estimate` |
+//! | `<root>/localization/peb` | queryable | `peb_query` → `peb_reply` |
+//! | `<root>/map/update/peb` | query to the map server, once at start | `layer_update` (the PEB layer) |
+//!
+//! A scan names its anchors and their positions, so the estimate uses exactly the
+//! anchors the robot heard; the sensing model (σ, d0, K, range) and the default
+//! constellation for PEB queries come from the configured scenario.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use roam_map_server::scenario::SensingSpec;
+use roam_proto::cells::Cells;
+use roam_proto::localization::{PebAt, PebQuery, PebReply, PebWhere, PositionEstimate};
+use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
+use roam_proto::sim::{NamedPoint, RangeScan};
+use roam_proto::{encode, keys, ErrorCode, ErrorReply};
+use roam_runtime::{reply, Requester, Service, ServiceError};
+use roam_sim::service::load_scenario;
+use serde::Deserialize;
+use tokio_util::sync::CancellationToken;
+use zenoh::query::Query;
+use zenoh::Wait;
+
+use crate::field::{bounds_at, peb_field, peb_gradient, GridRegion, DEFAULT_GRADIENT_STEP_M};
+use crate::fim::FimOptions;
+use crate::model::RangingModel;
+use crate::wls::{estimate, Range, WlsOptions};
+use crate::LocalizationError;
+
+pub const SERVICE_NAME: &str = "localization";
+/// Robots whose last estimate is kept as the next prior.
+pub const MAX_ROBOTS: usize = 1000;
+/// Largest PEB query, bytes.
+pub const MAX_REQUEST_BYTES: usize = 4 * 1024 * 1024;
+/// The name of the layer the service publishes to the map server.
+pub const PEB_LAYER: &str = "peb";
+
+/// The localization service's config file (YAML).
+///
+/// ```yaml
+/// root: roam
+/// scenario: config/scenarios/es1.yaml   # sensing model and constellation; default: built-in world
+/// variance_derivative: true             # include dσ²/dd in the Fisher information
+/// publish_peb_layer: true               # send the PEB field over the map to the map server
+/// ```
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LocalizationConfig {
+    pub root: String,
+    pub instance: Option<String>,
+    pub scenario: Option<PathBuf>,
+    pub variance_derivative: bool,
+    pub publish_peb_layer: bool,
+    pub zenoh: Option<serde_json::Value>,
+}
+
+impl Default for LocalizationConfig {
+    fn default() -> Self {
+        LocalizationConfig {
+            root: keys::DEFAULT_ROOT.to_owned(),
+            instance: None,
+            scenario: None,
+            variance_derivative: true,
+            publish_peb_layer: true,
+            zenoh: None,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum LocalizationServiceError {
+    #[error(transparent)]
+    Service(#[from] ServiceError),
+    #[error(transparent)]
+    Scenario(#[from] roam_map_server::scenario::ScenarioError),
+    #[error("the scenario's sensing model is unusable: {0}")]
+    Model(#[from] LocalizationError),
+}
+
+struct State {
+    root: String,
+    session: zenoh::Session,
+    sensing: SensingSpec,
+    /// The configured constellation, for PEB queries without their own anchors.
+    anchors: Vec<NamedPoint>,
+    map: GridMeta,
+    fim: FimOptions,
+    priors: Mutex<HashMap<String, [f64; 2]>>,
+}
+
+fn model_of(
+    anchors: &[[f64; 2]],
+    sensing: &SensingSpec,
+) -> Result<RangingModel, LocalizationError> {
+    RangingModel::from_spec(anchors, sensing)
+}
+
+fn error_reply(e: &LocalizationError) -> ErrorReply {
+    let message = e.to_string();
+    match e {
+        LocalizationError::TooManyAnchors { count, max } => {
+            ErrorReply::limit("max_anchors", *max as u64, *count as u64, message)
+        }
+        LocalizationError::TooManyPoints { count, max } => {
+            ErrorReply::limit("max_points", *max as u64, *count as u64, message)
+        }
+        LocalizationError::TooManyRanges { count, max } => {
+            ErrorReply::limit("max_ranges", *max as u64, *count as u64, message)
+        }
+        _ => ErrorReply::new(ErrorCode::InvalidRequest, message),
+    }
+}
+
+/// Runs the localization service until `cancel` is cancelled.
+pub async fn run(
+    config: LocalizationConfig,
+    zenoh_config: zenoh::Config,
+    cancel: CancellationToken,
+) -> Result<(), LocalizationServiceError> {
+    let (_, scenario) = load_scenario(config.scenario.as_deref())?;
+    let sensing = scenario.file.sensing;
+    let anchors: Vec<NamedPoint> = scenario
+        .file
+        .anchors
+        .iter()
+        .map(|a| NamedPoint {
+            name: a.name.clone(),
+            at: a.at,
+        })
+        .collect();
+    // Refuse a sensing model that cannot work before going live.
+    model_of(&anchors.iter().map(|a| a.at).collect::<Vec<_>>(), &sensing)?;
+    let mut service = Service::start(
+        SERVICE_NAME,
+        &config.root,
+        config.instance.as_deref(),
+        zenoh_config,
+        cancel,
+    )
+    .await?;
+    let state = Arc::new(State {
+        root: config.root.clone(),
+        session: service.session().clone(),
+        sensing,
+        anchors,
+        map: scenario.occupancy.meta,
+        fim: FimOptions {
+            variance_derivative: config.variance_derivative,
+            ..FimOptions::default()
+        },
+        priors: Mutex::new(HashMap::new()),
+    });
+    service
+        .subscribe(
+            &keys::robot_ranges_any(&config.root),
+            state.clone(),
+            |state: &Arc<State>, scan: RangeScan| on_scan(state, scan),
+        )
+        .await?;
+    let peb = service
+        .declare_queryable(&keys::localization_peb(&config.root))
+        .await?;
+    service.serve(
+        peb,
+        state.clone(),
+        |s, q| async move { answer_peb(s, q).await },
+    );
+    if config.publish_peb_layer {
+        let (state, cancel) = (state.clone(), service.cancel_token());
+        service.spawn(async move { publish_peb_layer(state, cancel).await });
+    }
+    service.announce().await?;
+    service.cancelled().await;
+    service
+        .shutdown(roam_runtime::service::DEFAULT_GRACE)
+        .await?;
+    Ok(())
+}
+
+/// Estimates a robot's position from one scan and publishes it.
+fn on_scan(state: &State, scan: RangeScan) {
+    let positions: Vec<[f64; 2]> = scan.ranges.iter().map(|r| r.at).collect();
+    let model = match model_of(&positions, &state.sensing) {
+        Ok(m) => m,
+        Err(e) => return tracing::warn!(robot = %scan.robot, "ignoring a scan: {e}"),
+    };
+    let ranges: Vec<Range> = scan
+        .ranges
+        .iter()
+        .enumerate()
+        .map(|(anchor, r)| Range {
+            anchor,
+            range_m: r.range_m,
+        })
+        .collect();
+    let prior = state
+        .priors
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .get(&scan.robot)
+        .copied();
+    let options = WlsOptions {
+        fim: state.fim,
+        ..WlsOptions::default()
+    };
+    let result = match estimate(&model, &ranges, prior, &options) {
+        Ok(r) => r,
+        Err(e) => return tracing::warn!(robot = %scan.robot, "ignoring a scan: {e}"),
+    };
+    {
+        let mut priors = state.priors.lock().unwrap_or_else(|p| p.into_inner());
+        if !result.degraded && (priors.len() < MAX_ROBOTS || priors.contains_key(&scan.robot)) {
+            priors.insert(scan.robot.clone(), result.position);
+        }
+    }
+    let finite = result.peb.is_finite();
+    let crb = result.covariance;
+    let message = PositionEstimate {
+        robot: scan.robot.clone(),
+        step: scan.step,
+        time_s: scan.time_s,
+        position: result.position,
+        crb: finite.then(|| [[crb[(0, 0)], crb[(0, 1)]], [crb[(1, 0)], crb[(1, 1)]]]),
+        peb_m: finite.then_some(result.peb),
+        anchors_used: result
+            .anchors_used
+            .iter()
+            .filter_map(|&i| scan.ranges.get(i).map(|r| r.anchor.clone()))
+            .collect(),
+        degraded: result.degraded,
+    };
+    let key = keys::robot_estimate(&state.root, &scan.robot);
+    if let Err(e) = state.session.put(&key, encode(&message)).wait() {
+        tracing::warn!(%key, "publishing the estimate failed: {e}");
+    }
+}
+
+async fn answer_peb(state: Arc<State>, query: Query) {
+    let request = match reply::decode_request::<PebQuery>(&query, MAX_REQUEST_BYTES) {
+        Ok(r) => r,
+        Err(e) => return reply::send_error(&query, &e).await,
+    };
+    let result = tokio::task::spawn_blocking(move || peb_reply(&state, &request))
+        .await
+        .unwrap_or_else(|e| {
+            Err(ErrorReply::new(
+                ErrorCode::Internal,
+                format!("the PEB task failed: {e}"),
+            ))
+        });
+    reply::send_result(&query, result).await;
+}
+
+fn peb_reply(state: &State, request: &PebQuery) -> Result<PebReply, ErrorReply> {
+    let anchors: Vec<[f64; 2]> = request
+        .anchors
+        .as_ref()
+        .unwrap_or(&state.anchors)
+        .iter()
+        .map(|a| a.at)
+        .collect();
+    let model = model_of(&anchors, &state.sensing).map_err(|e| error_reply(&e))?;
+    match &request.at {
+        PebWhere::Points(points) => {
+            let bounds = bounds_at(&model, points, &state.fim).map_err(|e| error_reply(&e))?;
+            let mut out = Vec::with_capacity(points.len());
+            for (p, b) in points.iter().zip(bounds) {
+                let finite = b.peb.is_finite();
+                let gradient = if request.gradient {
+                    peb_gradient(&model, *p, DEFAULT_GRADIENT_STEP_M, &state.fim)
+                        .map_err(|e| error_reply(&e))?
+                } else {
+                    None
+                };
+                out.push(PebAt {
+                    at: *p,
+                    peb_m: finite.then_some(b.peb),
+                    crb: finite.then(|| {
+                        [
+                            [b.crb[(0, 0)], b.crb[(0, 1)]],
+                            [b.crb[(1, 0)], b.crb[(1, 1)]],
+                        ]
+                    }),
+                    gradient,
+                });
+            }
+            Ok(PebReply::Points(out))
+        }
+        PebWhere::Region(meta) => {
+            let field =
+                peb_field(&model, &region_of(meta), &state.fim).map_err(|e| error_reply(&e))?;
+            Ok(PebReply::Field {
+                meta: *meta,
+                cells: Cells::F32(field.peb),
+            })
+        }
+    }
+}
+
+fn region_of(meta: &GridMeta) -> GridRegion {
+    GridRegion {
+        origin: [meta.origin.x, meta.origin.y],
+        resolution_m: meta.resolution,
+        width: meta.width as usize,
+        height: meta.height as usize,
+    }
+}
+
+/// Sends the PEB field over the scenario's map to the map server as layer `peb`,
+/// retrying until a map server answers (or the service stops).
+async fn publish_peb_layer(state: Arc<State>, cancel: CancellationToken) {
+    let anchors: Vec<[f64; 2]> = state.anchors.iter().map(|a| a.at).collect();
+    let field = match model_of(&anchors, &state.sensing)
+        .and_then(|m| peb_field(&m, &region_of(&state.map), &state.fim))
+    {
+        Ok(f) => f,
+        Err(e) => return tracing::warn!("no PEB layer: {e}"),
+    };
+    let meta = GridMeta {
+        origin: Origin {
+            yaw: 0.0,
+            ..state.map.origin
+        },
+        ..state.map
+    };
+    let requester = Requester::new(state.session.clone(), Duration::from_secs(5));
+    loop {
+        let sent = async {
+            let list: LayerList = requester
+                .request::<LayerList, LayerList>(&keys::map_index(&state.root), None)
+                .await?;
+            let base_version = list
+                .layers
+                .iter()
+                .find(|l| l.name == PEB_LAYER)
+                .map_or(0, |l| l.version);
+            let update = LayerUpdate {
+                base_version,
+                change: LayerChange::Replace {
+                    meta,
+                    cells: Cells::F32(field.peb.clone()),
+                },
+            };
+            requester
+                .request::<LayerUpdate, UpdateAck>(
+                    &keys::map_update(&state.root, PEB_LAYER),
+                    Some(&update),
+                )
+                .await
+        };
+        match sent.await {
+            Ok(ack) => {
+                return tracing::info!(version = ack.version, "PEB layer sent to the map server")
+            }
+            Err(e) => tracing::debug!("PEB layer not sent yet: {e}"),
+        }
+        tokio::select! {
+            _ = cancel.cancelled() => return,
+            _ = tokio::time::sleep(Duration::from_secs(1)) => {}
+        }
+    }
+}

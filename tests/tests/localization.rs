@@ -1,0 +1,206 @@
+//! Localization through Zenoh with the sim world: ranges in, estimates out at the sim's
+//! rate; a PEB field query on ES1 and its picture; the PEB layer in the map server.
+
+use roam_proto::cells::Cells;
+use roam_proto::localization::{PebQuery, PebReply, PebWhere, PositionEstimate};
+use roam_proto::map::{GridMeta, Layer, Origin};
+use roam_proto::sim::{GroundTruth, SimControl, SimStatus};
+use roam_proto::{decode, keys, ErrorCode};
+use roam_runtime::ClientError;
+use roam_tests::{within, Harness};
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn ranges_in_estimates_out_at_the_sim_rate() {
+    let harness = Harness::start().await;
+    let sim = harness
+        .start_sim(harness.sim_config(Some("config/scenarios/es1.yaml")))
+        .await;
+    let localization = harness
+        .start_localization(Some("config/scenarios/es1.yaml"))
+        .await;
+    let client = harness.client().await;
+    let root = harness.root.clone();
+    let estimates = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::robot_estimate(&root, "robot")),
+    )
+    .await
+    .expect("sub");
+    let truth = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::robot_truth(&root, "robot")),
+    )
+    .await
+    .expect("sub");
+    let steps = 10;
+    let _: SimStatus = within(
+        "step",
+        client.request(
+            &keys::sim_control(&root),
+            Some(&SimControl::Step { n: steps }),
+        ),
+    )
+    .await
+    .expect("step");
+    for step in 1..=u64::from(steps) {
+        let e: PositionEstimate = decode(
+            &within("estimate", estimates.recv_async())
+                .await
+                .expect("sample")
+                .payload()
+                .to_bytes(),
+        )
+        .expect("estimate");
+        let t: GroundTruth = decode(
+            &within("truth", truth.recv_async())
+                .await
+                .expect("sample")
+                .payload()
+                .to_bytes(),
+        )
+        .expect("truth");
+        assert_eq!(
+            (e.step, t.step),
+            (step, step),
+            "one estimate per scan, in order"
+        );
+        assert!(!e.degraded, "waypoint A is covered by three anchors");
+        let peb = e.peb_m.expect("finite PEB");
+        let error = (e.position[0] - t.at[0]).hypot(e.position[1] - t.at[1]);
+        assert!(
+            error < 5.0 * peb + 0.05,
+            "error {error} m against PEB {peb} m"
+        );
+        assert!(e.anchors_used.len() >= 3);
+    }
+    localization.stop().await.1.expect("clean stop");
+    sim.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_peb_field_on_es1_shows_the_well_covered_area() {
+    let harness = Harness::start().await;
+    let map_server = harness.start_map_server(harness.map_server_config()).await;
+    let localization = harness
+        .start_localization(Some("config/scenarios/es1.yaml"))
+        .await;
+    let client = harness.client().await;
+    let root = harness.root.clone();
+    // ES1 is 70 x 50 m: a 1 m field over it.
+    let meta = GridMeta {
+        width: 70,
+        height: 50,
+        resolution: 1.0,
+        origin: Origin::default(),
+    };
+    let query = PebQuery {
+        at: PebWhere::Region(meta),
+        anchors: None,
+        gradient: false,
+    };
+    let reply: PebReply = within(
+        "peb field",
+        client.request(&keys::localization_peb(&root), Some(&query)),
+    )
+    .await
+    .expect("field");
+    let PebReply::Field {
+        cells: Cells::F32(peb),
+        ..
+    } = reply
+    else {
+        panic!("a field")
+    };
+    assert_eq!(peb.len(), 70 * 50);
+    let at = |x: usize, y: usize| peb[y * 70 + x];
+    assert!(
+        at(10, 16) < 1.0,
+        "waypoint A is well covered: {}",
+        at(10, 16)
+    );
+    let uncovered = peb.iter().filter(|v| v.is_infinite()).count();
+    assert!(
+        uncovered > 0 && uncovered < peb.len(),
+        "ES1 is sparse: {uncovered} uncovered cells"
+    );
+
+    // The picture: covered cells are coloured by PEB, uncovered ones grey.
+    let out = tempfile::tempdir().expect("tmp");
+    let png = out.path().join("peb.png");
+    roam::peb_picture::render(&meta, &peb, 4)
+        .save(&png)
+        .expect("save");
+    let picture = image::open(&png).expect("png").to_rgb8();
+    let pixel = |x: usize, y: usize| *picture.get_pixel(x as u32 * 4 + 2, (49 - y) as u32 * 4 + 2);
+    assert_eq!(
+        pixel(10, 16),
+        roam::peb_picture::colour(at(10, 16)),
+        "A drawn by its PEB"
+    );
+    let (ux, uy) = (0..70 * 50)
+        .find(|&i| peb[i].is_infinite())
+        .map(|i| (i % 70, i / 70))
+        .expect("an uncovered cell");
+    assert_eq!(pixel(ux, uy), roam::peb_picture::UNCOVERED);
+
+    // Points with the gradient, and a refusal.
+    let points = PebQuery {
+        at: PebWhere::Points(vec![[10.0, 16.0], [35.0, 28.0]]),
+        anchors: None,
+        gradient: true,
+    };
+    let PebReply::Points(values) = within(
+        "points",
+        client.request::<PebQuery, PebReply>(&keys::localization_peb(&root), Some(&points)),
+    )
+    .await
+    .expect("points") else {
+        panic!("points")
+    };
+    assert!(values
+        .iter()
+        .all(|v| v.peb_m.is_some() && v.crb.is_some() && v.gradient.is_some()));
+    let bad = PebQuery {
+        at: PebWhere::Points(vec![[f64::NAN, 0.0]]),
+        anchors: None,
+        gradient: false,
+    };
+    match within(
+        "bad",
+        client.request::<PebQuery, PebReply>(&keys::localization_peb(&root), Some(&bad)),
+    )
+    .await
+    {
+        Err(ClientError::Refused(r)) => assert!(
+            matches!(r.code, ErrorCode::InvalidRequest | ErrorCode::Malformed),
+            "{r}"
+        ),
+        other => panic!("{other:?}"),
+    }
+
+    // The PEB layer arrives in the map server.
+    let layer = loop {
+        match within(
+            "peb layer",
+            client.request::<Layer, Layer>(&keys::map_layer(&root, "peb"), None),
+        )
+        .await
+        {
+            Ok(layer) => break layer,
+            Err(_) => tokio::time::sleep(std::time::Duration::from_millis(50)).await,
+        }
+    };
+    assert_eq!(
+        (layer.meta.width, layer.meta.height),
+        (140, 100),
+        "over ES1's 0.5 m map"
+    );
+    localization.stop().await.1.expect("clean stop");
+    map_server.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
