@@ -19,7 +19,8 @@ pub struct PositionEstimate {
     pub time_s: f64,
     /// World metres.
     pub position: [f64; 2],
-    /// The Cramér–Rao bound at the estimate, m² (row-major 2 × 2); `None` when the
+    /// The Cramér–Rao bound at the estimate, m² (row-major 2 × 2), which is also the
+    /// estimate's covariance (WLS attains the bound at convergence); `None` when the
     /// Fisher information is singular.
     pub crb: Option<[[f64; 2]; 2]>,
     /// Position error bound √tr(CRB), metres; `None` when unbounded.
