@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
 use roam::router::Router;
-use roam::stack::{wait_for_liveliness, wait_until_live};
+use roam::stack::wait_for_liveliness;
 use roam_localization::service::LocalizationConfig;
 use roam_map_server::MapServerConfig;
 use roam_planner::PlannerConfig;
@@ -95,6 +95,27 @@ impl Harness {
         Requester::new(session, Duration::from_secs(5))
     }
 
+    /// Starts a service in this process as a client of the router, and waits until the
+    /// liveliness token `live_key` appears. A service that stops before that fails the
+    /// test with its own error.
+    pub async fn start_service<F, Fut, E>(&self, live_key: String, run: F) -> RunningService
+    where
+        F: FnOnce(zenoh::Config, CancellationToken) -> Fut,
+        Fut: std::future::Future<Output = Result<(), E>> + Send + 'static,
+        E: std::fmt::Display,
+    {
+        let cancel = CancellationToken::new();
+        let service = run(self.client_config(), cancel.clone());
+        let mut handle = tokio::spawn(async move { service.await.map_err(|e| e.to_string()) });
+        let live = wait_for_liveliness(&self.router.session, &live_key, STEP);
+        tokio::pin!(live);
+        tokio::select! {
+            outcome = &mut live => outcome.expect("service up"),
+            finished = &mut handle => panic!("the service stopped at start: {finished:?}"),
+        }
+        RunningService { cancel, handle }
+    }
+
     /// A map server config under this harness's root, built-in world, no persistence.
     pub fn map_server_config(&self) -> MapServerConfig {
         MapServerConfig {
@@ -105,27 +126,11 @@ impl Harness {
 
     /// Starts a map server and waits until its liveliness token is seen.
     pub async fn start_map_server(&self, config: MapServerConfig) -> RunningService {
-        let cancel = CancellationToken::new();
-        let token = cancel.clone();
-        let zenoh_config = self.client_config();
-        let handle = tokio::spawn(async move {
-            roam_map_server::run(config, zenoh_config, token)
-                .await
-                .map_err(|e| e.to_string())
-        });
-        let live = wait_until_live(
-            &self.router.session,
-            &self.root,
-            roam_map_server::SERVICE_NAME,
-            STEP,
-        );
-        tokio::pin!(live);
-        let mut handle = handle;
-        tokio::select! {
-            outcome = &mut live => outcome.expect("map server up"),
-            finished = &mut handle => panic!("the map server stopped at start: {finished:?}"),
-        }
-        RunningService { cancel, handle }
+        let key = keys::liveliness_of(&self.root, roam_map_server::SERVICE_NAME);
+        self.start_service(key, |zenoh, cancel| {
+            roam_map_server::run(config, zenoh, cancel)
+        })
+        .await
     }
 
     /// A planner config under this harness's root with the given instance name.
@@ -140,24 +145,12 @@ impl Harness {
     /// Starts a planner and waits for its own liveliness token (it announces itself
     /// once it has a map, so start the map server first).
     pub async fn start_planner(&self, config: PlannerConfig) -> RunningService {
-        let cancel = CancellationToken::new();
-        let token = cancel.clone();
-        let zenoh_config = self.client_config();
         let instance = config.instance.clone().unwrap_or_default();
-        let handle = tokio::spawn(async move {
-            roam_planner::run(config, zenoh_config, token)
-                .await
-                .map_err(|e| e.to_string())
-        });
         let key = keys::liveliness(&self.root, roam_planner::SERVICE_NAME, &instance);
-        let live = wait_for_liveliness(&self.router.session, &key, STEP);
-        tokio::pin!(live);
-        let mut handle = handle;
-        tokio::select! {
-            outcome = &mut live => outcome.expect("planner up"),
-            finished = &mut handle => panic!("the planner stopped at start: {finished:?}"),
-        }
-        RunningService { cancel, handle }
+        self.start_service(key, |zenoh, cancel| {
+            roam_planner::run(config, zenoh, cancel)
+        })
+        .await
     }
 
     /// A sim config under this harness's root: `scenario` (the built-in world when
@@ -177,27 +170,11 @@ impl Harness {
 
     /// Starts the sim world and waits for its liveliness token.
     pub async fn start_sim(&self, config: SimConfig) -> RunningService {
-        let cancel = CancellationToken::new();
-        let token = cancel.clone();
-        let zenoh_config = self.client_config();
-        let handle = tokio::spawn(async move {
-            roam_sim::service::run(config, zenoh_config, token)
-                .await
-                .map_err(|e| e.to_string())
-        });
-        let live = wait_until_live(
-            &self.router.session,
-            &self.root,
-            roam_sim::service::SERVICE_NAME,
-            STEP,
-        );
-        tokio::pin!(live);
-        let mut handle = handle;
-        tokio::select! {
-            outcome = &mut live => outcome.expect("sim up"),
-            finished = &mut handle => panic!("the sim stopped at start: {finished:?}"),
-        }
-        RunningService { cancel, handle }
+        let key = keys::liveliness_of(&self.root, roam_sim::service::SERVICE_NAME);
+        self.start_service(key, |zenoh, cancel| {
+            roam_sim::service::run(config, zenoh, cancel)
+        })
+        .await
     }
 
     /// Starts the localization service on a scenario's sensing model and constellation.
@@ -211,27 +188,11 @@ impl Harness {
             }),
             ..LocalizationConfig::default()
         };
-        let cancel = CancellationToken::new();
-        let token = cancel.clone();
-        let zenoh_config = self.client_config();
-        let handle = tokio::spawn(async move {
-            roam_localization::service::run(config, zenoh_config, token)
-                .await
-                .map_err(|e| e.to_string())
-        });
-        let live = wait_until_live(
-            &self.router.session,
-            &self.root,
-            roam_localization::service::SERVICE_NAME,
-            STEP,
-        );
-        tokio::pin!(live);
-        let mut handle = handle;
-        tokio::select! {
-            outcome = &mut live => outcome.expect("localization up"),
-            finished = &mut handle => panic!("localization stopped at start: {finished:?}"),
-        }
-        RunningService { cancel, handle }
+        let key = keys::liveliness_of(&self.root, roam_localization::service::SERVICE_NAME);
+        self.start_service(key, |zenoh, cancel| {
+            roam_localization::service::run(config, zenoh, cancel)
+        })
+        .await
     }
 
     /// Whether any instance of `service` currently holds a liveliness token.

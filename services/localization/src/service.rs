@@ -179,10 +179,7 @@ pub async fn run(
         service.spawn(async move { publish_peb_layer(state, cancel).await });
     }
     service.announce().await?;
-    service.cancelled().await;
-    service
-        .shutdown(roam_runtime::service::DEFAULT_GRACE)
-        .await?;
+    service.run_until_stopped().await?;
     Ok(())
 }
 

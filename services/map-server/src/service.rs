@@ -182,10 +182,7 @@ pub async fn run(
     });
     service.announce().await?;
 
-    service.cancelled().await;
-    service
-        .shutdown(roam_runtime::service::DEFAULT_GRACE)
-        .await?;
+    service.run_until_stopped().await?;
     Ok(())
 }
 

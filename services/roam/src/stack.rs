@@ -57,6 +57,17 @@ pub enum StackError {
     Liveliness(String),
 }
 
+type ServiceTasks = JoinSet<(&'static str, Result<(), String>)>;
+
+/// Runs one service's future as a task that returns the service's name with its outcome.
+fn spawn<E: std::fmt::Display>(
+    services: &mut ServiceTasks,
+    name: &'static str,
+    run: impl std::future::Future<Output = Result<(), E>> + Send + 'static,
+) {
+    services.spawn(async move { (name, run.await.map_err(|e| e.to_string())) });
+}
+
 /// A running stack.
 #[derive(Debug)]
 pub struct Stack {
@@ -64,7 +75,7 @@ pub struct Stack {
     pub root: String,
     cancel: CancellationToken,
     /// Each service task returns its own name with its outcome.
-    services: JoinSet<(&'static str, Result<(), String>)>,
+    services: ServiceTasks,
 }
 
 impl Stack {
@@ -91,61 +102,49 @@ impl Stack {
             data_dir: options.data_dir.clone(),
             ..MapServerConfig::default()
         };
-        let zenoh_config = client.zenoh_config(None)?;
-        let token = cancel.child_token();
-        services.spawn(async move {
-            let outcome = roam_map_server::run(map_config, zenoh_config, token).await;
-            (
-                roam_map_server::SERVICE_NAME,
-                outcome.map_err(|e| e.to_string()),
-            )
-        });
-
+        spawn(
+            &mut services,
+            roam_map_server::SERVICE_NAME,
+            roam_map_server::run(map_config, client.zenoh_config(None)?, cancel.child_token()),
+        );
         for index in 0..options.planners.max(1) {
             let planner_config = PlannerConfig {
                 root: root.clone(),
                 instance: Some(format!("planner-{index}")),
                 ..PlannerConfig::default()
             };
-            let zenoh_config = client.zenoh_config(None)?;
-            let token = cancel.child_token();
-            services.spawn(async move {
-                let outcome = roam_planner::run(planner_config, zenoh_config, token).await;
-                (
-                    roam_planner::SERVICE_NAME,
-                    outcome.map_err(|e| e.to_string()),
-                )
-            });
+            spawn(
+                &mut services,
+                roam_planner::SERVICE_NAME,
+                roam_planner::run(
+                    planner_config,
+                    client.zenoh_config(None)?,
+                    cancel.child_token(),
+                ),
+            );
         }
-
         let sim_config = SimConfig {
             root: root.clone(),
             ..SimConfig::default()
         };
-        let zenoh_config = client.zenoh_config(None)?;
-        let token = cancel.child_token();
-        services.spawn(async move {
-            let outcome = roam_sim::service::run(sim_config, zenoh_config, token).await;
-            (
-                roam_sim::service::SERVICE_NAME,
-                outcome.map_err(|e| e.to_string()),
-            )
-        });
-
+        spawn(
+            &mut services,
+            roam_sim::service::SERVICE_NAME,
+            roam_sim::service::run(sim_config, client.zenoh_config(None)?, cancel.child_token()),
+        );
         let localization_config = LocalizationConfig {
             root: root.clone(),
             ..LocalizationConfig::default()
         };
-        let zenoh_config = client.zenoh_config(None)?;
-        let token = cancel.child_token();
-        services.spawn(async move {
-            let outcome =
-                roam_localization::service::run(localization_config, zenoh_config, token).await;
-            (
-                roam_localization::service::SERVICE_NAME,
-                outcome.map_err(|e| e.to_string()),
-            )
-        });
+        spawn(
+            &mut services,
+            roam_localization::service::SERVICE_NAME,
+            roam_localization::service::run(
+                localization_config,
+                client.zenoh_config(None)?,
+                cancel.child_token(),
+            ),
+        );
 
         let mut stack = Stack {
             router,

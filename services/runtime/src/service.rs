@@ -268,6 +268,13 @@ impl Service {
         Ok(())
     }
 
+    /// Waits until the service is told to stop, then stops it with the default grace
+    /// period: the tail of every service's `run` that has nothing to do in between.
+    pub async fn run_until_stopped(self) -> Result<(), ServiceError> {
+        self.cancelled().await;
+        self.shutdown(DEFAULT_GRACE).await
+    }
+
     /// Stops the service: cancels its loops, waits up to `grace` for in-flight work,
     /// drops the liveliness token and closes the session. Returns an error naming how
     /// many tasks did not stop in time (the session is closed all the same).

@@ -117,6 +117,58 @@ pub(crate) struct ServiceArgs {
     pub(crate) session: SessionArgs,
 }
 
+/// What every role's config file has: a key root, an instance name, a Zenoh section.
+pub(crate) trait RoleConfig: serde::de::DeserializeOwned + Default {
+    fn root_mut(&mut self) -> &mut String;
+    fn instance_mut(&mut self) -> &mut Option<String>;
+    fn zenoh(&self) -> Option<&serde_json::Value>;
+}
+
+macro_rules! role_config {
+    ($($config:ty),*) => {$(
+        impl RoleConfig for $config {
+            fn root_mut(&mut self) -> &mut String {
+                &mut self.root
+            }
+            fn instance_mut(&mut self) -> &mut Option<String> {
+                &mut self.instance
+            }
+            fn zenoh(&self) -> Option<&serde_json::Value> {
+                self.zenoh.as_ref()
+            }
+        }
+    )*};
+}
+
+role_config!(
+    roam_map_server::MapServerConfig,
+    roam_planner::PlannerConfig,
+    roam_sim::service::SimConfig,
+    roam_localization::service::LocalizationConfig
+);
+
+impl ServiceArgs {
+    /// The role's config: its file (or the defaults), then `--root` and `--instance`.
+    pub(crate) fn load_config<T: RoleConfig>(&self) -> anyhow::Result<T> {
+        let mut config: T = match &self.config {
+            Some(path) => roam_runtime::config_file::load(path)?,
+            None => T::default(),
+        };
+        if let Some(root) = &self.root {
+            *config.root_mut() = root.clone();
+        }
+        if let Some(instance) = &self.instance {
+            *config.instance_mut() = Some(instance.clone());
+        }
+        Ok(config)
+    }
+
+    /// The Zenoh config: the role's file section, `ZENOH_CONFIG`, then the flags.
+    pub(crate) fn zenoh_config<T: RoleConfig>(&self, config: &T) -> anyhow::Result<zenoh::Config> {
+        Ok(self.session.zenoh_config(config.zenoh())?)
+    }
+}
+
 #[derive(Debug, Args)]
 pub(crate) struct ClientArgs {
     #[arg(long, env = "ROAM_ROOT", default_value = keys::DEFAULT_ROOT)]

@@ -10,7 +10,7 @@ use roam::router::Router;
 use roam::stack::{Stack, StackOptions};
 use roam_map_server::{map_file, MapServerConfig};
 use roam_planner::PlannerConfig;
-use roam_runtime::{config_file, signals, Requester, SessionArgs};
+use roam_runtime::{signals, Requester, SessionArgs};
 
 use super::ServiceArgs;
 
@@ -67,43 +67,25 @@ pub(crate) struct StackArgs {
 }
 
 pub(crate) async fn map_server(args: MapServerArgs) -> anyhow::Result<()> {
-    let mut config: MapServerConfig = match &args.service.config {
-        Some(path) => config_file::load(path)?,
-        None => MapServerConfig::default(),
-    };
-    if let Some(root) = args.service.root {
-        config.root = root;
-    }
-    if args.service.instance.is_some() {
-        config.instance = args.service.instance;
-    }
+    let mut config: MapServerConfig = args.service.load_config()?;
     if args.map.is_some() {
         config.map = args.map;
     }
     if args.data_dir.is_some() {
         config.data_dir = args.data_dir;
     }
-    let zenoh = args.service.session.zenoh_config(config.zenoh.as_ref())?;
+    let zenoh = args.service.zenoh_config(&config)?;
     let cancel = signals::cancel_on_signal();
     roam_map_server::run(config, zenoh, cancel).await?;
     Ok(())
 }
 
 pub(crate) async fn planner(args: PlannerArgs) -> anyhow::Result<()> {
-    let mut config: PlannerConfig = match &args.service.config {
-        Some(path) => config_file::load(path)?,
-        None => PlannerConfig::default(),
-    };
-    if let Some(root) = args.service.root {
-        config.root = root;
-    }
-    if args.service.instance.is_some() {
-        config.instance = args.service.instance;
-    }
+    let mut config: PlannerConfig = args.service.load_config()?;
     if let Some(n) = args.max_concurrent_plans {
         config.max_concurrent_plans = n;
     }
-    let zenoh = args.service.session.zenoh_config(config.zenoh.as_ref())?;
+    let zenoh = args.service.zenoh_config(&config)?;
     roam_planner::run(config, zenoh, signals::cancel_on_signal()).await?;
     Ok(())
 }
@@ -211,20 +193,11 @@ pub(crate) struct LocalizationArgs {
 }
 
 pub(crate) async fn localization(args: LocalizationArgs) -> anyhow::Result<()> {
-    let mut config: roam_localization::service::LocalizationConfig = match &args.service.config {
-        Some(path) => config_file::load(path)?,
-        None => roam_localization::service::LocalizationConfig::default(),
-    };
-    if let Some(root) = args.service.root {
-        config.root = root;
-    }
-    if args.service.instance.is_some() {
-        config.instance = args.service.instance;
-    }
+    let mut config: roam_localization::service::LocalizationConfig = args.service.load_config()?;
     if args.scenario.is_some() {
         config.scenario = args.scenario;
     }
-    let zenoh = args.service.session.zenoh_config(config.zenoh.as_ref())?;
+    let zenoh = args.service.zenoh_config(&config)?;
     roam_localization::service::run(config, zenoh, signals::cancel_on_signal()).await?;
     Ok(())
 }

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use roam_runtime::{config_file, signals};
+use roam_runtime::signals;
 use roam_sim::service::{load_scenario, SimConfig};
 use roam_sim::Sim;
 
@@ -61,16 +61,7 @@ pub(crate) async fn sim(args: SimArgs) -> anyhow::Result<()> {
 }
 
 async fn run(args: SimRunArgs) -> anyhow::Result<()> {
-    let mut config: SimConfig = match &args.service.config {
-        Some(path) => config_file::load(path)?,
-        None => SimConfig::default(),
-    };
-    if let Some(root) = args.service.root {
-        config.root = root;
-    }
-    if args.service.instance.is_some() {
-        config.instance = args.service.instance;
-    }
+    let mut config: SimConfig = args.service.load_config()?;
     if args.scenario.is_some() {
         config.scenario = args.scenario;
     }
@@ -82,7 +73,7 @@ async fn run(args: SimRunArgs) -> anyhow::Result<()> {
     } else if args.rate.is_some() {
         config.rate = args.rate;
     }
-    let zenoh = args.service.session.zenoh_config(config.zenoh.as_ref())?;
+    let zenoh = args.service.zenoh_config(&config)?;
     roam_sim::service::run(config, zenoh, signals::cancel_on_signal()).await?;
     Ok(())
 }
