@@ -62,6 +62,9 @@ pub struct PebQuery {
     /// Also return the gradient of PEB at each point (points only).
     #[serde(default)]
     pub gradient: bool,
+    /// Also return the CRB's three distinct entries over a region (regions only).
+    #[serde(default)]
+    pub crb: bool,
 }
 
 impl Message for PebQuery {
@@ -84,11 +87,24 @@ pub struct PebAt {
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum PebReply {
     Points(Vec<PebAt>),
-    /// PEB in metres per cell, f32, infinity where unbounded.
+    /// PEB in metres per cell, f32, infinity where unbounded; with `crb` asked for, the
+    /// CRB's xx, xy and yy entries per cell (m², infinity on the diagonal and 0 off it
+    /// where unbounded).
     Field {
         meta: GridMeta,
         cells: Cells,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        crb: Option<CrbCells>,
     },
+}
+
+/// The CRB over a region, one f32 grid per distinct entry of the 2 × 2 matrix.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CrbCells {
+    pub xx: Cells,
+    pub xy: Cells,
+    pub yy: Cells,
 }
 
 impl Message for PebReply {

@@ -102,6 +102,7 @@ async fn a_peb_field_on_es1_shows_the_well_covered_area() {
         at: PebWhere::Region(meta),
         anchors: None,
         gradient: false,
+        crb: false,
     };
     let reply: PebReply = within(
         "peb field",
@@ -129,6 +130,49 @@ async fn a_peb_field_on_es1_shows_the_well_covered_area() {
         "ES1 is sparse: {uncovered} uncovered cells"
     );
 
+    // The CRB over a small region around A: PEB² is its trace.
+    let small = GridMeta {
+        width: 4,
+        height: 3,
+        resolution: 1.0,
+        origin: Origin {
+            x: 8.0,
+            y: 15.0,
+            yaw: 0.0,
+        },
+    };
+    let crb_query = PebQuery {
+        at: PebWhere::Region(small),
+        anchors: None,
+        gradient: false,
+        crb: true,
+    };
+    let reply: PebReply = within(
+        "crb field",
+        client.request(&keys::localization_peb(&root), Some(&crb_query)),
+    )
+    .await
+    .expect("crb field");
+    let PebReply::Field {
+        cells: Cells::F32(small_peb),
+        crb: Some(crb),
+        ..
+    } = reply
+    else {
+        panic!("a field with the CRB")
+    };
+    let (Cells::F32(xx), Cells::F32(yy)) = (crb.xx, crb.yy) else {
+        panic!("f32 CRB cells")
+    };
+    for i in 0..12 {
+        let trace = xx[i] + yy[i];
+        assert!(
+            (small_peb[i] * small_peb[i] - trace).abs() <= 1e-4 * trace.max(1e-6),
+            "cell {i}: PEB² {} vs tr CRB {trace}",
+            small_peb[i] * small_peb[i]
+        );
+    }
+
     // The picture: covered cells are coloured by PEB, uncovered ones grey.
     let out = tempfile::tempdir().expect("tmp");
     let png = out.path().join("peb.png");
@@ -153,6 +197,7 @@ async fn a_peb_field_on_es1_shows_the_well_covered_area() {
         at: PebWhere::Points(vec![[10.0, 16.0], [35.0, 28.0]]),
         anchors: None,
         gradient: true,
+        crb: false,
     };
     let PebReply::Points(values) = within(
         "points",
@@ -169,6 +214,7 @@ async fn a_peb_field_on_es1_shows_the_well_covered_area() {
         at: PebWhere::Points(vec![[f64::NAN, 0.0]]),
         anchors: None,
         gradient: false,
+        crb: false,
     };
     match within(
         "bad",

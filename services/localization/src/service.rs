@@ -19,7 +19,7 @@ use std::time::Duration;
 
 use roam_map_server::scenario::SensingSpec;
 use roam_proto::cells::Cells;
-use roam_proto::localization::{PebAt, PebQuery, PebReply, PebWhere, PositionEstimate};
+use roam_proto::localization::{CrbCells, PebAt, PebQuery, PebReply, PebWhere, PositionEstimate};
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
 use roam_proto::sim::{NamedPoint, RangeScan};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
@@ -30,7 +30,9 @@ use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
 use zenoh::Wait;
 
-use crate::field::{bounds_at, peb_field, peb_gradient, GridRegion, DEFAULT_GRADIENT_STEP_M};
+use crate::field::{
+    bounds_at, crb_field, peb_field, peb_gradient, GridRegion, DEFAULT_GRADIENT_STEP_M,
+};
 use crate::fim::FimOptions;
 use crate::model::RangingModel;
 use crate::wls::{estimate, Range, WlsOptions};
@@ -292,12 +294,26 @@ fn peb_reply(state: &State, request: &PebQuery) -> Result<PebReply, ErrorReply> 
             }
             Ok(PebReply::Points(out))
         }
+        PebWhere::Region(meta) if request.crb => {
+            let field =
+                crb_field(&model, &region_of(meta), &state.fim).map_err(|e| error_reply(&e))?;
+            Ok(PebReply::Field {
+                meta: *meta,
+                cells: Cells::F32(field.peb),
+                crb: Some(CrbCells {
+                    xx: Cells::F32(field.crb_xx),
+                    xy: Cells::F32(field.crb_xy),
+                    yy: Cells::F32(field.crb_yy),
+                }),
+            })
+        }
         PebWhere::Region(meta) => {
             let field =
                 peb_field(&model, &region_of(meta), &state.fim).map_err(|e| error_reply(&e))?;
             Ok(PebReply::Field {
                 meta: *meta,
                 cells: Cells::F32(field.peb),
+                crb: None,
             })
         }
     }
