@@ -205,6 +205,46 @@ pub fn localization_peb(root: &str) -> String {
     format!("{root}/localization/peb")
 }
 
+/// `<root>/robot/<robot>/mission`: put a [`Mission`](crate::controller::Mission) here
+/// to give the robot's controller its waypoints (replacing any it had).
+pub fn robot_mission(root: &str, robot: &str) -> String {
+    format!("{root}/robot/{robot}/mission")
+}
+
+/// `<root>/robot/*/mission`: what the controller subscribes to.
+pub fn robot_mission_any(root: &str) -> String {
+    format!("{root}/robot/*/mission")
+}
+
+/// `<root>/robot/*/estimate`: what the controller subscribes to.
+pub fn robot_estimate_any(root: &str) -> String {
+    format!("{root}/robot/*/estimate")
+}
+
+/// `<root>/robot/<robot>/controller`: the controller publishes a
+/// [`ControllerStatus`](crate::controller::ControllerStatus) after every estimate and
+/// whenever the mission's state changes.
+pub fn robot_controller(root: &str, robot: &str) -> String {
+    format!("{root}/robot/{robot}/controller")
+}
+
+/// `<root>/robot/*/observation`: what the mapper subscribes to.
+pub fn robot_observation_any(root: &str) -> String {
+    format!("{root}/robot/*/observation")
+}
+
+/// `<root>/robot/<robot>/goal`: the mapper's learner publishes an
+/// [`ExplorationGoal`](crate::mapper::ExplorationGoal) each time it picks one.
+pub fn robot_goal(root: &str, robot: &str) -> String {
+    format!("{root}/robot/{robot}/goal")
+}
+
+/// `<root>/mapper/status`: the mapper answers a `get` (no payload) with a
+/// [`MapperStatus`](crate::mapper::MapperStatus).
+pub fn mapper_status(root: &str) -> String {
+    format!("{root}/mapper/status")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -8,10 +8,12 @@
 
 pub mod cells;
 pub mod codec;
+pub mod controller;
 pub mod error;
 pub mod keys;
 pub mod localization;
 pub mod map;
+pub mod mapper;
 pub mod planner;
 pub mod sim;
 

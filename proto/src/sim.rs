@@ -87,6 +87,10 @@ impl Message for SimClock {
 #[serde(deny_unknown_fields)]
 pub struct RobotCommand {
     pub u: [f64; 2],
+    /// The estimate's step the command answers, when it answers one (the controller sets
+    /// it): lets a lock-step driver know that the command for step k has been sent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<u64>,
 }
 
 impl Message for RobotCommand {
@@ -125,6 +129,9 @@ pub struct LocalObservation {
     pub robot: String,
     pub step: u64,
     pub time_s: f64,
+    /// Where the sensor was, world metres: the pose the window was seen from (paper 004
+    /// maps with known poses; a real sensor message carries its frame's pose the same way).
+    pub at: [f64; 2],
     /// The window's lower-left cell in map coordinates.
     pub x0: u32,
     pub y0: u32,

@@ -444,9 +444,10 @@ mod sim_messages {
 
         #[test]
         fn sensor_messages_round_trip(robot in name(), step in any::<u64>(), time_s in finite(), u in point(), ranges in prop::collection::vec((name(), point(), finite()), 0..6), m in meta(), cells in prop::collection::vec(any::<i8>(), 0..50), events in prop::collection::vec(event(), 0..4)) {
-            round_trips(&RobotCommand { u });
+            round_trips(&RobotCommand { u, step: Some(step) });
+            round_trips(&RobotCommand { u, step: None });
             round_trips(&RangeScan { robot: robot.clone(), step, time_s, ranges: ranges.into_iter().map(|(anchor, at, range_m)| AnchorRange { anchor, at, range_m }).collect() });
-            round_trips(&LocalObservation { robot: robot.clone(), step, time_s, x0: 3, y0: 4, meta: m, cells: Cells::I8(cells) });
+            round_trips(&LocalObservation { robot: robot.clone(), step, time_s, at: u, x0: 3, y0: 4, meta: m, cells: Cells::I8(cells) });
             round_trips(&GroundTruth { robot: robot.clone(), step, time_s, at: u });
             round_trips(&RobotEvents { robot, step, events });
         }
@@ -482,6 +483,46 @@ mod localization_messages {
             round_trips(&PebReply::Points(points.iter().map(|&at| PebAt { at, peb_m: Some(1.0), crb: None, gradient: Some([0.1, -0.2]) }).collect()));
             round_trips(&PebReply::Field { meta: m, cells: Cells::F32(cells.clone()), crb: None });
             round_trips(&PebReply::Field { meta: m, cells: Cells::F32(cells.clone()), crb: Some(roam_proto::localization::CrbCells { xx: Cells::F32(cells.clone()), xy: Cells::F32(cells.clone()), yy: Cells::F32(cells) }) });
+        }
+    }
+}
+
+mod controller_and_mapper_messages {
+    use super::*;
+    use roam_proto::controller::{ControllerStatus, Mission, MissionState};
+    use roam_proto::mapper::{ExplorationGoal, ExplorerStatus, MapperStatus};
+
+    fn state() -> impl Strategy<Value = MissionState> {
+        prop_oneof![
+            Just(MissionState::Idle),
+            Just(MissionState::Active),
+            Just(MissionState::Completed),
+            Just(MissionState::Stuck),
+            Just(MissionState::HaltedPeb),
+            Just(MissionState::HaltedStale),
+            Just(MissionState::StepLimit),
+        ]
+    }
+
+    proptest! {
+        #[test]
+        fn controller_messages_round_trip(id in name(), waypoints in prop::collection::vec([finite(), finite()], 0..6), state in state(), steps in any::<u64>(), peb in prop::option::of(finite()), x in finite()) {
+            let mission = Mission { robot: id.clone(), id: id.clone(), waypoints };
+            round_trips(&mission);
+            round_trips(&ControllerStatus { robot: id.clone(), mission: Some(id), state, waypoint: Some(2), waypoints: 5, distance_left_m: Some(x), steps, estimate_step: Some(steps), peb_m: peb, omega_deg: x, z_isa: x, u: [x, x] });
+        }
+
+        #[test]
+        fn mapper_messages_round_trip(robot in name(), step in any::<u64>(), x in finite(), goal in prop::option::of([finite(), finite()])) {
+            round_trips(&ExplorationGoal { robot: robot.clone(), step, time_s: x, goal: [x, x], strategy: "poisson".into(), episodes: step });
+            round_trips(&MapperStatus { observations: step, map_changes: step, p: x, r: x, layers_sent: 3, explorers: vec![ExplorerStatus { robot, strategy: None, goal, episodes: 1 }] });
+        }
+
+        #[test]
+        fn controller_messages_refuse_garbage_and_versions(id in name(), g in garbage(), v in other_version()) {
+            let m = Mission { robot: id.clone(), id, waypoints: vec![[1.0, 2.0]] };
+            refuses_trailing(&m, &g);
+            refuses_version(&m, v);
         }
     }
 }

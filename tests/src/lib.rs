@@ -11,8 +11,10 @@ use std::time::{Duration, Instant};
 
 use roam::router::Router;
 use roam::stack::wait_for_liveliness;
+use roam_controller::service::ControllerConfig;
 use roam_localization::service::LocalizationConfig;
 use roam_map_server::MapServerConfig;
+use roam_mapper::service::MapperConfig;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
 use roam_runtime::{Requester, SessionArgs};
@@ -29,6 +31,13 @@ pub async fn within<F: IntoFuture>(what: &str, future: F) -> F::Output {
         Ok(value) => value,
         Err(_) => panic!("timed out after {STEP:?}: {what}"),
     }
+}
+
+/// A path in the repository (tests run from the `tests/` crate).
+pub fn repo_path(relative: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(relative)
 }
 
 /// A router and a unique key root for one test.
@@ -158,11 +167,7 @@ impl Harness {
     pub fn sim_config(&self, scenario: Option<&str>) -> SimConfig {
         SimConfig {
             root: self.root.clone(),
-            scenario: scenario.map(|s| {
-                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                    .join("..")
-                    .join(s)
-            }),
+            scenario: scenario.map(repo_path),
             rate: None,
             ..SimConfig::default()
         }
@@ -181,16 +186,46 @@ impl Harness {
     pub async fn start_localization(&self, scenario: Option<&str>) -> RunningService {
         let config = LocalizationConfig {
             root: self.root.clone(),
-            scenario: scenario.map(|s| {
-                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                    .join("..")
-                    .join(s)
-            }),
+            scenario: scenario.map(repo_path),
             ..LocalizationConfig::default()
         };
         let key = keys::liveliness_of(&self.root, roam_localization::service::SERVICE_NAME);
         self.start_service(key, |zenoh, cancel| {
             roam_localization::service::run(config, zenoh, cancel)
+        })
+        .await
+    }
+
+    /// A controller config under this harness's root (built-in world, paper defaults).
+    pub fn controller_config(&self) -> ControllerConfig {
+        ControllerConfig {
+            root: self.root.clone(),
+            ..ControllerConfig::default()
+        }
+    }
+
+    /// Starts the APF controller and waits for its liveliness token.
+    pub async fn start_controller(&self, config: ControllerConfig) -> RunningService {
+        let key = keys::liveliness_of(&self.root, roam_controller::service::SERVICE_NAME);
+        self.start_service(key, |zenoh, cancel| {
+            roam_controller::service::run(config, zenoh, cancel)
+        })
+        .await
+    }
+
+    /// A mapper config under this harness's root (built-in world, drives no robot).
+    pub fn mapper_config(&self) -> MapperConfig {
+        MapperConfig {
+            root: self.root.clone(),
+            ..MapperConfig::default()
+        }
+    }
+
+    /// Starts the change-rate mapper and waits for its liveliness token.
+    pub async fn start_mapper(&self, config: MapperConfig) -> RunningService {
+        let key = keys::liveliness_of(&self.root, roam_mapper::service::SERVICE_NAME);
+        self.start_service(key, |zenoh, cancel| {
+            roam_mapper::service::run(config, zenoh, cancel)
         })
         .await
     }

@@ -60,7 +60,7 @@ async fn command(client: &Requester, root: &str, robot: &str, u: [f64; 2]) {
         "command",
         client.session().put(
             keys::robot_command(root, robot),
-            encode(&RobotCommand { u }),
+            encode(&RobotCommand { u, step: None }),
         ),
     )
     .await

@@ -5,6 +5,7 @@
 //!
 //! Plain Rust over plain types: no Zenoh, no async. The service adapter, the controller's
 //! experiments and the benchmark runner call the same entry points:
+//! [`Tracker::on_scan`] (one position fix per range scan, from the robot's last fix),
 //! [`estimate`] (one position fix) and [`peb_field`] (a PEB layer).
 
 pub mod error;
@@ -12,6 +13,7 @@ pub mod field;
 pub mod fim;
 pub mod model;
 pub mod service;
+pub mod tracker;
 pub mod wls;
 
 pub use error::LocalizationError;
@@ -23,4 +25,5 @@ pub use fim::{bound, bound_from_fim, fim, Bound, FimOptions};
 pub use model::RangingModel;
 pub use nalgebra;
 pub use roam_sim::noise::ToaNoise;
+pub use tracker::Tracker;
 pub use wls::{estimate, Degraded, Estimate, Range, WlsOptions};

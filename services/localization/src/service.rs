@@ -1,5 +1,5 @@
-//! The localization service on Zenoh: a thin adapter around [`estimate`] and the PEB
-//! fields.
+//! The localization service on Zenoh: a thin adapter around [`Tracker`] (one estimate
+//! per range scan) and the PEB fields.
 //!
 //! | key | kind | payload |
 //! |---|---|---|
@@ -12,14 +12,13 @@
 //! anchors the robot heard; the sensing model (σ, d0, K, range) and the default
 //! constellation for PEB queries come from the configured scenario.
 
-use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use roam_map_server::scenario::SensingSpec;
 use roam_proto::cells::Cells;
-use roam_proto::localization::{CrbCells, PebAt, PebQuery, PebReply, PebWhere, PositionEstimate};
+use roam_proto::localization::{CrbCells, PebAt, PebQuery, PebReply, PebWhere};
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
 use roam_proto::sim::{NamedPoint, RangeScan};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
@@ -35,12 +34,12 @@ use crate::field::{
 };
 use crate::fim::FimOptions;
 use crate::model::RangingModel;
-use crate::wls::{estimate, Range, WlsOptions};
+use crate::tracker::Tracker;
 use crate::LocalizationError;
 
 pub const SERVICE_NAME: &str = "localization";
 /// Robots whose last estimate is kept as the next prior.
-pub const MAX_ROBOTS: usize = 1000;
+pub use crate::tracker::MAX_ROBOTS;
 /// Largest PEB query, bytes.
 pub const MAX_REQUEST_BYTES: usize = 4 * 1024 * 1024;
 /// The name of the layer the service publishes to the map server.
@@ -96,7 +95,8 @@ struct State {
     anchors: Vec<NamedPoint>,
     map: GridMeta,
     fim: FimOptions,
-    priors: Mutex<HashMap<String, [f64; 2]>>,
+    /// Per-robot priors: the one estimation code path the batch episodes share.
+    tracker: Mutex<Tracker>,
 }
 
 fn model_of(
@@ -149,17 +149,18 @@ pub async fn run(
         cancel,
     )
     .await?;
+    let fim = FimOptions {
+        variance_derivative: config.variance_derivative,
+        ..FimOptions::default()
+    };
     let state = Arc::new(State {
         root: config.root.clone(),
         session: service.session().clone(),
         sensing,
         anchors,
         map: scenario.occupancy.meta,
-        fim: FimOptions {
-            variance_derivative: config.variance_derivative,
-            ..FimOptions::default()
-        },
-        priors: Mutex::new(HashMap::new()),
+        fim,
+        tracker: Mutex::new(Tracker::new(sensing, fim)),
     });
     service
         .subscribe(
@@ -185,57 +186,16 @@ pub async fn run(
     Ok(())
 }
 
-/// Estimates a robot's position from one scan and publishes it.
+/// Estimates a robot's position from one scan ([`Tracker::on_scan`]) and publishes it.
 fn on_scan(state: &State, scan: RangeScan) {
-    let positions: Vec<[f64; 2]> = scan.ranges.iter().map(|r| r.at).collect();
-    let model = match model_of(&positions, &state.sensing) {
-        Ok(m) => m,
-        Err(e) => return tracing::warn!(robot = %scan.robot, "ignoring a scan: {e}"),
-    };
-    let ranges: Vec<Range> = scan
-        .ranges
-        .iter()
-        .enumerate()
-        .map(|(anchor, r)| Range {
-            anchor,
-            range_m: r.range_m,
-        })
-        .collect();
-    let prior = state
-        .priors
+    let message = match state
+        .tracker
         .lock()
         .unwrap_or_else(|p| p.into_inner())
-        .get(&scan.robot)
-        .copied();
-    let options = WlsOptions {
-        fim: state.fim,
-        ..WlsOptions::default()
-    };
-    let result = match estimate(&model, &ranges, prior, &options) {
-        Ok(r) => r,
-        Err(e) => return tracing::warn!(robot = %scan.robot, "ignoring a scan: {e}"),
-    };
+        .on_scan(&scan)
     {
-        let mut priors = state.priors.lock().unwrap_or_else(|p| p.into_inner());
-        if !result.degraded && (priors.len() < MAX_ROBOTS || priors.contains_key(&scan.robot)) {
-            priors.insert(scan.robot.clone(), result.position);
-        }
-    }
-    let finite = result.peb.is_finite();
-    let crb = result.covariance;
-    let message = PositionEstimate {
-        robot: scan.robot.clone(),
-        step: scan.step,
-        time_s: scan.time_s,
-        position: result.position,
-        crb: finite.then(|| [[crb[(0, 0)], crb[(0, 1)]], [crb[(1, 0)], crb[(1, 1)]]]),
-        peb_m: finite.then_some(result.peb),
-        anchors_used: result
-            .anchors_used
-            .iter()
-            .filter_map(|&i| scan.ranges.get(i).map(|r| r.anchor.clone()))
-            .collect(),
-        degraded: result.degraded,
+        Ok(m) => m,
+        Err(e) => return tracing::warn!(robot = %scan.robot, "ignoring a scan: {e}"),
     };
     let key = keys::robot_estimate(&state.root, &scan.robot);
     if let Err(e) = state.session.put(&key, encode(&message)).wait() {

@@ -8,6 +8,7 @@ pub mod bench_planner;
 pub mod bench_sim;
 pub mod peb_picture;
 pub mod report;
+pub mod reproduce_apf;
 pub mod reproduce_planner;
 pub mod router;
 pub mod stack;

@@ -1,13 +1,16 @@
 //! `roam stack`: every landed service in one process around an in-process router on
 //! loopback, multicast off. The same shape as a compose stack, so what works here works
-//! across machines. Services landed so far: the map server, the planner and the sim
-//! world (free-running at 1x on the built-in world) and localization.
+//! across machines: the map server, the planner, the sim world (free-running at 1x on the
+//! built-in world), localization, the APF controller (drives a robot once it is given a
+//! mission) and the change-rate mapper (maps; drives no robot unless configured to).
 
 use std::path::PathBuf;
 use std::time::Duration;
 
+use roam_controller::service::ControllerConfig;
 use roam_localization::service::LocalizationConfig;
 use roam_map_server::MapServerConfig;
+use roam_mapper::service::MapperConfig;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
 use roam_runtime::SessionArgs;
@@ -32,11 +35,13 @@ pub struct StackOptions {
 }
 
 /// The services `Stack::start` runs, in start order.
-pub const SERVICES: [&str; 4] = [
+pub const SERVICES: [&str; 6] = [
     roam_map_server::SERVICE_NAME,
     roam_planner::SERVICE_NAME,
     roam_sim::service::SERVICE_NAME,
     roam_localization::service::SERVICE_NAME,
+    roam_controller::service::SERVICE_NAME,
+    roam_mapper::service::SERVICE_NAME,
 ];
 
 #[derive(Debug, thiserror::Error)]
@@ -141,6 +146,33 @@ impl Stack {
             roam_localization::service::SERVICE_NAME,
             roam_localization::service::run(
                 localization_config,
+                client.zenoh_config(None)?,
+                cancel.child_token(),
+            ),
+        );
+
+        let controller_config = ControllerConfig {
+            root: root.clone(),
+            ..ControllerConfig::default()
+        };
+        spawn(
+            &mut services,
+            roam_controller::service::SERVICE_NAME,
+            roam_controller::service::run(
+                controller_config,
+                client.zenoh_config(None)?,
+                cancel.child_token(),
+            ),
+        );
+        let mapper_config = MapperConfig {
+            root: root.clone(),
+            ..MapperConfig::default()
+        };
+        spawn(
+            &mut services,
+            roam_mapper::service::SERVICE_NAME,
+            roam_mapper::service::run(
+                mapper_config,
                 client.zenoh_config(None)?,
                 cancel.child_token(),
             ),

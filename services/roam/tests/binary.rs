@@ -485,3 +485,121 @@ fn every_shipped_scenario_renders_and_es1_shows_anchor_wall_and_robot() {
         "the west wall"
     );
 }
+
+#[test]
+fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
+    let out = tempfile::tempdir().expect("tmp");
+    let output = Command::new(ROAM)
+        .args([
+            "reproduce",
+            "apf",
+            "--json",
+            "--es1-runs",
+            "2",
+            "--es2-runs",
+            "1",
+            "--es3-missions",
+            "1",
+            "--es3-runs",
+            "1",
+            "--out",
+        ])
+        .arg(out.path())
+        .output()
+        .expect("run");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
+    let es1 = value["es1"].as_array().expect("es1");
+    let schemes: Vec<&str> = es1.iter().filter_map(|r| r["scheme"].as_str()).collect();
+    assert_eq!(
+        schemes,
+        ["plain", "fixed", "cutoff", "linear", "sinusoidal"]
+    );
+    for row in es1 {
+        for field in ["success_rate", "rmse_m", "steps", "distance_m"] {
+            assert!(row.get(field).is_some(), "{field} missing in {row}");
+        }
+    }
+    let es2 = value["es2"].as_array().expect("es2");
+    assert_eq!(es2.len(), 4 * 10, "four IS schemes × z_is 0.0..0.9");
+    assert!(es2
+        .iter()
+        .all(|r| r["steps"].as_f64().is_some() && r["z_is"].as_f64().is_some()));
+    let es3 = value["es3"].as_array().expect("es3");
+    for row in es3 {
+        for field in ["rmse_change_pct", "steps_change_pct", "distance_change_pct"] {
+            assert!(row.get(field).is_some(), "{field} missing in {row}");
+        }
+    }
+    for picture in [
+        "es1_trajectories.png",
+        "es2_trajectories.png",
+        "es2_steps.png",
+        "es2_distance.png",
+    ] {
+        let image = image::open(out.path().join(picture)).expect(picture);
+        assert!(image.width() > 100 && image.height() > 100);
+    }
+    assert!(
+        String::from_utf8_lossy(&output.stderr).contains("es3: 5/5 runs"),
+        "progress on stderr"
+    );
+}
+
+#[test]
+fn reproduce_mapper_prints_the_three_strategies_and_draws_fig_3() {
+    let out = tempfile::tempdir().expect("tmp");
+    let output = Command::new(ROAM)
+        .args([
+            "reproduce",
+            "mapper",
+            "--json",
+            "--repetitions",
+            "1",
+            "--steps",
+            "300",
+            "--out",
+        ])
+        .arg(out.path())
+        .output()
+        .expect("run");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
+    let strategies = value["strategies"].as_array().expect("strategies");
+    let names: Vec<&str> = strategies
+        .iter()
+        .filter_map(|s| s["name"].as_str())
+        .collect();
+    assert_eq!(names.len(), 3, "{names:?}");
+    for s in strategies {
+        assert!(s["rate_error_auc"].as_f64().expect("auc") > 0.0);
+        let quality = s["final_map_quality"].as_f64().expect("quality");
+        assert!((0.0..=1.0).contains(&quality));
+    }
+    let image = image::open(out.path().join("mapper_fig3.png")).expect("figure");
+    assert!(image.width() > 100);
+}
+
+#[test]
+fn bench_mapper_prints_updates_per_second() {
+    let output = Command::new(ROAM)
+        .args(["bench", "mapper", "--json", "--updates", "50"])
+        .output()
+        .expect("run");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
+    assert_eq!(value["map_cells"], 1_000_000);
+    assert!(value["updates_with_features_per_s"].as_f64().expect("rate") > 0.0);
+}

@@ -95,6 +95,7 @@ pub fn robot_messages(sim: &Sim, step: u64, time_s: f64, report: &RobotReport) -
             robot: report.name.clone(),
             step,
             time_s,
+            at: report.readings.truth,
             x0: o.x0,
             y0: o.y0,
             meta: GridMeta {

@@ -36,6 +36,13 @@ ROLES
                Run several; clients spread plans over the live instances.
   localization Position estimates from TOA ranges (weighted least squares) with their
                Cramér-Rao bound and PEB; PEB at points or over a region; a PEB layer.
+  controller   The APF controller (paper 002 §3): attractive, repulsive and
+               information-seeking forces with adaptive weights; follows a mission's
+               waypoints from the position estimates; halts on stale estimates or a
+               lost fix and reports local minima.
+  mapper       The change-rate mapper (paper 004): two Poisson processes per cell,
+               change-probability, rate and recency layers to the map server; with
+               --explore, the curious learner drives robots to where the world changes.
   sim          The sim world: robots (paper 002's motion model), anchors and TOA
                ranges, moving blocks (paper 004), line-of-sight observations, a clock;
                free-running or in lock-step. `roam sim render` draws a scenario.
@@ -83,6 +90,10 @@ enum Command {
     Planner(PlannerArgs),
     /// Run the localization / CRB service (paper 002 §2).
     Localization(roles::LocalizationArgs),
+    /// Run the APF controller with adaptive information seeking (paper 002 §3).
+    Controller(roles::ControllerArgs),
+    /// Run the change-rate mapper and the curious exploration learner (paper 004).
+    Mapper(roles::MapperArgs),
     /// Run the sim world (papers 002 and 004), or `sim render` a scenario to a PNG.
     Sim(sim::SimArgs),
     /// Ask a running planner for a curious path (a client).
@@ -144,7 +155,9 @@ role_config!(
     roam_map_server::MapServerConfig,
     roam_planner::PlannerConfig,
     roam_sim::service::SimConfig,
-    roam_localization::service::LocalizationConfig
+    roam_localization::service::LocalizationConfig,
+    roam_controller::service::ControllerConfig,
+    roam_mapper::service::MapperConfig
 );
 
 impl ServiceArgs {
@@ -186,6 +199,8 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Planner(args) => roles::planner(args).await,
         Command::Sim(args) => sim::sim(args).await,
         Command::Localization(args) => roles::localization(args).await,
+        Command::Controller(args) => roles::controller(args).await,
+        Command::Mapper(args) => roles::mapper(args).await,
         Command::Plan(args) => plan::plan(args).await,
         Command::Router(args) => roles::router(args).await,
         Command::Stack(args) => roles::stack(args).await,

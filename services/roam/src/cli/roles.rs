@@ -192,6 +192,86 @@ pub(crate) struct LocalizationArgs {
     scenario: Option<PathBuf>,
 }
 
+#[derive(Debug, Args)]
+pub(crate) struct ControllerArgs {
+    #[command(flatten)]
+    service: ServiceArgs,
+    /// The scenario whose obstacles, anchors and sensing model to use (default: the
+    /// built-in world).
+    #[arg(long, value_name = "PATH")]
+    scenario: Option<PathBuf>,
+    /// The information-seeking weighting scheme (paper 002 Eq. 2).
+    #[arg(long, value_enum)]
+    scheme: Option<SchemeArg>,
+    /// The information-seeking weight z_is.
+    #[arg(long)]
+    z_is: Option<f64>,
+}
+
+/// Paper 002's weighting schemes, as the command line spells them.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub(crate) enum SchemeArg {
+    Plain,
+    Fixed,
+    Cutoff,
+    Linear,
+    Sinusoidal,
+}
+
+impl From<SchemeArg> for roam_controller::weights::Scheme {
+    fn from(s: SchemeArg) -> Self {
+        use roam_controller::weights::Scheme;
+        match s {
+            SchemeArg::Plain => Scheme::Plain,
+            SchemeArg::Fixed => Scheme::Fixed,
+            SchemeArg::Cutoff => Scheme::Cutoff,
+            SchemeArg::Linear => Scheme::Linear,
+            SchemeArg::Sinusoidal => Scheme::Sinusoidal,
+        }
+    }
+}
+
+pub(crate) async fn controller(args: ControllerArgs) -> anyhow::Result<()> {
+    let mut config: roam_controller::service::ControllerConfig = args.service.load_config()?;
+    if args.scenario.is_some() {
+        config.scenario = args.scenario;
+    }
+    if let Some(scheme) = args.scheme {
+        config.apf.scheme = scheme.into();
+    }
+    if let Some(z_is) = args.z_is {
+        config.apf.z_is = z_is;
+    }
+    let zenoh = args.service.zenoh_config(&config)?;
+    roam_controller::service::run(config, zenoh, signals::cancel_on_signal()).await?;
+    Ok(())
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct MapperArgs {
+    #[command(flatten)]
+    service: ServiceArgs,
+    /// The scenario whose map the change layers cover (default: the built-in world).
+    #[arg(long, value_name = "PATH")]
+    scenario: Option<PathBuf>,
+    /// A robot the learner drives (paper 004's curious exploration); repeat for more.
+    #[arg(long, value_name = "ROBOT")]
+    explore: Vec<String>,
+}
+
+pub(crate) async fn mapper(args: MapperArgs) -> anyhow::Result<()> {
+    let mut config: roam_mapper::service::MapperConfig = args.service.load_config()?;
+    if args.scenario.is_some() {
+        config.scenario = args.scenario;
+    }
+    if !args.explore.is_empty() {
+        config.explore = args.explore;
+    }
+    let zenoh = args.service.zenoh_config(&config)?;
+    roam_mapper::service::run(config, zenoh, signals::cancel_on_signal()).await?;
+    Ok(())
+}
+
 pub(crate) async fn localization(args: LocalizationArgs) -> anyhow::Result<()> {
     let mut config: roam_localization::service::LocalizationConfig = args.service.load_config()?;
     if args.scenario.is_some() {

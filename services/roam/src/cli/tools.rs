@@ -38,6 +38,17 @@ pub(crate) enum BenchCommand {
         #[arg(long, default_value_t = 10.0)]
         seconds: f64,
     },
+    /// Change-map observation updates per second on a 1000 x 1000 map (paper 004 §3).
+    Mapper {
+        #[arg(long)]
+        json: bool,
+        /// Map side in cells.
+        #[arg(long, default_value_t = 1000)]
+        side: u32,
+        /// Observation updates to run.
+        #[arg(long, default_value_t = 4000)]
+        updates: u64,
+    },
     /// The GA per curiosity model (2000 generations, population 200) and the service overhead.
     Planner {
         #[arg(long)]
@@ -50,6 +61,47 @@ pub(crate) enum BenchCommand {
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum ReproduceCommand {
+    /// Paper 002 §4: ES1-ES3 for plain APF and the fixed, cutoff, linear and sinusoidal
+    /// information-seeking weights.
+    Apf {
+        /// Print {"es1": [...], "es2": [...], "es3": [...]} as JSON.
+        #[arg(long)]
+        json: bool,
+        /// ES1 runs per scheme (the paper: 100).
+        #[arg(long, default_value_t = roam_controller::experiments::DEFAULT_ES1_RUNS)]
+        es1_runs: usize,
+        /// ES2 runs per scheme and z_is.
+        #[arg(long, default_value_t = roam_controller::experiments::DEFAULT_ES2_RUNS)]
+        es2_runs: usize,
+        /// ES3 random missions (the paper: 10).
+        #[arg(long, default_value_t = roam_controller::experiments::DEFAULT_ES3_MISSIONS)]
+        es3_missions: usize,
+        /// ES3 runs per mission (the paper: 100).
+        #[arg(long, default_value_t = roam_controller::experiments::DEFAULT_ES3_RUNS)]
+        es3_runs: usize,
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Where the trajectory and chart pictures go.
+        #[arg(long, default_value = "roam-reproduce/apf")]
+        out: PathBuf,
+    },
+    /// Paper 004 §5: curious vs recency-only vs Poisson-only mapping on the grid world.
+    Mapper {
+        /// Print {"strategies": [{"name", "rate_error_auc", "final_map_quality"}], ...}.
+        #[arg(long)]
+        json: bool,
+        /// Runs per strategy (the paper: 5).
+        #[arg(long, default_value_t = 5)]
+        repetitions: usize,
+        /// Steps per run (one second of sim time each).
+        #[arg(long, default_value_t = roam_mapper::experiment::DEFAULT_STEPS)]
+        steps: u64,
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Where the Fig. 3-like picture goes.
+        #[arg(long, default_value = "roam-reproduce/mapper")]
+        out: PathBuf,
+    },
     /// Paper 000 §III: Models 0 / I / II, two goals, three t_plan/t_exec ratios.
     Planner {
         /// Print {"rows": [...], "comparisons": [...], "pictures": [...]} as JSON.
@@ -113,6 +165,23 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             let result = roam::bench_sim::sim(robots, rate_hz, seconds).await?;
             print_json(&result, json)
         }
+        BenchCommand::Mapper {
+            json,
+            side,
+            updates,
+        } => {
+            if updates == 0 || !(128..=2048).contains(&side) {
+                bail!("--updates must be at least 1 and --side 128..=2048 cells");
+            }
+            let options = roam_mapper::bench::BenchOptions {
+                map_cells: side,
+                updates,
+                ..roam_mapper::bench::BenchOptions::default()
+            };
+            let result =
+                tokio::task::spawn_blocking(move || roam_mapper::bench::bench(&options)).await??;
+            print_json(&result, json)
+        }
         BenchCommand::Planner { json, runs } => {
             if runs == 0 {
                 bail!("--runs must be at least 1");
@@ -125,6 +194,89 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
 
 pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
     match command {
+        ReproduceCommand::Apf {
+            json,
+            es1_runs,
+            es2_runs,
+            es3_missions,
+            es3_runs,
+            seed,
+            out,
+        } => {
+            if es1_runs == 0 || es2_runs == 0 || es3_missions == 0 || es3_runs == 0 {
+                bail!("--es1-runs, --es2-runs, --es3-missions and --es3-runs must be at least 1");
+            }
+            let (result, pictures) = tokio::task::spawn_blocking(move || {
+                roam::reproduce_apf::run(&roam::reproduce_apf::Sizes {
+                    es1_runs,
+                    es2_runs,
+                    es3_missions,
+                    es3_runs,
+                    seed,
+                    out_dir: out,
+                })
+            })
+            .await??;
+            if json {
+                println!("{}", serde_json::to_string(&result)?);
+            } else {
+                print!(
+                    "{}",
+                    roam_controller::experiments::paper::comparison_table(&result)
+                );
+                for picture in pictures {
+                    println!("picture: {}", picture.display());
+                }
+            }
+            Ok(())
+        }
+        ReproduceCommand::Mapper {
+            json,
+            repetitions,
+            steps,
+            seed,
+            out,
+        } => {
+            if repetitions == 0 || steps == 0 {
+                bail!("--repetitions and --steps must be at least 1");
+            }
+            let options = roam_mapper::experiment::ExperimentOptions {
+                repetitions,
+                steps,
+                seed,
+                ..roam_mapper::experiment::ExperimentOptions::default()
+            };
+            let (result, picture) = tokio::task::spawn_blocking(move || {
+                let scenario = roam_mapper::experiment::grid004()?;
+                let progress = |p: roam_mapper::experiment::Progress| {
+                    eprint!(
+                        "\rpaper 004: run {}/{} ({} #{})   ",
+                        p.done,
+                        p.total,
+                        p.mode.as_str(),
+                        p.repetition + 1
+                    );
+                };
+                let result = roam_mapper::experiment::run(
+                    roam_mapper::experiment::GRID004_NAME,
+                    &scenario,
+                    &options,
+                    &progress,
+                )?;
+                eprintln!();
+                std::fs::create_dir_all(&out)?;
+                let picture = roam_mapper::plot::write_figure(&scenario, &result, &out)?;
+                anyhow::Ok((result, picture))
+            })
+            .await??;
+            if json {
+                println!("{}", serde_json::to_string(&result)?);
+            } else {
+                print!("{}", roam_mapper::experiment::table(&result));
+                println!("picture: {}", picture.display());
+            }
+            Ok(())
+        }
         ReproduceCommand::Planner {
             json,
             runs,

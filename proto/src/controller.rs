@@ -1,0 +1,82 @@
+//! Messages of the APF controller (paper 002 §3): the mission a robot is given and the
+//! controller's report on it.
+
+use serde::{Deserialize, Serialize};
+
+use crate::codec::Message;
+
+/// The most waypoints one mission may hold.
+pub const MAX_WAYPOINTS: usize = 10_000;
+
+/// A mission for one robot, put on `<root>/robot/<id>/mission`: visit the waypoints in
+/// order. A new mission replaces the current one at once; an empty one stops the robot.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Mission {
+    /// The robot, as in the key.
+    pub robot: String,
+    /// The sender's name for the mission, echoed in every status.
+    pub id: String,
+    /// World metres.
+    pub waypoints: Vec<[f64; 2]>,
+}
+
+impl Message for Mission {
+    const KIND: &'static str = "mission";
+}
+
+/// Where a mission stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MissionState {
+    /// No mission (or an empty one).
+    Idle,
+    /// Driving to the current waypoint.
+    Active,
+    /// Every waypoint was reached.
+    Completed,
+    /// No progress toward the waypoint over the controller's window: a local minimum of
+    /// the potential field, or an oscillation. The robot is held until a new mission.
+    Stuck,
+    /// The PEB at the estimate is above the configured bound (or unbounded: the fix is
+    /// lost). The robot is held while it lasts.
+    HaltedPeb,
+    /// No estimate arrived for the configured time. The robot is held until one does.
+    HaltedStale,
+    /// The mission used up the controller's step limit.
+    StepLimit,
+}
+
+/// The controller's report on a robot's mission, on `<root>/robot/<id>/controller`, after
+/// every estimate and whenever the state changes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerStatus {
+    pub robot: String,
+    /// The mission's id; `None` before the first mission.
+    pub mission: Option<String>,
+    pub state: MissionState,
+    /// Index of the current waypoint; `None` when there is none.
+    pub waypoint: Option<usize>,
+    pub waypoints: usize,
+    /// Distance left along the remaining legs from the estimate, metres; `None` until
+    /// the mission's first estimate.
+    pub distance_left_m: Option<f64>,
+    /// Commands sent for this mission.
+    pub steps: u64,
+    /// The step of the last estimate used.
+    pub estimate_step: Option<u64>,
+    /// The PEB of that estimate; `None` when unbounded or when there is none.
+    pub peb_m: Option<f64>,
+    /// The angle between the attractive and the information-seeking force, degrees
+    /// (paper 002 Eq. 2's ω).
+    pub omega_deg: f64,
+    /// The information-seeking weight used, z_isa(ω) (paper 002 Eq. 2).
+    pub z_isa: f64,
+    /// The command sent, u of paper 002 Eq. 3.
+    pub u: [f64; 2],
+}
+
+impl Message for ControllerStatus {
+    const KIND: &'static str = "controller_status";
+}

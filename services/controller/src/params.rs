@@ -1,0 +1,282 @@
+//! The controller's parameters: paper 002 §4's values are the defaults, and roam's safety
+//! parameters (not in the paper) say when a mission is given up. Every value is checked
+//! by [`ApfParams::check`], which names the parameter and its allowed range.
+
+use serde::Deserialize;
+
+use crate::weights::Scheme;
+
+/// Paper 002 §4: z_a = 1.0.
+pub const DEFAULT_Z_A: f64 = 1.0;
+/// Paper 002 §4: z_r = 20.0.
+pub const DEFAULT_Z_R: f64 = 20.0;
+/// Paper 002 §4: the repulsive potential's influence range η_thres = 3.0 m.
+pub const DEFAULT_ETA_THRES_M: f64 = 3.0;
+/// Paper 002 §4: a waypoint is reached within g_thres = 0.10 m.
+pub const DEFAULT_G_THRES_M: f64 = 0.10;
+/// Paper 002 §4: the simulation ends after max_steps = 10 000 steps.
+pub const DEFAULT_MAX_STEPS: u64 = 10_000;
+/// Paper 002 §4 ES1: z_is = 0.8.
+pub const DEFAULT_Z_IS: f64 = 0.8;
+/// The adaptation threshold ω_t. Paper 002 does not state it; ES1's cutoff robot "due
+/// to its setup (i.e. ω = 90°…)" implies 90°.
+pub const DEFAULT_OMEGA_T_DEG: f64 = 90.0;
+/// The share of z_is the cutoff scheme keeps above ω_t (paper 002 §3.1: "a percentage of
+/// z_is or completely disabled"; Eq. 2 and ES1 use 0).
+pub const DEFAULT_CUTOFF_KEEP: f64 = 0.0;
+/// roam's safety bound on the PEB, metres (not in paper 002).
+pub const DEFAULT_MAX_PEB_M: f64 = 2.0;
+/// roam's stuck window, updates (not in paper 002).
+pub const DEFAULT_STUCK_WINDOW_STEPS: u64 = 300;
+/// roam's least progress over the stuck window, metres (not in paper 002).
+pub const DEFAULT_STUCK_MIN_PROGRESS_M: f64 = 0.25;
+
+/// The largest step limit a mission may have.
+pub const MAX_MAX_STEPS: u64 = 10_000_000;
+/// The largest force weight (z_a, z_r, z_is) accepted.
+pub const MAX_WEIGHT: f64 = 1e6;
+
+/// The APF controller's parameters (paper 002 §3–4), with units.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ApfParams {
+    /// z_a, the attractive force's weight (paper 002 Eq. 3), unitless.
+    pub z_a: f64,
+    /// z_r, the repulsive force's weight (paper 002 Eq. 3), unitless.
+    pub z_r: f64,
+    /// η_thres, the repulsive potential's influence range, metres (paper 002 §4).
+    pub eta_thres_m: f64,
+    /// g_thres, the distance within which a waypoint counts as reached, metres.
+    pub g_thres_m: f64,
+    /// Updates a mission may take before it ends as `step_limit` (paper 002 §4).
+    pub max_steps: u64,
+    /// z_is, the information-seeking weight (paper 002 Eqs. 2–3), unitless.
+    pub z_is: f64,
+    /// ω_t, the adaptation threshold of Eq. 2, degrees in [0, 180].
+    pub omega_t_deg: f64,
+    /// The share of z_is the cutoff scheme keeps above ω_t, in [0, 1].
+    pub cutoff_keep: f64,
+    /// How z_is adapts to ω (paper 002 Eq. 2), or `plain` for no IS force. roam's
+    /// default is `linear`, paper 002's fastest scheme that reached B in ES1.
+    pub scheme: Scheme,
+    /// Safety, not in paper 002: a robot whose PEB is above this (or unbounded: a lost
+    /// fix) gets a zero command and the status `halted_peb` while it lasts, metres.
+    /// +∞ turns the guard off (the unbounded PEB included): paper 002's ES2 runs on true
+    /// positions, where a lost fix does not matter.
+    pub max_peb_m: f64,
+    /// Safety, not in paper 002: when the best distance to the current waypoint has not
+    /// improved by `stuck_min_progress_m` over this many (unhalted) updates, the mission
+    /// ends as `stuck` (a local minimum or an oscillation).
+    pub stuck_window_steps: u64,
+    /// See `stuck_window_steps`, metres.
+    pub stuck_min_progress_m: f64,
+}
+
+impl Default for ApfParams {
+    fn default() -> Self {
+        ApfParams {
+            z_a: DEFAULT_Z_A,
+            z_r: DEFAULT_Z_R,
+            eta_thres_m: DEFAULT_ETA_THRES_M,
+            g_thres_m: DEFAULT_G_THRES_M,
+            max_steps: DEFAULT_MAX_STEPS,
+            z_is: DEFAULT_Z_IS,
+            omega_t_deg: DEFAULT_OMEGA_T_DEG,
+            cutoff_keep: DEFAULT_CUTOFF_KEEP,
+            scheme: Scheme::Linear,
+            max_peb_m: DEFAULT_MAX_PEB_M,
+            stuck_window_steps: DEFAULT_STUCK_WINDOW_STEPS,
+            stuck_min_progress_m: DEFAULT_STUCK_MIN_PROGRESS_M,
+        }
+    }
+}
+
+/// A parameter outside its allowed range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("parameter {name} = {value} is out of range: use {range}")]
+pub struct ParamError {
+    pub name: &'static str,
+    pub value: f64,
+    pub range: &'static str,
+}
+
+fn check(name: &'static str, value: f64, ok: bool, range: &'static str) -> Result<(), ParamError> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(ParamError { name, value, range })
+    }
+}
+
+impl ApfParams {
+    /// Refuses a value the controller cannot work with, naming it and its range.
+    pub fn check(&self) -> Result<(), ParamError> {
+        let weight = |v: f64| (0.0..=MAX_WEIGHT).contains(&v);
+        check("z_a", self.z_a, weight(self.z_a), "0 to 1e6")?;
+        check("z_r", self.z_r, weight(self.z_r), "0 to 1e6")?;
+        check("z_is", self.z_is, weight(self.z_is), "0 to 1e6")?;
+        check(
+            "eta_thres_m",
+            self.eta_thres_m,
+            self.eta_thres_m > 0.0 && self.eta_thres_m <= 1e4,
+            "more than 0 up to 1e4 metres",
+        )?;
+        check(
+            "g_thres_m",
+            self.g_thres_m,
+            self.g_thres_m > 0.0 && self.g_thres_m <= 1e4,
+            "more than 0 up to 1e4 metres",
+        )?;
+        check(
+            "max_steps",
+            self.max_steps as f64,
+            (1..=MAX_MAX_STEPS).contains(&self.max_steps),
+            "1 to 10000000",
+        )?;
+        check(
+            "omega_t_deg",
+            self.omega_t_deg,
+            (0.0..=180.0).contains(&self.omega_t_deg),
+            "0 to 180 degrees",
+        )?;
+        check(
+            "cutoff_keep",
+            self.cutoff_keep,
+            (0.0..=1.0).contains(&self.cutoff_keep),
+            "0 to 1",
+        )?;
+        // +∞ is allowed: it turns the PEB guard off.
+        if self.max_peb_m.is_nan() || self.max_peb_m <= 0.0 {
+            return Err(ParamError {
+                name: "max_peb_m",
+                value: self.max_peb_m,
+                range: "more than 0 metres (infinity turns the guard off)",
+            });
+        }
+        check(
+            "stuck_window_steps",
+            self.stuck_window_steps as f64,
+            (1..=MAX_MAX_STEPS).contains(&self.stuck_window_steps),
+            "1 to 10000000",
+        )?;
+        check(
+            "stuck_min_progress_m",
+            self.stuck_min_progress_m,
+            self.stuck_min_progress_m >= 0.0 && self.stuck_min_progress_m <= 1e4,
+            "0 to 1e4 metres",
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_defaults_are_paper_002s_and_pass() {
+        let p = ApfParams::default();
+        assert_eq!((p.z_a, p.z_r, p.eta_thres_m), (1.0, 20.0, 3.0));
+        assert_eq!((p.g_thres_m, p.max_steps, p.z_is), (0.10, 10_000, 0.8));
+        assert_eq!((p.omega_t_deg, p.cutoff_keep), (90.0, 0.0));
+        assert_eq!(p.check(), Ok(()));
+    }
+
+    #[test]
+    fn bad_values_are_named() {
+        let bad = |p: ApfParams| p.check().err().map(|e| e.name);
+        let d = ApfParams::default;
+        assert_eq!(bad(ApfParams { z_a: -1.0, ..d() }), Some("z_a"));
+        assert_eq!(
+            bad(ApfParams {
+                z_is: f64::NAN,
+                ..d()
+            }),
+            Some("z_is")
+        );
+        assert_eq!(
+            bad(ApfParams {
+                eta_thres_m: 0.0,
+                ..d()
+            }),
+            Some("eta_thres_m")
+        );
+        assert_eq!(
+            bad(ApfParams {
+                g_thres_m: -0.1,
+                ..d()
+            }),
+            Some("g_thres_m")
+        );
+        assert_eq!(
+            bad(ApfParams {
+                max_steps: 0,
+                ..d()
+            }),
+            Some("max_steps")
+        );
+        assert_eq!(
+            bad(ApfParams {
+                omega_t_deg: 181.0,
+                ..d()
+            }),
+            Some("omega_t_deg")
+        );
+        assert_eq!(
+            bad(ApfParams {
+                cutoff_keep: 1.5,
+                ..d()
+            }),
+            Some("cutoff_keep")
+        );
+        assert_eq!(
+            bad(ApfParams {
+                max_peb_m: 0.0,
+                ..d()
+            }),
+            Some("max_peb_m")
+        );
+        assert_eq!(
+            bad(ApfParams {
+                max_peb_m: f64::NAN,
+                ..d()
+            }),
+            Some("max_peb_m")
+        );
+        assert_eq!(
+            bad(ApfParams {
+                max_peb_m: f64::INFINITY,
+                ..d()
+            }),
+            None
+        );
+        assert_eq!(
+            bad(ApfParams {
+                stuck_window_steps: 0,
+                ..d()
+            }),
+            Some("stuck_window_steps")
+        );
+        let e = ApfParams {
+            cutoff_keep: 2.0,
+            ..d()
+        }
+        .check()
+        .err()
+        .map(|e| e.to_string());
+        assert_eq!(
+            e.as_deref(),
+            Some("parameter cutoff_keep = 2 is out of range: use 0 to 1")
+        );
+    }
+
+    #[test]
+    fn a_config_embeds_it_with_defaults_and_refuses_typos() {
+        let p: ApfParams =
+            serde_json::from_str(r#"{"scheme": "sinusoidal", "z_is": 0.9}"#).expect("parse");
+        assert_eq!(p.scheme, Scheme::Sinusoidal);
+        assert_eq!(p.z_is, 0.9);
+        assert_eq!(p.z_r, 20.0);
+        assert!(serde_json::from_str::<ApfParams>(r#"{"zis": 0.9}"#).is_err());
+        assert!(serde_json::from_str::<ApfParams>(r#"{"scheme": "spline"}"#).is_err());
+    }
+}

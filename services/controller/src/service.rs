@@ -1,0 +1,370 @@
+//! The APF controller on Zenoh: a thin adapter around [`Controller`], one per robot that
+//! has been given a mission.
+//!
+//! | key | kind | payload |
+//! |---|---|---|
+//! | `<root>/robot/*/mission` | subscription | `mission` (replaces the robot's mission) |
+//! | `<root>/robot/*/estimate` | subscription | `position_estimate` (from localization) |
+//! | `<root>/robot/<id>/cmd` | publication, one per estimate while a mission runs | `robot_command` |
+//! | `<root>/robot/<id>/controller` | publication, per estimate and on state changes | `controller_status` |
+//!
+//! Robots without a mission are left alone (another driver may command them). The
+//! obstacle map, the anchors and the sensing model come from the configured scenario,
+//! like the localization service's.
+//!
+//! **Safety** (not in paper 002): a robot whose estimates stop for `stale_after_s` (wall
+//! time) gets a zero command and the state `halted_stale`, repeated every
+//! `stale_after_s / 4` until estimates return; a PEB above the bound holds it
+//! (`halted_peb`); no progress over the controller's window ends the mission as `stuck`.
+//! The watchdog runs on wall time because a stalled estimate stream is exactly when sim
+//! time stops being informative.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+use roam_localization::fim::FimOptions;
+use roam_localization::model::RangingModel;
+use roam_proto::controller::{ControllerStatus, Mission, MissionState, MAX_WAYPOINTS};
+use roam_proto::localization::PositionEstimate;
+use roam_proto::sim::RobotCommand;
+use roam_proto::{encode, keys, Message};
+use roam_runtime::{Service, ServiceError};
+use roam_sim::service::load_scenario;
+use serde::Deserialize;
+use tokio_util::sync::CancellationToken;
+use zenoh::qos::CongestionControl;
+use zenoh::Wait;
+
+use crate::controller::{Controller, Decision, MissionStatus};
+use crate::information::InformationField;
+use crate::obstacle_field::ObstacleField;
+use crate::params::ApfParams;
+
+pub const SERVICE_NAME: &str = "controller";
+/// Robots one controller instance drives at most.
+pub const MAX_ROBOTS: usize = 1000;
+
+/// The controller service's config file (YAML).
+///
+/// ```yaml
+/// root: roam
+/// scenario: config/scenarios/es1.yaml   # obstacles, anchors, sensing; default: built-in world
+/// stale_after_s: 1.0                    # zero command when estimates stop this long
+/// apf:                                  # paper 002 §4's values are the defaults
+///   scheme: linear                      # plain | fixed | cutoff | linear | sinusoidal
+///   z_is: 0.8
+/// ```
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControllerConfig {
+    pub root: String,
+    pub instance: Option<String>,
+    pub scenario: Option<PathBuf>,
+    pub stale_after_s: f64,
+    pub apf: ApfParams,
+    pub zenoh: Option<serde_json::Value>,
+}
+
+impl Default for ControllerConfig {
+    fn default() -> Self {
+        ControllerConfig {
+            root: keys::DEFAULT_ROOT.to_owned(),
+            instance: None,
+            scenario: None,
+            stale_after_s: 1.0,
+            apf: ApfParams::default(),
+            zenoh: None,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ControllerServiceError {
+    #[error(transparent)]
+    Service(#[from] ServiceError),
+    #[error(transparent)]
+    Scenario(#[from] roam_map_server::scenario::ScenarioError),
+    #[error("invalid config: {0}")]
+    Config(String),
+}
+
+/// One robot under control.
+struct Driven {
+    controller: Controller,
+    mission: String,
+    waypoints: usize,
+    last_estimate: Instant,
+    stale: bool,
+    last: Option<ControllerStatus>,
+}
+
+struct State {
+    root: String,
+    session: zenoh::Session,
+    params: ApfParams,
+    obstacles: Arc<ObstacleField>,
+    information: Arc<InformationField>,
+    stale_after: Duration,
+    robots: Mutex<HashMap<String, Driven>>,
+}
+
+impl State {
+    fn robots(&self) -> MutexGuard<'_, HashMap<String, Driven>> {
+        self.robots.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn put<T: Message>(&self, key: &str, message: &T) {
+        let sent = self
+            .session
+            .put(key, encode(message))
+            .congestion_control(CongestionControl::Block)
+            .wait();
+        if let Err(e) = sent {
+            tracing::warn!(%key, "publishing failed: {e}");
+        }
+    }
+
+    fn command(&self, robot: &str, u: [f64; 2], step: Option<u64>) {
+        self.put(
+            &keys::robot_command(&self.root, robot),
+            &RobotCommand { u, step },
+        );
+    }
+}
+
+fn state_of(status: MissionStatus) -> MissionState {
+    match status {
+        MissionStatus::Idle => MissionState::Idle,
+        MissionStatus::Active => MissionState::Active,
+        MissionStatus::Completed => MissionState::Completed,
+        MissionStatus::Stuck => MissionState::Stuck,
+        MissionStatus::HaltedPeb => MissionState::HaltedPeb,
+        MissionStatus::StepLimit => MissionState::StepLimit,
+    }
+}
+
+fn status_of(
+    robot: &str,
+    driven: &Driven,
+    decision: &Decision,
+    estimate: Option<&PositionEstimate>,
+) -> ControllerStatus {
+    ControllerStatus {
+        robot: robot.to_owned(),
+        mission: Some(driven.mission.clone()),
+        state: state_of(decision.status),
+        waypoint: decision.waypoint,
+        waypoints: driven.waypoints,
+        distance_left_m: Some(decision.distance_left_m),
+        steps: decision.steps,
+        estimate_step: estimate.map(|e| e.step),
+        peb_m: estimate.and_then(|e| e.peb_m),
+        omega_deg: decision.omega_deg,
+        z_isa: decision.z_isa,
+        u: decision.u,
+    }
+}
+
+/// Checks a mission before it replaces the robot's current one.
+fn check_mission(mission: &Mission) -> Result<(), String> {
+    keys::check_name("robot", &mission.robot).map_err(|e| e.to_string())?;
+    if mission.waypoints.len() > MAX_WAYPOINTS {
+        return Err(format!(
+            "{} waypoints; a mission holds at most {MAX_WAYPOINTS} (max_waypoints)",
+            mission.waypoints.len()
+        ));
+    }
+    if let Some(bad) = mission
+        .waypoints
+        .iter()
+        .find(|w| !(w[0].is_finite() && w[1].is_finite()))
+    {
+        return Err(format!("waypoint {bad:?} is not a finite point"));
+    }
+    Ok(())
+}
+
+fn on_mission(state: &State, mission: Mission) {
+    if let Err(e) = check_mission(&mission) {
+        return tracing::warn!(robot = %mission.robot, id = %mission.id, "mission refused: {e}");
+    }
+    let mut robots = state.robots();
+    if robots.len() >= MAX_ROBOTS && !robots.contains_key(&mission.robot) {
+        return tracing::warn!(
+            robot = %mission.robot,
+            "mission refused: this controller already drives {MAX_ROBOTS} robots (max_robots)"
+        );
+    }
+    let driven = robots
+        .entry(mission.robot.clone())
+        .or_insert_with(|| Driven {
+            controller: Controller::new(
+                state.params.clone(),
+                state.obstacles.clone(),
+                state.information.clone(),
+            ),
+            mission: String::new(),
+            waypoints: 0,
+            last_estimate: Instant::now(),
+            stale: false,
+            last: None,
+        });
+    driven.controller.set_mission(mission.waypoints.clone());
+    driven.mission = mission.id.clone();
+    driven.waypoints = mission.waypoints.len();
+    driven.last_estimate = Instant::now();
+    driven.stale = false;
+    let state_now = if mission.waypoints.is_empty() {
+        MissionState::Idle
+    } else {
+        MissionState::Active
+    };
+    let status = ControllerStatus {
+        robot: mission.robot.clone(),
+        mission: Some(mission.id.clone()),
+        state: state_now,
+        waypoint: (!mission.waypoints.is_empty()).then_some(0),
+        waypoints: driven.waypoints,
+        distance_left_m: None,
+        steps: 0,
+        estimate_step: None,
+        peb_m: None,
+        omega_deg: 0.0,
+        z_isa: 0.0,
+        u: [0.0, 0.0],
+    };
+    driven.last = Some(status.clone());
+    drop(robots);
+    tracing::info!(robot = %mission.robot, id = %mission.id, waypoints = mission.waypoints.len(), "mission set");
+    if mission.waypoints.is_empty() {
+        // An empty mission stops the robot now, not at its next estimate.
+        state.command(&mission.robot, [0.0, 0.0], None);
+    }
+    state.put(
+        &keys::robot_controller(&state.root, &mission.robot),
+        &status,
+    );
+}
+
+fn on_estimate(state: &State, estimate: PositionEstimate) {
+    let (status, u) = {
+        let mut robots = state.robots();
+        let Some(driven) = robots.get_mut(&estimate.robot) else {
+            return;
+        };
+        driven.last_estimate = Instant::now();
+        driven.stale = false;
+        let decision = driven.controller.update(estimate.position, estimate.peb_m);
+        let status = status_of(&estimate.robot, driven, &decision, Some(&estimate));
+        driven.last = Some(status.clone());
+        let u = match decision.status {
+            MissionStatus::Idle => None,
+            _ => Some(decision.u),
+        };
+        (status, u)
+    };
+    if let Some(u) = u {
+        state.command(&estimate.robot, u, Some(estimate.step));
+    }
+    state.put(
+        &keys::robot_controller(&state.root, &estimate.robot),
+        &status,
+    );
+}
+
+/// Holds every robot whose estimates have stopped: a zero command and `halted_stale`.
+async fn watchdog(state: Arc<State>, cancel: CancellationToken) {
+    let tick = (state.stale_after / 4).max(Duration::from_millis(5));
+    loop {
+        tokio::select! {
+            _ = cancel.cancelled() => return,
+            _ = tokio::time::sleep(tick) => {}
+        }
+        let halted: Vec<(String, ControllerStatus, bool)> = {
+            let mut robots = state.robots();
+            robots
+                .iter_mut()
+                .filter(|(_, d)| {
+                    d.controller.is_active() && d.last_estimate.elapsed() >= state.stale_after
+                })
+                .filter_map(|(robot, d)| {
+                    let first = !d.stale;
+                    d.stale = true;
+                    let mut status = d.last.clone()?;
+                    status.state = MissionState::HaltedStale;
+                    status.u = [0.0, 0.0];
+                    Some((robot.clone(), status, first))
+                })
+                .collect()
+        };
+        for (robot, status, first) in halted {
+            if first {
+                tracing::warn!(%robot, "no estimate for {:?}: holding the robot", state.stale_after);
+            }
+            state.command(&robot, [0.0, 0.0], None);
+            state.put(&keys::robot_controller(&state.root, &robot), &status);
+        }
+    }
+}
+
+/// Runs the controller service until `cancel` is cancelled.
+pub async fn run(
+    config: ControllerConfig,
+    zenoh_config: zenoh::Config,
+    cancel: CancellationToken,
+) -> Result<(), ControllerServiceError> {
+    config
+        .apf
+        .check()
+        .map_err(|e| ControllerServiceError::Config(e.to_string()))?;
+    if !(config.stale_after_s.is_finite() && config.stale_after_s > 0.0) {
+        return Err(ControllerServiceError::Config(format!(
+            "stale_after_s is {}; give a positive number of seconds",
+            config.stale_after_s
+        )));
+    }
+    let (_, scenario) = load_scenario(config.scenario.as_deref())?;
+    let anchors: Vec<[f64; 2]> = scenario.file.anchors.iter().map(|a| a.at).collect();
+    let model = RangingModel::from_spec(&anchors, &scenario.file.sensing)
+        .map_err(|e| ControllerServiceError::Config(format!("the scenario's sensing: {e}")))?;
+    let information = Arc::new(InformationField::new(model, FimOptions::default()));
+    let obstacles = Arc::new(ObstacleField::new(&scenario.occupancy));
+    let mut service = Service::start(
+        SERVICE_NAME,
+        &config.root,
+        config.instance.as_deref(),
+        zenoh_config,
+        cancel,
+    )
+    .await?;
+    let state = Arc::new(State {
+        root: config.root.clone(),
+        session: service.session().clone(),
+        params: config.apf.clone(),
+        obstacles,
+        information,
+        stale_after: Duration::from_secs_f64(config.stale_after_s),
+        robots: Mutex::new(HashMap::new()),
+    });
+    service
+        .subscribe(
+            &keys::robot_mission_any(&config.root),
+            state.clone(),
+            |state: &Arc<State>, mission: Mission| on_mission(state, mission),
+        )
+        .await?;
+    service
+        .subscribe(
+            &keys::robot_estimate_any(&config.root),
+            state.clone(),
+            |state: &Arc<State>, estimate: PositionEstimate| on_estimate(state, estimate),
+        )
+        .await?;
+    let (watched, token) = (state.clone(), service.cancel_token());
+    service.spawn(async move { watchdog(watched, token).await });
+    service.announce().await?;
+    service.run_until_stopped().await?;
+    Ok(())
+}

@@ -1,0 +1,61 @@
+//! Why the mapper refused something. Every limit an error names is a constant of this
+//! crate, so a caller can tell the user what to change.
+
+use crate::change_map::MAX_MAP_CELLS;
+
+/// Why the change map or the explorer refused an input. Nothing changes when a call is
+/// refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MapperError {
+    #[error("the map has {cells} cells; the change map holds at most {max} (limit max_map_cells)")]
+    MapTooLarge { cells: u64, max: u64 },
+    #[error("the map has no cells: width and height must be at least 1")]
+    EmptyMap,
+    #[error("the map resolution {0} must be a positive number of metres per cell")]
+    BadResolution(f64),
+    #[error("parameter {field}: {reason}")]
+    Param { field: &'static str, reason: String },
+    #[error(
+        "the observation window at ({x0}, {y0}) of {width} x {height} cells does not fit in \
+         the {map_width} x {map_height} map; send windows inside the map"
+    )]
+    WindowOutside {
+        x0: u32,
+        y0: u32,
+        width: u32,
+        height: u32,
+        map_width: u32,
+        map_height: u32,
+    },
+    #[error("the observation window is {width} x {height} cells but carries {got} values")]
+    WindowSize { width: u32, height: u32, got: usize },
+    #[error(
+        "observation value {value} at window cell {index}: use -1 (unseen) or 0..=100 \
+         (0 free, 100 occupied)"
+    )]
+    BadValue { value: i8, index: usize },
+    #[error("time {0} s is not a finite number")]
+    BadTime(f64),
+    #[error(
+        "observation time {t} s is before the latest observation at {latest} s; send \
+         observations in time order"
+    )]
+    TimeWentBack { t: f64, latest: f64 },
+    #[error("cell ({x}, {y}) is outside the {width} x {height} map")]
+    CellOffMap {
+        x: i64,
+        y: i64,
+        width: u32,
+        height: u32,
+    },
+}
+
+impl MapperError {
+    /// The size error for a map of `cells` cells.
+    pub(crate) fn too_large(cells: u64) -> MapperError {
+        MapperError::MapTooLarge {
+            cells,
+            max: MAX_MAP_CELLS,
+        }
+    }
+}

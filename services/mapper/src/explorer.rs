@@ -1,0 +1,677 @@
+//! The per-robot loop of paper 004 §2 and §4: the learning agent picks a strategy and a
+//! goal, the grid controller drives there and explores locally, and after `max_steps`
+//! steps the episode's reward updates the learner. The batch experiment and the Zenoh
+//! service both run this, one [`Explorer`] per robot, calling
+//! [`Explorer::on_update`] once per sensor update with the map after the update; each
+//! call answers the robot's next unit command.
+//!
+//! **An episode** (one iteration of §4's loop):
+//! 1. The strategy: uniformly at random for the first episode (curious mode), then by
+//!    the learner's softmax at the features of the update that ended the previous one;
+//!    fixed in the single-strategy modes.
+//! 2. The goal: sampled from the strategy's weights (recency r^c or P_c(E > 0)) over
+//!    patches ([`crate::goals`]).
+//! 3. Navigation: one wavefront step per update toward the goal, or as close as
+//!    possible ([`crate::wavefront`]).
+//! 4. Local exploration, once the target is reached (§2): if the last update changed
+//!    the map, the next goal is the centroid of the changed cells (rounded to a cell)
+//!    and the robot steps toward it; if nothing changed (or the robot already stands on
+//!    the centroid's target), one random step to a 4-neighbour not known occupied.
+//!    Never two random steps in a row (§5): where a second one would come, the robot
+//!    instead *waits* one step and keeps looking (the default, [`AfterRandomStep::Wait`]:
+//!    a block that passes by is then seen and followed), or the episode ends early
+//!    ([`AfterRandomStep::EndEpisode`]: the local area is taken as explored). The paper
+//!    bounds consecutive random steps but does not say what happens at the bound.
+//! 5. Every command counts as a step, waiting too; after `max_steps` (42, §5) the
+//!    episode ends: its trajectory T holds the features (p, r) after each of its
+//!    updates, its reward is R = map changes during the episode / |T|, and the learner
+//!    updates V_S over T.
+//!
+//! The robot's cell is given by the caller: paper 004 uses noise-free odometry (the batch
+//! experiment passes the sim's true pose, the service the pose an observation carries).
+
+use rand::{Rng, RngCore};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::change_map::{ChangeMap, Update};
+use crate::error::MapperError;
+use crate::features::Features;
+use crate::goals::{sample_goal, DEFAULT_PATCH_CELLS};
+use crate::learner::{Learner, LearnerParams};
+pub use crate::learner::{Mode, Strategy};
+use crate::seed;
+use crate::wavefront::{Wavefront, NEIGHBOURS};
+
+/// The longest episode (limit `max_episode_steps`): the trajectory is kept in memory.
+pub const MAX_EPISODE_STEPS: u32 = 100_000;
+/// The largest patch side, cells (limit `max_patch_cells`).
+pub const MAX_PATCH_CELLS: u32 = 1024;
+
+/// What happens where a second random step in a row would come.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AfterRandomStep {
+    /// Stand still for one step and keep looking.
+    Wait,
+    /// End the episode now: the local area is explored.
+    EndEpisode,
+}
+
+/// The explorer's parameters (paper 004's values where it gives them).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExplorerParams {
+    /// Steps per episode (§5: 42, the longest path of a block in the grid world).
+    pub max_steps: u32,
+    /// Side of the goal distribution's patches, cells (paper: not given; see
+    /// [`crate::goals`]).
+    pub patch_cells: u32,
+    /// Whether discovering an unknown cell is a map change (for the reward and the
+    /// local exploration centroid), besides a known cell flipping.
+    pub count_discoveries: bool,
+    /// See [`AfterRandomStep`].
+    pub after_random_step: AfterRandomStep,
+    /// The length of the command `u` that moves the robot one cell: the cell size over
+    /// the sim's μ (grid world: 1 m / 1.0 = 1).
+    pub cell_command: f64,
+    pub learner: LearnerParams,
+}
+
+impl Default for ExplorerParams {
+    fn default() -> Self {
+        ExplorerParams {
+            max_steps: 42,
+            patch_cells: DEFAULT_PATCH_CELLS,
+            count_discoveries: true,
+            after_random_step: AfterRandomStep::Wait,
+            cell_command: 1.0,
+            learner: LearnerParams::default(),
+        }
+    }
+}
+
+impl ExplorerParams {
+    pub fn check(&self) -> Result<(), MapperError> {
+        let bad = |field: &'static str, reason: String| Err(MapperError::Param { field, reason });
+        if self.max_steps == 0 || self.max_steps > MAX_EPISODE_STEPS {
+            return bad(
+                "max_steps",
+                format!(
+                    "must be 1 to {MAX_EPISODE_STEPS} (limit max_episode_steps), got {}",
+                    self.max_steps
+                ),
+            );
+        }
+        if self.patch_cells == 0 || self.patch_cells > MAX_PATCH_CELLS {
+            return bad(
+                "patch_cells",
+                format!(
+                    "must be 1 to {MAX_PATCH_CELLS} (limit max_patch_cells), got {}",
+                    self.patch_cells
+                ),
+            );
+        }
+        if !(self.cell_command.is_finite() && self.cell_command > 0.0) {
+            return bad(
+                "cell_command",
+                format!("must be a positive number, got {}", self.cell_command),
+            );
+        }
+        self.learner.check()
+    }
+}
+
+/// Where the controller is within an episode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Phase {
+    /// Driving to the episode's goal.
+    Navigate,
+    /// At the goal: following changes, or stepping at random.
+    Local,
+}
+
+/// What the robot does this step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Action {
+    /// A planned step toward the goal (or the local goal).
+    Move,
+    /// A random step (local exploration, nothing changed).
+    RandomStep,
+    /// Standing still (where a second random step would come, or boxed in).
+    Wait,
+}
+
+/// An episode that just ended, after the learner was updated.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct EpisodeEnd {
+    pub strategy: Strategy,
+    /// R = map changes / |T|.
+    pub reward: f64,
+    /// |T|: updates in the episode's trajectory.
+    pub length: u32,
+    /// Map changes during the episode.
+    pub map_changes: u64,
+}
+
+/// The explorer's answer to one update.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ExplorerStep {
+    /// The next command: one cell along an axis (`±cell_command`), or [0, 0] to stand.
+    pub u: [f64; 2],
+    /// The cell the command leads to (the robot's own when standing).
+    pub next_cell: (u32, u32),
+    pub action: Action,
+    /// The goal the robot heads for now: the episode's goal while navigating, the local
+    /// goal (centroid of the changes) or its own cell while exploring locally.
+    pub goal: (u32, u32),
+    /// The episode's goal, sampled by its strategy.
+    pub episode_goal: (u32, u32),
+    pub strategy: Strategy,
+    pub phase: Phase,
+    /// Steps taken in the current episode, this one included.
+    pub episode_steps: u32,
+    /// The features after the update.
+    pub features: Features,
+    /// Set when the update ended an episode (the learner has been updated).
+    pub episode: Option<EpisodeEnd>,
+}
+
+/// One step's decision: the action, the next cell, the goal the robot heads for now.
+type Decision = (Action, (u32, u32), (u32, u32));
+
+#[derive(Debug, Clone)]
+struct Episode {
+    strategy: Strategy,
+    goal: (u32, u32),
+    phase: Phase,
+    steps: u32,
+    trajectory: Vec<Features>,
+    map_changes: u64,
+    last_random: bool,
+}
+
+/// One robot's curious explorer: learner, goal sampling and grid controller.
+#[derive(Debug, Clone)]
+pub struct Explorer {
+    params: ExplorerParams,
+    mode: Mode,
+    learner: Learner,
+    /// Strategy choices, goals and random steps.
+    rng: ChaCha8Rng,
+    wave: Wavefront,
+    episode: Option<Episode>,
+    episodes_ended: u64,
+    /// Episodes started with each strategy, in [`Strategy::ALL`] order.
+    started: [u64; 2],
+}
+
+impl Explorer {
+    /// An explorer whose every random choice comes from `seed` (stream `"tiles"` for the
+    /// tile offsets, `"explorer"` for the rest).
+    pub fn new(params: ExplorerParams, mode: Mode, seed: u64) -> Result<Explorer, MapperError> {
+        params.check()?;
+        let learner = Learner::new(&params.learner, &mut seed::stream(seed, "tiles"))?;
+        Ok(Explorer {
+            params,
+            mode,
+            learner,
+            rng: seed::stream(seed, "explorer"),
+            wave: Wavefront::new(),
+            episode: None,
+            episodes_ended: 0,
+            started: [0, 0],
+        })
+    }
+
+    pub fn params(&self) -> &ExplorerParams {
+        &self.params
+    }
+
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    pub fn learner(&self) -> &Learner {
+        &self.learner
+    }
+
+    /// Episodes ended so far.
+    pub fn episodes_ended(&self) -> u64 {
+        self.episodes_ended
+    }
+
+    /// Episodes started with each strategy, in [`Strategy::ALL`] order.
+    pub fn strategy_counts(&self) -> [u64; 2] {
+        self.started
+    }
+
+    /// One sensor update: `update` is what the robot's latest observation did to `map`
+    /// (already applied), `robot` its cell now, `t` the time (seconds). Records the
+    /// update in the episode, ends the episode when it is over, starts the next, and
+    /// answers the next command. `&mut` on the map only refreshes its feature caches.
+    pub fn on_update(
+        &mut self,
+        map: &mut ChangeMap,
+        update: &Update,
+        robot: (u32, u32),
+        t: f64,
+    ) -> Result<ExplorerStep, MapperError> {
+        if !t.is_finite() {
+            return Err(MapperError::BadTime(t));
+        }
+        if map.index(robot.0, robot.1).is_none() {
+            return Err(MapperError::CellOffMap {
+                x: i64::from(robot.0),
+                y: i64::from(robot.1),
+                width: map.width(),
+                height: map.height(),
+            });
+        }
+        let features = map.features(t);
+        let mut ended = None;
+        let mut ep = match self.episode.take() {
+            Some(mut ep) => {
+                ep.trajectory.push(features);
+                ep.map_changes += update.map_changes(self.params.count_discoveries) as u64;
+                if ep.steps >= self.params.max_steps {
+                    ended = Some(self.end_episode(ep));
+                    self.start_episode(map, robot, t, features)
+                } else {
+                    ep
+                }
+            }
+            None => self.start_episode(map, robot, t, features),
+        };
+        let (action, next, goal) = match self.decide(&mut ep, map, update, robot) {
+            Some(step) => step,
+            None => {
+                // The local area is explored: a new episode takes this step. Its first
+                // decision is never an early end (no random step came before it).
+                ended = Some(self.end_episode(ep));
+                ep = self.start_episode(map, robot, t, features);
+                self.decide(&mut ep, map, update, robot)
+                    .unwrap_or((Action::Wait, robot, robot))
+            }
+        };
+        ep.steps += 1;
+        let c = self.params.cell_command;
+        let u = [
+            (i64::from(next.0) - i64::from(robot.0)) as f64 * c,
+            (i64::from(next.1) - i64::from(robot.1)) as f64 * c,
+        ];
+        let step = ExplorerStep {
+            u,
+            next_cell: next,
+            action,
+            goal,
+            episode_goal: ep.goal,
+            strategy: ep.strategy,
+            phase: ep.phase,
+            episode_steps: ep.steps,
+            features,
+            episode: ended,
+        };
+        self.episode = Some(ep);
+        Ok(step)
+    }
+
+    /// Ends an episode: reward R = map changes / |T|, the learner's update over T.
+    fn end_episode(&mut self, ep: Episode) -> EpisodeEnd {
+        let length = ep.trajectory.len() as u32;
+        let reward = if length == 0 {
+            0.0
+        } else {
+            ep.map_changes as f64 / f64::from(length)
+        };
+        self.learner.update(ep.strategy, &ep.trajectory, reward);
+        self.episodes_ended += 1;
+        EpisodeEnd {
+            strategy: ep.strategy,
+            reward,
+            length,
+            map_changes: ep.map_changes,
+        }
+    }
+
+    /// A new episode: its strategy (uniform for the first in curious mode, the softmax
+    /// after) and its goal (the robot's own cell if every cell is known occupied).
+    fn start_episode(
+        &mut self,
+        map: &ChangeMap,
+        robot: (u32, u32),
+        t: f64,
+        features: Features,
+    ) -> Episode {
+        let strategy = match self.mode.forced() {
+            Some(s) => s,
+            None if self.started == [0, 0] => {
+                Strategy::ALL[self.rng.random_range(0..Strategy::ALL.len())]
+            }
+            None => self.learner.choose(features, &mut self.rng),
+        };
+        let weights = match strategy {
+            Strategy::Recency => map.recency_layer(t),
+            Strategy::Poisson => map.probability_layer(t),
+        };
+        let goal = sample_goal(
+            &weights.cells,
+            map.obstacles(),
+            map.width(),
+            map.height(),
+            self.params.patch_cells,
+            &mut self.rng,
+        )
+        .unwrap_or(robot);
+        self.started[match strategy {
+            Strategy::Recency => 0,
+            Strategy::Poisson => 1,
+        }] += 1;
+        Episode {
+            strategy,
+            goal,
+            phase: Phase::Navigate,
+            steps: 0,
+            trajectory: Vec::with_capacity(self.params.max_steps as usize),
+            map_changes: 0,
+            last_random: false,
+        }
+    }
+
+    /// The controller's decision for this step: (action, next cell, goal now), or
+    /// `None` to end the episode early ([`AfterRandomStep::EndEpisode`]).
+    fn decide(
+        &mut self,
+        ep: &mut Episode,
+        map: &ChangeMap,
+        update: &Update,
+        robot: (u32, u32),
+    ) -> Option<Decision> {
+        let (w, h) = (map.width(), map.height());
+        if ep.phase == Phase::Navigate {
+            if let Some(next) = self
+                .wave
+                .plan(map.obstacles(), w, h, robot, ep.goal)
+                .and_then(|s| s.next)
+            {
+                return Some((Action::Move, next, ep.goal));
+            }
+            ep.phase = Phase::Local;
+        }
+        if let Some(centroid) = update.centroid(self.params.count_discoveries) {
+            if let Some(next) = self
+                .wave
+                .plan(map.obstacles(), w, h, robot, centroid)
+                .and_then(|s| s.next)
+            {
+                ep.last_random = false;
+                return Some((Action::Move, next, centroid));
+            }
+        }
+        if !ep.last_random {
+            ep.last_random = true;
+            return Some(match random_neighbour(map, robot, &mut self.rng) {
+                Some(next) => (Action::RandomStep, next, robot),
+                None => (Action::Wait, robot, robot),
+            });
+        }
+        ep.last_random = false;
+        match self.params.after_random_step {
+            AfterRandomStep::Wait => Some((Action::Wait, robot, robot)),
+            AfterRandomStep::EndEpisode => None,
+        }
+    }
+}
+
+/// A uniformly drawn 4-neighbour of `robot` on the map and not known occupied.
+fn random_neighbour(
+    map: &ChangeMap,
+    robot: (u32, u32),
+    rng: &mut impl RngCore,
+) -> Option<(u32, u32)> {
+    let options: Vec<(u32, u32)> = NEIGHBOURS
+        .iter()
+        .filter_map(|&(dx, dy)| {
+            let (x, y) = (i64::from(robot.0) + dx, i64::from(robot.1) + dy);
+            let (x, y) = (u32::try_from(x).ok()?, u32::try_from(y).ok()?);
+            let i = map.index(x, y)?;
+            (map.obstacles().get(i) != Some(&roam_map_server::grid::occupancy::OCCUPIED))
+                .then_some((x, y))
+        })
+        .collect();
+    if options.is_empty() {
+        return None;
+    }
+    Some(options[rng.random_range(0..options.len())])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::change_map::{MapParams, ObservationWindow};
+    use roam_proto::map::{GridMeta, Origin};
+
+    /// A `w × h` map seen entirely free at t = 0.
+    fn free_map(w: u32, h: u32) -> ChangeMap {
+        let meta = GridMeta {
+            width: w,
+            height: h,
+            resolution: 1.0,
+            origin: Origin::default(),
+        };
+        let mut map = ChangeMap::new(meta, MapParams::default()).expect("map");
+        let cells = vec![0i8; (w * h) as usize];
+        let window = ObservationWindow {
+            x0: 0,
+            y0: 0,
+            width: w,
+            height: h,
+            cells: &cells,
+        };
+        map.observe(&window, 0.0).expect("observe");
+        map
+    }
+
+    fn update(flipped: &[(u32, u32)], discovered: &[(u32, u32)]) -> Update {
+        Update {
+            flipped: flipped.to_vec(),
+            discovered: discovered.to_vec(),
+            ..Update::default()
+        }
+    }
+
+    fn params(max_steps: u32) -> ExplorerParams {
+        ExplorerParams {
+            max_steps,
+            ..ExplorerParams::default()
+        }
+    }
+
+    #[test]
+    fn an_episode_is_max_steps_updates_and_its_reward_is_changes_per_update() {
+        let mut map = free_map(5, 5);
+        let mut ex = Explorer::new(params(4), Mode::PoissonOnly, 1).expect("explorer");
+        let mut robot = (2, 2);
+        // Update 1 starts the episode (it belongs to no episode); updates 2–5 are the
+        // results of its four steps: 1, 0, 2 + 2 discoveries, 3 changes.
+        let updates = [
+            update(&[(0, 0)], &[]),
+            update(&[(0, 0)], &[]),
+            update(&[], &[]),
+            update(&[(1, 1), (1, 2)], &[(3, 3), (3, 4)]),
+            update(&[(0, 0), (0, 1), (0, 2)], &[]),
+        ];
+        let mut ends = Vec::new();
+        for (k, u) in updates.iter().enumerate() {
+            // Time stands still, so every (p, r) of the trajectory is the same point.
+            let step = ex.on_update(&mut map, u, robot, 0.0).expect("step");
+            assert_eq!(step.strategy, Strategy::Poisson);
+            let expected_steps = if k == 4 { 1 } else { k as u32 + 1 };
+            assert_eq!(step.episode_steps, expected_steps, "update {k}");
+            robot = step.next_cell;
+            ends.extend(step.episode);
+        }
+        assert_eq!(ends.len(), 1);
+        let end = ends[0];
+        assert_eq!((end.length, end.map_changes), (4, 8));
+        assert!((end.reward - 2.0).abs() < 1e-12);
+        assert_eq!(ex.episodes_ended(), 1);
+        // Four updates at the same tiles: w = 2·(1 − 0.1⁴) = 1.9998.
+        let v = ex.learner().value(Strategy::Poisson, map.features(0.0));
+        assert!((v - 1.9998).abs() < 1e-12, "{v}");
+        assert_eq!(
+            ex.learner().value(Strategy::Recency, map.features(0.0)),
+            0.0
+        );
+    }
+
+    #[test]
+    fn without_discoveries_only_flips_count() {
+        let mut map = free_map(5, 5);
+        let p = ExplorerParams {
+            count_discoveries: false,
+            ..params(2)
+        };
+        let mut ex = Explorer::new(p, Mode::RecencyOnly, 2).expect("explorer");
+        let mut robot = (2, 2);
+        let mut end = None;
+        for u in [
+            update(&[], &[]),
+            update(&[(0, 0)], &[(1, 1), (2, 1)]),
+            update(&[], &[(4, 4)]),
+        ] {
+            let step = ex.on_update(&mut map, &u, robot, 0.0).expect("step");
+            robot = step.next_cell;
+            end = end.or(step.episode);
+        }
+        let end = end.expect("ended");
+        assert_eq!((end.map_changes, end.length), (1, 2));
+        assert!((end.reward - 0.5).abs() < 1e-12);
+    }
+
+    /// Drives the explorer (robot obeying, nothing changing) until it explores locally;
+    /// the robot's cell and the first local action.
+    fn until_local(
+        ex: &mut Explorer,
+        map: &mut ChangeMap,
+        mut robot: (u32, u32),
+    ) -> ((u32, u32), Action) {
+        for _ in 0..20 {
+            let step = ex
+                .on_update(map, &update(&[], &[]), robot, 0.0)
+                .expect("step");
+            robot = step.next_cell;
+            if step.phase == Phase::Local {
+                return (robot, step.action);
+            }
+        }
+        panic!("never reached the goal");
+    }
+
+    #[test]
+    fn local_exploration_follows_changes_and_never_steps_at_random_twice() {
+        let mut map = free_map(9, 9);
+        let mut ex = Explorer::new(params(1000), Mode::RecencyOnly, 3).expect("explorer");
+        let (mut robot, first) = until_local(&mut ex, &mut map, (4, 4));
+        // Nothing changes: the first local action is a random step; then a wait and a
+        // random step by turns, never two random steps in a row.
+        assert_eq!(first, Action::RandomStep);
+        let mut previous = first;
+        let mut randoms = 0;
+        for _ in 0..10 {
+            let step = ex
+                .on_update(&mut map, &update(&[], &[]), robot, 0.0)
+                .expect("step");
+            assert_eq!(step.phase, Phase::Local);
+            assert!(!(previous == Action::RandomStep && step.action == Action::RandomStep));
+            let length = step.u[0].abs() + step.u[1].abs();
+            match step.action {
+                Action::RandomStep => {
+                    randoms += 1;
+                    assert_eq!(length, 1.0);
+                }
+                Action::Wait => assert_eq!(step.u, [0.0, 0.0]),
+                Action::Move => panic!("nothing to move to"),
+            }
+            previous = step.action;
+            robot = step.next_cell;
+        }
+        assert_eq!(randoms, 5, "random, wait, random, wait, …");
+        // A change at the far corner: the local goal is its centroid, one step closer.
+        let changes = update(&[(8, 8), (8, 7)], &[]);
+        let step = ex.on_update(&mut map, &changes, robot, 0.0).expect("step");
+        assert_eq!(step.action, Action::Move);
+        assert_eq!(step.goal, (8, 8)); // (8, 7.5) rounds up
+        let before = (8 - i64::from(robot.0)).abs() + (8 - i64::from(robot.1)).abs();
+        let after =
+            (8 - i64::from(step.next_cell.0)).abs() + (8 - i64::from(step.next_cell.1)).abs();
+        assert_eq!(after, before - 1);
+    }
+
+    #[test]
+    fn ending_the_episode_instead_of_a_second_random_step() {
+        let mut map = free_map(9, 9);
+        let p = ExplorerParams {
+            after_random_step: AfterRandomStep::EndEpisode,
+            ..params(1000)
+        };
+        let mut ex = Explorer::new(p, Mode::RecencyOnly, 4).expect("explorer");
+        let (robot, first) = until_local(&mut ex, &mut map, (4, 4));
+        assert_eq!(first, Action::RandomStep);
+        let second = ex
+            .on_update(&mut map, &update(&[], &[]), robot, 0.0)
+            .expect("end");
+        let end = second.episode.expect("the episode ended");
+        assert!(end.length >= 2);
+        assert_eq!(second.episode_steps, 1, "a new episode took the step");
+    }
+
+    #[test]
+    fn commands_scale_and_bad_input_is_refused() {
+        let mut map = free_map(5, 5);
+        let p = ExplorerParams {
+            cell_command: 0.25,
+            ..params(42)
+        };
+        let mut ex = Explorer::new(p, Mode::Curious, 5).expect("explorer");
+        let step = ex
+            .on_update(&mut map, &update(&[], &[]), (2, 2), 0.0)
+            .expect("step");
+        let length = step.u[0].abs() + step.u[1].abs();
+        assert!(length == 0.25 || length == 0.0, "{:?}", step.u);
+        assert!(matches!(
+            ex.on_update(&mut map, &update(&[], &[]), (5, 0), 1.0),
+            Err(MapperError::CellOffMap { .. })
+        ));
+        assert!(matches!(
+            ex.on_update(&mut map, &update(&[], &[]), (0, 0), f64::INFINITY),
+            Err(MapperError::BadTime(_))
+        ));
+        assert!(Explorer::new(params(0), Mode::Curious, 0).is_err());
+    }
+
+    #[test]
+    fn the_same_seed_gives_the_same_steps() {
+        let run = |seed| {
+            let mut map = free_map(9, 9);
+            let mut ex = Explorer::new(params(5), Mode::Curious, seed).expect("explorer");
+            let mut robot = (4, 4);
+            let mut out = Vec::new();
+            for k in 0..40 {
+                let u = if k % 7 == 3 {
+                    update(&[(k % 9, 0)], &[])
+                } else {
+                    update(&[], &[])
+                };
+                let step = ex.on_update(&mut map, &u, robot, 0.0).expect("step");
+                robot = step.next_cell;
+                out.push((step.next_cell, step.strategy, step.goal));
+            }
+            out
+        };
+        assert_eq!(run(11), run(11));
+        assert_ne!(run(11), run(12));
+    }
+}

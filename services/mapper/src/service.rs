@@ -1,0 +1,455 @@
+//! The change-rate mapper on Zenoh: a thin adapter around [`ChangeMap`] and, for the
+//! robots it is told to drive, [`Explorer`].
+//!
+//! | key | kind | payload |
+//! |---|---|---|
+//! | `<root>/robot/*/observation` | subscription | `observation` (from the sim or a robot) |
+//! | `<root>/map/update/{change_rate,change_probability,recency}` | queries to the map server, throttled | `layer_update` |
+//! | `<root>/robot/<id>/cmd` | publication, one per observation of a driven robot | `robot_command` |
+//! | `<root>/robot/<id>/goal` | publication, when the learner picks a goal | `exploration_goal` |
+//! | `<root>/mapper/status` | queryable | → `mapper_status` |
+//!
+//! Every robot's observations merge into one map. The layers are computed and sent at
+//! most once per `publish_period_s` (wall time), and only when something was observed
+//! since the last send: a map server is never flooded, whatever the robots' rate.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use roam_proto::cells::Cells;
+use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
+
+type MapMeta = GridMeta;
+use roam_proto::mapper::{
+    ExplorationGoal, ExplorerStatus, MapperStatus, CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER,
+    RECENCY_LAYER,
+};
+use roam_proto::sim::{LocalObservation, RobotCommand};
+use roam_proto::{encode, keys, ErrorReply, Message};
+use roam_runtime::{reply, Requester, Service, ServiceError};
+use roam_sim::service::load_scenario;
+use serde::Deserialize;
+use tokio_util::sync::CancellationToken;
+use zenoh::qos::CongestionControl;
+use zenoh::query::Query;
+use zenoh::Wait;
+
+use crate::change_map::{ChangeMap, MapParams, ObservationWindow};
+use crate::explorer::{Explorer, ExplorerParams, Mode};
+
+pub const SERVICE_NAME: &str = "mapper";
+/// Robots the learner drives at most.
+pub const MAX_EXPLORERS: usize = 64;
+
+/// The mapper's config file (YAML).
+///
+/// ```yaml
+/// root: roam
+/// scenario: config/scenarios/grid004.yaml   # the map the layers cover; default: built-in world
+/// explore: [robot]                          # robots the curious learner drives (default none)
+/// publish_period_s: 1.0                     # the layers go to the map server at most this often
+/// seed: 0
+/// ```
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MapperConfig {
+    pub root: String,
+    pub instance: Option<String>,
+    pub scenario: Option<PathBuf>,
+    pub explore: Vec<String>,
+    pub publish_period_s: f64,
+    pub seed: u64,
+    pub explorer: ExplorerParams,
+    /// The map's parameters; `observation_period_s` is taken from the scenario's step.
+    pub map: MapParams,
+    pub zenoh: Option<serde_json::Value>,
+}
+
+impl Default for MapperConfig {
+    fn default() -> Self {
+        MapperConfig {
+            root: keys::DEFAULT_ROOT.to_owned(),
+            instance: None,
+            scenario: None,
+            explore: Vec::new(),
+            publish_period_s: 1.0,
+            seed: 0,
+            explorer: ExplorerParams::default(),
+            map: MapParams::default(),
+            zenoh: None,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum MapperServiceError {
+    #[error(transparent)]
+    Service(#[from] ServiceError),
+    #[error(transparent)]
+    Scenario(#[from] roam_map_server::scenario::ScenarioError),
+    #[error("invalid config: {0}")]
+    Config(String),
+}
+
+/// What observations change.
+struct Mapping {
+    map: ChangeMap,
+    explorers: BTreeMap<String, Explorer>,
+    goals: BTreeMap<String, ([f64; 2], String, u64)>,
+    observations: u64,
+    map_changes: u64,
+    features: (f64, f64),
+    /// Sim time of the newest observation.
+    now_s: f64,
+    /// Something was observed since the layers were last sent.
+    dirty: bool,
+    layers_sent: u64,
+}
+
+struct State {
+    root: String,
+    session: zenoh::Session,
+    meta: MapMeta,
+    mapping: Mutex<Mapping>,
+}
+
+impl State {
+    fn mapping(&self) -> MutexGuard<'_, Mapping> {
+        self.mapping.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn put<T: Message>(&self, key: &str, message: &T) {
+        let sent = self
+            .session
+            .put(key, encode(message))
+            .congestion_control(CongestionControl::Block)
+            .wait();
+        if let Err(e) = sent {
+            tracing::warn!(%key, "publishing failed: {e}");
+        }
+    }
+}
+
+/// Why an observation cannot be merged (logged; a subscriber has no one to answer).
+fn check_observation(meta: &MapMeta, o: &LocalObservation) -> Result<(), String> {
+    if (o.meta.resolution - meta.resolution).abs() > 1e-9 * meta.resolution {
+        return Err(format!(
+            "its resolution {} m differs from the map's {} m",
+            o.meta.resolution, meta.resolution
+        ));
+    }
+    let (x1, y1) = (
+        u64::from(o.x0) + u64::from(o.meta.width),
+        u64::from(o.y0) + u64::from(o.meta.height),
+    );
+    if x1 > u64::from(meta.width) || y1 > u64::from(meta.height) {
+        return Err(format!(
+            "its window ends at cell ({x1}, {y1}), outside the {} x {} map",
+            meta.width, meta.height
+        ));
+    }
+    match &o.cells {
+        Cells::I8(c) if c.len() as u64 == u64::from(o.meta.width) * u64::from(o.meta.height) => {
+            Ok(())
+        }
+        Cells::I8(c) => Err(format!(
+            "it has {} cells for a {} x {} window",
+            c.len(),
+            o.meta.width,
+            o.meta.height
+        )),
+        _ => Err("its cells are not i8 occupancy values".to_owned()),
+    }
+}
+
+fn cell_centre(meta: &MapMeta, (x, y): (u32, u32)) -> [f64; 2] {
+    [
+        meta.origin.x + (f64::from(x) + 0.5) * meta.resolution,
+        meta.origin.y + (f64::from(y) + 0.5) * meta.resolution,
+    ]
+}
+
+fn on_observation(state: &State, o: LocalObservation) {
+    if let Err(e) = check_observation(&state.meta, &o) {
+        return tracing::warn!(robot = %o.robot, step = o.step, "ignoring an observation: {e}");
+    }
+    let Cells::I8(cells) = &o.cells else {
+        return;
+    };
+    let window = ObservationWindow {
+        x0: o.x0,
+        y0: o.y0,
+        width: o.meta.width,
+        height: o.meta.height,
+        cells,
+    };
+    let out = {
+        let mut guard = state.mapping();
+        let m = &mut *guard;
+        let update = match m.map.observe(&window, o.time_s) {
+            Ok(u) => u,
+            Err(e) => {
+                return tracing::warn!(robot = %o.robot, "ignoring an observation: {e}");
+            }
+        };
+        m.observations += 1;
+        m.map_changes += update.map_changes(true) as u64;
+        m.now_s = m.now_s.max(o.time_s);
+        m.dirty = true;
+        let features = m.map.features(o.time_s);
+        m.features = (features.p, features.r);
+        match (m.explorers.get_mut(&o.robot), m.map.cell_of(o.at)) {
+            (Some(explorer), Some(cell)) => {
+                match explorer.on_update(&mut m.map, &update, cell, o.time_s) {
+                    Ok(step) => {
+                        let at = cell_centre(&state.meta, step.episode_goal);
+                        let strategy = step.strategy.as_str().to_owned();
+                        let episodes = explorer.episodes_ended();
+                        let fresh = m.goals.get(&o.robot).is_none_or(|(goal, s, e)| {
+                            *goal != at || *s != strategy || *e != episodes
+                        });
+                        let goal = fresh.then(|| {
+                            m.goals
+                                .insert(o.robot.clone(), (at, strategy.clone(), episodes));
+                            ExplorationGoal {
+                                robot: o.robot.clone(),
+                                step: o.step,
+                                time_s: o.time_s,
+                                goal: at,
+                                strategy,
+                                episodes,
+                            }
+                        });
+                        Some((step.u, goal))
+                    }
+                    Err(e) => {
+                        tracing::warn!(robot = %o.robot, "no exploration step: {e}");
+                        None
+                    }
+                }
+            }
+            _ => None,
+        }
+    };
+    if let Some((u, goal)) = out {
+        state.put(
+            &keys::robot_command(&state.root, &o.robot),
+            &RobotCommand {
+                u,
+                step: Some(o.step),
+            },
+        );
+        if let Some(goal) = goal {
+            state.put(&keys::robot_goal(&state.root, &o.robot), &goal);
+        }
+    }
+}
+
+fn status(state: &State) -> MapperStatus {
+    let m = state.mapping();
+    MapperStatus {
+        observations: m.observations,
+        map_changes: m.map_changes,
+        p: m.features.0,
+        r: m.features.1,
+        layers_sent: m.layers_sent,
+        explorers: m
+            .explorers
+            .iter()
+            .map(|(robot, e)| {
+                let goal = m.goals.get(robot);
+                ExplorerStatus {
+                    robot: robot.clone(),
+                    strategy: goal.map(|g| g.1.clone()),
+                    goal: goal.map(|g| g.0),
+                    episodes: e.episodes_ended(),
+                }
+            })
+            .collect(),
+    }
+}
+
+async fn answer_status(state: Arc<State>, query: Query) {
+    let result: Result<MapperStatus, ErrorReply> = Ok(status(&state));
+    reply::send_result(&query, result).await;
+}
+
+/// The three layers at the newest observation's time, if anything was observed since
+/// they were last sent.
+fn layers_to_send(state: &State) -> Option<[(&'static str, Vec<f32>); 3]> {
+    let mut m = state.mapping();
+    if !m.dirty {
+        return None;
+    }
+    m.dirty = false;
+    let now = m.now_s;
+    Some([
+        (CHANGE_RATE_LAYER, f32_cells(m.map.rate_layer().cells)),
+        (
+            CHANGE_PROBABILITY_LAYER,
+            f32_cells(m.map.probability_layer(now).cells),
+        ),
+        (RECENCY_LAYER, f32_cells(m.map.recency_layer(now).cells)),
+    ])
+}
+
+/// Layers travel as f32 cells: the map server's float layer type, half the bytes.
+fn f32_cells(cells: Vec<f64>) -> Vec<f32> {
+    cells.into_iter().map(|v| v as f32).collect()
+}
+
+/// Sends the layers to the map server at most once per period.
+async fn publish_layers(state: Arc<State>, period: Duration, cancel: CancellationToken) {
+    let requester = Requester::new(state.session.clone(), Duration::from_secs(5));
+    let meta = GridMeta {
+        width: state.meta.width,
+        height: state.meta.height,
+        resolution: state.meta.resolution,
+        origin: Origin {
+            x: state.meta.origin.x,
+            y: state.meta.origin.y,
+            yaw: 0.0,
+        },
+    };
+    loop {
+        tokio::select! {
+            _ = cancel.cancelled() => return,
+            _ = tokio::time::sleep(period) => {}
+        }
+        let Some(layers) = layers_to_send(&state) else {
+            continue;
+        };
+        let list: LayerList = match requester
+            .request::<LayerList, LayerList>(&keys::map_index(&state.root), None)
+            .await
+        {
+            Ok(l) => l,
+            Err(e) => {
+                // Try again next period with fresher layers.
+                state.mapping().dirty = true;
+                tracing::debug!("no map server to send the layers to: {e}");
+                continue;
+            }
+        };
+        let mut all_sent = true;
+        for (name, cells) in layers {
+            let base_version = list
+                .layers
+                .iter()
+                .find(|l| l.name == name)
+                .map_or(0, |l| l.version);
+            let update = LayerUpdate {
+                base_version,
+                change: LayerChange::Replace {
+                    meta,
+                    cells: Cells::F32(cells),
+                },
+            };
+            let sent = requester
+                .request::<LayerUpdate, UpdateAck>(
+                    &keys::map_update(&state.root, name),
+                    Some(&update),
+                )
+                .await;
+            if let Err(e) = sent {
+                all_sent = false;
+                tracing::warn!(layer = name, "the map server refused the layer: {e}");
+            }
+        }
+        if all_sent {
+            state.mapping().layers_sent += 1;
+        } else {
+            state.mapping().dirty = true;
+        }
+    }
+}
+
+/// Runs the mapper until `cancel` is cancelled.
+pub async fn run(
+    config: MapperConfig,
+    zenoh_config: zenoh::Config,
+    cancel: CancellationToken,
+) -> Result<(), MapperServiceError> {
+    if !(config.publish_period_s.is_finite() && config.publish_period_s > 0.0) {
+        return Err(MapperServiceError::Config(format!(
+            "publish_period_s is {}; give a positive number of seconds",
+            config.publish_period_s
+        )));
+    }
+    let explore: BTreeSet<String> = config.explore.iter().cloned().collect();
+    if explore.len() > MAX_EXPLORERS {
+        return Err(MapperServiceError::Config(format!(
+            "{} robots to explore with; at most {MAX_EXPLORERS} (max_explorers)",
+            explore.len()
+        )));
+    }
+    for robot in &explore {
+        keys::check_name("robot", robot).map_err(|e| MapperServiceError::Config(e.to_string()))?;
+    }
+    let (_, scenario) = load_scenario(config.scenario.as_deref())?;
+    let meta = scenario.occupancy.meta;
+    let observation_period_s = scenario.file.time.step_s;
+    let map = ChangeMap::new(
+        meta,
+        MapParams {
+            observation_period_s,
+            ..config.map
+        },
+    )
+    .map_err(|e| MapperServiceError::Config(e.to_string()))?;
+    let explorers = explore
+        .iter()
+        .enumerate()
+        .map(|(i, robot)| {
+            let seed = config.seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            Explorer::new(config.explorer, Mode::Curious, seed)
+                .map(|e| (robot.clone(), e))
+                .map_err(|e| MapperServiceError::Config(e.to_string()))
+        })
+        .collect::<Result<_, _>>()?;
+    let mut service = Service::start(
+        SERVICE_NAME,
+        &config.root,
+        config.instance.as_deref(),
+        zenoh_config,
+        cancel,
+    )
+    .await?;
+    let state = Arc::new(State {
+        root: config.root.clone(),
+        session: service.session().clone(),
+        meta,
+        mapping: Mutex::new(Mapping {
+            map,
+            explorers,
+            goals: BTreeMap::new(),
+            observations: 0,
+            map_changes: 0,
+            features: (0.0, 0.0),
+            now_s: 0.0,
+            dirty: false,
+            layers_sent: 0,
+        }),
+    });
+    service
+        .subscribe(
+            &keys::robot_observation_any(&config.root),
+            state.clone(),
+            |state: &Arc<State>, o: LocalObservation| on_observation(state, o),
+        )
+        .await?;
+    let status_queryable = service
+        .declare_queryable(&keys::mapper_status(&config.root))
+        .await?;
+    service.serve(status_queryable, state.clone(), |s, q| async move {
+        answer_status(s, q).await
+    });
+    let (published, token) = (state.clone(), service.cancel_token());
+    let period = Duration::from_secs_f64(config.publish_period_s);
+    service.spawn(async move { publish_layers(published, period, token).await });
+    service.announce().await?;
+    service.run_until_stopped().await?;
+    Ok(())
+}

@@ -1,0 +1,151 @@
+//! The change-rate mapper through Zenoh: the sim's grid world (paper 004) → mapper (its
+//! learner driving the robot) → map server; the change-probability and rate layers are
+//! fetched with a `get` and their hot cells are where the blocks move.
+
+use std::time::{Duration, Instant};
+
+use roam_mapper::service::MapperConfig;
+use roam_proto::cells::Cells;
+use roam_proto::map::Layer;
+use roam_proto::mapper::{
+    ExplorationGoal, MapperStatus, CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER, RECENCY_LAYER,
+};
+use roam_proto::sim::{RobotCommand, SimControl, SimStatus};
+use roam_proto::{decode, keys};
+use roam_tests::{repo_path, within, Harness};
+
+const GRID004: &str = "config/scenarios/grid004.yaml";
+
+fn f32_cells(layer: &Layer) -> &[f32] {
+    match &layer.cells {
+        Cells::F32(c) => c,
+        other => panic!("expected f32 cells, got {other:?}"),
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn sim_to_mapper_to_map_server_shows_where_the_blocks_move() {
+    let harness = Harness::start().await;
+    let mut map_config = harness.map_server_config();
+    map_config.map = Some(repo_path(GRID004));
+    let _map_server = harness.start_map_server(map_config).await;
+    let _sim = harness.start_sim(harness.sim_config(Some(GRID004))).await;
+    let _mapper = harness
+        .start_mapper(MapperConfig {
+            scenario: Some(repo_path(GRID004)),
+            explore: vec!["robot".into()],
+            publish_period_s: 0.2,
+            seed: 3,
+            ..harness.mapper_config()
+        })
+        .await;
+    let client = harness.client().await;
+    let root = harness.root.clone();
+    let commands = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::robot_command(&root, "robot")),
+    )
+    .await
+    .expect("subscriber");
+    let goals = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::robot_goal(&root, "robot")),
+    )
+    .await
+    .expect("subscriber");
+
+    // Lock-step: each step's observation goes to the mapper, whose learner answers with
+    // the robot's next move before the next step.
+    let steps = 1500u64;
+    for step in 1..=steps {
+        let _: SimStatus = within(
+            "step",
+            client.request(&keys::sim_control(&root), Some(&SimControl::Step { n: 1 })),
+        )
+        .await
+        .expect("step");
+        loop {
+            let sample = within("a command", commands.recv_async())
+                .await
+                .expect("sample");
+            let command: RobotCommand = decode(&sample.payload().to_bytes()).expect("command");
+            if command.step == Some(step) {
+                break;
+            }
+        }
+    }
+    let status: MapperStatus = within(
+        "status",
+        client.request::<MapperStatus, MapperStatus>(&keys::mapper_status(&root), None),
+    )
+    .await
+    .expect("status");
+    assert_eq!(status.observations, steps);
+    assert!(status.map_changes > 0);
+    assert_eq!(status.explorers.len(), 1);
+    assert!(
+        status.explorers[0].episodes > 5,
+        "episodes of at most 42 steps: {status:?}"
+    );
+    let goal_sample = goals
+        .try_recv()
+        .expect("recv")
+        .expect("a goal was published");
+    let goal: ExplorationGoal = decode(&goal_sample.payload().to_bytes()).expect("goal");
+    assert!(goal.strategy == "recency" || goal.strategy == "poisson");
+
+    // The layers arrive within a few publish periods after the last observation.
+    let until = Instant::now() + Duration::from_secs(10);
+    let (rate, probability) = loop {
+        let rate = fetch(&client, &root, CHANGE_RATE_LAYER).await;
+        let probability = fetch(&client, &root, CHANGE_PROBABILITY_LAYER).await;
+        let recency = fetch(&client, &root, RECENCY_LAYER).await;
+        if let (Some(rate), Some(probability), Some(_)) = (rate, probability, recency) {
+            break (rate, probability);
+        }
+        assert!(
+            Instant::now() < until,
+            "the mapper's layers never reached the map server"
+        );
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    };
+
+    let scenario = roam_mapper::experiment::grid004().expect("grid004");
+    let truth = roam_mapper::truth::true_rates(&scenario, 1.0).expect("true rates");
+    let changing: std::collections::BTreeSet<usize> = truth.changing.iter().copied().collect();
+    let rates = f32_cells(&rate);
+    let learned: Vec<usize> = (0..rates.len()).filter(|&i| rates[i] > 0.0).collect();
+    assert!(
+        learned.len() >= 8,
+        "only {} cells with a learned rate",
+        learned.len()
+    );
+    for i in &learned {
+        assert!(
+            changing.contains(i),
+            "cell {i} has a rate but no block ever moves there"
+        );
+    }
+    // The hot cells of P(E > 0) are where the blocks move: every cell above 0.5 changes
+    // in truth, and there are some.
+    let p = f32_cells(&probability);
+    let hot: Vec<usize> = (0..p.len()).filter(|&i| p[i] > 0.5).collect();
+    assert!(
+        !hot.is_empty(),
+        "no hot cell in the change-probability layer"
+    );
+    for i in &hot {
+        assert!(changing.contains(i), "hot cell {i} never changes in truth");
+    }
+}
+
+async fn fetch(client: &roam_runtime::Requester, root: &str, name: &str) -> Option<Layer> {
+    client
+        .request::<Layer, Layer>(&keys::map_layer(root, name), None)
+        .await
+        .ok()
+}
