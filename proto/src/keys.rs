@@ -239,6 +239,12 @@ pub fn robot_goal(root: &str, robot: &str) -> String {
     format!("{root}/robot/{robot}/goal")
 }
 
+/// `<root>/robot/<robot>/mission_report`: the mission executive publishes a
+/// [`WindowReport`](crate::mission::WindowReport) at the end of each downtime window.
+pub fn robot_mission_report(root: &str, robot: &str) -> String {
+    format!("{root}/robot/{robot}/mission_report")
+}
+
 /// `<root>/mapper/status`: the mapper answers a `get` (no payload) with a
 /// [`MapperStatus`](crate::mapper::MapperStatus).
 pub fn mapper_status(root: &str) -> String {

@@ -14,6 +14,7 @@ pub mod keys;
 pub mod localization;
 pub mod map;
 pub mod mapper;
+pub mod mission;
 pub mod planner;
 pub mod sim;
 

@@ -526,3 +526,15 @@ mod controller_and_mapper_messages {
         }
     }
 }
+
+mod mission_messages {
+    use super::*;
+    use roam_proto::mission::WindowReport;
+
+    proptest! {
+        #[test]
+        fn window_reports_round_trip(robot in name(), x in finite(), arrival in prop::option::of(finite()), on_time in any::<bool>()) {
+            round_trips(&WindowReport { robot: robot.clone(), task: robot, window: 1, began_s: x, task_start_s: x, arrival_s: arrival, on_time, budget_s: x, planned_information: x, driven_information: x, shortest_information: x, peb_mean_m: arrival, replans: 2, replan_reasons: vec!["off_path".into()] });
+        }
+    }
+}

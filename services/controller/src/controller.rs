@@ -229,7 +229,12 @@ impl Controller {
         self.halted_updates = 0;
         self.active_steps += 1;
         while let Some(&w) = self.waypoints.get(self.current) {
-            if (w[0] - position[0]).hypot(w[1] - position[1]) > self.params.g_thres_m {
+            let last = self.current + 1 == self.waypoints.len();
+            let reach = match self.params.via_thres_m {
+                Some(via) if !last => via,
+                _ => self.params.g_thres_m,
+            };
+            if (w[0] - position[0]).hypot(w[1] - position[1]) > reach {
                 break;
             }
             self.current += 1;
@@ -356,6 +361,24 @@ mod tests {
         // Final: nothing changes any more.
         let again = c.update([0.0, 0.0], GOOD);
         assert_eq!((again.status, again.steps), (MissionStatus::Completed, 3));
+    }
+
+    #[test]
+    fn via_thres_loosens_every_waypoint_but_the_last() {
+        let mut c = controller(ApfParams {
+            via_thres_m: Some(0.5),
+            ..plain()
+        });
+        c.set_mission(vec![[20.4, 20.0], [25.0, 20.0]]);
+        // 0.4 m from the first: passed (via 0.5 m), the last is current.
+        let d = c.update([20.0, 20.0], GOOD);
+        assert_eq!(d.waypoint, Some(1));
+        // The last still needs g_thres.
+        assert_eq!(c.update([24.6, 20.0], GOOD).waypoint, Some(1));
+        assert_eq!(
+            c.update([24.95, 20.0], GOOD).status,
+            MissionStatus::Completed
+        );
     }
 
     #[test]

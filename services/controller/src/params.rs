@@ -48,6 +48,11 @@ pub struct ApfParams {
     pub eta_thres_m: f64,
     /// g_thres, the distance within which a waypoint counts as reached, metres.
     pub g_thres_m: f64,
+    /// The distance within which a waypoint that is not the mission's last counts as
+    /// passed, metres; `None` means g_thres (paper 002 §4 uses g_thres for every
+    /// waypoint). A mission executive that hands over a planned path as many waypoints
+    /// wants a looser value: only the last one is a place the robot must reach exactly.
+    pub via_thres_m: Option<f64>,
     /// Updates a mission may take before it ends as `step_limit` (paper 002 §4).
     pub max_steps: u64,
     /// z_is, the information-seeking weight (paper 002 Eqs. 2–3), unitless.
@@ -79,6 +84,7 @@ impl Default for ApfParams {
             z_r: DEFAULT_Z_R,
             eta_thres_m: DEFAULT_ETA_THRES_M,
             g_thres_m: DEFAULT_G_THRES_M,
+            via_thres_m: None,
             max_steps: DEFAULT_MAX_STEPS,
             z_is: DEFAULT_Z_IS,
             omega_t_deg: DEFAULT_OMEGA_T_DEG,
@@ -127,6 +133,14 @@ impl ApfParams {
             self.g_thres_m > 0.0 && self.g_thres_m <= 1e4,
             "more than 0 up to 1e4 metres",
         )?;
+        if let Some(via) = self.via_thres_m {
+            check(
+                "via_thres_m",
+                via,
+                via > 0.0 && via <= 1e4,
+                "more than 0 up to 1e4 metres",
+            )?;
+        }
         check(
             "max_steps",
             self.max_steps as f64,

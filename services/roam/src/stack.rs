@@ -32,6 +32,10 @@ pub struct StackOptions {
     pub listen: Option<String>,
     /// Planner instances to run (default 1).
     pub planners: usize,
+    /// The sim's real-time factor (default 1; 0 runs as fast as possible).
+    pub sim_rate: Option<f64>,
+    /// The controller's parameters (default: paper 002's).
+    pub apf: Option<roam_controller::params::ApfParams>,
 }
 
 /// The services `Stack::start` runs, in start order.
@@ -130,6 +134,7 @@ impl Stack {
         }
         let sim_config = SimConfig {
             root: root.clone(),
+            rate: Some(options.sim_rate.unwrap_or(1.0)),
             ..SimConfig::default()
         };
         spawn(
@@ -153,6 +158,7 @@ impl Stack {
 
         let controller_config = ControllerConfig {
             root: root.clone(),
+            apf: options.apf.clone().unwrap_or_default(),
             ..ControllerConfig::default()
         };
         spawn(

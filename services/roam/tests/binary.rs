@@ -184,6 +184,10 @@ fn help_reads_like_a_manual() {
         "map-server",
         "router",
         "stack",
+        "demo",
+        "controller",
+        "mapper",
+        "mission",
         "ZENOH_CONFIG",
         "RUST_LOG",
         "ROAM_ROOT",
@@ -602,4 +606,68 @@ fn bench_mapper_prints_updates_per_second() {
     let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
     assert_eq!(value["map_cells"], 1_000_000);
     assert!(value["updates_with_features_per_s"].as_f64().expect("rate") > 0.0);
+}
+
+#[test]
+fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
+    let out = tempfile::tempdir().expect("tmp");
+    let output = Command::new(ROAM)
+        .args(["demo", "--rate", "10", "--out"])
+        .arg(out.path())
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("run");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(stderr.contains("window 1 -> goal1"), "progress: {stderr}");
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.path().join("report.json")).expect("json"))
+            .expect("parses");
+    for field in [
+        "on_time",
+        "information",
+        "information_shortest_path",
+        "peb_mean_m",
+    ] {
+        assert!(!report[field].is_null(), "{field} missing: {report}");
+    }
+    assert_eq!(report["windows"].as_array().expect("windows").len(), 2);
+    let markdown = std::fs::read_to_string(out.path().join("report.md")).expect("md");
+    assert!(markdown.contains("| 1 | goal1 |") && markdown.contains("world.png"));
+
+    // The built-in world: 100 x 100 cells of 0.2 m from (-10, -10), 8 px per cell.
+    let picture = image::open(out.path().join("world.png"))
+        .expect("png")
+        .to_rgb8();
+    assert_eq!(picture.dimensions(), (800, 800));
+    let pixel = |p: [f64; 2]| {
+        let (x, y) = ((p[0] + 10.0) / 0.2, (p[1] + 10.0) / 0.2);
+        let (px, py) = (x.floor() * 8.0 + 4.0, (99.0 - y.floor()) * 8.0 + 4.0);
+        *picture.get_pixel(px as u32, py as u32)
+    };
+    let driven: Vec<[f64; 2]> =
+        serde_json::from_value(report["driven_path"].clone()).expect("driven path");
+    assert!(driven.len() > 50);
+    // Away from the start and task markers, the driven path is red where it was driven.
+    let markers = [[-8.0, -8.0], [-2.0, 4.0], [6.0, -7.0]];
+    let away: Vec<[f64; 2]> = driven
+        .iter()
+        .copied()
+        .filter(|p| {
+            markers
+                .iter()
+                .all(|m| (p[0] - m[0]).hypot(p[1] - m[1]) > 0.8)
+        })
+        .collect();
+    let red = away
+        .iter()
+        .filter(|p| pixel(**p) == image::Rgb([220, 20, 20]))
+        .count();
+    assert!(
+        red * 10 >= away.len() * 9,
+        "{red} of {} driven points are red in the picture",
+        away.len()
+    );
+    // The task places are marked green.
+    assert_eq!(pixel([-2.0, 4.0]), image::Rgb([0, 170, 60]));
 }

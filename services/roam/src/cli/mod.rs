@@ -43,6 +43,9 @@ ROLES
   mapper       The change-rate mapper (paper 004): two Poisson processes per cell,
                change-probability, rate and recency layers to the map server; with
                --explore, the curious learner drives robots to where the world changes.
+  mission      The mission executive: one robot's tasks; in each downtime window a
+               curious path from the planner, driven by the controller, watched,
+               replanned when blocked, pushed off or late, and reported.
   sim          The sim world: robots (paper 002's motion model), anchors and TOA
                ranges, moving blocks (paper 004), line-of-sight observations, a clock;
                free-running or in lock-step. `roam sim render` draws a scenario.
@@ -68,6 +71,7 @@ ENVIRONMENT
                 see each other.
 
 EXAMPLES
+  roam demo                                  roam's main job on the built-in world, with a report
   roam stack --once                          boot the stack, fetch every layer, report
   roam router --listen tcp/0.0.0.0:7447      on the site server
   roam map-server --mode client --connect tcp/10.0.0.5:7447 --map config/maps/depot.yaml
@@ -94,6 +98,11 @@ enum Command {
     Controller(roles::ControllerArgs),
     /// Run the change-rate mapper and the curious exploration learner (paper 004).
     Mapper(roles::MapperArgs),
+    /// Run a mission executive: one robot's tasks, curious downtime paths, reports.
+    Mission(roles::MissionArgs),
+    /// roam's main job: the whole stack on the built-in world, one robot, two tasks with
+    /// downtime between them; writes a report directory.
+    Demo(roles::DemoArgs),
     /// Run the sim world (papers 002 and 004), or `sim render` a scenario to a PNG.
     Sim(sim::SimArgs),
     /// Ask a running planner for a curious path (a client).
@@ -157,7 +166,8 @@ role_config!(
     roam_sim::service::SimConfig,
     roam_localization::service::LocalizationConfig,
     roam_controller::service::ControllerConfig,
-    roam_mapper::service::MapperConfig
+    roam_mapper::service::MapperConfig,
+    roam_mission::service::MissionConfig
 );
 
 impl ServiceArgs {
@@ -201,6 +211,8 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Localization(args) => roles::localization(args).await,
         Command::Controller(args) => roles::controller(args).await,
         Command::Mapper(args) => roles::mapper(args).await,
+        Command::Mission(args) => roles::mission(args).await,
+        Command::Demo(args) => roles::demo(args).await,
         Command::Plan(args) => plan::plan(args).await,
         Command::Router(args) => roles::router(args).await,
         Command::Stack(args) => roles::stack(args).await,

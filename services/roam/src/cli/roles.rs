@@ -141,6 +141,7 @@ pub(crate) async fn stack(args: StackArgs) -> anyhow::Result<()> {
         data_dir: args.data_dir,
         listen: args.listen,
         planners: args.planners,
+        ..StackOptions::default()
     };
     let mut stack = Stack::start(options, Duration::from_secs(30)).await?;
     eprintln!(
@@ -269,6 +270,63 @@ pub(crate) async fn mapper(args: MapperArgs) -> anyhow::Result<()> {
     }
     let zenoh = args.service.zenoh_config(&config)?;
     roam_mapper::service::run(config, zenoh, signals::cancel_on_signal()).await?;
+    Ok(())
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct MissionArgs {
+    #[command(flatten)]
+    service: ServiceArgs,
+    /// The robot to drive (default: the config's, or `robot`).
+    #[arg(long)]
+    robot: Option<String>,
+}
+
+pub(crate) async fn mission(args: MissionArgs) -> anyhow::Result<()> {
+    let mut config: roam_mission::service::MissionConfig = args.service.load_config()?;
+    if let Some(robot) = args.robot {
+        config.executive.robot = robot;
+    }
+    let zenoh = args.service.zenoh_config(&config)?;
+    roam_mission::service::run(config, zenoh, signals::cancel_on_signal()).await?;
+    Ok(())
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct DemoArgs {
+    /// Where the report goes (world.png, report.json, report.md).
+    #[arg(long, default_value = "roam-demo")]
+    out: PathBuf,
+    /// The sim's real-time factor.
+    #[arg(long, default_value_t = 20.0)]
+    rate: f64,
+    /// The planner's seed.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
+    if !(args.rate.is_finite() && args.rate > 0.0 && args.rate <= 100.0) {
+        anyhow::bail!("--rate must be more than 0 and at most 100 (times real time)");
+    }
+    let options = roam::demo::DemoOptions {
+        out_dir: args.out,
+        rate: args.rate,
+        seed: args.seed,
+        root: None,
+    };
+    let say = |line: &str| eprintln!("roam demo: {line}");
+    let report = roam::demo::run(&options, &say).await?;
+    println!(
+        "on time: {}   information: {:.0} (shortest path: {:.0})   mean PEB: {}",
+        if report.on_time { "yes" } else { "no" },
+        report.information,
+        report.information_shortest_path,
+        report
+            .peb_mean_m
+            .map_or("-".to_owned(), |p| format!("{p:.3} m"))
+    );
+    println!("report: {}", options.out_dir.display());
     Ok(())
 }
 

@@ -1,0 +1,42 @@
+//! Messages of the mission executive: what a robot did with one downtime window.
+
+use serde::{Deserialize, Serialize};
+
+use crate::codec::Message;
+
+/// One downtime window's outcome, on `<root>/robot/<id>/mission_report` when the window
+/// ends (the robot reached the task, or gave up).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WindowReport {
+    pub robot: String,
+    /// The task the window leads to.
+    pub task: String,
+    /// 0 for the first window.
+    pub window: usize,
+    /// When the window began and when the task starts, sim seconds.
+    pub began_s: f64,
+    pub task_start_s: f64,
+    /// When the robot reached the task's place; `None` if it did not.
+    pub arrival_s: Option<f64>,
+    /// Reached no later than the task's start.
+    pub on_time: bool,
+    /// The driving budget the planner was given (paper 000's t_exec), seconds.
+    pub budget_s: f64,
+    /// The information of the distinct cells seen along the planned curious path, along
+    /// the path the robot drove (from its estimates), and along the shortest path of the
+    /// same window (paper 000's information map, perception window d).
+    pub planned_information: f64,
+    pub driven_information: f64,
+    pub shortest_information: f64,
+    /// The mean PEB of the window's estimates (bounded ones), metres.
+    pub peb_mean_m: Option<f64>,
+    /// Plans after the first (blocked, pushed off the path, ETA slipping).
+    pub replans: u32,
+    /// Why each replan happened, in order.
+    pub replan_reasons: Vec<String>,
+}
+
+impl Message for WindowReport {
+    const KIND: &'static str = "window_report";
+}

@@ -1,0 +1,589 @@
+//! The mission executive on Zenoh: a client of the planner, the controller,
+//! localization and the clock. One executive drives one robot through its tasks.
+//!
+//! | key | kind | payload |
+//! |---|---|---|
+//! | `<root>/map/layer/{inflated,information}` | get, at start | `layer` (to thin paths and score them) |
+//! | `<root>/planner/…/plan` | get, per window and replan | `plan_request` → `plan` |
+//! | `<root>/robot/<id>/mission` | put, per plan | `mission` (the thinned waypoints) |
+//! | `<root>/robot/<id>/estimate` | subscription | `position_estimate` |
+//! | `<root>/robot/<id>/controller` | subscription | `controller_status` |
+//! | `<root>/sim/clock` | subscription | `sim_clock` (the mission clock; wall time without a sim) |
+//!
+//! **Time.** Task start times are on the mission clock: sim seconds when a sim world
+//! publishes its clock. The planner's deadline is wall time, so what planning costs on
+//! the mission clock is the deadline times the clock's measured rate (a sim running at
+//! 20× charges a 0.5 s plan 10 s of downtime); the driving budget t_exec is the time to
+//! the task's start minus that.
+
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+use roam_map_server::grid::Grid;
+use roam_map_server::store::{INFLATED, INFORMATION};
+use roam_planner::client::PlannerClient;
+use roam_planner::params::GaParams;
+use roam_planner::world::World;
+use roam_proto::cells::Cells;
+use roam_proto::controller::{ControllerStatus, Mission, MissionState};
+use roam_proto::localization::PositionEstimate;
+use roam_proto::map::Layer;
+use roam_proto::mission::WindowReport;
+use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
+use roam_proto::sim::SimClock;
+use roam_proto::{decode, encode, keys};
+use roam_runtime::{ClientError, Requester};
+use serde::Deserialize;
+use tokio_util::sync::CancellationToken;
+use zenoh::qos::CongestionControl;
+
+use crate::information::gathered;
+use crate::path::{eta_slips, off_path_m, thin};
+use crate::tasks::{self, Task, TaskError};
+
+/// How the executive plans and watches.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ExecutiveConfig {
+    /// The robot this executive drives.
+    pub robot: String,
+    pub tasks: Vec<Task>,
+    /// The curiosity model for downtime paths (paper 000).
+    pub model: PlannerModel,
+    /// The planner's deadline, wall seconds (paper 000's t_plan).
+    pub plan_deadline_s: f64,
+    /// Generations the GA may run at most (it stops at the deadline anyway).
+    pub max_generations: Option<u32>,
+    pub seed: u64,
+    /// Waypoints are at most this far apart along the planned path, metres.
+    pub waypoint_spacing_m: f64,
+    /// An estimate farther than this from the planned path means the robot was pushed
+    /// off it: replan from where it is, metres.
+    pub off_path_m: f64,
+    /// The robot's top speed for the ETA-slip check, m/s.
+    pub speed_m_per_s: f64,
+    /// Replans per window at most.
+    pub max_replans: u32,
+    /// A window is given up this long after its task's start, seconds.
+    pub give_up_after_s: f64,
+}
+
+impl Default for ExecutiveConfig {
+    fn default() -> Self {
+        ExecutiveConfig {
+            robot: "robot".to_owned(),
+            tasks: tasks::builtin(),
+            model: PlannerModel::Model1,
+            plan_deadline_s: 1.0,
+            max_generations: Some(1000),
+            seed: 0,
+            waypoint_spacing_m: 1.0,
+            off_path_m: 1.5,
+            speed_m_per_s: 0.5,
+            max_replans: 5,
+            give_up_after_s: 60.0,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ExecutiveError {
+    #[error(transparent)]
+    Tasks(#[from] TaskError),
+    #[error("invalid config: {0}")]
+    Config(String),
+    #[error(transparent)]
+    Client(#[from] ClientError),
+    #[error("the map server's {0} layer is not usable: {1}")]
+    Layer(&'static str, String),
+    #[error("no estimate of robot {robot:?} within {waited:?}: is localization running and the robot in range of the anchors?")]
+    NoEstimate { robot: String, waited: Duration },
+    #[error("zenoh: {0}")]
+    Zenoh(String),
+    #[error("stopped")]
+    Cancelled,
+}
+
+/// A window's outcome with the paths, for pictures.
+#[derive(Debug, Clone)]
+pub struct WindowOutcome {
+    pub report: WindowReport,
+    /// Every plan the robot was given in the window, in order.
+    pub plans: Vec<Vec<[f64; 2]>>,
+    /// The shortest path of the window, for comparison.
+    pub shortest: Vec<[f64; 2]>,
+    /// The estimates the robot drove on.
+    pub driven: Vec<[f64; 2]>,
+}
+
+/// What the executive is doing, for a progress display.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Progress {
+    Planned {
+        window: usize,
+        task: String,
+        budget_s: f64,
+        eta_s: f64,
+        curious: bool,
+    },
+    Replanned {
+        window: usize,
+        reason: String,
+    },
+    Arrived {
+        window: usize,
+        task: String,
+        at_s: f64,
+        start_s: f64,
+    },
+    GaveUp {
+        window: usize,
+        task: String,
+    },
+}
+
+/// The mission clock: the sim's when it publishes one, wall time otherwise.
+#[derive(Debug)]
+struct Clock {
+    started: Instant,
+    first: Option<(Instant, f64)>,
+    latest: Option<(Instant, f64)>,
+}
+
+impl Clock {
+    fn now_s(&self) -> f64 {
+        match self.latest {
+            Some((_, sim)) => sim,
+            None => self.started.elapsed().as_secs_f64(),
+        }
+    }
+
+    /// Mission seconds per wall second, measured; 1 until half a second was seen.
+    fn rate(&self) -> f64 {
+        match (self.first, self.latest) {
+            (Some((w0, s0)), Some((w1, s1))) => {
+                let wall = w1.duration_since(w0).as_secs_f64();
+                if wall >= 0.5 {
+                    ((s1 - s0) / wall).max(1.0)
+                } else {
+                    1.0
+                }
+            }
+            _ => 1.0,
+        }
+    }
+}
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+fn check(config: &ExecutiveConfig) -> Result<(), ExecutiveError> {
+    tasks::check(&config.tasks)?;
+    keys::check_name("robot", &config.robot).map_err(|e| ExecutiveError::Config(e.to_string()))?;
+    for (name, value) in [
+        ("plan_deadline_s", config.plan_deadline_s),
+        ("waypoint_spacing_m", config.waypoint_spacing_m),
+        ("off_path_m", config.off_path_m),
+        ("speed_m_per_s", config.speed_m_per_s),
+        ("give_up_after_s", config.give_up_after_s),
+    ] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(ExecutiveError::Config(format!(
+                "{name} is {value}; give a positive number"
+            )));
+        }
+    }
+    Ok(())
+}
+
+async fn fetch_world(requester: &Requester, root: &str) -> Result<World, ExecutiveError> {
+    let inflated: Layer = requester
+        .request::<Layer, Layer>(&keys::map_layer(root, INFLATED), None)
+        .await?;
+    let information: Layer = requester
+        .request::<Layer, Layer>(&keys::map_layer(root, INFORMATION), None)
+        .await?;
+    let Cells::I8(occ) = inflated.cells else {
+        return Err(ExecutiveError::Layer(INFLATED, "not i8 cells".into()));
+    };
+    let Cells::U8(info) = information.cells else {
+        return Err(ExecutiveError::Layer(INFORMATION, "not u8 cells".into()));
+    };
+    World::new(
+        &Grid {
+            meta: inflated.meta,
+            cells: occ,
+        },
+        &Grid {
+            meta: information.meta,
+            cells: info,
+        },
+        GaParams::default().heuristic_compression,
+    )
+    .map_err(|e| ExecutiveError::Layer(INFORMATION, e.to_string()))
+}
+
+/// Whether the straight segment a→b stays on traversable cells of the planning grid.
+fn clear(world: &World, a: [f64; 2], b: [f64; 2]) -> bool {
+    let step = world.meta.resolution / 2.0;
+    let n = ((b[0] - a[0]).hypot(b[1] - a[1]) / step).ceil().max(1.0) as usize;
+    (0..=n).all(|i| {
+        let t = i as f64 / n as f64;
+        let (x, y) = (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]));
+        world.cell_at(x, y).is_some_and(|c| world.is_traversable(c))
+    })
+}
+
+/// Everything the executive listens to.
+struct Inputs {
+    clock: Arc<Mutex<Clock>>,
+    estimates:
+        zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
+    statuses: zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
+    _clock: zenoh::pubsub::Subscriber<()>,
+}
+
+async fn listen(
+    session: &zenoh::Session,
+    root: &str,
+    robot: &str,
+) -> Result<Inputs, ExecutiveError> {
+    let clock = Arc::new(Mutex::new(Clock {
+        started: Instant::now(),
+        first: None,
+        latest: None,
+    }));
+    let shared = clock.clone();
+    let clock_sub = session
+        .declare_subscriber(keys::sim_clock(root))
+        .callback(move |sample| {
+            if let Ok(c) = decode::<SimClock>(&sample.payload().to_bytes()) {
+                let mut clock = lock(&shared);
+                let now = (Instant::now(), c.time_s);
+                clock.first.get_or_insert(now);
+                clock.latest = Some(now);
+            }
+        })
+        .await
+        .map_err(|e| ExecutiveError::Zenoh(e.to_string()))?;
+    let estimates = session
+        .declare_subscriber(keys::robot_estimate(root, robot))
+        .await
+        .map_err(|e| ExecutiveError::Zenoh(e.to_string()))?;
+    let statuses = session
+        .declare_subscriber(keys::robot_controller(root, robot))
+        .await
+        .map_err(|e| ExecutiveError::Zenoh(e.to_string()))?;
+    Ok(Inputs {
+        clock,
+        estimates,
+        statuses,
+        _clock: clock_sub,
+    })
+}
+
+/// The executive's view of one robot while it runs its tasks.
+struct Run<'a> {
+    session: &'a zenoh::Session,
+    root: &'a str,
+    config: &'a ExecutiveConfig,
+    planner: PlannerClient,
+    world: World,
+    params: GaParams,
+    inputs: Inputs,
+    position: Option<[f64; 2]>,
+    missions_sent: u64,
+}
+
+impl Run<'_> {
+    fn now(&self) -> f64 {
+        lock(&self.inputs.clock).now_s()
+    }
+
+    /// What planning costs on the mission clock.
+    fn planning_cost_s(&self) -> f64 {
+        self.config.plan_deadline_s * lock(&self.inputs.clock).rate()
+    }
+
+    async fn plan(
+        &self,
+        from: [f64; 2],
+        to: [f64; 2],
+        model: PlannerModel,
+        t_exec_s: f64,
+    ) -> Result<Plan, ClientError> {
+        let request = PlanRequest {
+            request_id: None,
+            start: from,
+            goal: to,
+            t_exec_s,
+            deadline_s: self.config.plan_deadline_s,
+            model,
+            params: GaOverrides {
+                max_generations: self.config.max_generations,
+                ..GaOverrides::default()
+            },
+            seed: self.config.seed,
+            map_version: None,
+        };
+        self.planner.plan(&request).await
+    }
+
+    /// The curious plan for the budget, or the shortest when curiosity does not fit.
+    async fn plan_window(
+        &self,
+        from: [f64; 2],
+        task: &Task,
+        shortest: &Plan,
+        curious: bool,
+    ) -> Result<(Plan, f64), ClientError> {
+        let budget = task.start_s - self.now() - self.planning_cost_s();
+        if !curious || budget <= shortest.t_eta_s {
+            return Ok((shortest.clone(), budget));
+        }
+        let plan = self.plan(from, task.at, self.config.model, budget).await?;
+        if plan.reaches_goal && plan.within_budget {
+            Ok((plan, budget))
+        } else {
+            Ok((shortest.clone(), budget))
+        }
+    }
+
+    fn send(&mut self, window: usize, waypoints: Vec<[f64; 2]>) -> String {
+        self.missions_sent += 1;
+        let id = format!("{}-w{window}-m{}", self.config.robot, self.missions_sent);
+        let mission = Mission {
+            robot: self.config.robot.clone(),
+            id: id.clone(),
+            waypoints,
+        };
+        let key = keys::robot_mission(self.root, &self.config.robot);
+        if let Err(e) = zenoh::Wait::wait(
+            self.session
+                .put(&key, encode(&mission))
+                .congestion_control(CongestionControl::Block),
+        ) {
+            tracing::warn!(%key, "sending the mission failed: {e}");
+        }
+        id
+    }
+
+    fn waypoints(&self, plan: &Plan) -> Vec<[f64; 2]> {
+        thin(&plan.points, self.config.waypoint_spacing_m, |a, b| {
+            clear(&self.world, a, b)
+        })
+    }
+
+    async fn first_position(
+        &mut self,
+        cancel: &CancellationToken,
+    ) -> Result<[f64; 2], ExecutiveError> {
+        if let Some(p) = self.position {
+            return Ok(p);
+        }
+        let waited = Duration::from_secs(30);
+        let deadline = tokio::time::sleep(waited);
+        tokio::pin!(deadline);
+        loop {
+            tokio::select! {
+                _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
+                _ = &mut deadline => {
+                    return Err(ExecutiveError::NoEstimate { robot: self.config.robot.clone(), waited });
+                }
+                sample = self.inputs.estimates.recv_async() => {
+                    let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
+                    if let Ok(e) = decode::<PositionEstimate>(&sample.payload().to_bytes()) {
+                        if !e.degraded {
+                            self.position = Some(e.position);
+                            return Ok(e.position);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    async fn window(
+        &mut self,
+        window: usize,
+        task: &Task,
+        cancel: &CancellationToken,
+        progress: &(dyn Fn(Progress) + Sync),
+    ) -> Result<WindowOutcome, ExecutiveError> {
+        let began = self.now();
+        let from = self.first_position(cancel).await?;
+        let shortest = self
+            .plan(from, task.at, PlannerModel::Shortest, 86_400.0)
+            .await?;
+        let (plan, budget) = self.plan_window(from, task, &shortest, true).await?;
+        progress(Progress::Planned {
+            window,
+            task: task.name.clone(),
+            budget_s: budget,
+            eta_s: plan.t_eta_s,
+            curious: plan.model != PlannerModel::Shortest,
+        });
+        let planned_information = plan.distinct_information;
+        let mut path = plan.points.clone();
+        let mut plans = vec![plan.points.clone()];
+        let mut mission = {
+            let w = self.waypoints(&plan);
+            self.send(window, w)
+        };
+        let mut driven = vec![from];
+        let mut pebs = Vec::new();
+        let mut reasons: Vec<String> = Vec::new();
+        let mut arrival = None;
+        let mut slipped = false;
+        let mut tick = tokio::time::interval(Duration::from_millis(100));
+        loop {
+            let mut replan: Option<(&'static str, bool)> = None;
+            tokio::select! {
+                _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
+                _ = tick.tick() => {
+                    if self.now() > task.start_s + self.config.give_up_after_s {
+                        progress(Progress::GaveUp { window, task: task.name.clone() });
+                        break;
+                    }
+                }
+                sample = self.inputs.estimates.recv_async() => {
+                    let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
+                    let Ok(e) = decode::<PositionEstimate>(&sample.payload().to_bytes()) else { continue };
+                    if e.degraded {
+                        continue;
+                    }
+                    self.position = Some(e.position);
+                    driven.push(e.position);
+                    if let Some(p) = e.peb_m {
+                        pebs.push(p);
+                    }
+                    if off_path_m(e.position, &path) > self.config.off_path_m {
+                        replan = Some(("pushed off the path", !slipped));
+                    }
+                }
+                sample = self.inputs.statuses.recv_async() => {
+                    let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
+                    let Ok(s) = decode::<ControllerStatus>(&sample.payload().to_bytes()) else { continue };
+                    if s.mission.as_deref() != Some(mission.as_str()) {
+                        continue;
+                    }
+                    match s.state {
+                        MissionState::Completed => {
+                            let at_s = self.now();
+                            arrival = Some(at_s);
+                            progress(Progress::Arrived { window, task: task.name.clone(), at_s, start_s: task.start_s });
+                            break;
+                        }
+                        MissionState::Stuck | MissionState::StepLimit => {
+                            replan = Some(("stuck: the path is blocked", false));
+                        }
+                        MissionState::Active if !slipped => {
+                            let left = s.distance_left_m.unwrap_or(0.0);
+                            if eta_slips(self.now(), left, self.config.speed_m_per_s, task.start_s) {
+                                slipped = true;
+                                replan = Some(("the ETA slipped past the task's start", false));
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+            }
+            if let Some((reason, curious)) = replan {
+                if reasons.len() as u32 >= self.config.max_replans {
+                    continue;
+                }
+                let here = self.position.unwrap_or(from);
+                let shortest_here = match self
+                    .plan(here, task.at, PlannerModel::Shortest, 86_400.0)
+                    .await
+                {
+                    Ok(p) => p,
+                    Err(e) => {
+                        tracing::warn!("replanning failed: {e}");
+                        continue;
+                    }
+                };
+                let (plan, _) = self
+                    .plan_window(here, task, &shortest_here, curious)
+                    .await?;
+                reasons.push(reason.to_owned());
+                progress(Progress::Replanned {
+                    window,
+                    reason: reason.to_owned(),
+                });
+                path = std::iter::once(here)
+                    .chain(plan.points.iter().copied())
+                    .collect();
+                plans.push(plan.points.clone());
+                let w = self.waypoints(&plan);
+                mission = self.send(window, w);
+            }
+        }
+        // The task keeps the robot at its place until it ends.
+        while arrival.is_some() && self.now() < task.start_s + task.duration_s {
+            tokio::select! {
+                _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
+                _ = tokio::time::sleep(Duration::from_millis(20)) => {}
+            }
+        }
+        while self.inputs.estimates.try_recv().ok().flatten().is_some() {}
+        let driven_information = gathered(&self.world, &self.params, &driven);
+        let report = WindowReport {
+            robot: self.config.robot.clone(),
+            task: task.name.clone(),
+            window,
+            began_s: began,
+            task_start_s: task.start_s,
+            arrival_s: arrival,
+            on_time: arrival.is_some_and(|a| a <= task.start_s),
+            budget_s: budget,
+            planned_information,
+            driven_information,
+            shortest_information: shortest.distinct_information,
+            peb_mean_m: (!pebs.is_empty()).then(|| pebs.iter().sum::<f64>() / pebs.len() as f64),
+            replans: reasons.len() as u32,
+            replan_reasons: reasons,
+        };
+        Ok(WindowOutcome {
+            report,
+            plans,
+            shortest: shortest.points,
+            driven,
+        })
+    }
+}
+
+/// Drives `config.robot` through its tasks and returns each window's outcome, calling
+/// `on_window` as each one ends.
+pub async fn run(
+    session: &zenoh::Session,
+    root: &str,
+    config: &ExecutiveConfig,
+    cancel: &CancellationToken,
+    progress: &(dyn Fn(Progress) + Sync),
+    on_window: &(dyn Fn(&WindowOutcome) + Sync),
+) -> Result<Vec<WindowOutcome>, ExecutiveError> {
+    check(config)?;
+    let requester = Requester::new(session.clone(), Duration::from_secs(10));
+    let world = fetch_world(&requester, root).await?;
+    let inputs = listen(session, root, &config.robot).await?;
+    let mut run = Run {
+        session,
+        root,
+        config,
+        planner: PlannerClient::new(session.clone(), root),
+        world,
+        params: GaParams::default(),
+        inputs,
+        position: None,
+        missions_sent: 0,
+    };
+    let mut outcomes = Vec::with_capacity(config.tasks.len());
+    for (window, task) in config.tasks.iter().enumerate() {
+        let outcome = run.window(window, task, cancel, progress).await?;
+        on_window(&outcome);
+        outcomes.push(outcome);
+    }
+    Ok(outcomes)
+}

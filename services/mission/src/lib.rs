@@ -1,0 +1,23 @@
+//! roam's mission executive: what ties the papers together for one robot.
+//!
+//! The robot has fixed tasks (places and start times). Between two of them it has
+//! downtime. For each window the executive asks the planner (paper 000) for a curious
+//! path to the next task with t_exec = the time to the task's start minus what planning
+//! costs, hands the path to the controller (paper 002) as waypoints, watches the robot's
+//! estimates and the controller's status, replans when the robot is stuck (the path is
+//! blocked), pushed off the path, or when its ETA slips past the task's start, and
+//! reports each window: the information gathered, the arrival against the task's start,
+//! the PEB along the way.
+//!
+//! - [`tasks`]: the task sequence and its checks; the built-in world's day.
+//! - [`path`]: thinning a planned path into waypoints; off-path distance; ETA slip.
+//! - [`information`]: the information a path gathers, on the planner's own scale.
+//! - [`executive`]: the executive on Zenoh (a client of the planner, the controller,
+//!   localization and the sim clock).
+//! - [`service`]: `roam mission`, the executive as a service that publishes its reports.
+
+pub mod executive;
+pub mod information;
+pub mod path;
+pub mod service;
+pub mod tasks;

@@ -1,0 +1,133 @@
+//! `roam mission`: the executive as a service. It announces itself, drives its robot
+//! through the configured tasks, publishes a `window_report` on
+//! `<root>/robot/<id>/mission_report` as each window ends, and stays up (answering to
+//! liveliness) until it is stopped.
+
+use std::path::PathBuf;
+
+use roam_proto::{encode, keys};
+use roam_runtime::{Service, ServiceError};
+use serde::Deserialize;
+use tokio_util::sync::CancellationToken;
+use zenoh::qos::CongestionControl;
+use zenoh::Wait;
+
+use crate::executive::{self, ExecutiveConfig, ExecutiveError, Progress};
+
+pub const SERVICE_NAME: &str = "mission";
+
+/// The mission service's config file (YAML).
+///
+/// ```yaml
+/// root: roam
+/// executive:
+///   robot: robot
+///   tasks:
+///     - { name: goal1, at: [-2.0, 4.0], start_s: 75.0 }
+///     - { name: goal2, at: [6.0, -7.0], start_s: 165.0, duration_s: 5.0 }
+///   model: model1        # model0 | model1 | model2 | shortest
+///   plan_deadline_s: 1.0
+/// ```
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MissionConfig {
+    pub root: String,
+    pub instance: Option<String>,
+    pub executive: ExecutiveConfig,
+    /// Unused here; kept so every role's config has the same shape.
+    pub scenario: Option<PathBuf>,
+    pub zenoh: Option<serde_json::Value>,
+}
+
+impl Default for MissionConfig {
+    fn default() -> Self {
+        MissionConfig {
+            root: keys::DEFAULT_ROOT.to_owned(),
+            instance: None,
+            executive: ExecutiveConfig::default(),
+            scenario: None,
+            zenoh: None,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum MissionServiceError {
+    #[error(transparent)]
+    Service(#[from] ServiceError),
+    #[error(transparent)]
+    Executive(#[from] ExecutiveError),
+}
+
+fn log(p: Progress) {
+    match p {
+        Progress::Planned {
+            window,
+            task,
+            budget_s,
+            eta_s,
+            curious,
+        } => tracing::info!(
+            window, %task, budget_s, eta_s, curious, "planned"
+        ),
+        Progress::Replanned { window, reason } => tracing::info!(window, %reason, "replanned"),
+        Progress::Arrived {
+            window,
+            task,
+            at_s,
+            start_s,
+        } => {
+            tracing::info!(window, %task, at_s, start_s, "arrived")
+        }
+        Progress::GaveUp { window, task } => tracing::warn!(window, %task, "gave up"),
+    }
+}
+
+/// Runs the executive as a service until its tasks are done and `cancel` is cancelled.
+pub async fn run(
+    config: MissionConfig,
+    zenoh_config: zenoh::Config,
+    cancel: CancellationToken,
+) -> Result<(), MissionServiceError> {
+    crate::tasks::check(&config.executive.tasks).map_err(ExecutiveError::from)?;
+    let mut service = Service::start(
+        SERVICE_NAME,
+        &config.root,
+        config.instance.as_deref(),
+        zenoh_config,
+        cancel.clone(),
+    )
+    .await?;
+    service.announce().await?;
+    let session = service.session().clone();
+    let key = keys::robot_mission_report(&config.root, &config.executive.robot);
+    let publish = |outcome: &executive::WindowOutcome| {
+        let sent = session
+            .put(&key, encode(&outcome.report))
+            .congestion_control(CongestionControl::Block)
+            .wait();
+        if let Err(e) = sent {
+            tracing::warn!(%key, "publishing the window report failed: {e}");
+        }
+    };
+    match executive::run(
+        &session,
+        &config.root,
+        &config.executive,
+        &cancel,
+        &log,
+        &publish,
+    )
+    .await
+    {
+        Ok(_) | Err(ExecutiveError::Cancelled) => {}
+        Err(e) => {
+            service
+                .shutdown(roam_runtime::service::DEFAULT_GRACE)
+                .await?;
+            return Err(e.into());
+        }
+    }
+    service.run_until_stopped().await?;
+    Ok(())
+}

@@ -1,0 +1,111 @@
+//! A robot's task sequence: places it must be at, and when.
+
+use serde::Deserialize;
+
+/// One fixed task: be at `at` by `start_s` (sim seconds) and stay `duration_s`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Task {
+    pub name: String,
+    /// World metres.
+    pub at: [f64; 2],
+    /// When the task starts, seconds on the mission clock (the sim clock when a sim runs).
+    pub start_s: f64,
+    /// How long the task keeps the robot at its place; the next window begins after it.
+    #[serde(default = "default_duration")]
+    pub duration_s: f64,
+}
+
+fn default_duration() -> f64 {
+    5.0
+}
+
+/// The most tasks one executive takes.
+pub const MAX_TASKS: usize = 1000;
+
+/// Why a task list is refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TaskError {
+    #[error("no tasks: give at least one (name, at, start_s)")]
+    Empty,
+    #[error("{count} tasks; at most {max} (max_tasks)")]
+    TooMany { count: usize, max: usize },
+    #[error("task {name:?}: {what}")]
+    Bad { name: String, what: String },
+}
+
+/// Checks a task list: finite places, start times that increase with room for each
+/// task's duration.
+pub fn check(tasks: &[Task]) -> Result<(), TaskError> {
+    if tasks.is_empty() {
+        return Err(TaskError::Empty);
+    }
+    if tasks.len() > MAX_TASKS {
+        return Err(TaskError::TooMany {
+            count: tasks.len(),
+            max: MAX_TASKS,
+        });
+    }
+    let mut free_from = f64::NEG_INFINITY;
+    for t in tasks {
+        let bad = |what: String| TaskError::Bad {
+            name: t.name.clone(),
+            what,
+        };
+        if !(t.at[0].is_finite() && t.at[1].is_finite()) {
+            return Err(bad(format!("its place {:?} is not a finite point", t.at)));
+        }
+        if !(t.duration_s.is_finite() && t.duration_s >= 0.0) {
+            return Err(bad(format!(
+                "duration_s {} must be 0 or more seconds",
+                t.duration_s
+            )));
+        }
+        if !(t.start_s.is_finite() && t.start_s >= free_from) {
+            return Err(bad(format!(
+                "start_s {} must come after the previous task ends ({free_from} s)",
+                t.start_s
+            )));
+        }
+        free_from = t.start_s + t.duration_s;
+    }
+    Ok(())
+}
+
+/// The built-in world's downtime day (`config/scenarios/downtime.yaml`): from `start`,
+/// a task at `goal1` at 75 s and one at `goal2` at 165 s, 5 s each. The shortest drives
+/// take about 30 s and 35 s (paper 000's ETA), so each window holds about twice its
+/// shortest drive plus the planning time: downtime to spend on curiosity.
+pub fn builtin() -> Vec<Task> {
+    vec![
+        Task {
+            name: "goal1".into(),
+            at: [-2.0, 4.0],
+            start_s: 75.0,
+            duration_s: 5.0,
+        },
+        Task {
+            name: "goal2".into(),
+            at: [6.0, -7.0],
+            start_s: 165.0,
+            duration_s: 5.0,
+        },
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_builtin_day_is_valid_and_overlaps_are_refused() {
+        assert_eq!(check(&builtin()), Ok(()));
+        let mut tasks = builtin();
+        tasks[1].start_s = 77.0; // goal1 runs until 80 s
+        assert!(matches!(check(&tasks), Err(TaskError::Bad { .. })));
+        assert_eq!(check(&[]), Err(TaskError::Empty));
+        let mut tasks = builtin();
+        tasks[0].at = [f64::NAN, 0.0];
+        assert!(check(&tasks).is_err());
+    }
+}

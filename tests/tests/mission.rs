@@ -1,0 +1,79 @@
+//! The downtime mission through Zenoh: the map server, the planner, the sim (faster than
+//! real time), localization, the controller and the mission executive as separate
+//! services on loopback; the executive's window reports say the robot was on time at
+//! both tasks and gathered more information than the shortest paths would have.
+
+use std::time::Duration;
+
+use roam_controller::service::ControllerConfig;
+use roam_mission::service::MissionConfig;
+use roam_proto::mission::WindowReport;
+use roam_proto::{decode, keys};
+use roam_tests::{within, Harness};
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn the_demo_mission_is_on_time_and_more_curious_than_the_shortest_path() {
+    let harness = Harness::start().await;
+    let _map_server = harness.start_map_server(harness.map_server_config()).await;
+    let _planner = harness
+        .start_planner(harness.planner_config("planner-0"))
+        .await;
+    let mut sim_config = harness.sim_config(None);
+    sim_config.rate = Some(10.0);
+    let _sim = harness.start_sim(sim_config).await;
+    let _localization = harness.start_localization(None).await;
+    let _controller = harness
+        .start_controller(ControllerConfig {
+            apf: roam::demo::indoor_apf(),
+            ..harness.controller_config()
+        })
+        .await;
+    let client = harness.client().await;
+    let reports = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::robot_mission_report(&harness.root, "robot")),
+    )
+    .await
+    .expect("subscriber");
+    let root = harness.root.clone();
+    let key = keys::liveliness_of(&root, roam_mission::service::SERVICE_NAME);
+    let _mission = harness
+        .start_service(key, |zenoh, cancel| {
+            roam_mission::service::run(
+                MissionConfig {
+                    root,
+                    ..MissionConfig::default()
+                },
+                zenoh,
+                cancel,
+            )
+        })
+        .await;
+
+    // Two windows of 75 s and 90 s of sim time at 10x: about 17 s.
+    let mut windows = Vec::new();
+    for _ in 0..2 {
+        let sample = tokio::time::timeout(Duration::from_secs(60), reports.recv_async())
+            .await
+            .expect("a window report within 60 s")
+            .expect("sample");
+        let report: WindowReport = decode(&sample.payload().to_bytes()).expect("report");
+        windows.push(report);
+    }
+    assert_eq!(
+        windows.iter().map(|w| w.task.as_str()).collect::<Vec<_>>(),
+        ["goal1", "goal2"]
+    );
+    for w in &windows {
+        assert!(w.on_time, "late at {}: {w:?}", w.task);
+        assert!(w.peb_mean_m.is_some_and(|p| p < 0.5), "{w:?}");
+    }
+    let driven: f64 = windows.iter().map(|w| w.driven_information).sum();
+    let shortest: f64 = windows.iter().map(|w| w.shortest_information).sum();
+    assert!(
+        driven > shortest,
+        "driven {driven} against the shortest paths' {shortest}"
+    );
+}
