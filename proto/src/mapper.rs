@@ -13,6 +13,10 @@ pub const CHANGE_RATE_LAYER: &str = "change_rate";
 /// Layer of P_c(E > 0), the probability that a cell changed since it was last seen
 /// (paper 004 Eq. 2).
 pub const CHANGE_PROBABILITY_LAYER: &str = "change_probability";
+/// Layer of round(100 · P_c(E > 0)) as u8 scores 0–100: the change probability in the
+/// form of paper 000's information map, for a planner configured with
+/// `information_layer: change_information`.
+pub const CHANGE_INFORMATION_LAYER: &str = "change_information";
 /// Layer of recency r^c = t_now − t_last, seconds (paper 004 §3).
 pub const RECENCY_LAYER: &str = "recency";
 

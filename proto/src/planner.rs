@@ -58,6 +58,9 @@ pub struct GaOverrides {
     pub heuristic_compression: Option<f64>,
     pub perception_diameter: Option<u32>,
     pub coverage_gain: Option<f64>,
+    /// W_loc: weight of the localizability cost (roam, not paper 000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub w_loc: Option<f64>,
 }
 
 /// Ask for a plan: from `start` to `goal` (world metres) within `t_exec_s` seconds of
@@ -98,6 +101,10 @@ pub struct FitnessTerms {
     pub f3_goal: f64,
     pub f4_overtime: f64,
     pub f5_idle: f64,
+    /// roam's localizability cost: −W_loc · Σ PEB over the path's cells (0 unless the
+    /// planner has a PEB layer and W_loc > 0).
+    #[serde(default)]
+    pub f6_localizability: f64,
     pub total: f64,
 }
 

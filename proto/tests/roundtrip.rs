@@ -345,6 +345,7 @@ mod planner_messages {
                             f3_goal: f[2],
                             f4_overtime: f[3],
                             f5_idle: f[4],
+                            f6_localizability: -f[0],
                             total: f[5],
                         },
                         u_ges,

@@ -8,8 +8,10 @@ use roam_mapper::service::MapperConfig;
 use roam_proto::cells::Cells;
 use roam_proto::map::Layer;
 use roam_proto::mapper::{
-    ExplorationGoal, MapperStatus, CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER, RECENCY_LAYER,
+    ExplorationGoal, MapperStatus, CHANGE_INFORMATION_LAYER, CHANGE_PROBABILITY_LAYER,
+    CHANGE_RATE_LAYER, RECENCY_LAYER,
 };
+use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
 use roam_proto::sim::{RobotCommand, SimControl, SimStatus};
 use roam_proto::{decode, keys};
 use roam_tests::{repo_path, within, Harness};
@@ -141,6 +143,63 @@ async fn sim_to_mapper_to_map_server_shows_where_the_blocks_move() {
     for i in &hot {
         assert!(changing.contains(i), "hot cell {i} never changes in truth");
     }
+
+    // The papers joined: a planner told to take the mapper's change_information layer
+    // (100 · P(E > 0) as u8 scores) as its information map plans on it.
+    // Both layers are sent in the same round, so equal versions are the same instant.
+    let until = Instant::now() + Duration::from_secs(10);
+    let (scores, probability) = loop {
+        let scores = fetch(&client, &root, CHANGE_INFORMATION_LAYER).await;
+        let probability = fetch(&client, &root, CHANGE_PROBABILITY_LAYER).await;
+        if let (Some(s), Some(p)) = (scores, probability) {
+            if s.version == p.version {
+                break (s, p);
+            }
+        }
+        assert!(Instant::now() < until, "no matching change layers");
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    };
+    let Cells::U8(s) = &scores.cells else {
+        panic!("change_information is not u8");
+    };
+    for (i, (&score, &p)) in s.iter().zip(f32_cells(&probability)).enumerate() {
+        assert!(
+            (f32::from(score) - (p * 100.0).round()).abs() <= 1.0,
+            "cell {i}: score {score} for P {p}"
+        );
+    }
+    let mut planner_config = harness.planner_config("curious-about-change");
+    planner_config.information_layer = CHANGE_INFORMATION_LAYER.into();
+    let _planner = harness.start_planner(planner_config).await;
+    let plan: Plan = within(
+        "plan",
+        client.request::<PlanRequest, Plan>(
+            &keys::planner_plan_at(&root, "curious-about-change"),
+            Some(&PlanRequest {
+                request_id: None,
+                start: [0.5, 0.5],
+                goal: [0.5, -6.5],
+                t_exec_s: 60.0,
+                deadline_s: 2.0,
+                model: PlannerModel::Model1,
+                params: GaOverrides {
+                    max_generations: Some(200),
+                    ..GaOverrides::default()
+                },
+                seed: 1,
+                map_version: None,
+            }),
+        ),
+    )
+    .await
+    .expect("plan");
+    assert!(plan.reaches_goal);
+    assert!(
+        plan.map_version.information >= scores.version,
+        "planned on information version {} (change_information is at {})",
+        plan.map_version.information,
+        scores.version
+    );
 }
 
 async fn fetch(client: &roam_runtime::Requester, root: &str, name: &str) -> Option<Layer> {

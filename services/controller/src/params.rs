@@ -115,6 +115,24 @@ fn check(name: &'static str, value: f64, ok: bool, range: &'static str) -> Resul
 }
 
 impl ApfParams {
+    /// Parameters for buildings like the built-in world. Paper 002's η_thres = 3 m and
+    /// z_r = 20 suit its open 50–70 m fields; in a 20 m building with 2 m doors they
+    /// would push the robot out of every door (1 m from a jamb the repulsion is 13 times
+    /// the attraction). Here the repulsion reaches 0.6 m, the robot's radius plus a
+    /// margin (a planned path already keeps the inflation radius from walls), and IS is
+    /// gentle (z_is 0.3): the building's anchors cover it well. A mission executive
+    /// hands a planned path over as many waypoints, and only the last is a place to
+    /// reach exactly (`via_thres_m` 0.5 m).
+    pub fn indoor() -> ApfParams {
+        ApfParams {
+            eta_thres_m: 0.6,
+            z_r: 0.05,
+            z_is: 0.3,
+            via_thres_m: Some(0.5),
+            ..ApfParams::default()
+        }
+    }
+
     /// Refuses a value the controller cannot work with, naming it and its range.
     pub fn check(&self) -> Result<(), ParamError> {
         let weight = |v: f64| (0.0..=MAX_WEIGHT).contains(&v);

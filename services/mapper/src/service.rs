@@ -23,8 +23,8 @@ use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, Upd
 
 type MapMeta = GridMeta;
 use roam_proto::mapper::{
-    ExplorationGoal, ExplorerStatus, MapperStatus, CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER,
-    RECENCY_LAYER,
+    ExplorationGoal, ExplorerStatus, MapperStatus, CHANGE_INFORMATION_LAYER,
+    CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER, RECENCY_LAYER,
 };
 use roam_proto::sim::{LocalObservation, RobotCommand};
 use roam_proto::{encode, keys, ErrorReply, Message};
@@ -278,20 +278,29 @@ async fn answer_status(state: Arc<State>, query: Query) {
 
 /// The three layers at the newest observation's time, if anything was observed since
 /// they were last sent.
-fn layers_to_send(state: &State) -> Option<[(&'static str, Vec<f32>); 3]> {
+fn layers_to_send(state: &State) -> Option<[(&'static str, Cells); 4]> {
     let mut m = state.mapping();
     if !m.dirty {
         return None;
     }
     m.dirty = false;
     let now = m.now_s;
+    let probability = m.map.probability_layer(now).cells;
+    let scores = probability
+        .iter()
+        .map(|p| (p.clamp(0.0, 1.0) * 100.0).round() as u8)
+        .collect();
     Some([
-        (CHANGE_RATE_LAYER, f32_cells(m.map.rate_layer().cells)),
         (
-            CHANGE_PROBABILITY_LAYER,
-            f32_cells(m.map.probability_layer(now).cells),
+            CHANGE_RATE_LAYER,
+            Cells::F32(f32_cells(m.map.rate_layer().cells)),
         ),
-        (RECENCY_LAYER, f32_cells(m.map.recency_layer(now).cells)),
+        (CHANGE_PROBABILITY_LAYER, Cells::F32(f32_cells(probability))),
+        (CHANGE_INFORMATION_LAYER, Cells::U8(scores)),
+        (
+            RECENCY_LAYER,
+            Cells::F32(f32_cells(m.map.recency_layer(now).cells)),
+        ),
     ])
 }
 
@@ -342,10 +351,7 @@ async fn publish_layers(state: Arc<State>, period: Duration, cancel: Cancellatio
                 .map_or(0, |l| l.version);
             let update = LayerUpdate {
                 base_version,
-                change: LayerChange::Replace {
-                    meta,
-                    cells: Cells::F32(cells),
-                },
+                change: LayerChange::Replace { meta, cells },
             };
             let sent = requester
                 .request::<LayerUpdate, UpdateAck>(

@@ -38,7 +38,7 @@ use tokio_util::sync::CancellationToken;
 use zenoh::qos::CongestionControl;
 
 use crate::information::gathered;
-use crate::path::{eta_slips, off_path_m, thin};
+use crate::path::{clear, eta_slips, off_path_m, thin};
 use crate::tasks::{self, Task, TaskError};
 
 /// How the executive plans and watches.
@@ -222,17 +222,6 @@ async fn fetch_world(requester: &Requester, root: &str) -> Result<World, Executi
         GaParams::default().heuristic_compression,
     )
     .map_err(|e| ExecutiveError::Layer(INFORMATION, e.to_string()))
-}
-
-/// Whether the straight segment a→b stays on traversable cells of the planning grid.
-fn clear(world: &World, a: [f64; 2], b: [f64; 2]) -> bool {
-    let step = world.meta.resolution / 2.0;
-    let n = ((b[0] - a[0]).hypot(b[1] - a[1]) / step).ceil().max(1.0) as usize;
-    (0..=n).all(|i| {
-        let t = i as f64 / n as f64;
-        let (x, y) = (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]));
-        world.cell_at(x, y).is_some_and(|c| world.is_traversable(c))
-    })
 }
 
 /// Everything the executive listens to.

@@ -12,11 +12,13 @@
 //! - [`tasks`]: the task sequence and its checks; the built-in world's day.
 //! - [`path`]: thinning a planned path into waypoints; off-path distance; ETA slip.
 //! - [`information`]: the information a path gathers, on the planner's own scale.
+//! - [`experiment`]: `roam reproduce mission`, the couplings compared in batch.
 //! - [`executive`]: the executive on Zenoh (a client of the planner, the controller,
 //!   localization and the sim clock).
 //! - [`service`]: `roam mission`, the executive as a service that publishes its reports.
 
 pub mod executive;
+pub mod experiment;
 pub mod information;
 pub mod path;
 pub mod service;

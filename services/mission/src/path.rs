@@ -35,6 +35,19 @@ pub fn thin(
     out
 }
 
+/// Whether the straight segment a→b stays on traversable cells of the planning grid
+/// (sampled every half cell).
+pub fn clear(world: &roam_planner::world::World, a: [f64; 2], b: [f64; 2]) -> bool {
+    let step = world.meta.resolution / 2.0;
+    let n = (distance(a, b) / step).ceil().max(1.0) as usize;
+    (0..=n).all(|i| {
+        let t = i as f64 / n as f64;
+        world
+            .cell_at(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]))
+            .is_some_and(|c| world.is_traversable(c))
+    })
+}
+
 pub fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }

@@ -152,6 +152,8 @@ impl<'a> Evaluator<'a> {
         let mut t = 0.0;
         let mut prev_dir = 8;
         let mut information = 0.0;
+        let mut localizability = 0.0;
+        let costed = self.params.w_loc > 0.0 && !self.world.localizability.is_empty();
         // The position is tracked move by move: no division per gene.
         let (mut cx, mut cy) = path.first().map_or((0, 0), |&c| self.world.xy(c));
         for (gene, &cell) in path.iter().enumerate() {
@@ -169,6 +171,10 @@ impl<'a> Evaluator<'a> {
                 }
             }
             let (x, y) = (cx as i32, cy as i32);
+            if costed {
+                localizability +=
+                    f64::from(self.world.localizability[cy * self.world.width() + cx]);
+            }
             let count = moved.map_or(self.window.len(), |dir| self.entering[dir].len());
             for k in 0..count {
                 let (dx, dy) = match moved {
@@ -194,6 +200,7 @@ impl<'a> Evaluator<'a> {
         let f3 = if reaches_goal { p.w3 } else { 0.0 };
         let f4 = -p.w4 * (t - self.t_exec).max(0.0);
         let f5 = -p.w5 * (self.t_exec - t).max(0.0);
+        let f6 = -p.w_loc * localizability;
         Evaluation {
             fitness: FitnessTerms {
                 f1_information: f1,
@@ -201,7 +208,8 @@ impl<'a> Evaluator<'a> {
                 f3_goal: f3,
                 f4_overtime: f4,
                 f5_idle: f5,
-                total: f1 + f2 + f3 + f4 + f5,
+                f6_localizability: f6,
+                total: f1 + f2 + f3 + f4 + f5 + f6,
             },
             model_information: information,
             t_eta: t,

@@ -14,6 +14,8 @@ use crate::world::World;
 /// The layer names the planner reads.
 pub const INFLATED: &str = "inflated";
 pub const INFORMATION: &str = "information";
+/// Localization's PEB layer: the localizability cost's input (`w_loc`).
+pub const PEB: &str = "peb";
 
 /// Heuristic compression the cached worlds are built with (Table I); requests with
 /// another c_h get their blocks recut.
@@ -24,24 +26,42 @@ pub const DEFAULT_COMPRESSION: f64 = 0.25;
 pub struct MapCache {
     inflated: Option<Layer>,
     information: Option<Layer>,
+    peb: Option<Layer>,
     worlds: VecDeque<(MapVersion, Arc<World>)>,
     history: usize,
+    /// The layer taken as the information map.
+    information_layer: String,
 }
 
 impl MapCache {
     pub fn new(history: usize) -> Self {
+        MapCache::with_information(history, INFORMATION)
+    }
+
+    /// A cache that takes `information_layer` (a u8 layer) as the information map.
+    pub fn with_information(history: usize, information_layer: &str) -> Self {
         MapCache {
             history: history.max(1),
+            information_layer: information_layer.to_owned(),
             ..MapCache::default()
         }
+    }
+
+    /// The layer names this cache follows.
+    pub fn layers(&self) -> [&str; 3] {
+        [INFLATED, self.information_layer.as_str(), PEB]
     }
 
     /// Takes a new layer; rebuilds the world when both layers are present and agree in
     /// size. Returns the new version when a world was built.
     pub fn update(&mut self, layer: Layer) -> Option<MapVersion> {
+        if layer.name == PEB {
+            self.take_peb(layer);
+            return None;
+        }
         let slot = match layer.name.as_str() {
             INFLATED => &mut self.inflated,
-            INFORMATION => &mut self.information,
+            name if name == self.information_layer => &mut self.information,
             _ => return None,
         };
         if slot
@@ -74,7 +94,10 @@ impl MapCache {
             cells: info.clone(),
         };
         match World::new(&occ, &info, DEFAULT_COMPRESSION) {
-            Ok(world) => {
+            Ok(mut world) => {
+                if let Some(Cells::F32(peb)) = self.peb.as_ref().map(|l| &l.cells) {
+                    world.set_localizability(peb);
+                }
                 self.worlds.push_back((version, Arc::new(world)));
                 while self.worlds.len() > self.history {
                     self.worlds.pop_front();
@@ -86,6 +109,27 @@ impl MapCache {
                 None
             }
         }
+    }
+
+    /// Takes a newer PEB layer and gives every cached world its localizability cost
+    /// (a world of another size gets none).
+    fn take_peb(&mut self, layer: Layer) {
+        if self
+            .peb
+            .as_ref()
+            .is_some_and(|old| old.version >= layer.version)
+        {
+            return;
+        }
+        let Cells::F32(peb) = &layer.cells else {
+            return tracing::warn!("the PEB layer is not f32 cells; no localizability cost");
+        };
+        for (_, world) in self.worlds.iter_mut() {
+            let mut w = World::clone(world);
+            w.set_localizability(peb);
+            *world = Arc::new(w);
+        }
+        self.peb = Some(layer);
     }
 
     /// The world for a version, or the latest.

@@ -46,6 +46,12 @@ pub struct GaParams {
     pub perception_diameter: u32,
     /// I_0: Model 0's gain per newly perceived cell (Eq. 8). Not in Table I; 1.0 here.
     pub coverage_gain: f64,
+    /// W_loc: roam's coupling of paper 002 into paper 000's fitness. When the planner
+    /// has a PEB layer (localization's `peb`), the fitness subtracts W_loc · Σ PEB (m)
+    /// over the path's genes, so a path through corridors where the controller would
+    /// have to fight for its position costs more. 0 (off) by default: Table I has no
+    /// such term.
+    pub w_loc: f64,
 }
 
 impl Default for GaParams {
@@ -68,6 +74,7 @@ impl Default for GaParams {
             heuristic_compression: 0.25,
             perception_diameter: 3,
             coverage_gain: 1.0,
+            w_loc: 0.0,
         }
     }
 }
@@ -124,7 +131,8 @@ impl GaParams {
             w_t,
             w_n,
             heuristic_compression,
-            coverage_gain
+            coverage_gain,
+            w_loc
         );
         if let Some(v) = o.perception_diameter {
             p.perception_diameter = v;
@@ -172,6 +180,7 @@ impl GaParams {
             ("w_t", self.w_t),
             ("w_n", self.w_n),
             ("coverage_gain", self.coverage_gain),
+            ("w_loc", self.w_loc),
         ] {
             check(
                 name,

@@ -22,7 +22,7 @@ use zenoh::query::Query;
 use zenoh::Wait;
 
 use crate::config::PlannerConfig;
-use crate::maps::{MapCache, INFLATED, INFORMATION};
+use crate::maps::MapCache;
 use crate::params::GaParams;
 use crate::plan::{plan, PlanOutcome, PlanSpec};
 use crate::world::World;
@@ -90,6 +90,8 @@ pub async fn run(
             "max_concurrent_plans must be at least 1".into(),
         ));
     }
+    keys::check_name("information_layer", &config.information_layer)
+        .map_err(|e| PlannerError::Config(e.to_string()))?;
     let mut service = Service::start(
         SERVICE_NAME,
         &config.root,
@@ -102,7 +104,10 @@ pub async fn run(
         root: config.root.clone(),
         instance: service.instance().to_owned(),
         session: service.session().clone(),
-        maps: Mutex::new(MapCache::new(config.map_history)),
+        maps: Mutex::new(MapCache::with_information(
+            config.map_history,
+            &config.information_layer,
+        )),
         in_flight: AtomicUsize::new(0),
         max_in_flight: config.max_concurrent_plans,
         cancels: Mutex::new(HashMap::new()),
@@ -111,7 +116,8 @@ pub async fn run(
     let root = config.root.as_str();
 
     // Maps: follow publications, and fetch the current layers until we have them.
-    for layer in [INFLATED, INFORMATION] {
+    let layers = state.maps().layers().map(str::to_owned);
+    for layer in &layers {
         service
             .subscribe(
                 &keys::map_layer(root, layer),
@@ -187,7 +193,8 @@ fn take_layer(state: &State, layer: Layer) {
 /// Gets the two layers from the map server, retrying until both arrive.
 async fn fetch_maps(state: Arc<State>, requester: Requester, cancel: CancellationToken) {
     loop {
-        for name in [INFLATED, INFORMATION] {
+        let layers = state.maps().layers().map(str::to_owned);
+        for name in &layers {
             match requester
                 .request::<Layer, Layer>(&keys::map_layer(&state.root, name), None)
                 .await
@@ -340,14 +347,7 @@ pub fn to_message(
     outcome: PlanOutcome,
 ) -> Plan {
     let cells = world.grid_cells(&outcome.path);
-    let points = outcome
-        .path
-        .iter()
-        .map(|&c| {
-            let (x, y) = world.center(c);
-            [x, y]
-        })
-        .collect();
+    let points = world.centers(&outcome.path);
     Plan {
         request_id,
         model: request.model,

@@ -38,9 +38,17 @@ pub struct World {
     pub block_sums: Vec<f64>,
     /// The c_h the blocks were cut for.
     pub heuristic_compression: f64,
+    /// The PEB at each cell, metres (localization's `peb` layer), for the
+    /// localizability cost; empty when the planner has none. Unbounded cells are held
+    /// at [`MAX_LOCALIZABILITY_COST_M`].
+    pub localizability: Vec<f32>,
     /// Index difference of each move: `dx + dy · width`.
     move_offsets: [i64; 8],
 }
+
+/// The PEB a cell without a position fix counts as in the localizability cost, metres:
+/// large against the decimetres of a covered area, finite so paths still compare.
+pub const MAX_LOCALIZABILITY_COST_M: f32 = 10.0;
 
 /// Why a world could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -82,12 +90,33 @@ impl World {
             block_cells: Vec::new(),
             block_sums: Vec::new(),
             heuristic_compression,
+            localizability: Vec::new(),
             move_offsets: std::array::from_fn(|d| {
                 i64::from(MOVES[d].0) + i64::from(MOVES[d].1) * w as i64
             }),
         };
         world.set_heuristic_compression(heuristic_compression);
         Ok(world)
+    }
+
+    /// Sets the PEB per cell for the localizability cost (row-major, the world's size;
+    /// anything else clears it). NaN and values above [`MAX_LOCALIZABILITY_COST_M`]
+    /// (an unbounded PEB: no fix there) count as that cap.
+    pub fn set_localizability(&mut self, peb: &[f32]) {
+        if peb.len() != self.cell_count() {
+            self.localizability.clear();
+            return;
+        }
+        self.localizability = peb
+            .iter()
+            .map(|&v| {
+                if v.is_nan() {
+                    MAX_LOCALIZABILITY_COST_M
+                } else {
+                    v.clamp(0.0, MAX_LOCALIZABILITY_COST_M)
+                }
+            })
+            .collect();
     }
 
     /// Recomputes the heuristic blocks for compression `c_h` (see
@@ -155,6 +184,16 @@ impl World {
             .map(|&c| {
                 let (x, y) = self.xy(c);
                 [x as u32, y as u32]
+            })
+            .collect()
+    }
+
+    /// The world points (cell centres) of a path.
+    pub fn centers(&self, path: &[Cell]) -> Vec<[f64; 2]> {
+        path.iter()
+            .map(|&c| {
+                let (x, y) = self.center(c);
+                [x, y]
             })
             .collect()
     }

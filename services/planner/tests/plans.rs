@@ -286,3 +286,44 @@ fn a_walled_in_goal_has_no_path() {
     );
     assert_eq!(outcome.expect_err("must be refused"), PlanError::NoPath);
 }
+
+/// roam's coupling of paper 002 into paper 000: with W_loc > 0 the fitness pays for the
+/// PEB along the path (f6 = −W_loc · Σ PEB over the genes' cells), so the plan keeps out
+/// of a band where localization is poor; with W_loc = 0 nothing changes.
+#[test]
+fn the_localizability_cost_keeps_plans_out_of_poorly_covered_cells() {
+    let mut world = common::open_world(60, 40);
+    // A band of unbounded PEB (no fix) across the middle, 2 m wide, except a gap at the
+    // top; elsewhere 0.1 m.
+    let (w, h) = (world.width(), world.height());
+    let mut peb = vec![0.1f32; w * h];
+    for y in 0..h - 6 {
+        for x in 25..35 {
+            peb[y * w + x] = f32::INFINITY;
+        }
+    }
+    world.set_localizability(&peb);
+    let cost_along = |path: &[u32]| -> f64 {
+        path.iter()
+            .map(|&c| f64::from(world.localizability[c as usize]))
+            .sum()
+    };
+    let base = spec(PlannerModel::Model1, [1.0, 2.0], [11.0, 2.0], 60.0, 5, 800);
+    let free = run(&world, &base);
+    assert_eq!(free.fitness.f6_localizability, 0.0, "off by default");
+    let mut costed_spec = base.clone();
+    costed_spec.params.w_loc = 20_000.0;
+    let costed = run(&world, &costed_spec);
+    check_geometry(&world, &costed_spec, &costed);
+    let along = cost_along(&costed.path);
+    assert!(
+        (costed.fitness.f6_localizability + 20_000.0 * along).abs() < 1e-6 * along.max(1.0),
+        "f6 {} against -W_loc * {along}",
+        costed.fitness.f6_localizability
+    );
+    assert!(
+        along < cost_along(&free.path),
+        "the costed plan crosses {along} m of PEB, the free one {}",
+        cost_along(&free.path)
+    );
+}

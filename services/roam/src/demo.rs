@@ -39,6 +39,10 @@ pub struct DemoOptions {
     pub seed: u64,
     /// The key root (a unique one lets several demos share a machine).
     pub root: Option<String>,
+    /// Serve the live view (a Foxglove WebSocket server) here while the demo runs.
+    pub view: Option<std::net::SocketAddr>,
+    /// Record the run to this MCAP file.
+    pub record: Option<PathBuf>,
 }
 
 impl Default for DemoOptions {
@@ -48,25 +52,15 @@ impl Default for DemoOptions {
             rate: 20.0,
             seed: 0,
             root: None,
+            view: None,
+            record: None,
         }
     }
 }
 
-/// The controller's parameters for the built-in world. Paper 002's η_thres = 3 m and
-/// z_r = 20 suit its open 50–70 m fields; in a 20 m building with 2 m doors they would
-/// push the robot out of every door (at 1 m from a jamb the repulsion is 13 times the
-/// attraction). Here the repulsion reaches 0.6 m, about the robot's radius plus a margin
-/// (the planner's path already keeps the inflation radius from walls), and IS is gentle:
-/// five anchors cover the whole building well. The executive hands a planned path over
-/// as many waypoints, and only the last is a place to reach exactly.
+/// The controller's parameters for the built-in world: [`ApfParams::indoor`].
 pub fn indoor_apf() -> ApfParams {
-    ApfParams {
-        eta_thres_m: 0.6,
-        z_r: 0.05,
-        z_is: 0.3,
-        via_thres_m: Some(0.5),
-        ..ApfParams::default()
-    }
+    ApfParams::indoor()
 }
 
 /// `report.json`.
@@ -102,6 +96,8 @@ pub enum DemoError {
     Client(#[from] roam_runtime::ClientError),
     #[error("zenoh: {0}")]
     Zenoh(String),
+    #[error(transparent)]
+    View(#[from] roam_view::ViewError),
     #[error("cannot write {path}: {reason}")]
     Write { path: PathBuf, reason: String },
 }
@@ -131,9 +127,52 @@ pub async fn run(
         Duration::from_secs(30),
     )
     .await?;
+    let view_cancel = CancellationToken::new();
+    let view = match start_view(&stack, options, &view_cancel, progress).await {
+        Ok(view) => view,
+        Err(e) => {
+            let _ = stack.shutdown().await;
+            return Err(e);
+        }
+    };
     let result = drive(&stack, options, progress, started).await;
+    view_cancel.cancel();
+    let viewed = match view {
+        Some(view) => view.join().await.map(|_| ()),
+        None => Ok(()),
+    };
     let _ = stack.shutdown().await;
-    result
+    let report = result?;
+    viewed?;
+    Ok(report)
+}
+
+/// Starts the live view on the stack's router session when `--view` or `--record` asks
+/// for it (`roam_view`: maps, robots, anchors, planned and driven paths).
+async fn start_view(
+    stack: &Stack,
+    options: &DemoOptions,
+    cancel: &CancellationToken,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<Option<roam_view::ViewHandle>, DemoError> {
+    if options.view.is_none() && options.record.is_none() {
+        return Ok(None);
+    }
+    let config = roam_view::ViewConfig {
+        root: stack.root.clone(),
+        listen: options.view,
+        mcap: options.record.clone(),
+    };
+    let view = roam_view::run(stack.router.session.clone(), config, cancel.clone()).await?;
+    if let Some(url) = view.websocket_url() {
+        progress(&format!(
+            "live view: in the Foxglove app, Open connection -> Foxglove WebSocket -> {url}"
+        ));
+    }
+    if let Some(path) = view.mcap_path() {
+        progress(&format!("recording to {}", path.display()));
+    }
+    Ok(Some(view))
 }
 
 async fn drive(

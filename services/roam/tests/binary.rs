@@ -493,8 +493,8 @@ fn every_shipped_scenario_renders_and_es1_shows_anchor_wall_and_robot() {
 #[test]
 fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
     let out = tempfile::tempdir().expect("tmp");
-    let output = Command::new(ROAM)
-        .args([
+    let (value, stderr) = run_json(
+        &[
             "reproduce",
             "apf",
             "--json",
@@ -506,17 +506,9 @@ fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
             "1",
             "--es3-runs",
             "1",
-            "--out",
-        ])
-        .arg(out.path())
-        .output()
-        .expect("run");
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
+        ],
+        Some(out.path()),
     );
-    let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
     let es1 = value["es1"].as_array().expect("es1");
     let schemes: Vec<&str> = es1.iter().filter_map(|r| r["scheme"].as_str()).collect();
     assert_eq!(
@@ -548,17 +540,14 @@ fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
         let image = image::open(out.path().join(picture)).expect(picture);
         assert!(image.width() > 100 && image.height() > 100);
     }
-    assert!(
-        String::from_utf8_lossy(&output.stderr).contains("es3: 5/5 runs"),
-        "progress on stderr"
-    );
+    assert!(stderr.contains("es3: 5/5 runs"), "progress on stderr");
 }
 
 #[test]
 fn reproduce_mapper_prints_the_three_strategies_and_draws_fig_3() {
     let out = tempfile::tempdir().expect("tmp");
-    let output = Command::new(ROAM)
-        .args([
+    let (value, _) = run_json(
+        &[
             "reproduce",
             "mapper",
             "--json",
@@ -566,17 +555,9 @@ fn reproduce_mapper_prints_the_three_strategies_and_draws_fig_3() {
             "1",
             "--steps",
             "300",
-            "--out",
-        ])
-        .arg(out.path())
-        .output()
-        .expect("run");
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
+        ],
+        Some(out.path()),
     );
-    let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
     let strategies = value["strategies"].as_array().expect("strategies");
     let names: Vec<&str> = strategies
         .iter()
@@ -594,16 +575,7 @@ fn reproduce_mapper_prints_the_three_strategies_and_draws_fig_3() {
 
 #[test]
 fn bench_mapper_prints_updates_per_second() {
-    let output = Command::new(ROAM)
-        .args(["bench", "mapper", "--json", "--updates", "50"])
-        .output()
-        .expect("run");
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
+    let (value, _) = run_json(&["bench", "mapper", "--json", "--updates", "50"], None);
     assert_eq!(value["map_cells"], 1_000_000);
     assert!(value["updates_with_features_per_s"].as_f64().expect("rate") > 0.0);
 }
@@ -670,4 +642,48 @@ fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
     );
     // The task places are marked green.
     assert_eq!(pixel([-2.0, 4.0]), image::Rgb([0, 170, 60]));
+}
+
+#[test]
+fn reproduce_mission_compares_the_couplings() {
+    let (value, _) = run_json(
+        &[
+            "reproduce",
+            "mission",
+            "--json",
+            "--missions",
+            "1",
+            "--generations",
+            "50",
+        ],
+        None,
+    );
+    let variants: Vec<&str> = value["variants"]
+        .as_array()
+        .expect("variants")
+        .iter()
+        .filter_map(|v| v["variant"].as_str())
+        .collect();
+    assert_eq!(variants, ["static", "peb_cost", "change", "shortest"]);
+    for v in value["variants"].as_array().expect("variants") {
+        assert!(v["information"].as_f64().expect("information") > 0.0);
+        let share = v["on_time_share"].as_f64().expect("share");
+        assert!((0.0..=1.0).contains(&share));
+        assert!(v["peb_mean_m"].as_f64().expect("peb") > 0.0);
+    }
+}
+
+/// Runs `roam <args> [--out DIR]`, asserts it succeeded, and returns its stdout as JSON
+/// with its stderr.
+fn run_json(args: &[&str], out: Option<&std::path::Path>) -> (serde_json::Value, String) {
+    let mut command = Command::new(ROAM);
+    command.args(args);
+    if let Some(dir) = out {
+        command.arg("--out").arg(dir);
+    }
+    let output = command.output().expect("run");
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert!(output.status.success(), "{stderr}");
+    let value = serde_json::from_slice(&output.stdout).expect("json");
+    (value, stderr)
 }

@@ -250,7 +250,7 @@ impl World {
             }
         }
         for i in 0..self.walkers.len() {
-            if step % u64::from(self.walkers[i].every_steps) != 0 {
+            if !step.is_multiple_of(u64::from(self.walkers[i].every_steps)) {
                 continue;
             }
             // Always one draw per move tick; 2⁶⁴ is a multiple of 4, so no bias.

@@ -6,6 +6,7 @@ mod plan;
 mod roles;
 mod sim;
 mod tools;
+mod view;
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -57,6 +58,7 @@ CLIENTS AND TOOLS
   plan         Ask a running planner for a path; --png draws it.
   map          Inspect map files offline; list, load and fetch layers of a running stack.
   bench        Benchmarks that print JSON.
+  view         The live view in the Foxglove app (Foxglove WebSocket), MCAP recording.
 
 CONFIG FILE
   A service reads its own YAML config with --config (see config/map-server.yaml). Its
@@ -77,7 +79,8 @@ EXAMPLES
   roam map-server --mode client --connect tcp/10.0.0.5:7447 --map config/maps/depot.yaml
   roam map layers --connect tcp/10.0.0.5:7447
   roam plan --connect tcp/10.0.0.5:7447 --start -8,-8 --goal 6,-7 --budget 60 --png plan.png
-  roam map inspect config/maps/depot.yaml --json";
+  roam map inspect config/maps/depot.yaml --json
+  roam view --connect tcp/127.0.0.1:7447      then open ws://127.0.0.1:8765 in the Foxglove app";
 
 #[derive(Debug, Parser)]
 #[command(name = "roam", version, about = ABOUT, long_about = LONG_ABOUT)]
@@ -111,6 +114,8 @@ enum Command {
     Router(RouterArgs),
     /// Run every landed service in one process around an in-process router.
     Stack(StackArgs),
+    /// The live view of a running stack in the Foxglove app, and MCAP recording.
+    View(view::ViewArgs),
     /// Map files and the map server's layers.
     #[command(subcommand)]
     Map(MapCommand),
@@ -216,6 +221,7 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Plan(args) => plan::plan(args).await,
         Command::Router(args) => roles::router(args).await,
         Command::Stack(args) => roles::stack(args).await,
+        Command::View(args) => view::view(args).await,
         Command::Map(command) => map::map(command).await,
         Command::Bench(command) => tools::bench(command).await,
         Command::Reproduce(command) => tools::reproduce(command).await,

@@ -303,6 +303,13 @@ pub(crate) struct DemoArgs {
     /// The planner's seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Serve the live view here while the demo runs: open ws://ADDR in the Foxglove app
+    /// (e.g. 127.0.0.1:8765; --rate 1 to watch at a human pace).
+    #[arg(long, value_name = "ADDR")]
+    view: Option<std::net::SocketAddr>,
+    /// Record the run to this MCAP file (opens in the Foxglove app).
+    #[arg(long, value_name = "FILE")]
+    record: Option<PathBuf>,
 }
 
 pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
@@ -314,6 +321,8 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
         rate: args.rate,
         seed: args.seed,
         root: None,
+        view: args.view,
+        record: args.record,
     };
     let say = |line: &str| eprintln!("roam demo: {line}");
     let report = roam::demo::run(&options, &say).await?;

@@ -61,6 +61,23 @@ pub(crate) enum BenchCommand {
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum ReproduceCommand {
+    /// The papers joined: seeded downtime missions in the built-in world, planned on the
+    /// static information map, with the PEB localizability cost, and the shortest path.
+    Mission {
+        /// Print {"missions", "variants": [{"variant", "information", "on_time_share", "peb_mean_m"}]}.
+        #[arg(long)]
+        json: bool,
+        #[arg(long, default_value_t = 20)]
+        missions: usize,
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// GA generations per plan.
+        #[arg(long, default_value_t = 1000)]
+        generations: u32,
+        /// W_loc of the PEB-cost variant.
+        #[arg(long, default_value_t = 2000.0)]
+        w_loc: f64,
+    },
     /// Paper 002 §4: ES1-ES3 for plain APF and the fixed, cutoff, linear and sinusoidal
     /// information-seeking weights.
     Apf {
@@ -194,6 +211,38 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
 
 pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
     match command {
+        ReproduceCommand::Mission {
+            json,
+            missions,
+            seed,
+            generations,
+            w_loc,
+        } => {
+            if missions == 0 || generations == 0 || !(w_loc.is_finite() && w_loc >= 0.0) {
+                bail!("--missions and --generations must be at least 1, --w-loc 0 or more");
+            }
+            let options = roam_mission::experiment::MissionExperiment {
+                missions,
+                seed,
+                generations,
+                w_loc,
+            };
+            let result = tokio::task::spawn_blocking(move || {
+                roam_mission::experiment::run(&options, &|done, total| {
+                    eprint!("\rthe papers joined: mission {done}/{total}   ");
+                    if done == total {
+                        eprintln!();
+                    }
+                })
+            })
+            .await??;
+            if json {
+                println!("{}", serde_json::to_string(&result)?);
+            } else {
+                print!("{}", roam_mission::experiment::table(&result));
+            }
+            Ok(())
+        }
         ReproduceCommand::Apf {
             json,
             es1_runs,

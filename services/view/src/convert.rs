@@ -1,0 +1,633 @@
+//! roam messages as Foxglove messages: pure functions, no I/O.
+//!
+//! Everything is drawn in one frame, [`FRAME`], whose axes are roam's world metres (the
+//! frame the map's `origin` is given in), with z up. Grids keep roam's cell values
+//! exactly; scene entities get one colour per kind, the colours of `roam demo`'s picture.
+
+use std::collections::VecDeque;
+
+use foxglove::bytes::Bytes;
+use foxglove::messages::packed_element_field::NumericType;
+use foxglove::messages::{
+    line_primitive, scene_entity_deletion, Color, CubePrimitive, Grid, KeyValuePair, LinePrimitive,
+    PackedElementField, Point3, Pose, Quaternion, SceneEntity, SceneEntityDeletion, SceneUpdate,
+    SpherePrimitive, TextPrimitive, Timestamp, Vector2, Vector3,
+};
+use roam_proto::cells::Dtype;
+use roam_proto::controller::Mission;
+use roam_proto::localization::PositionEstimate;
+use roam_proto::map::{GridMeta, Layer};
+use roam_proto::sim::{GroundTruth, NamedPoint};
+
+/// The frame every roam message is drawn in: world metres, z up.
+pub const FRAME: &str = "map";
+
+/// The name of the one field of every grid.
+pub const GRID_FIELD: &str = "value";
+
+/// The colour of the robots' true positions and driven paths (as in `roam demo`'s picture).
+pub const DRIVEN: Color = rgb(220, 20, 20);
+/// The colour of the planned paths (the mission's waypoints).
+pub const PLANNED: Color = rgb(30, 90, 220);
+/// The colour of the anchors.
+pub const ANCHOR: Color = rgb(140, 0, 200);
+/// The colour of the position estimates and their uncertainty ellipses.
+pub const ESTIMATE: Color = rgb(255, 150, 0);
+
+const fn rgb(r: u8, g: u8, b: u8) -> Color {
+    Color {
+        r: r as f64 / 255.0,
+        g: g as f64 / 255.0,
+        b: b as f64 / 255.0,
+        a: 1.0,
+    }
+}
+
+fn with_alpha(color: Color, a: f64) -> Color {
+    Color { a, ..color }
+}
+
+/// The diameter of a robot's marker, metres.
+pub const ROBOT_SIZE_M: f64 = 0.4;
+/// The edge of an anchor's cube, metres.
+pub const ANCHOR_SIZE_M: f64 = 0.3;
+/// Path line thickness, screen pixels.
+const LINE_PX: f64 = 3.0;
+/// How many standard deviations the estimate's ellipse spans on each side.
+pub const ELLIPSE_SIGMAS: f64 = 2.0;
+/// The largest ellipse diameter drawn, metres (a nearly singular CRB would fill the scene).
+pub const ELLIPSE_MAX_M: f64 = 50.0;
+
+/// The Foxglove topic of a map layer.
+pub fn layer_topic(layer: &str) -> String {
+    format!("/map/{layer}")
+}
+
+/// Why a layer cannot be drawn.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConvertError {
+    #[error("layer '{layer}' has {cells} cells but its size is {width} x {height}")]
+    CellCount {
+        layer: String,
+        cells: usize,
+        width: u32,
+        height: u32,
+    },
+}
+
+fn vector3(x: f64, y: f64, z: f64) -> Vector3 {
+    Vector3 { x, y, z }
+}
+
+/// A rotation about z by `yaw` radians.
+pub fn yaw_quaternion(yaw: f64) -> Quaternion {
+    let half = yaw / 2.0;
+    Quaternion {
+        x: 0.0,
+        y: 0.0,
+        z: half.sin(),
+        w: half.cos(),
+    }
+}
+
+fn pose(x: f64, y: f64, z: f64, yaw: f64) -> Pose {
+    Pose {
+        position: Some(vector3(x, y, z)),
+        orientation: Some(yaw_quaternion(yaw)),
+    }
+}
+
+fn numeric_type(dtype: Dtype) -> NumericType {
+    match dtype {
+        Dtype::I8 => NumericType::Int8,
+        Dtype::U8 => NumericType::Uint8,
+        Dtype::F32 => NumericType::Float32,
+    }
+}
+
+/// A map layer as a `foxglove.Grid` in [`FRAME`]: the grid's corner at the layer's
+/// `origin` (rotated by its yaw), square cells of its resolution, row 0 at the origin as
+/// in roam (and ROS). One field, [`GRID_FIELD`], holds the cells unchanged: i8 occupancy
+/// as ROS values (-1 unknown, 0 free … 100 occupied), u8 scores, f32 values (+∞ where
+/// the PEB is unbounded).
+pub fn grid(layer: &Layer, timestamp: Timestamp) -> Result<Grid, ConvertError> {
+    let meta: &GridMeta = &layer.meta;
+    if layer.cells.len() as u64 != meta.cell_count() {
+        return Err(ConvertError::CellCount {
+            layer: layer.name.clone(),
+            cells: layer.cells.len(),
+            width: meta.width,
+            height: meta.height,
+        });
+    }
+    let dtype = layer.cells.dtype();
+    let cell_stride = dtype.size() as u32;
+    Ok(Grid {
+        timestamp: Some(timestamp),
+        frame_id: FRAME.to_owned(),
+        pose: Some(pose(meta.origin.x, meta.origin.y, 0.0, meta.origin.yaw)),
+        column_count: meta.width,
+        cell_size: Some(Vector2 {
+            x: meta.resolution,
+            y: meta.resolution,
+        }),
+        row_stride: meta.width * cell_stride,
+        cell_stride,
+        fields: vec![PackedElementField {
+            name: GRID_FIELD.to_owned(),
+            offset: 0,
+            r#type: numeric_type(dtype) as i32,
+        }],
+        data: Bytes::from(layer.cells.to_le_bytes()),
+    })
+}
+
+fn metadata(pairs: &[(&str, String)]) -> Vec<KeyValuePair> {
+    pairs
+        .iter()
+        .map(|(key, value)| KeyValuePair {
+            key: (*key).to_owned(),
+            value: value.clone(),
+        })
+        .collect()
+}
+
+fn entity(id: String, timestamp: Timestamp) -> SceneEntity {
+    SceneEntity {
+        timestamp: Some(timestamp),
+        frame_id: FRAME.to_owned(),
+        id,
+        ..SceneEntity::default()
+    }
+}
+
+fn label(text: &str, at: [f64; 2], z: f64, color: Color) -> TextPrimitive {
+    TextPrimitive {
+        pose: Some(pose(at[0], at[1], z, 0.0)),
+        billboard: true,
+        font_size: 14.0,
+        scale_invariant: true,
+        color: Some(color),
+        text: text.to_owned(),
+    }
+}
+
+fn sphere(at: [f64; 2], diameter: f64, color: Color) -> SpherePrimitive {
+    SpherePrimitive {
+        pose: Some(pose(at[0], at[1], diameter / 2.0, 0.0)),
+        size: Some(vector3(diameter, diameter, diameter)),
+        color: Some(color),
+    }
+}
+
+fn line(points: impl Iterator<Item = [f64; 2]>, z: f64, color: Color) -> LinePrimitive {
+    LinePrimitive {
+        r#type: line_primitive::Type::LineStrip as i32,
+        pose: Some(pose(0.0, 0.0, 0.0, 0.0)),
+        thickness: LINE_PX,
+        scale_invariant: true,
+        points: points
+            .map(|p| Point3 {
+                x: p[0],
+                y: p[1],
+                z,
+            })
+            .collect(),
+        color: Some(color),
+        ..LinePrimitive::default()
+    }
+}
+
+fn delete(id: String, timestamp: Timestamp) -> SceneEntityDeletion {
+    SceneEntityDeletion {
+        timestamp: Some(timestamp),
+        r#type: scene_entity_deletion::Type::MatchingId as i32,
+        id,
+    }
+}
+
+/// A robot's true position (`/robots/truth`): entity `truth/<robot>`, a sphere and its name.
+pub fn truth(t: &GroundTruth, timestamp: Timestamp) -> SceneUpdate {
+    let mut e = entity(format!("truth/{}", t.robot), timestamp);
+    e.spheres.push(sphere(t.at, ROBOT_SIZE_M, DRIVEN));
+    e.texts.push(label(
+        &t.robot,
+        t.at,
+        ROBOT_SIZE_M + 0.3,
+        with_alpha(DRIVEN, 1.0),
+    ));
+    e.metadata = metadata(&[
+        ("step", t.step.to_string()),
+        ("sim_time_s", format!("{:.3}", t.time_s)),
+    ]);
+    SceneUpdate {
+        entities: vec![e],
+        ..SceneUpdate::default()
+    }
+}
+
+/// The axes of the `sigmas`-σ ellipse of a 2 × 2 covariance: the two diameters (metres,
+/// larger first) and the direction of the first, radians. `None` when the matrix is not
+/// a covariance (not finite or not positive semi-definite).
+pub fn covariance_ellipse(cov: [[f64; 2]; 2], sigmas: f64) -> Option<(f64, f64, f64)> {
+    let (a, b, c) = (cov[0][0], (cov[0][1] + cov[1][0]) / 2.0, cov[1][1]);
+    if ![a, b, c].iter().all(|v| v.is_finite()) || a < 0.0 || c < 0.0 {
+        return None;
+    }
+    let mean = (a + c) / 2.0;
+    let spread = (((a - c) / 2.0).powi(2) + b * b).sqrt();
+    let (l1, l2) = (mean + spread, (mean - spread).max(0.0));
+    let angle = 0.5 * (2.0 * b).atan2(a - c);
+    let diameter = |l: f64| (2.0 * sigmas * l.sqrt()).min(ELLIPSE_MAX_M);
+    Some((diameter(l1), diameter(l2), angle))
+}
+
+/// A robot's position estimate (`/robots/estimate`): entity `estimate/<robot>`, a small
+/// sphere at the estimate and, when the CRB is known, its [`ELLIPSE_SIGMAS`]-σ ellipse
+/// (the CRB is the estimate's covariance). A degraded estimate is drawn faint.
+pub fn estimate(p: &PositionEstimate, timestamp: Timestamp) -> SceneUpdate {
+    let mut e = entity(format!("estimate/{}", p.robot), timestamp);
+    let color = if p.degraded {
+        with_alpha(ESTIMATE, 0.35)
+    } else {
+        ESTIMATE
+    };
+    e.spheres
+        .push(sphere(p.position, ROBOT_SIZE_M / 2.0, color));
+    if let Some((d1, d2, angle)) = p
+        .crb
+        .and_then(|crb| covariance_ellipse(crb, ELLIPSE_SIGMAS))
+    {
+        e.spheres.push(SpherePrimitive {
+            pose: Some(pose(p.position[0], p.position[1], 0.02, angle)),
+            size: Some(vector3(d1.max(0.01), d2.max(0.01), 0.02)),
+            color: Some(with_alpha(ESTIMATE, 0.3)),
+        });
+    }
+    e.metadata = metadata(&[
+        ("step", p.step.to_string()),
+        ("sim_time_s", format!("{:.3}", p.time_s)),
+        (
+            "peb_m",
+            p.peb_m
+                .map_or("unbounded".to_owned(), |v| format!("{v:.4}")),
+        ),
+        ("degraded", p.degraded.to_string()),
+        ("anchors_used", p.anchors_used.join(",")),
+    ]);
+    SceneUpdate {
+        entities: vec![e],
+        ..SceneUpdate::default()
+    }
+}
+
+/// A robot's planned path (`/robots/mission`): entity `mission/<robot>`, a line through
+/// its waypoints and a small cube at each. An empty mission (the robot is stopped)
+/// deletes the entity.
+pub fn mission(m: &Mission, timestamp: Timestamp) -> SceneUpdate {
+    let id = format!("mission/{}", m.robot);
+    if m.waypoints.is_empty() {
+        return SceneUpdate {
+            deletions: vec![delete(id, timestamp)],
+            ..SceneUpdate::default()
+        };
+    }
+    let mut e = entity(id, timestamp);
+    e.lines
+        .push(line(m.waypoints.iter().copied(), 0.03, PLANNED));
+    e.cubes.extend(m.waypoints.iter().map(|w| CubePrimitive {
+        pose: Some(pose(w[0], w[1], 0.03, 0.0)),
+        size: Some(vector3(0.1, 0.1, 0.1)),
+        color: Some(PLANNED),
+    }));
+    e.metadata = metadata(&[
+        ("mission", m.id.clone()),
+        ("waypoints", m.waypoints.len().to_string()),
+    ]);
+    SceneUpdate {
+        entities: vec![e],
+        ..SceneUpdate::default()
+    }
+}
+
+/// Every robot's planned path in one update (what `/robots/mission` latches, so a
+/// viewer that connects later sees them all): [`mission`] of each.
+pub fn missions<'a>(all: impl Iterator<Item = &'a Mission>, timestamp: Timestamp) -> SceneUpdate {
+    let mut update = SceneUpdate::default();
+    for m in all {
+        let one = mission(m, timestamp);
+        update.entities.extend(one.entities);
+        update.deletions.extend(one.deletions);
+    }
+    update
+}
+
+/// The anchors (`/anchors`): entity `anchors`, a cube and a name at each.
+pub fn anchors(points: &[NamedPoint], timestamp: Timestamp) -> SceneUpdate {
+    let mut e = entity("anchors".to_owned(), timestamp);
+    for a in points {
+        e.cubes.push(CubePrimitive {
+            pose: Some(pose(a.at[0], a.at[1], ANCHOR_SIZE_M / 2.0, 0.0)),
+            size: Some(vector3(ANCHOR_SIZE_M, ANCHOR_SIZE_M, ANCHOR_SIZE_M)),
+            color: Some(ANCHOR),
+        });
+        e.texts
+            .push(label(&a.name, a.at, ANCHOR_SIZE_M + 0.3, ANCHOR));
+    }
+    SceneUpdate {
+        entities: vec![e],
+        ..SceneUpdate::default()
+    }
+}
+
+/// The path one robot drove: its true positions, thinned and bounded. A point closer
+/// than `min_step_m` to the last kept one is skipped; past `max_points` the oldest go.
+#[derive(Debug, Clone)]
+pub struct DrivenPath {
+    points: VecDeque<[f64; 2]>,
+    max_points: usize,
+    min_step_m: f64,
+}
+
+impl DrivenPath {
+    pub fn new(max_points: usize, min_step_m: f64) -> Self {
+        DrivenPath {
+            points: VecDeque::new(),
+            max_points: max_points.max(2),
+            min_step_m,
+        }
+    }
+
+    /// Adds a true position; returns whether the path changed.
+    pub fn push(&mut self, at: [f64; 2]) -> bool {
+        if !(at[0].is_finite() && at[1].is_finite()) {
+            return false;
+        }
+        if let Some(last) = self.points.back() {
+            if (at[0] - last[0]).hypot(at[1] - last[1]) < self.min_step_m {
+                return false;
+            }
+        }
+        if self.points.len() == self.max_points {
+            self.points.pop_front();
+        }
+        self.points.push_back(at);
+        true
+    }
+
+    pub fn points(&self) -> impl Iterator<Item = [f64; 2]> + '_ {
+        self.points.iter().copied()
+    }
+
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+}
+
+/// The driven paths (`/robots/driven`): entity `driven/<robot>` per robot, a line.
+pub fn driven<'a>(
+    paths: impl Iterator<Item = (&'a str, &'a DrivenPath)>,
+    timestamp: Timestamp,
+) -> SceneUpdate {
+    let entities = paths
+        .filter(|(_, path)| !path.is_empty())
+        .map(|(robot, path)| {
+            let mut e = entity(format!("driven/{robot}"), timestamp);
+            e.lines.push(line(path.points(), 0.02, DRIVEN));
+            e
+        })
+        .collect();
+    SceneUpdate {
+        entities,
+        ..SceneUpdate::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roam_proto::cells::Cells;
+    use roam_proto::map::Origin;
+
+    fn stamp() -> Timestamp {
+        Timestamp::new(1_700_000_000, 5)
+    }
+
+    fn layer(name: &str, cells: Cells, width: u32, height: u32) -> Layer {
+        Layer {
+            name: name.to_owned(),
+            version: 3,
+            meta: GridMeta {
+                width,
+                height,
+                resolution: 0.25,
+                origin: Origin {
+                    x: -10.0,
+                    y: -5.0,
+                    yaw: 0.0,
+                },
+            },
+            derived_from: None,
+            cells,
+        }
+    }
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-9
+    }
+
+    #[test]
+    fn an_occupancy_layer_is_a_grid_of_ros_values_placed_by_its_meta() {
+        // 3 wide, 2 high; row 0 (at the origin) is -1 0 100, row 1 is 50 0 -1.
+        let l = layer("occupancy", Cells::I8(vec![-1, 0, 100, 50, 0, -1]), 3, 2);
+        let g = grid(&l, stamp()).expect("grid");
+        assert_eq!(g.frame_id, "map");
+        assert_eq!(g.column_count, 3);
+        assert_eq!((g.cell_stride, g.row_stride), (1, 3));
+        let cell = g.cell_size.expect("cell size");
+        assert!(close(cell.x, 0.25) && close(cell.y, 0.25));
+        let position = g.pose.and_then(|p| p.position).expect("position");
+        assert!(close(position.x, -10.0) && close(position.y, -5.0) && close(position.z, 0.0));
+        assert_eq!(g.fields.len(), 1);
+        assert_eq!(g.fields[0].name, GRID_FIELD);
+        assert_eq!(g.fields[0].r#type, NumericType::Int8 as i32);
+        // The bytes are the cells, row 0 first, -1 as 0xff.
+        assert_eq!(g.data.as_ref(), &[0xff, 0, 100, 50, 0, 0xff]);
+        assert_eq!(g.timestamp, Some(stamp()));
+    }
+
+    #[test]
+    fn u8_and_f32_layers_keep_their_type_and_values() {
+        let info = grid(
+            &layer("information", Cells::U8(vec![0, 7, 100, 255]), 2, 2),
+            stamp(),
+        )
+        .expect("grid");
+        assert_eq!(info.fields[0].r#type, NumericType::Uint8 as i32);
+        assert_eq!(info.data.as_ref(), &[0, 7, 100, 255]);
+
+        let peb = layer("peb", Cells::F32(vec![0.5, f32::INFINITY]), 2, 1);
+        let g = grid(&peb, stamp()).expect("grid");
+        assert_eq!(g.fields[0].r#type, NumericType::Float32 as i32);
+        assert_eq!((g.cell_stride, g.row_stride), (4, 8));
+        let values: Vec<f32> = g
+            .data
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        assert_eq!(values, vec![0.5, f32::INFINITY]);
+    }
+
+    #[test]
+    fn a_rotated_origin_rotates_the_grid() {
+        let mut l = layer("occupancy", Cells::I8(vec![0; 4]), 2, 2);
+        l.meta.origin.yaw = std::f64::consts::FRAC_PI_2;
+        let q = grid(&l, stamp())
+            .expect("grid")
+            .pose
+            .and_then(|p| p.orientation)
+            .expect("orientation");
+        let half = std::f64::consts::FRAC_PI_4;
+        assert!(close(q.z, half.sin()) && close(q.w, half.cos()) && close(q.x, 0.0));
+    }
+
+    #[test]
+    fn a_layer_whose_cells_do_not_fill_its_size_is_refused() {
+        let l = layer("occupancy", Cells::I8(vec![0; 5]), 3, 2);
+        assert!(matches!(
+            grid(&l, stamp()),
+            Err(ConvertError::CellCount { cells: 5, .. })
+        ));
+    }
+
+    #[test]
+    fn an_anchor_is_a_cube_standing_on_the_floor_at_its_place() {
+        let update = anchors(
+            &[
+                NamedPoint {
+                    name: "a1".into(),
+                    at: [3.5, -2.0],
+                },
+                NamedPoint {
+                    name: "a2".into(),
+                    at: [0.0, 7.25],
+                },
+            ],
+            stamp(),
+        );
+        assert_eq!(update.entities.len(), 1);
+        let e = &update.entities[0];
+        assert_eq!((e.id.as_str(), e.frame_id.as_str()), ("anchors", "map"));
+        assert_eq!(e.cubes.len(), 2);
+        let p = e.cubes[0].pose.and_then(|p| p.position).expect("position");
+        assert!(close(p.x, 3.5) && close(p.y, -2.0) && close(p.z, ANCHOR_SIZE_M / 2.0));
+        let size = e.cubes[0].size.expect("size");
+        assert!(close(size.x, ANCHOR_SIZE_M) && close(size.z, ANCHOR_SIZE_M));
+        assert_eq!(e.cubes[0].color, Some(ANCHOR));
+        let p2 = e.cubes[1].pose.and_then(|p| p.position).expect("position");
+        assert!(close(p2.x, 0.0) && close(p2.y, 7.25));
+        let names: Vec<&str> = e.texts.iter().map(|t| t.text.as_str()).collect();
+        assert_eq!(names, vec!["a1", "a2"]);
+    }
+
+    #[test]
+    fn a_true_position_is_a_robot_sphere_at_that_point() {
+        let update = truth(
+            &GroundTruth {
+                robot: "r1".into(),
+                step: 4,
+                time_s: 1.6,
+                at: [1.0, 2.0],
+            },
+            stamp(),
+        );
+        let e = &update.entities[0];
+        assert_eq!(e.id, "truth/r1");
+        let p = e.spheres[0]
+            .pose
+            .and_then(|p| p.position)
+            .expect("position");
+        assert!(close(p.x, 1.0) && close(p.y, 2.0));
+    }
+
+    #[test]
+    fn the_covariance_ellipse_has_the_axes_of_the_covariance() {
+        // Variances 4 and 1 along x and y: 2-sigma diameters 8 and 4, along x.
+        let (d1, d2, angle) = covariance_ellipse([[4.0, 0.0], [0.0, 1.0]], 2.0).expect("ellipse");
+        assert!(close(d1, 8.0) && close(d2, 4.0) && close(angle, 0.0));
+        // The same rotated by 90 degrees.
+        let (d1, d2, angle) = covariance_ellipse([[1.0, 0.0], [0.0, 4.0]], 2.0).expect("ellipse");
+        assert!(close(d1, 8.0) && close(d2, 4.0));
+        assert!(close(angle.abs(), std::f64::consts::FRAC_PI_2));
+        // Correlated: the major axis along the diagonal.
+        let (_, _, angle) = covariance_ellipse([[2.0, 1.0], [1.0, 2.0]], 1.0).expect("ellipse");
+        assert!(close(angle, std::f64::consts::FRAC_PI_4));
+        assert!(covariance_ellipse([[f64::INFINITY, 0.0], [0.0, 1.0]], 2.0).is_none());
+    }
+
+    #[test]
+    fn an_estimate_with_a_crb_has_an_ellipse() {
+        let p = PositionEstimate {
+            robot: "r1".into(),
+            step: 1,
+            time_s: 0.4,
+            position: [1.0, 1.0],
+            crb: Some([[0.01, 0.0], [0.0, 0.04]]),
+            peb_m: Some(0.2236),
+            anchors_used: vec!["a1".into(), "a2".into(), "a3".into()],
+            degraded: false,
+        };
+        let e = &estimate(&p, stamp()).entities[0];
+        assert_eq!(e.id, "estimate/r1");
+        assert_eq!(e.spheres.len(), 2);
+        let size = e.spheres[1].size.expect("size");
+        assert!(close(size.x, 0.8) && close(size.y, 0.4));
+        let without = PositionEstimate { crb: None, ..p };
+        assert_eq!(estimate(&without, stamp()).entities[0].spheres.len(), 1);
+    }
+
+    #[test]
+    fn a_mission_is_a_line_through_its_waypoints_and_an_empty_one_deletes_it() {
+        let m = Mission {
+            robot: "r1".into(),
+            id: "w1".into(),
+            waypoints: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 2.0]],
+        };
+        let update = mission(&m, stamp());
+        let e = &update.entities[0];
+        assert_eq!(e.id, "mission/r1");
+        let xy: Vec<(f64, f64)> = e.lines[0].points.iter().map(|p| (p.x, p.y)).collect();
+        assert_eq!(xy, vec![(0.0, 0.0), (1.0, 0.0), (1.0, 2.0)]);
+        assert_eq!(e.cubes.len(), 3);
+        let stop = mission(
+            &Mission {
+                waypoints: Vec::new(),
+                ..m
+            },
+            stamp(),
+        );
+        assert!(stop.entities.is_empty());
+        assert_eq!(stop.deletions[0].id, "mission/r1");
+    }
+
+    #[test]
+    fn a_driven_path_is_thinned_and_bounded() {
+        let mut path = DrivenPath::new(3, 0.1);
+        assert!(path.push([0.0, 0.0]));
+        assert!(!path.push([0.05, 0.0]), "closer than the minimum step");
+        assert!(path.push([0.2, 0.0]));
+        assert!(path.push([0.4, 0.0]));
+        assert!(path.push([0.6, 0.0]));
+        assert!(!path.push([f64::NAN, 0.0]));
+        assert_eq!(path.len(), 3);
+        let xs: Vec<f64> = path.points().map(|p| p[0]).collect();
+        assert_eq!(xs, vec![0.2, 0.4, 0.6], "the oldest point went");
+        let update = driven([("r1", &path)].into_iter(), stamp());
+        assert_eq!(update.entities[0].id, "driven/r1");
+        assert_eq!(update.entities[0].lines[0].points.len(), 3);
+    }
+}
