@@ -54,6 +54,9 @@ pub struct ExecutiveConfig {
     pub plan_deadline_s: f64,
     /// Generations the GA may run at most (it stops at the deadline anyway).
     pub max_generations: Option<u32>,
+    /// The planner's localizability cost W_loc (paper 002's PEB in paper 000's fitness;
+    /// see the planner's `w_loc`). `None`: the planner's default, off.
+    pub w_loc: Option<f64>,
     pub seed: u64,
     /// Waypoints are at most this far apart along the planned path, metres.
     pub waypoint_spacing_m: f64,
@@ -76,6 +79,7 @@ impl Default for ExecutiveConfig {
             model: PlannerModel::Model1,
             plan_deadline_s: 1.0,
             max_generations: Some(1000),
+            w_loc: None,
             seed: 0,
             waypoint_spacing_m: 1.0,
             off_path_m: 1.5,
@@ -311,6 +315,7 @@ impl Run<'_> {
             model,
             params: GaOverrides {
                 max_generations: self.config.max_generations,
+                w_loc: self.config.w_loc,
                 ..GaOverrides::default()
             },
             seed: self.config.seed,

@@ -27,6 +27,7 @@ pub const SERVICE_NAME: &str = "mission";
 ///     - { name: goal2, at: [6.0, -7.0], start_s: 165.0, duration_s: 5.0 }
 ///   model: model1        # model0 | model1 | model2 | shortest
 ///   plan_deadline_s: 1.0
+///   w_loc: 2000          # the PEB localizability cost in the planner's fitness (default off)
 /// ```
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -130,4 +131,18 @@ pub async fn run(
     }
     service.run_until_stopped().await?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_shipped_config_is_the_builtin_day() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/mission.yaml");
+        let config: MissionConfig = roam_runtime::config_file::load(&path).expect("parses");
+        assert_eq!(config.executive.tasks, crate::tasks::builtin());
+        assert_eq!(config.executive.robot, "robot");
+    }
 }
