@@ -3,6 +3,7 @@
 //! arguments and calls in here, so the integration tests boot exactly what users run.
 
 pub mod bench;
+pub mod bench_load;
 pub mod bench_localization;
 pub mod bench_planner;
 pub mod bench_sim;

@@ -687,3 +687,17 @@ fn run_json(args: &[&str], out: Option<&std::path::Path>) -> (serde_json::Value,
     let value = serde_json::from_slice(&output.stdout).expect("json");
     (value, stderr)
 }
+
+#[test]
+fn bench_load_answers_or_refuses_every_request_and_none_hangs() {
+    let (value, _) = run_json(&["bench", "load", "--json", "--requests", "30"], None);
+    let count = |field: &str| value[field].as_u64().expect(field);
+    assert_eq!(count("hung"), 0, "{value}");
+    assert_eq!(count("failed"), 0, "{value}");
+    assert_eq!(count("answered") + count("refused_busy"), 30, "{value}");
+    assert!(
+        count("answered") >= 2,
+        "two planners answer at least one each: {value}"
+    );
+    assert!(value["peak_rss_mib"].as_f64().is_some());
+}

@@ -38,6 +38,14 @@ pub(crate) enum BenchCommand {
         #[arg(long, default_value_t = 10.0)]
         seconds: f64,
     },
+    /// Many concurrent plan requests to two planners: answered or refused `busy`, none hung.
+    Load {
+        #[arg(long)]
+        json: bool,
+        /// Concurrent plan requests.
+        #[arg(long, default_value_t = 100)]
+        requests: usize,
+    },
     /// Change-map observation updates per second on a 1000 x 1000 map (paper 004 §3).
     Mapper {
         #[arg(long)]
@@ -180,6 +188,13 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
                 bail!("--robots must be 1..=1000, --rate-hz and --seconds positive");
             }
             let result = roam::bench_sim::sim(robots, rate_hz, seconds).await?;
+            print_json(&result, json)
+        }
+        BenchCommand::Load { json, requests } => {
+            if requests == 0 || requests > roam::bench_load::MAX_REQUESTS {
+                bail!("--requests must be 1..={}", roam::bench_load::MAX_REQUESTS);
+            }
+            let result = roam::bench_load::load(requests).await?;
             print_json(&result, json)
         }
         BenchCommand::Mapper {
