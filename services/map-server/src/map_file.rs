@@ -62,7 +62,7 @@ impl MapFileError {
 
 /// Reads a ROS map or a scenario, telling them apart by the ROS `image:` key.
 pub fn read(path: &Path, max_cells: u64) -> Result<MapContent, MapFileError> {
-    let is_ros = std::fs::read_to_string(path)
+    let is_ros = ros_map::read_bounded_text(path)
         .ok()
         .and_then(|text| serde_yaml_ng::from_str::<serde_yaml_ng::Value>(&text).ok())
         .is_some_and(|v| v.get("image").is_some());

@@ -95,6 +95,49 @@ pub enum RosMapError {
     },
 }
 
+/// The largest map, image or scenario file read, bytes: far above any real map (a
+/// 1.7-million-cell PGM is 1.7 MB), low enough that a wrong path cannot exhaust memory.
+pub const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;
+
+/// Reads a whole file, refusing anything that is not a regular file (a FIFO or a device
+/// would block or never end) and files over [`MAX_FILE_BYTES`].
+pub fn read_bounded(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let meta = std::fs::metadata(path)?;
+    if !meta.is_file() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a folder, FIFO or device cannot be a map)",
+        ));
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "the file has {} bytes; the limit max_file_bytes is {MAX_FILE_BYTES}",
+                meta.len()
+            ),
+        ));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    std::fs::File::open(path)?
+        .take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("the file grew past the limit max_file_bytes ({MAX_FILE_BYTES})"),
+        ));
+    }
+    Ok(bytes)
+}
+
+/// [`read_bounded`] as UTF-8 text.
+pub fn read_bounded_text(path: &Path) -> std::io::Result<String> {
+    String::from_utf8(read_bounded(path)?)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+}
+
 fn io_error(path: &Path, e: std::io::Error) -> RosMapError {
     if e.kind() == std::io::ErrorKind::NotFound {
         RosMapError::Missing {
@@ -110,7 +153,7 @@ fn io_error(path: &Path, e: std::io::Error) -> RosMapError {
 
 /// Reads a `map.yaml` and its image. The image path is relative to the yaml's folder.
 pub fn load(yaml_path: &Path, max_cells: u64) -> Result<RosMap, RosMapError> {
-    let text = std::fs::read_to_string(yaml_path).map_err(|e| io_error(yaml_path, e))?;
+    let text = read_bounded_text(yaml_path).map_err(|e| io_error(yaml_path, e))?;
     let invalid = |reason: String| RosMapError::Invalid {
         path: yaml_path.to_owned(),
         reason,
@@ -179,7 +222,7 @@ fn load_image(
     max_cells: u64,
 ) -> Result<Grid<i8>, RosMapError> {
     let path = &params.image;
-    let bytes = std::fs::read(path).map_err(|e| io_error(path, e))?;
+    let bytes = read_bounded(path).map_err(|e| io_error(path, e))?;
     let image_error = |reason: String| RosMapError::Image {
         path: path.clone(),
         reason,

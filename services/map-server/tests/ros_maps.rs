@@ -152,3 +152,23 @@ fn bad_maps_are_refused_naming_the_file() {
     let err = ros_map::load(&yaml, MAX).expect_err("must be refused");
     assert!(err.to_string().contains("resolution"), "{err}");
 }
+
+/// A FIFO (or a device) as a map path would block the reader forever: it is refused at
+/// once with an error that says why.
+#[test]
+fn a_fifo_is_refused_not_read() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let fifo = dir.path().join("map.yaml");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo");
+    assert!(made.success());
+    let started = std::time::Instant::now();
+    let err = roam_map_server::map_file::read(&fifo, 1 << 22).expect_err("refused");
+    assert!(started.elapsed() < std::time::Duration::from_secs(2));
+    assert!(err.to_string().contains("not a regular file"), "{err}");
+    let err = roam_map_server::ros_map::read_bounded(std::path::Path::new("/dev/zero"))
+        .expect_err("a device");
+    assert!(err.to_string().contains("not a regular file"), "{err}");
+}

@@ -225,7 +225,7 @@ pub enum ScenarioError {
 
 /// Reads a scenario file and builds its grids.
 pub fn load(path: &Path, max_cells: u64) -> Result<Scenario, ScenarioError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    let text = crate::ros_map::read_bounded_text(path).map_err(|e| {
         if e.kind() == std::io::ErrorKind::NotFound {
             ScenarioError::Missing {
                 path: path.to_owned(),
