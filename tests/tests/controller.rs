@@ -34,6 +34,16 @@ async fn put<T: Message>(client: &roam_runtime::Requester, key: String, message:
         .expect("put");
 }
 
+/// Puts a one-waypoint mission for the robot `robot`, as a mission executive would.
+async fn give_mission(client: &roam_runtime::Requester, root: &str, id: &str, to: [f64; 2]) {
+    let mission = Mission {
+        robot: "robot".into(),
+        id: id.into(),
+        waypoints: vec![to],
+    };
+    put(client, keys::robot_mission(root, "robot"), &mission).await;
+}
+
 /// Waits for the controller status of a mission that satisfies `done`.
 async fn status_until(
     statuses: &Sub,
@@ -86,16 +96,7 @@ async fn an_es1_mission_through_zenoh_drives_the_batch_trajectory() {
     let commands = subscribe(&client, keys::robot_command(&root, "robot")).await;
     let truth = subscribe(&client, keys::robot_truth(&root, "robot")).await;
     let statuses = subscribe(&client, keys::robot_controller(&root, "robot")).await;
-    put(
-        &client,
-        keys::robot_mission(&root, "robot"),
-        &Mission {
-            robot: "robot".into(),
-            id: "es1".into(),
-            waypoints: vec![[60.0, 16.0]],
-        },
-    )
-    .await;
+    give_mission(&client, &root, "es1", [60.0, 16.0]).await;
     status_until(&statuses, Duration::from_secs(10), |s| {
         s.mission.as_deref() == Some("es1")
     })
@@ -159,16 +160,7 @@ async fn stale_estimates_halt_the_robot_within_the_configured_time() {
     let root = harness.root.clone();
     let statuses = subscribe(&client, keys::robot_controller(&root, "robot")).await;
     let truth = subscribe(&client, keys::robot_truth(&root, "robot")).await;
-    put(
-        &client,
-        keys::robot_mission(&root, "robot"),
-        &Mission {
-            robot: "robot".into(),
-            id: "far".into(),
-            waypoints: vec![[45.0, 45.0]],
-        },
-    )
-    .await;
+    give_mission(&client, &root, "far", [45.0, 45.0]).await;
     status_until(&statuses, Duration::from_secs(10), |s| {
         s.state == MissionState::Active && s.steps >= 10
     })
@@ -218,16 +210,7 @@ async fn a_local_minimum_is_reported_as_stuck() {
     let client = harness.client().await;
     let root = harness.root.clone();
     let statuses = subscribe(&client, keys::robot_controller(&root, "robot")).await;
-    put(
-        &client,
-        keys::robot_mission(&root, "robot"),
-        &Mission {
-            robot: "robot".into(),
-            id: "through the wall".into(),
-            waypoints: vec![[25.0, 10.0]],
-        },
-    )
-    .await;
+    give_mission(&client, &root, "through the wall", [25.0, 10.0]).await;
     let stuck = status_until(&statuses, Duration::from_secs(60), |s| {
         matches!(
             s.state,

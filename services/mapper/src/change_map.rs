@@ -590,6 +590,28 @@ mod tests {
         assert_eq!(f, map.features_exact(3.0));
     }
 
+    /// Two robots' windows of the same instant merge into the one map; where they
+    /// overlap and disagree, the later one sets the cell but no time passed, so there is
+    /// no event. A second later, a change either robot sees is an event of the map.
+    #[test]
+    fn two_robots_windows_merge_into_one_map() {
+        let mut map = ChangeMap::new(meta(4, 1), MapParams::default()).expect("map");
+        // Robot a sees cells 0..=2, robot b cells 2..=3, both at t = 1.
+        map.observe(&window(0, 0, 3, 1, &[0, 0, 0]), 1.0)
+            .expect("a");
+        let u = map.observe(&window(2, 0, 2, 1, &[100, 0]), 1.0).expect("b");
+        assert_eq!(u.events, 0, "a disagreement at one instant is not an event");
+        assert_eq!(map.obstacles(), &[0, 0, 100, 0]);
+        assert_eq!(map.stats().seen_cells, 4);
+        // At t = 2 robot b sees cell 3 blocked: one free→blocked event, rate 1/s.
+        let u = map
+            .observe(&window(2, 0, 2, 1, &[100, 100]), 2.0)
+            .expect("b again");
+        assert_eq!((u.events, u.flipped.clone()), (1, vec![(3, 0)]));
+        assert_eq!(map.rate_layer().get(3, 0), Some(1.0));
+        assert_eq!(map.rate_layer().get(0, 0), Some(0.0));
+    }
+
     #[test]
     fn once_everything_is_seen_r_is_the_stalest_cell() {
         let mut map = ChangeMap::new(meta(2, 1), MapParams::default()).expect("map");

@@ -1,0 +1,281 @@
+//! The `roam` binary's experiment and benchmark runners and the demo, run as a user runs
+//! them: each prints its JSON, draws its pictures and shows progress on stderr.
+
+use std::process::Command;
+
+const ROAM: &str = env!("CARGO_BIN_EXE_roam");
+
+/// Counts pixels of exactly `colour` in a PNG.
+fn count_colour(path: &std::path::Path, colour: [u8; 3]) -> usize {
+    let picture = image::open(path).expect("png").to_rgb8();
+    picture.pixels().filter(|p| p.0 == colour).count()
+}
+
+#[test]
+fn reproduce_planner_prints_every_row_and_draws_each_model() {
+    let out = tempfile::tempdir().expect("tmp");
+    let output = Command::new(ROAM)
+        .args([
+            "reproduce",
+            "planner",
+            "--json",
+            "--runs",
+            "1",
+            "--generations-per-t",
+            "40",
+            "--out",
+        ])
+        .arg(out.path())
+        .output()
+        .expect("run");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
+    let rows = value["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 2 * 3 * 3, "2 goals × 3 ratios × 3 models");
+    for row in rows {
+        for field in [
+            "goal",
+            "ratio",
+            "model",
+            "u_ges_median",
+            "u_ges_mean",
+            "d_median",
+            "within_budget",
+            "reached_goal",
+        ] {
+            assert!(!row[field].is_null(), "{field} missing in {row}");
+        }
+        assert!(row["u_ges_median"].as_f64().expect("number") > 0.0);
+    }
+    assert!(!value["comparisons"]
+        .as_array()
+        .expect("comparisons")
+        .is_empty());
+    for model in ["model0", "model1", "model2"] {
+        let png = out.path().join(format!("{model}.png"));
+        assert!(
+            count_colour(&png, roam_map_server::render::PATH.0) > 50,
+            "{model}: the path is drawn"
+        );
+        assert!(
+            count_colour(&png, roam_map_server::render::MARKER.0) > 50,
+            "{model}: start and goal marked"
+        );
+    }
+}
+
+#[test]
+fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
+    let out = tempfile::tempdir().expect("tmp");
+    let (value, stderr) = run_json(
+        &[
+            "reproduce",
+            "apf",
+            "--json",
+            "--es1-runs",
+            "2",
+            "--es2-runs",
+            "1",
+            "--es3-missions",
+            "1",
+            "--es3-runs",
+            "1",
+        ],
+        Some(out.path()),
+    );
+    let es1 = value["es1"].as_array().expect("es1");
+    let schemes: Vec<&str> = es1.iter().filter_map(|r| r["scheme"].as_str()).collect();
+    assert_eq!(
+        schemes,
+        ["plain", "fixed", "cutoff", "linear", "sinusoidal"]
+    );
+    for row in es1 {
+        for field in ["success_rate", "rmse_m", "steps", "distance_m"] {
+            assert!(row.get(field).is_some(), "{field} missing in {row}");
+        }
+    }
+    let es2 = value["es2"].as_array().expect("es2");
+    assert_eq!(es2.len(), 4 * 10, "four IS schemes × z_is 0.0..0.9");
+    assert!(es2
+        .iter()
+        .all(|r| r["steps"].as_f64().is_some() && r["z_is"].as_f64().is_some()));
+    let es3 = value["es3"].as_array().expect("es3");
+    for row in es3 {
+        for field in ["rmse_change_pct", "steps_change_pct", "distance_change_pct"] {
+            assert!(row.get(field).is_some(), "{field} missing in {row}");
+        }
+    }
+    for picture in [
+        "es1_trajectories.png",
+        "es2_trajectories.png",
+        "es2_steps.png",
+        "es2_distance.png",
+    ] {
+        let image = image::open(out.path().join(picture)).expect(picture);
+        assert!(image.width() > 100 && image.height() > 100);
+    }
+    assert!(stderr.contains("es3: 5/5 runs"), "progress on stderr");
+}
+
+#[test]
+fn reproduce_mapper_prints_the_three_strategies_and_draws_fig_3() {
+    let out = tempfile::tempdir().expect("tmp");
+    let (value, _) = run_json(
+        &[
+            "reproduce",
+            "mapper",
+            "--json",
+            "--repetitions",
+            "1",
+            "--steps",
+            "300",
+        ],
+        Some(out.path()),
+    );
+    let strategies = value["strategies"].as_array().expect("strategies");
+    let names: Vec<&str> = strategies
+        .iter()
+        .filter_map(|s| s["name"].as_str())
+        .collect();
+    assert_eq!(names.len(), 3, "{names:?}");
+    for s in strategies {
+        assert!(s["rate_error_auc"].as_f64().expect("auc") > 0.0);
+        let quality = s["final_map_quality"].as_f64().expect("quality");
+        assert!((0.0..=1.0).contains(&quality));
+    }
+    let image = image::open(out.path().join("mapper_fig3.png")).expect("figure");
+    assert!(image.width() > 100);
+}
+
+#[test]
+fn bench_mapper_prints_updates_per_second() {
+    let (value, _) = run_json(&["bench", "mapper", "--json", "--updates", "50"], None);
+    assert_eq!(value["map_cells"], 1_000_000);
+    assert!(value["updates_with_features_per_s"].as_f64().expect("rate") > 0.0);
+}
+
+#[test]
+fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
+    let out = tempfile::tempdir().expect("tmp");
+    let output = Command::new(ROAM)
+        .args(["demo", "--rate", "10", "--out"])
+        .arg(out.path())
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("run");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(stderr.contains("window 1 -> goal1"), "progress: {stderr}");
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.path().join("report.json")).expect("json"))
+            .expect("parses");
+    for field in [
+        "on_time",
+        "information",
+        "information_shortest_path",
+        "peb_mean_m",
+    ] {
+        assert!(!report[field].is_null(), "{field} missing: {report}");
+    }
+    assert_eq!(report["windows"].as_array().expect("windows").len(), 2);
+    let markdown = std::fs::read_to_string(out.path().join("report.md")).expect("md");
+    assert!(markdown.contains("| 1 | goal1 |") && markdown.contains("world.png"));
+
+    // The built-in world: 100 x 100 cells of 0.2 m from (-10, -10), 8 px per cell.
+    let picture = image::open(out.path().join("world.png"))
+        .expect("png")
+        .to_rgb8();
+    assert_eq!(picture.dimensions(), (800, 800));
+    let pixel = |p: [f64; 2]| {
+        let (x, y) = ((p[0] + 10.0) / 0.2, (p[1] + 10.0) / 0.2);
+        let (px, py) = (x.floor() * 8.0 + 4.0, (99.0 - y.floor()) * 8.0 + 4.0);
+        *picture.get_pixel(px as u32, py as u32)
+    };
+    let driven: Vec<[f64; 2]> =
+        serde_json::from_value(report["driven_path"].clone()).expect("driven path");
+    assert!(driven.len() > 50);
+    // Away from the start and task markers, the driven path is red where it was driven.
+    let markers = [[-8.0, -8.0], [-2.0, 4.0], [6.0, -7.0]];
+    let away: Vec<[f64; 2]> = driven
+        .iter()
+        .copied()
+        .filter(|p| {
+            markers
+                .iter()
+                .all(|m| (p[0] - m[0]).hypot(p[1] - m[1]) > 0.8)
+        })
+        .collect();
+    let red = away
+        .iter()
+        .filter(|p| pixel(**p) == image::Rgb([220, 20, 20]))
+        .count();
+    assert!(
+        red * 10 >= away.len() * 9,
+        "{red} of {} driven points are red in the picture",
+        away.len()
+    );
+    // The task places are marked green.
+    assert_eq!(pixel([-2.0, 4.0]), image::Rgb([0, 170, 60]));
+}
+
+#[test]
+fn reproduce_mission_compares_the_couplings() {
+    let (value, _) = run_json(
+        &[
+            "reproduce",
+            "mission",
+            "--json",
+            "--missions",
+            "1",
+            "--generations",
+            "50",
+        ],
+        None,
+    );
+    let variants: Vec<&str> = value["variants"]
+        .as_array()
+        .expect("variants")
+        .iter()
+        .filter_map(|v| v["variant"].as_str())
+        .collect();
+    assert_eq!(variants, ["static", "peb_cost", "change", "shortest"]);
+    for v in value["variants"].as_array().expect("variants") {
+        assert!(v["information"].as_f64().expect("information") > 0.0);
+        let share = v["on_time_share"].as_f64().expect("share");
+        assert!((0.0..=1.0).contains(&share));
+        assert!(v["peb_mean_m"].as_f64().expect("peb") > 0.0);
+    }
+}
+
+/// Runs `roam <args> [--out DIR]`, asserts it succeeded, and returns its stdout as JSON
+/// with its stderr.
+fn run_json(args: &[&str], out: Option<&std::path::Path>) -> (serde_json::Value, String) {
+    let mut command = Command::new(ROAM);
+    command.args(args);
+    if let Some(dir) = out {
+        command.arg("--out").arg(dir);
+    }
+    let output = command.output().expect("run");
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert!(output.status.success(), "{stderr}");
+    let value = serde_json::from_slice(&output.stdout).expect("json");
+    (value, stderr)
+}
+
+#[test]
+fn bench_load_answers_or_refuses_every_request_and_none_hangs() {
+    let (value, _) = run_json(&["bench", "load", "--json", "--requests", "30"], None);
+    let count = |field: &str| value[field].as_u64().expect(field);
+    assert_eq!(count("hung"), 0, "{value}");
+    assert_eq!(count("failed"), 0, "{value}");
+    assert_eq!(count("answered") + count("refused_busy"), 30, "{value}");
+    assert!(
+        count("answered") >= 2,
+        "two planners answer at least one each: {value}"
+    );
+    assert!(value["peak_rss_mib"].as_f64().is_some());
+}
