@@ -45,6 +45,18 @@ pub fn repo_path(relative: &str) -> std::path::PathBuf {
 pub struct Harness {
     pub router: Router,
     pub root: String,
+    /// On a secure site ([`Harness::start_secure`]), the Zenoh config of each role; the
+    /// services a harness starts then open their sessions as their own role.
+    site: Option<SecureSite>,
+}
+
+/// The client side of a secure site: the Zenoh config a session without credentials
+/// uses (TLS to the router, nothing else) and one config per role (the same plus the
+/// role's user name and password), keyed by role name (`map-server`, `sim`, ...).
+#[derive(Debug, Clone)]
+pub struct SecureSite {
+    pub anonymous: zenoh::Config,
+    pub roles: std::collections::BTreeMap<String, zenoh::Config>,
 }
 
 /// A service running in this process.
@@ -68,13 +80,17 @@ impl RunningService {
 
 static NEXT_ROOT: AtomicU32 = AtomicU32::new(0);
 
+fn init_tracing() {
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
+        .with_test_writer()
+        .try_init();
+}
+
 impl Harness {
     /// Starts a router on a free loopback port with a fresh key root.
     pub async fn start() -> Harness {
-        let _ = tracing_subscriber::fmt()
-            .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
-            .with_test_writer()
-            .try_init();
+        init_tracing();
         let router = within("router start", Router::on_loopback())
             .await
             .expect("router");
@@ -83,17 +99,64 @@ impl Harness {
             std::process::id(),
             NEXT_ROOT.fetch_add(1, Ordering::Relaxed)
         );
-        Harness { router, root }
+        Harness {
+            router,
+            root,
+            site: None,
+        }
     }
 
-    /// A Zenoh config for a client session connected to this harness's router.
+    /// A harness around a router the test started itself (with TLS, authentication and
+    /// access control, say), under `root`: the services it starts use their role's
+    /// config from `site` ([`Harness::role_config`]), and [`Harness::client_config`] is
+    /// `site.anonymous`. The key root is the caller's because an access-control policy
+    /// names its keys.
+    pub fn start_secure(router: Router, root: &str, site: SecureSite) -> Harness {
+        init_tracing();
+        Harness {
+            router,
+            root: root.to_owned(),
+            site: Some(site),
+        }
+    }
+
+    /// A Zenoh config for a client session connected to this harness's router (on a
+    /// secure site: without credentials).
     pub fn client_config(&self) -> zenoh::Config {
-        SessionArgs::client_of(&self.router.endpoint)
-            .zenoh_config(None)
-            .expect("client config")
+        match &self.site {
+            Some(site) => site.anonymous.clone(),
+            None => SessionArgs::client_of(&self.router.endpoint)
+                .zenoh_config(None)
+                .expect("client config"),
+        }
     }
 
-    /// A client session with a request helper.
+    /// The Zenoh config of a session acting as `role` (a service name, or `operator`):
+    /// on a secure site that role's credentials, otherwise [`Harness::client_config`].
+    pub fn role_config(&self, role: &str) -> zenoh::Config {
+        match &self.site {
+            Some(site) => site
+                .roles
+                .get(role)
+                .cloned()
+                .unwrap_or_else(|| panic!("the secure site has no credentials for '{role}'")),
+            None => self.client_config(),
+        }
+    }
+
+    /// A client session acting as `role` ([`Harness::role_config`]) with a request helper.
+    pub async fn client_as(&self, role: &str) -> Requester {
+        let session = within(
+            "client open",
+            roam_runtime::session::open(self.role_config(role)),
+        )
+        .await
+        .unwrap_or_else(|e| panic!("client session as {role}: {e}"));
+        Requester::new(session, Duration::from_secs(5))
+    }
+
+    /// A client session with a request helper (on a secure site it has no credentials,
+    /// so the router refuses it: use [`Harness::client_as`] there).
     pub async fn client(&self) -> Requester {
         let session = within(
             "client open",
@@ -113,8 +176,40 @@ impl Harness {
         Fut: std::future::Future<Output = Result<(), E>> + Send + 'static,
         E: std::fmt::Display,
     {
+        self.start_service_with(self.client_config(), live_key, run)
+            .await
+    }
+
+    /// [`Harness::start_service`] with the session config of `role`
+    /// ([`Harness::role_config`]): how the `start_*` helpers start each service as itself.
+    pub async fn start_service_as<F, Fut, E>(
+        &self,
+        role: &str,
+        live_key: String,
+        run: F,
+    ) -> RunningService
+    where
+        F: FnOnce(zenoh::Config, CancellationToken) -> Fut,
+        Fut: std::future::Future<Output = Result<(), E>> + Send + 'static,
+        E: std::fmt::Display,
+    {
+        self.start_service_with(self.role_config(role), live_key, run)
+            .await
+    }
+
+    async fn start_service_with<F, Fut, E>(
+        &self,
+        config: zenoh::Config,
+        live_key: String,
+        run: F,
+    ) -> RunningService
+    where
+        F: FnOnce(zenoh::Config, CancellationToken) -> Fut,
+        Fut: std::future::Future<Output = Result<(), E>> + Send + 'static,
+        E: std::fmt::Display,
+    {
         let cancel = CancellationToken::new();
-        let service = run(self.client_config(), cancel.clone());
+        let service = run(config, cancel.clone());
         let mut handle = tokio::spawn(async move { service.await.map_err(|e| e.to_string()) });
         let live = wait_for_liveliness(&self.router.session, &live_key, STEP);
         tokio::pin!(live);
@@ -136,7 +231,7 @@ impl Harness {
     /// Starts a map server and waits until its liveliness token is seen.
     pub async fn start_map_server(&self, config: MapServerConfig) -> RunningService {
         let key = keys::liveliness_of(&self.root, roam_map_server::SERVICE_NAME);
-        self.start_service(key, |zenoh, cancel| {
+        self.start_service_as(roam_map_server::SERVICE_NAME, key, |zenoh, cancel| {
             roam_map_server::run(config, zenoh, cancel)
         })
         .await
@@ -156,7 +251,7 @@ impl Harness {
     pub async fn start_planner(&self, config: PlannerConfig) -> RunningService {
         let instance = config.instance.clone().unwrap_or_default();
         let key = keys::liveliness(&self.root, roam_planner::SERVICE_NAME, &instance);
-        self.start_service(key, |zenoh, cancel| {
+        self.start_service_as(roam_planner::SERVICE_NAME, key, |zenoh, cancel| {
             roam_planner::run(config, zenoh, cancel)
         })
         .await
@@ -176,7 +271,7 @@ impl Harness {
     /// Starts the sim world and waits for its liveliness token.
     pub async fn start_sim(&self, config: SimConfig) -> RunningService {
         let key = keys::liveliness_of(&self.root, roam_sim::service::SERVICE_NAME);
-        self.start_service(key, |zenoh, cancel| {
+        self.start_service_as(roam_sim::service::SERVICE_NAME, key, |zenoh, cancel| {
             roam_sim::service::run(config, zenoh, cancel)
         })
         .await
@@ -190,9 +285,11 @@ impl Harness {
             ..LocalizationConfig::default()
         };
         let key = keys::liveliness_of(&self.root, roam_localization::service::SERVICE_NAME);
-        self.start_service(key, |zenoh, cancel| {
-            roam_localization::service::run(config, zenoh, cancel)
-        })
+        self.start_service_as(
+            roam_localization::service::SERVICE_NAME,
+            key,
+            |zenoh, cancel| roam_localization::service::run(config, zenoh, cancel),
+        )
         .await
     }
 
@@ -207,9 +304,11 @@ impl Harness {
     /// Starts the APF controller and waits for its liveliness token.
     pub async fn start_controller(&self, config: ControllerConfig) -> RunningService {
         let key = keys::liveliness_of(&self.root, roam_controller::service::SERVICE_NAME);
-        self.start_service(key, |zenoh, cancel| {
-            roam_controller::service::run(config, zenoh, cancel)
-        })
+        self.start_service_as(
+            roam_controller::service::SERVICE_NAME,
+            key,
+            |zenoh, cancel| roam_controller::service::run(config, zenoh, cancel),
+        )
         .await
     }
 
@@ -224,7 +323,7 @@ impl Harness {
     /// Starts the change-rate mapper and waits for its liveliness token.
     pub async fn start_mapper(&self, config: MapperConfig) -> RunningService {
         let key = keys::liveliness_of(&self.root, roam_mapper::service::SERVICE_NAME);
-        self.start_service(key, |zenoh, cancel| {
+        self.start_service_as(roam_mapper::service::SERVICE_NAME, key, |zenoh, cancel| {
             roam_mapper::service::run(config, zenoh, cancel)
         })
         .await

@@ -232,3 +232,41 @@ async fn a_local_minimum_is_reported_as_stuck() {
     .await
     .expect("pause");
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_controller_on_board_one_robot_leaves_the_others_alone() {
+    let scenario = "config/scenarios/es2.yaml";
+    let harness = Harness::start().await;
+    let mut sim_config = harness.sim_config(Some(scenario));
+    sim_config.rate = Some(10.0);
+    let _sim = harness.start_sim(sim_config).await;
+    let _localization = harness.start_localization(Some(scenario)).await;
+    let on_board = |robot: &str| ControllerConfig {
+        scenario: Some(repo_path(scenario)),
+        robots: vec![robot.to_owned()],
+        instance: Some(format!("on-{robot}")),
+        ..harness.controller_config()
+    };
+    let other = harness.start_controller(on_board("other")).await;
+    let client = harness.client().await;
+    let root = harness.root.clone();
+    let statuses = subscribe(&client, keys::robot_controller(&root, "robot")).await;
+    let commands = subscribe(&client, keys::robot_command(&root, "robot")).await;
+    give_mission(&client, &root, "not-yours", [45.0, 45.0]).await;
+    tokio::time::sleep(Duration::from_secs(1)).await;
+    assert!(
+        statuses.try_recv().ok().flatten().is_none()
+            && commands.try_recv().ok().flatten().is_none(),
+        "a controller on board 'other' took robot's mission"
+    );
+    other.stop().await.1.expect("clean stop");
+
+    let _mine = harness.start_controller(on_board("robot")).await;
+    give_mission(&client, &root, "yours", [45.0, 45.0]).await;
+    let status = status_until(&statuses, Duration::from_secs(10), |s| {
+        s.state == MissionState::Active && s.steps >= 5
+    })
+    .await;
+    assert_eq!(status.mission.as_deref(), Some("yours"));
+    let _: RobotCommand = next(&commands).await;
+}

@@ -52,6 +52,7 @@ pub const MAX_ROBOTS: usize = 1000;
 /// root: roam
 /// scenario: config/scenarios/es1.yaml   # obstacles, anchors, sensing; default: built-in world
 /// stale_after_s: 1.0                    # zero command when estimates stop this long
+/// robots: [r1]                          # drive only these robots; default: every robot
 /// apf:                                  # paper 002 §4's values are the defaults
 ///   scheme: linear                      # plain | fixed | cutoff | linear | sinusoidal
 ///   z_is: 0.8
@@ -63,6 +64,11 @@ pub struct ControllerConfig {
     pub instance: Option<String>,
     pub scenario: Option<PathBuf>,
     pub stale_after_s: f64,
+    /// The robots this instance drives; empty: every robot that is given a mission. A
+    /// controller on board a robot names its own, so it subscribes only to that robot's
+    /// missions and estimates (nothing else crosses the robot's link) and never drives
+    /// another robot when a fleet runs one controller per robot.
+    pub robots: Vec<String>,
     pub apf: ApfParams,
     pub zenoh: Option<serde_json::Value>,
 }
@@ -74,6 +80,7 @@ impl Default for ControllerConfig {
             instance: None,
             scenario: None,
             stale_after_s: 1.0,
+            robots: Vec::new(),
             apf: ApfParams::default(),
             zenoh: None,
         }
@@ -107,6 +114,8 @@ struct State {
     obstacles: Arc<ObstacleField>,
     information: Arc<InformationField>,
     stale_after: Duration,
+    /// The robots this instance may drive; empty: any.
+    allowed: Vec<String>,
     robots: Mutex<HashMap<String, Driven>>,
 }
 
@@ -189,6 +198,12 @@ fn check_mission(mission: &Mission) -> Result<(), String> {
 fn on_mission(state: &State, mission: Mission) {
     if let Err(e) = check_mission(&mission) {
         return tracing::warn!(robot = %mission.robot, id = %mission.id, "mission refused: {e}");
+    }
+    if !state.allowed.is_empty() && !state.allowed.contains(&mission.robot) {
+        return tracing::warn!(
+            robot = %mission.robot, id = %mission.id,
+            "mission refused: this controller drives only {:?} (robots)", state.allowed
+        );
     }
     let mut robots = state.robots();
     if robots.len() >= MAX_ROBOTS && !robots.contains_key(&mission.robot) {
@@ -325,6 +340,10 @@ pub async fn run(
             config.stale_after_s
         )));
     }
+    for robot in &config.robots {
+        keys::check_name("robot", robot)
+            .map_err(|e| ControllerServiceError::Config(format!("robots: {e}")))?;
+    }
     let (_, scenario) = load_scenario(config.scenario.as_deref())?;
     let anchors: Vec<[f64; 2]> = scenario.file.anchors.iter().map(|a| a.at).collect();
     let model = RangingModel::from_spec(&anchors, &scenario.file.sensing)
@@ -346,25 +365,64 @@ pub async fn run(
         obstacles,
         information,
         stale_after: Duration::from_secs_f64(config.stale_after_s),
+        allowed: config.robots.clone(),
         robots: Mutex::new(HashMap::new()),
     });
-    service
-        .subscribe(
-            &keys::robot_mission_any(&config.root),
-            state.clone(),
-            |state: &Arc<State>, mission: Mission| on_mission(state, mission),
+    let (mission_keys, estimate_keys): (Vec<String>, Vec<String>) = if config.robots.is_empty() {
+        (
+            vec![keys::robot_mission_any(&config.root)],
+            vec![keys::robot_estimate_any(&config.root)],
         )
-        .await?;
-    service
-        .subscribe(
-            &keys::robot_estimate_any(&config.root),
-            state.clone(),
-            |state: &Arc<State>, estimate: PositionEstimate| on_estimate(state, estimate),
-        )
-        .await?;
+    } else {
+        config
+            .robots
+            .iter()
+            .map(|r| {
+                (
+                    keys::robot_mission(&config.root, r),
+                    keys::robot_estimate(&config.root, r),
+                )
+            })
+            .unzip()
+    };
+    for key in &mission_keys {
+        service
+            .subscribe(
+                key,
+                state.clone(),
+                |state: &Arc<State>, mission: Mission| on_mission(state, mission),
+            )
+            .await?;
+    }
+    for key in &estimate_keys {
+        service
+            .subscribe(
+                key,
+                state.clone(),
+                |state: &Arc<State>, estimate: PositionEstimate| on_estimate(state, estimate),
+            )
+            .await?;
+    }
     let (watched, token) = (state.clone(), service.cancel_token());
     service.spawn(async move { watchdog(watched, token).await });
     service.announce().await?;
     service.run_until_stopped().await?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_shipped_config_is_the_indoor_controller() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/controller.yaml");
+        let config: ControllerConfig = roam_runtime::config_file::load(&path).expect("parses");
+        assert_eq!(config.apf, ApfParams::indoor());
+        assert!(
+            config.robots.is_empty(),
+            "the shipped controller drives any robot"
+        );
+    }
 }

@@ -117,6 +117,10 @@ pub fn open_store(config: &MapServerConfig) -> Result<LayerStore, MapServerError
     }
     let mut store = LayerStore::new(config.limits, derived, data);
     if store.restore() {
+        tracing::info!(
+            layers = store.names().count(),
+            "restored the layers and their versions from the data dir"
+        );
         return Ok(store);
     }
     let content = match &config.map {

@@ -69,6 +69,10 @@ pub struct ExecutiveConfig {
     pub max_replans: u32,
     /// A window is given up this long after its task's start, seconds.
     pub give_up_after_s: f64,
+    /// No status from the controller on the current mission for this long (wall
+    /// seconds) means the controller lost it (it restarted, or the robot's link was
+    /// down when the mission was sent): replan from where the robot is and send again.
+    pub controller_silence_s: f64,
 }
 
 impl Default for ExecutiveConfig {
@@ -86,6 +90,7 @@ impl Default for ExecutiveConfig {
             speed_m_per_s: 0.5,
             max_replans: 5,
             give_up_after_s: 60.0,
+            controller_silence_s: 3.0,
         }
     }
 }
@@ -144,6 +149,12 @@ pub enum Progress {
         window: usize,
         task: String,
     },
+    /// The task was over before its window began: the executive was down through it
+    /// (restarted after a crash). Nothing is driven or reported for it.
+    Skipped {
+        window: usize,
+        task: String,
+    },
 }
 
 /// The mission clock: the sim's when it publishes one, wall time otherwise.
@@ -155,6 +166,11 @@ struct Clock {
 }
 
 impl Clock {
+    /// Whether the sim's clock has been heard (else the clock is wall time).
+    fn heard(&self) -> bool {
+        self.latest.is_some()
+    }
+
     fn now_s(&self) -> f64 {
         match self.latest {
             Some((_, sim)) => sim,
@@ -178,6 +194,12 @@ impl Clock {
     }
 }
 
+/// How often the executive asks again for a window's first plans when none came.
+const PLAN_RETRY: Duration = Duration::from_secs(1);
+
+/// How long the executive waits for the sim's clock at its start.
+const CLOCK_WAIT: Duration = Duration::from_secs(2);
+
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|p| p.into_inner())
 }
@@ -191,6 +213,7 @@ fn check(config: &ExecutiveConfig) -> Result<(), ExecutiveError> {
         ("off_path_m", config.off_path_m),
         ("speed_m_per_s", config.speed_m_per_s),
         ("give_up_after_s", config.give_up_after_s),
+        ("controller_silence_s", config.controller_silence_s),
     ] {
         if !(value.is_finite() && value > 0.0) {
             return Err(ExecutiveError::Config(format!(
@@ -227,6 +250,32 @@ async fn fetch_world(requester: &Requester, root: &str) -> Result<World, Executi
     )
     .map_err(|e| ExecutiveError::Layer(INFORMATION, e.to_string()))
 }
+
+/// The map server's world, asked for again every [`WORLD_RETRY`] until it answers: in
+/// a stack started all at once (compose, systemd at boot) the executive may be up before
+/// the map server, and a supervisor restarting it in a loop would only add noise.
+async fn wait_for_world(
+    requester: &Requester,
+    root: &str,
+    cancel: &CancellationToken,
+) -> Result<World, ExecutiveError> {
+    loop {
+        match fetch_world(requester, root).await {
+            Ok(world) => return Ok(world),
+            Err(ExecutiveError::Client(e)) => {
+                tracing::warn!("waiting for the map server: {e}");
+            }
+            Err(e) => return Err(e),
+        }
+        tokio::select! {
+            _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
+            _ = tokio::time::sleep(WORLD_RETRY) => {}
+        }
+    }
+}
+
+/// How often the executive asks again for a world the map server did not give.
+const WORLD_RETRY: Duration = Duration::from_secs(1);
 
 /// Everything the executive listens to.
 struct Inputs {
@@ -369,6 +418,54 @@ impl Run<'_> {
         })
     }
 
+    /// The window's shortest and curious plans, asked again every [`PLAN_RETRY`] while
+    /// no planner answers (a router restart, every planner down); `None` when the
+    /// window is given up meanwhile. An outage costs downtime, not the mission.
+    async fn first_plans(
+        &self,
+        from: [f64; 2],
+        task: &Task,
+        cancel: &CancellationToken,
+    ) -> Result<Option<(Plan, Plan, f64)>, ExecutiveError> {
+        loop {
+            let planned = match self
+                .plan(from, task.at, PlannerModel::Shortest, 86_400.0)
+                .await
+            {
+                Ok(shortest) => self
+                    .plan_window(from, task, &shortest, true)
+                    .await
+                    .map(|(plan, budget)| (shortest, plan, budget)),
+                Err(e) => Err(e),
+            };
+            match planned {
+                Ok(plans) => return Ok(Some(plans)),
+                Err(e) => tracing::warn!(task = %task.name, "planning failed, asking again: {e}"),
+            }
+            if self.now() > task.start_s + self.config.give_up_after_s {
+                return Ok(None);
+            }
+            tokio::select! {
+                _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
+                _ = tokio::time::sleep(PLAN_RETRY) => {}
+            }
+        }
+    }
+
+    /// Waits briefly for the sim's clock, so that an executive restarted mid-mission
+    /// sees the mission time and skips the tasks that ended while it was down. Without
+    /// a sim (a real fleet on wall time) it goes on after the wait.
+    async fn hear_the_clock(&self, cancel: &CancellationToken) -> Result<(), ExecutiveError> {
+        let waited = Instant::now();
+        while !lock(&self.inputs.clock).heard() && waited.elapsed() < CLOCK_WAIT {
+            tokio::select! {
+                _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
+                _ = tokio::time::sleep(Duration::from_millis(20)) => {}
+            }
+        }
+        Ok(())
+    }
+
     async fn first_position(
         &mut self,
         cancel: &CancellationToken,
@@ -404,13 +501,25 @@ impl Run<'_> {
         task: &Task,
         cancel: &CancellationToken,
         progress: &(dyn Fn(Progress) + Sync),
-    ) -> Result<WindowOutcome, ExecutiveError> {
-        let began = self.now();
+    ) -> Result<Option<WindowOutcome>, ExecutiveError> {
+        // The first estimate comes through the router with the clock, so after it the
+        // mission time is known even when the executive (re)started with the router down.
         let from = self.first_position(cancel).await?;
-        let shortest = self
-            .plan(from, task.at, PlannerModel::Shortest, 86_400.0)
-            .await?;
-        let (plan, budget) = self.plan_window(from, task, &shortest, true).await?;
+        let began = self.now();
+        if began >= task.start_s + task.duration_s {
+            progress(Progress::Skipped {
+                window,
+                task: task.name.clone(),
+            });
+            return Ok(None);
+        }
+        let Some((shortest, plan, budget)) = self.first_plans(from, task, cancel).await? else {
+            progress(Progress::GaveUp {
+                window,
+                task: task.name.clone(),
+            });
+            return Ok(None);
+        };
         progress(Progress::Planned {
             window,
             task: task.name.clone(),
@@ -428,17 +537,26 @@ impl Run<'_> {
         let mut driven = vec![from];
         let mut pebs = Vec::new();
         let mut reasons: Vec<String> = Vec::new();
+        let mut resends = 0usize;
         let mut arrival = None;
         let mut slipped = false;
         let mut tick = tokio::time::interval(Duration::from_millis(100));
+        let silence = Duration::from_secs_f64(self.config.controller_silence_s);
+        let mut heard_at = Instant::now();
         loop {
             let mut replan: Option<(&'static str, bool)> = None;
+            let mut resend = false;
             tokio::select! {
                 _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
                 _ = tick.tick() => {
                     if self.now() > task.start_s + self.config.give_up_after_s {
                         progress(Progress::GaveUp { window, task: task.name.clone() });
                         break;
+                    }
+                    if heard_at.elapsed() >= silence {
+                        heard_at = Instant::now();
+                        resend = true;
+                        replan = Some(("the controller went silent on the mission", !slipped));
                     }
                 }
                 sample = self.inputs.estimates.recv_async() => {
@@ -462,6 +580,7 @@ impl Run<'_> {
                     if s.mission.as_deref() != Some(mission.as_str()) {
                         continue;
                     }
+                    heard_at = Instant::now();
                     match s.state {
                         MissionState::Completed => {
                             let at_s = self.now();
@@ -484,9 +603,13 @@ impl Run<'_> {
                 }
             }
             if let Some((reason, curious)) = replan {
-                if reasons.len() as u32 >= self.config.max_replans {
+                // A lost mission is always sent again (at most once per silence period);
+                // the replan limit is for the robot's own trouble.
+                let replans = reasons.len() - resends;
+                if !resend && replans as u32 >= self.config.max_replans {
                     continue;
                 }
+                resends += usize::from(resend);
                 let here = self.position.unwrap_or(from);
                 let shortest_here = match self
                     .plan(here, task.at, PlannerModel::Shortest, 86_400.0)
@@ -512,6 +635,7 @@ impl Run<'_> {
                 plans.push(plan.points.clone());
                 let w = self.waypoints(&plan);
                 mission = self.send(window, w);
+                heard_at = Instant::now();
             }
         }
         // The task keeps the robot at its place until it ends.
@@ -539,12 +663,12 @@ impl Run<'_> {
             replans: reasons.len() as u32,
             replan_reasons: reasons,
         };
-        Ok(WindowOutcome {
+        Ok(Some(WindowOutcome {
             report,
             plans,
             shortest: shortest.points,
             driven,
-        })
+        }))
     }
 }
 
@@ -560,7 +684,7 @@ pub async fn run(
 ) -> Result<Vec<WindowOutcome>, ExecutiveError> {
     check(config)?;
     let requester = Requester::new(session.clone(), Duration::from_secs(10));
-    let world = fetch_world(&requester, root).await?;
+    let world = wait_for_world(&requester, root, cancel).await?;
     let inputs = listen(session, root, &config.robot).await?;
     let mut run = Run {
         session,
@@ -573,11 +697,13 @@ pub async fn run(
         position: None,
         missions_sent: 0,
     };
+    run.hear_the_clock(cancel).await?;
     let mut outcomes = Vec::with_capacity(config.tasks.len());
     for (window, task) in config.tasks.iter().enumerate() {
-        let outcome = run.window(window, task, cancel, progress).await?;
-        on_window(&outcome);
-        outcomes.push(outcome);
+        if let Some(outcome) = run.window(window, task, cancel, progress).await? {
+            on_window(&outcome);
+            outcomes.push(outcome);
+        }
     }
     Ok(outcomes)
 }

@@ -81,6 +81,9 @@ fn log(p: Progress) {
             tracing::info!(window, %task, at_s, start_s, "arrived")
         }
         Progress::GaveUp { window, task } => tracing::warn!(window, %task, "gave up"),
+        Progress::Skipped { window, task } => {
+            tracing::warn!(window, %task, "skipped: the task was over before its window began")
+        }
     }
 }
 

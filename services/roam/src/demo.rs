@@ -241,6 +241,10 @@ async fn drive(
             "window {}: gave up on reaching {task}",
             window + 1
         )),
+        Progress::Skipped { window, task } => progress(&format!(
+            "window {}: {task} was over before the window began",
+            window + 1
+        )),
     };
     let cancel = CancellationToken::new();
     let outcomes = executive::run(&session, &root, &config, &cancel, &say, &|_| {}).await?;

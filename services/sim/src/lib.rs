@@ -15,6 +15,8 @@
 //!   with line of sight; [`raster`]: the cells a segment crosses.
 //! - [`sim`]: [`Sim`], its step, reset, robots, reports and errors; [`event`]: what
 //!   happened to a robot in a step.
+//! - [`snapshot`]: the sim's clock and robots on disk, so a restarted sim service goes
+//!   on where it was.
 //!
 //! Where papers 002 and 004 are ambiguous, the choice is written next to the code that
 //! makes it and is a parameter of the scenario file: the exponent K and the step at d0
@@ -32,6 +34,7 @@ pub mod robot;
 pub mod sensors;
 pub mod service;
 pub mod sim;
+pub mod snapshot;
 pub mod world;
 
 pub use event::Event;

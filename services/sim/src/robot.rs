@@ -46,6 +46,15 @@ impl Robot {
         self.pending.clear();
     }
 
+    /// Put back where a snapshot saw it at `step`, its stream restarted from
+    /// `(seed, name, step)` (see [`crate::snapshot`]).
+    pub(crate) fn resume(&mut self, start: [f64; 2], at: [f64; 2], seed: u64, step: u64) {
+        self.start = start;
+        self.at = at;
+        self.rng = noise::stream(seed, &format!("robot/{}/resumed/{step}", self.name));
+        self.pending.clear();
+    }
+
     pub fn name(&self) -> &str {
         &self.name
     }

@@ -32,6 +32,7 @@ use zenoh::query::Query;
 
 use crate::messages::{points, robot_messages, RobotMessages};
 use crate::sim::{Command, Sim, SimError};
+use crate::snapshot::{self, SnapshotError};
 
 pub const SERVICE_NAME: &str = "sim";
 /// Steps one `step` request may ask for.
@@ -40,6 +41,8 @@ pub const MAX_STEPS_PER_REQUEST: u32 = 100_000;
 pub const MAX_RATE: f64 = 1000.0;
 /// Largest control request, bytes.
 pub const MAX_REQUEST_BYTES: usize = 64 * 1024;
+/// How often a stepping sim writes its snapshot (wall time): what a crash can cost.
+pub const SNAPSHOT_PERIOD: Duration = Duration::from_millis(500);
 
 /// The sim service's config file (YAML).
 ///
@@ -48,6 +51,7 @@ pub const MAX_REQUEST_BYTES: usize = 64 * 1024;
 /// scenario: config/scenarios/es1.yaml   # default: the built-in downtime world
 /// seed: 0
 /// rate: 1.0                             # free-run at 1x; absent: start paused (lock-step)
+/// state_file: /var/lib/roam/sim.json    # snapshot here; a restart resumes from it
 /// ```
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -57,6 +61,10 @@ pub struct SimConfig {
     pub scenario: Option<PathBuf>,
     pub seed: u64,
     pub rate: Option<f64>,
+    /// Where the sim keeps a snapshot of its clock and robots (every
+    /// [`SNAPSHOT_PERIOD`] while it steps); at start it resumes from the snapshot when
+    /// it is of the same scenario and seed. Absent: a restart begins at step 0.
+    pub state_file: Option<PathBuf>,
     pub zenoh: Option<serde_json::Value>,
 }
 
@@ -68,6 +76,7 @@ impl Default for SimConfig {
             scenario: None,
             seed: 0,
             rate: Some(1.0),
+            state_file: None,
             zenoh: None,
         }
     }
@@ -83,6 +92,8 @@ pub enum SimServiceError {
     Sim(#[from] SimError),
     #[error("invalid config: {0}")]
     Config(String),
+    #[error(transparent)]
+    Snapshot(#[from] SnapshotError),
 }
 
 /// What control requests change.
@@ -160,7 +171,10 @@ pub async fn run(
         check_rate(rate).map_err(|e| SimServiceError::Config(e.message))?;
     }
     let (name, scenario) = load_scenario(config.scenario.as_deref())?;
-    let sim = Sim::new(&scenario, config.seed)?;
+    let mut sim = Sim::new(&scenario, config.seed)?;
+    if let Some(path) = &config.state_file {
+        resume_from(&mut sim, &name, config.seed, path)?;
+    }
     let mut service = Service::start(
         SERVICE_NAME,
         &config.root,
@@ -215,6 +229,10 @@ pub async fn run(
         let (state, cancel) = (state.clone(), service.cancel_token());
         service.spawn(async move { free_run(state, cancel).await });
     }
+    if let Some(path) = config.state_file.clone() {
+        let (state, cancel) = (state.clone(), service.cancel_token());
+        service.spawn(async move { keep_snapshots(state, path, cancel).await });
+    }
     service.announce().await?;
     service.cancelled().await;
     drop(commands);
@@ -222,6 +240,55 @@ pub async fn run(
         .shutdown(roam_runtime::service::DEFAULT_GRACE)
         .await?;
     Ok(())
+}
+
+/// Resumes `sim` from the snapshot at `path` when it is of this scenario and seed; a
+/// snapshot of another run is left alone (and overwritten at the first save).
+fn resume_from(sim: &mut Sim, name: &str, seed: u64, path: &Path) -> Result<(), SimServiceError> {
+    let Some(saved) = snapshot::load(path)? else {
+        return Ok(());
+    };
+    if saved.scenario != name || saved.seed != seed {
+        tracing::warn!(
+            path = %path.display(), scenario = %saved.scenario, seed = saved.seed,
+            "the snapshot is of another scenario or seed: starting at step 0"
+        );
+        return Ok(());
+    }
+    sim.resume(&saved)?;
+    tracing::info!(
+        path = %path.display(), step = saved.step, robots = saved.robots.len(),
+        "resumed from the snapshot"
+    );
+    Ok(())
+}
+
+/// Writes the snapshot every [`SNAPSHOT_PERIOD`] while the step count changes, and once
+/// more at shutdown.
+async fn keep_snapshots(state: Arc<State>, path: PathBuf, cancel: CancellationToken) {
+    let mut saved_step = None;
+    loop {
+        let stopping = tokio::select! {
+            _ = cancel.cancelled() => true,
+            _ = tokio::time::sleep(SNAPSHOT_PERIOD) => false,
+        };
+        let snap = {
+            let c = state.control();
+            c.sim.snapshot(&c.scenario)
+        };
+        if saved_step != Some(snap.step) {
+            let target = path.clone();
+            let step = snap.step;
+            match tokio::task::spawn_blocking(move || snapshot::save(&target, &snap)).await {
+                Ok(Ok(())) => saved_step = Some(step),
+                Ok(Err(e)) => tracing::warn!("{e}"),
+                Err(e) => tracing::warn!("the snapshot writer failed: {e}"),
+            }
+        }
+        if stopping {
+            return;
+        }
+    }
 }
 
 /// Stores a command for the next step; commands for unknown robots or with non-finite

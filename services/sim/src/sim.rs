@@ -11,6 +11,7 @@ use crate::los::LosTable;
 use crate::noise;
 use crate::robot::{step_motion, Robot};
 use crate::sensors::{self, Readings};
+use crate::snapshot::{RobotState, SimSnapshot};
 use crate::world::{Anchor, Obstacle, World, WorldError};
 
 /// The most robots one sim holds (limit `max_robots`): each costs a stream, a report
@@ -269,6 +270,59 @@ impl Sim {
             time_s: self.time_s(),
             robots: reports,
         })
+    }
+
+    /// What a snapshot keeps of this sim (see [`crate::snapshot`]).
+    pub fn snapshot(&self, scenario: &str) -> SimSnapshot {
+        let robots = self
+            .robots
+            .values()
+            .map(|r| RobotState {
+                name: r.name().to_owned(),
+                start: r.start(),
+                at: r.position(),
+            })
+            .collect();
+        SimSnapshot::new(scenario, self.seed, self.steps(), robots)
+    }
+
+    /// Back to where `snapshot` was taken: the world replayed to its step, its robots
+    /// (and only those) at their positions, their streams restarted from the step. The
+    /// snapshot's seed becomes the sim's.
+    pub fn resume(&mut self, snapshot: &SimSnapshot) -> Result<(), SimError> {
+        if snapshot.robots.len() > MAX_ROBOTS {
+            return Err(SimError::TooManyRobots { max: MAX_ROBOTS });
+        }
+        for r in &snapshot.robots {
+            if r.name.is_empty() || r.name.len() > MAX_ROBOT_NAME_BYTES {
+                return Err(SimError::BadName(r.name.clone()));
+            }
+            if !r.at.iter().chain(&r.start).all(|v| v.is_finite()) {
+                return Err(SimError::BadStart {
+                    robot: r.name.clone(),
+                    x: r.at[0],
+                    y: r.at[1],
+                    reason: "the snapshot's position is not finite".into(),
+                });
+            }
+        }
+        self.seed = snapshot.seed;
+        self.world.reset(snapshot.seed);
+        let starts: Vec<_> = snapshot
+            .robots
+            .iter()
+            .filter_map(|r| self.world.cell_of(r.start))
+            .collect();
+        for _ in 0..snapshot.step {
+            self.world.advance(&starts);
+        }
+        self.robots.clear();
+        for r in &snapshot.robots {
+            let mut robot = Robot::new(&r.name, r.start, snapshot.seed);
+            robot.resume(r.start, r.at, snapshot.seed, snapshot.step);
+            self.robots.insert(r.name.clone(), robot);
+        }
+        Ok(())
     }
 
     /// The seed of the last `new` or `reset`.

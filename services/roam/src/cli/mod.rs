@@ -110,7 +110,8 @@ enum Command {
     Sim(sim::SimArgs),
     /// Ask a running planner for a curious path (a client).
     Plan(PlanArgs),
-    /// Run a Zenoh router (no separate zenohd needed).
+    /// Run a Zenoh router (no separate zenohd needed). It listens on `--listen`, else on
+    /// the endpoints of the `ZENOH_CONFIG` file, else on tcp/0.0.0.0:7447.
     Router(RouterArgs),
     /// Run every landed service in one process around an in-process router.
     Stack(StackArgs),

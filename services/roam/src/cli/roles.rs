@@ -122,10 +122,17 @@ pub(crate) fn scenario_missions(map: Option<&std::path::Path>) -> Vec<Mission> {
 
 pub(crate) async fn router(args: RouterArgs) -> anyhow::Result<()> {
     let mut session = args.session;
-    if session.listen.is_empty() {
+    // A Zenoh config file is authoritative about where to listen (the secure router's
+    // TLS endpoint, say); the flags' default applies only without one.
+    let from_file = std::env::var_os(roam_runtime::session::ZENOH_CONFIG_ENV).is_some();
+    if session.listen.is_empty() && !from_file {
         session.listen.push("tcp/0.0.0.0:7447".into());
     }
-    let endpoint = session.listen.join(", ");
+    let endpoint = if session.listen.is_empty() {
+        "the endpoints of the ZENOH_CONFIG file".to_owned()
+    } else {
+        session.listen.join(", ")
+    };
     let router = Router::start(&session, endpoint).await?;
     tracing::info!(listen = %router.endpoint, "router running; stop with Ctrl-C or SIGTERM");
     signals::wait_for_stop_signal().await;
@@ -207,6 +214,10 @@ pub(crate) struct ControllerArgs {
     /// The information-seeking weight z_is.
     #[arg(long)]
     z_is: Option<f64>,
+    /// Drive only this robot (repeat for several); default: every robot given a
+    /// mission. A controller on board a robot names its own.
+    #[arg(long = "robot", value_name = "ROBOT")]
+    robots: Vec<String>,
 }
 
 /// Paper 002's weighting schemes, as the command line spells them.
@@ -242,6 +253,9 @@ pub(crate) async fn controller(args: ControllerArgs) -> anyhow::Result<()> {
     }
     if let Some(z_is) = args.z_is {
         config.apf.z_is = z_is;
+    }
+    if !args.robots.is_empty() {
+        config.robots = args.robots;
     }
     let zenoh = args.service.zenoh_config(&config)?;
     roam_controller::service::run(config, zenoh, signals::cancel_on_signal()).await?;

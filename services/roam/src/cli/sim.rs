@@ -47,6 +47,9 @@ struct SimRunArgs {
     /// Start paused: step only on `step` requests (lock-step).
     #[arg(long)]
     paused: bool,
+    /// Keep a snapshot of the clock and robots here and resume from it after a restart.
+    #[arg(long, value_name = "FILE")]
+    state_file: Option<PathBuf>,
 }
 
 pub(crate) async fn sim(args: SimArgs) -> anyhow::Result<()> {
@@ -67,6 +70,9 @@ async fn run(args: SimRunArgs) -> anyhow::Result<()> {
     }
     if let Some(seed) = args.seed {
         config.seed = seed;
+    }
+    if args.state_file.is_some() {
+        config.state_file = args.state_file;
     }
     if args.paused {
         config.rate = None;

@@ -1,0 +1,305 @@
+//! A secure site through the real `deploy/secure/router.json5`: TLS, user/password
+//! authentication and access control. One test attacks a real map server and sim with
+//! no credentials, a wrong password, an authenticated user no rule names, and other
+//! roles' credentials; the other runs every role's real service through the router, to
+//! show the policy lets each role do its whole job.
+//!
+//! Certificates and the user dictionary are made at test time (rcgen) in a temporary
+//! directory; the router loads the shipped config with only the paths and the port
+//! overridden, and every session uses the shipped `deploy/secure/client.json5` with one
+//! role's credentials. Each negative check is one that would fail with the access control
+//! off (`access_control/enabled:false` on the router makes every one of them fail): a
+//! command that would move the robot, a write that a subscriber would receive, a map
+//! update or load the map server would accept.
+
+use std::time::Duration;
+
+use roam_controller::service::ControllerConfig;
+use roam_mission::service::MissionConfig;
+use roam_proto::cells::Cells;
+use roam_proto::localization::{PebQuery, PebReply, PebWhere};
+use roam_proto::map::{Layer, LayerChange, LayerList, LayerUpdate, UpdateAck};
+use roam_proto::mapper::MapperStatus;
+use roam_proto::mission::WindowReport;
+use roam_proto::sim::RobotCommand;
+use roam_proto::{decode, encode, keys, ErrorCode};
+use roam_runtime::ClientError;
+use roam_tests::{within, RunningService};
+
+mod intrusion;
+mod observe;
+mod site;
+
+use intrusion::{
+    assert_intrusion_has_no_effect, assert_intrusion_has_no_effect_on_robot,
+    assert_only_the_right_credentials_open, Watch,
+};
+use observe::{alive_services, drain, put, step_and_locate, subscribe, versions};
+use site::{secure_site, GUEST};
+
+/// The key root `router.json5`'s rules are written for.
+const ROOT: &str = "roam";
+/// The built-in world's robot.
+const ROBOT: &str = "robot";
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn only_the_controller_drives_and_only_map_writers_change_the_map() {
+    let (secrets, harness) = secure_site().await;
+    let endpoint = harness.router.endpoint.clone();
+
+    // The real services, each as its own role.
+    let map_server = harness.start_map_server(harness.map_server_config()).await;
+    let sim = harness.start_sim(harness.sim_config(None)).await;
+
+    assert_only_the_right_credentials_open(&secrets, &endpoint).await;
+
+    let watch = Watch::start(&harness).await;
+    let planner = harness.client_as("planner").await;
+
+    // Positive control: the controller's command moves the robot in one step, and the
+    // sim's rights receive it.
+    let controller = harness.client_as("controller").await;
+    let at_start = step_and_locate(&watch.operator).await;
+    drain(&watch.sim_spy);
+    put(
+        &controller,
+        &keys::robot_command(ROOT, ROBOT),
+        encode(&RobotCommand {
+            u: [1.0, 1.0],
+            step: None,
+        }),
+    )
+    .await;
+    let at_driven = step_and_locate(&watch.operator).await;
+    let moved = (at_driven[0] - at_start[0]).hypot(at_driven[1] - at_start[1]);
+    assert!(
+        moved > 1e-3,
+        "the controller's command must move the robot: {at_start:?} -> {at_driven:?}"
+    );
+    assert_eq!(
+        drain(&watch.sim_spy),
+        vec![keys::robot_command(ROOT, ROBOT)],
+        "the sim's rights receive the controller's command"
+    );
+
+    // An authenticated user that no subject names (the ACL's default deny).
+    let guest = harness.client_as(GUEST).await;
+    assert_intrusion_has_no_effect("guest", &guest, &watch).await;
+
+    // Another role's valid credentials: the planner may read maps, not write them, and
+    // may not drive.
+    let occupancy: Layer = within(
+        "planner reads a layer",
+        planner.request::<Layer, Layer>(&keys::map_layer(ROOT, "occupancy"), None),
+    )
+    .await
+    .expect("the planner may read layers");
+    assert_eq!(occupancy.name, "occupancy");
+    assert_intrusion_has_no_effect("planner", &planner, &watch).await;
+    // The operator may read everything but not command a robot either.
+    assert_intrusion_has_no_effect_on_robot("operator", &watch).await;
+
+    // A map writer: the mapper's update reaches the map server, which applies it (a new
+    // change_rate layer, as the mapper sends) and publishes it, and the planner's rights
+    // receive the real map server's publication. A write the server itself refuses
+    // (`inflated` is derived) comes back as the server's structured error.
+    let mapper = harness.client_as("mapper").await;
+    let list: LayerList = within(
+        "mapper lists layers",
+        mapper.request::<LayerList, LayerList>(&keys::map_index(ROOT), None),
+    )
+    .await
+    .expect("the mapper may list the layers");
+    let meta = list
+        .layers
+        .iter()
+        .find(|l| l.name == "occupancy")
+        .map(|l| l.meta)
+        .expect("an occupancy layer");
+    drain(&watch.planner_spy);
+    let base_version = list
+        .layers
+        .iter()
+        .find(|l| l.name == "change_rate")
+        .map_or(0, |l| l.version);
+    let update = LayerUpdate {
+        base_version,
+        change: LayerChange::Replace {
+            meta,
+            cells: Cells::F32(vec![0.25; meta.cell_count() as usize]),
+        },
+    };
+    let ack: UpdateAck = within(
+        "mapper update",
+        mapper.request(&keys::map_update(ROOT, "change_rate"), Some(&update)),
+    )
+    .await
+    .expect("the mapper's update is applied");
+    assert_eq!(ack.layer, "change_rate");
+    assert_eq!(ack.version, base_version + 1);
+    assert_eq!(
+        versions(&watch.operator).await.get("change_rate"),
+        Some(&ack.version)
+    );
+    let published = within("layer publication", watch.planner_spy.recv_async())
+        .await
+        .expect("a layer publication");
+    assert_eq!(
+        published.key_expr().as_str(),
+        keys::map_layer(ROOT, "change_rate"),
+        "the planner's rights receive the map server's own layers"
+    );
+    let refused = within(
+        "mapper writes a derived layer",
+        mapper.request::<LayerUpdate, UpdateAck>(
+            &keys::map_update(ROOT, "inflated"),
+            Some(&LayerUpdate {
+                base_version: 0,
+                change: LayerChange::Replace {
+                    meta,
+                    cells: Cells::I8(vec![0; meta.cell_count() as usize]),
+                },
+            }),
+        ),
+    )
+    .await;
+    match refused {
+        Err(ClientError::Refused(reply)) => assert_ne!(
+            reply.code,
+            ErrorCode::Internal,
+            "a structured refusal from the map server: {reply:?}"
+        ),
+        other => panic!("the map server answers the mapper with an error reply, got {other:?}"),
+    }
+
+    stop(sim).await;
+    stop(map_server).await;
+    harness.close().await;
+}
+
+async fn stop(service: RunningService) {
+    service.stop().await.1.expect("the service stops cleanly");
+}
+
+/// The policy is complete: every role, run as itself, does its whole job through the
+/// secure router. The mission executive finds the planner by liveliness, gets maps and a
+/// curious plan, gives the controller its waypoints, the controller drives the sim on
+/// localization's estimates, and the first window's report reaches the operator; the
+/// mapper's and localization's layers reach the map server; the operator can ask the
+/// localization and the mapper and see every service's liveliness token.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn every_role_does_its_job_through_the_secure_router() {
+    let (_secrets, harness) = secure_site().await;
+    let mut services = vec![
+        harness.start_map_server(harness.map_server_config()).await,
+        harness
+            .start_planner(harness.planner_config("planner-0"))
+            .await,
+    ];
+    let mut sim_config = harness.sim_config(None);
+    sim_config.rate = Some(10.0);
+    services.push(harness.start_sim(sim_config).await);
+    services.push(harness.start_localization(None).await);
+    services.push(
+        harness
+            .start_controller(ControllerConfig {
+                apf: roam::demo::indoor_apf(),
+                ..harness.controller_config()
+            })
+            .await,
+    );
+    services.push(harness.start_mapper(harness.mapper_config()).await);
+
+    let operator = harness.client_as("operator").await;
+    let reports = subscribe(&operator, &keys::robot_mission_report(ROOT, ROBOT)).await;
+    let mission_key = keys::liveliness_of(ROOT, roam_mission::service::SERVICE_NAME);
+    services.push(
+        harness
+            .start_service_as(
+                roam_mission::service::SERVICE_NAME,
+                mission_key,
+                |zenoh, cancel| {
+                    roam_mission::service::run(
+                        MissionConfig {
+                            root: ROOT.to_owned(),
+                            ..MissionConfig::default()
+                        },
+                        zenoh,
+                        cancel,
+                    )
+                },
+            )
+            .await,
+    );
+
+    // The first downtime window: 75 s of sim time at 10x, plus planning.
+    let sample = tokio::time::timeout(Duration::from_secs(40), reports.recv_async())
+        .await
+        .expect("the first window's report within 40 s")
+        .expect("sample");
+    let report: WindowReport = decode(&sample.payload().to_bytes()).expect("a window report");
+    assert_eq!(report.task, "goal1", "{report:?}");
+    assert!(
+        report.driven_information > 0.0,
+        "the robot drove and saw: {report:?}"
+    );
+
+    // The map writers' layers are on the map server.
+    let deadline = tokio::time::Instant::now() + Duration::from_secs(10);
+    loop {
+        let held = versions(&operator).await;
+        if held.contains_key("peb") && held.contains_key("change_rate") {
+            break;
+        }
+        assert!(
+            tokio::time::Instant::now() < deadline,
+            "localization's and the mapper's layers reach the map server: {held:?}"
+        );
+        tokio::time::sleep(Duration::from_millis(200)).await;
+    }
+
+    // The operator asks the other services and sees every service alive.
+    let status: MapperStatus = within(
+        "mapper status",
+        operator.request::<MapperStatus, MapperStatus>(&keys::mapper_status(ROOT), None),
+    )
+    .await
+    .expect("the operator may ask the mapper");
+    assert!(status.observations > 0, "{status:?}");
+    let peb: PebReply = within(
+        "peb query",
+        operator.request(
+            &keys::localization_peb(ROOT),
+            Some(&PebQuery {
+                at: PebWhere::Points(vec![[0.0, 0.0]]),
+                anchors: None,
+                gradient: false,
+                crb: false,
+            }),
+        ),
+    )
+    .await
+    .expect("the operator may ask for the PEB");
+    assert!(
+        matches!(peb, PebReply::Points(ref at) if at.len() == 1),
+        "{peb:?}"
+    );
+    assert_eq!(
+        alive_services(&operator).await,
+        [
+            "controller",
+            "localization",
+            "map-server",
+            "mapper",
+            "mission",
+            "planner",
+            "sim"
+        ],
+        "the operator sees every service's liveliness token"
+    );
+
+    for service in services.into_iter().rev() {
+        stop(service).await;
+    }
+    harness.close().await;
+}
