@@ -14,12 +14,14 @@
 //! - [`information`]: the information a path gathers, on the planner's own scale.
 //! - [`experiment`]: `roam reproduce mission`, the couplings compared in batch.
 //! - [`executive`]: the executive on Zenoh (a client of the planner, the controller,
-//!   localization and the sim clock).
+//!   localization and the sim clock); `inputs`: what it hears (clock, estimates,
+//!   controller status, the world).
 //! - [`service`]: `roam mission`, the executive as a service that publishes its reports.
 
 pub mod executive;
 pub mod experiment;
 pub mod information;
+mod inputs;
 pub mod path;
 pub mod service;
 pub mod tasks;

@@ -1,0 +1,162 @@
+//! What the executive hears: the mission clock, the robot's estimates, the
+//! controller's status on the robot, and the world (the map server's inflated and
+//! information layers) it thins and scores paths on.
+
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+use roam_map_server::grid::Grid;
+use roam_map_server::store::{INFLATED, INFORMATION};
+use roam_planner::params::GaParams;
+use roam_planner::world::World;
+use roam_proto::cells::Cells;
+use roam_proto::map::Layer;
+use roam_proto::sim::SimClock;
+use roam_proto::{decode, keys};
+use roam_runtime::Requester;
+use tokio_util::sync::CancellationToken;
+
+use crate::executive::ExecutiveError;
+
+/// The mission clock: the sim's when it publishes one, wall time otherwise.
+#[derive(Debug)]
+pub(crate) struct Clock {
+    started: Instant,
+    first: Option<(Instant, f64)>,
+    latest: Option<(Instant, f64)>,
+}
+
+impl Clock {
+    /// Whether the sim's clock has been heard (else the clock is wall time).
+    pub(crate) fn heard(&self) -> bool {
+        self.latest.is_some()
+    }
+
+    pub(crate) fn now_s(&self) -> f64 {
+        match self.latest {
+            Some((_, sim)) => sim,
+            None => self.started.elapsed().as_secs_f64(),
+        }
+    }
+
+    /// Mission seconds per wall second, measured; 1 until half a second was seen.
+    pub(crate) fn rate(&self) -> f64 {
+        match (self.first, self.latest) {
+            (Some((w0, s0)), Some((w1, s1))) => {
+                let wall = w1.duration_since(w0).as_secs_f64();
+                if wall >= 0.5 {
+                    ((s1 - s0) / wall).max(1.0)
+                } else {
+                    1.0
+                }
+            }
+            _ => 1.0,
+        }
+    }
+}
+
+pub(crate) fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+async fn fetch_world(requester: &Requester, root: &str) -> Result<World, ExecutiveError> {
+    let inflated: Layer = requester
+        .request::<Layer, Layer>(&keys::map_layer(root, INFLATED), None)
+        .await?;
+    let information: Layer = requester
+        .request::<Layer, Layer>(&keys::map_layer(root, INFORMATION), None)
+        .await?;
+    let Cells::I8(occ) = inflated.cells else {
+        return Err(ExecutiveError::Layer(INFLATED, "not i8 cells".into()));
+    };
+    let Cells::U8(info) = information.cells else {
+        return Err(ExecutiveError::Layer(INFORMATION, "not u8 cells".into()));
+    };
+    World::new(
+        &Grid {
+            meta: inflated.meta,
+            cells: occ,
+        },
+        &Grid {
+            meta: information.meta,
+            cells: info,
+        },
+        GaParams::default().heuristic_compression,
+    )
+    .map_err(|e| ExecutiveError::Layer(INFORMATION, e.to_string()))
+}
+
+/// The map server's world, asked for again every [`WORLD_RETRY`] until it answers: in
+/// a stack started all at once (compose, systemd at boot) the executive may be up before
+/// the map server, and a supervisor restarting it in a loop would only add noise.
+pub(crate) async fn wait_for_world(
+    requester: &Requester,
+    root: &str,
+    cancel: &CancellationToken,
+) -> Result<World, ExecutiveError> {
+    loop {
+        match fetch_world(requester, root).await {
+            Ok(world) => return Ok(world),
+            Err(ExecutiveError::Client(e)) => {
+                tracing::warn!("waiting for the map server: {e}");
+            }
+            Err(e) => return Err(e),
+        }
+        tokio::select! {
+            _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
+            _ = tokio::time::sleep(WORLD_RETRY) => {}
+        }
+    }
+}
+
+/// How often the executive asks again for a world the map server did not give.
+const WORLD_RETRY: Duration = Duration::from_secs(1);
+
+/// Everything the executive listens to.
+pub(crate) struct Inputs {
+    pub(crate) clock: Arc<Mutex<Clock>>,
+    pub(crate) estimates:
+        zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
+    pub(crate) statuses:
+        zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
+    _clock: zenoh::pubsub::Subscriber<()>,
+}
+
+pub(crate) async fn listen(
+    session: &zenoh::Session,
+    root: &str,
+    robot: &str,
+) -> Result<Inputs, ExecutiveError> {
+    let clock = Arc::new(Mutex::new(Clock {
+        started: Instant::now(),
+        first: None,
+        latest: None,
+    }));
+    let shared = clock.clone();
+    let clock_sub = session
+        .declare_subscriber(keys::sim_clock(root))
+        .callback(move |sample| {
+            if let Ok(c) = decode::<SimClock>(&sample.payload().to_bytes()) {
+                let mut clock = lock(&shared);
+                let now = (Instant::now(), c.time_s);
+                clock.first.get_or_insert(now);
+                clock.latest = Some(now);
+            }
+        })
+        .await
+        .map_err(|e| ExecutiveError::Zenoh(e.to_string()))?;
+    let estimates = session
+        .declare_subscriber(keys::robot_estimate(root, robot))
+        .await
+        .map_err(|e| ExecutiveError::Zenoh(e.to_string()))?;
+    let statuses = session
+        .declare_subscriber(keys::robot_controller(root, robot))
+        .await
+        .map_err(|e| ExecutiveError::Zenoh(e.to_string()))?;
+    Ok(Inputs {
+        clock,
+        estimates,
+        statuses,
+        _clock: clock_sub,
+    })
+}
