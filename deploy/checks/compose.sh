@@ -86,9 +86,9 @@ fi
 say "podman $(podman --version | awk '{print $3}'), $("${pc[@]}" --version 2>/dev/null | awk '/podman-compose/ {print $3}' | head -1 | sed 's/^/podman-compose /'), CONTAINERS_CONF=${CONTAINERS_CONF:-unset}"
 
 pc_run() { bounded "$1" "${pc[@]}" -p "$project" -f "$compose_file" "${@:2}"; }
-containers() { podman ps -a --filter "label=io.podman.compose.project=$project" --format '{{.Names}}'; }
+containers() { timeout 20 podman ps -a --filter "label=io.podman.compose.project=$project" --format '{{.Names}}'; }
 container_of() {
-    podman ps -a --filter "label=io.podman.compose.project=$project" \
+    timeout 20 podman ps -a --filter "label=io.podman.compose.project=$project" \
         --filter "label=io.podman.compose.service=$1" --format '{{.Names}}' | head -1
 }
 
@@ -143,7 +143,13 @@ if (exec 3<>"/dev/tcp/127.0.0.1/$ROAM_HOST_PORT") 2>/dev/null; then
     die "127.0.0.1:$ROAM_HOST_PORT is already in use on the host; set ROAM_HOST_PORT to a free port"
 fi
 t_up=$(date +%s.%N)
-pc_run 90 up -d >/dev/null 2>&1 || die "podman-compose up failed"
+up_log=$(mktemp)
+if ! pc_run 90 up -d >"$up_log" 2>&1; then
+    tail -n 40 "$up_log" >&2
+    rm -f "$up_log"
+    die "podman-compose up failed (its last lines above)"
+fi
+rm -f "$up_log"
 services=(router map-server planner-a planner-b sim localization controller mapper mission)
 say "up: ${#services[@]} services in $(elapsed "$t_up") s; waiting for every service to be ready"
 
@@ -336,11 +342,16 @@ rt=$(container_of router)
 declare -A r0
 for s in "${services[@]}"; do r0[$s]=$(podman inspect -f '{{.RestartCount}}' "$(container_of "$s")"); done
 t=$(date +%s.%N)
+router_pid=$(timeout 10 podman inspect -f '{{.State.Pid}}' "$rt")
 bounded 30 podman restart -t 5 "$rt" >/dev/null &
 restarting=$!
 # A service that dies while the router is down (here the mission executive, SIGKILLed
-# from the host) must be restarted all the same.
-sleep 0.2
+# from the host) must be restarted all the same: wait until the old router process is
+# gone (at most 10 s), then kill it.
+for _ in $(seq 200); do
+    kill -0 "${router_pid:-0}" 2>/dev/null || break
+    sleep 0.05
+done
 mpid=$(podman inspect -f '{{.State.Pid}}' "$(container_of mission)")
 crashed=""
 [ "${mpid:-0}" -gt 0 ] && kill -KILL "$mpid" 2>/dev/null && crashed=mission

@@ -8,6 +8,7 @@ use roam_controller::params::ApfParams;
 use roam_controller::service::ControllerConfig;
 use roam_controller::weights::Scheme;
 use roam_proto::controller::{ControllerStatus, Mission, MissionState};
+use roam_proto::localization::PositionEstimate;
 use roam_proto::sim::{GroundTruth, RobotCommand, SimControl, SimStatus};
 use roam_proto::{decode, encode, keys, Message};
 use roam_tests::{repo_path, within, Harness};
@@ -252,8 +253,13 @@ async fn a_controller_on_board_one_robot_leaves_the_others_alone() {
     let root = harness.root.clone();
     let statuses = subscribe(&client, keys::robot_controller(&root, "robot")).await;
     let commands = subscribe(&client, keys::robot_command(&root, "robot")).await;
+    let estimates = subscribe(&client, keys::robot_estimate(&root, "robot")).await;
     give_mission(&client, &root, "not-yours", [45.0, 45.0]).await;
-    tokio::time::sleep(Duration::from_secs(1)).await;
+    // Ten estimates of the robot after the mission: a controller that took it would
+    // have commanded on them.
+    for _ in 0..10 {
+        let _: PositionEstimate = next(&estimates).await;
+    }
     assert!(
         statuses.try_recv().ok().flatten().is_none()
             && commands.try_recv().ok().flatten().is_none(),

@@ -189,6 +189,10 @@ struct Run<'a> {
     inputs: Inputs,
     position: Option<[f64; 2]>,
     missions_sent: u64,
+    /// This executive's own tag in its mission ids (from its Zenoh session id), so a
+    /// restarted executive never reuses an id its predecessor sent: the controller's
+    /// statuses on an old mission are not taken for a new one's.
+    tag: String,
 }
 
 impl Run<'_> {
@@ -248,7 +252,10 @@ impl Run<'_> {
 
     fn send(&mut self, window: usize, waypoints: Vec<[f64; 2]>) -> String {
         self.missions_sent += 1;
-        let id = format!("{}-w{window}-m{}", self.config.robot, self.missions_sent);
+        let id = format!(
+            "{}-{}-w{window}-m{}",
+            self.config.robot, self.tag, self.missions_sent
+        );
         let mission = Mission {
             robot: self.config.robot.clone(),
             id: id.clone(),
@@ -367,11 +374,33 @@ impl Run<'_> {
             return Ok(None);
         }
         let Some((shortest, plan, budget)) = self.first_plans(from, task, cancel).await? else {
+            // Given up before a plan came: reported like any window that was given up.
             progress(Progress::GaveUp {
                 window,
                 task: task.name.clone(),
             });
-            return Ok(None);
+            let report = WindowReport {
+                robot: self.config.robot.clone(),
+                task: task.name.clone(),
+                window,
+                began_s: began,
+                task_start_s: task.start_s,
+                arrival_s: None,
+                on_time: false,
+                budget_s: task.start_s - began,
+                planned_information: 0.0,
+                driven_information: 0.0,
+                shortest_information: 0.0,
+                peb_mean_m: None,
+                replans: 0,
+                replan_reasons: vec!["no planner answered before the window was given up".into()],
+            };
+            return Ok(Some(WindowOutcome {
+                report,
+                plans: Vec::new(),
+                shortest: Vec::new(),
+                driven: vec![from],
+            }));
         };
         progress(Progress::Planned {
             window,
@@ -458,11 +487,10 @@ impl Run<'_> {
             if let Some((reason, curious)) = replan {
                 // A lost mission is always sent again (at most once per silence period);
                 // the replan limit is for the robot's own trouble.
-                let replans = reasons.len() - resends;
+                let replans = reasons.len().saturating_sub(resends);
                 if !resend && replans as u32 >= self.config.max_replans {
                     continue;
                 }
-                resends += usize::from(resend);
                 let here = self.position.unwrap_or(from);
                 let shortest_here = match self
                     .plan(here, task.at, PlannerModel::Shortest, 86_400.0)
@@ -474,9 +502,15 @@ impl Run<'_> {
                         continue;
                     }
                 };
-                let (plan, _) = self
-                    .plan_window(here, task, &shortest_here, curious)
-                    .await?;
+                // A curious plan that fails (busy, an outage) leaves the shortest way.
+                let plan = match self.plan_window(here, task, &shortest_here, curious).await {
+                    Ok((plan, _)) => plan,
+                    Err(e) => {
+                        tracing::warn!("the curious replan failed, taking the shortest path: {e}");
+                        shortest_here
+                    }
+                };
+                resends += usize::from(resend);
                 reasons.push(reason.to_owned());
                 progress(Progress::Replanned {
                     window,
@@ -549,6 +583,7 @@ pub async fn run(
         inputs,
         position: None,
         missions_sent: 0,
+        tag: session.zid().to_string().chars().take(8).collect(),
     };
     run.hear_the_clock(cancel).await?;
     let mut outcomes = Vec::with_capacity(config.tasks.len());

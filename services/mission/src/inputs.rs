@@ -12,8 +12,9 @@ use roam_planner::world::World;
 use roam_proto::cells::Cells;
 use roam_proto::map::Layer;
 use roam_proto::sim::SimClock;
+use roam_proto::ErrorCode;
 use roam_proto::{decode, keys};
-use roam_runtime::Requester;
+use roam_runtime::{ClientError, Requester};
 use tokio_util::sync::CancellationToken;
 
 use crate::executive::ExecutiveError;
@@ -97,7 +98,7 @@ pub(crate) async fn wait_for_world(
     loop {
         match fetch_world(requester, root).await {
             Ok(world) => return Ok(world),
-            Err(ExecutiveError::Client(e)) => {
+            Err(ExecutiveError::Client(e)) if transient(&e) => {
                 tracing::warn!("waiting for the map server: {e}");
             }
             Err(e) => return Err(e),
@@ -106,6 +107,19 @@ pub(crate) async fn wait_for_world(
             _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
             _ = tokio::time::sleep(WORLD_RETRY) => {}
         }
+    }
+}
+
+/// Whether asking again may help: nobody answered, Zenoh failed, or the service said
+/// so. A refusal or an undecodable reply (another root, another protocol) will not
+/// change by waiting.
+fn transient(e: &ClientError) -> bool {
+    match e {
+        ClientError::NoReply { .. } | ClientError::Zenoh { .. } => true,
+        ClientError::Refused(reply) => {
+            matches!(reply.code, ErrorCode::Unavailable | ErrorCode::Busy)
+        }
+        ClientError::Decode { .. } => false,
     }
 }
 

@@ -255,7 +255,10 @@ fn resume_from(sim: &mut Sim, name: &str, seed: u64, path: &Path) -> Result<(), 
         );
         return Ok(());
     }
-    sim.resume(&saved)?;
+    sim.resume(&saved).map_err(|e| SnapshotError::Resume {
+        path: path.to_owned(),
+        reason: e.to_string(),
+    })?;
     tracing::info!(
         path = %path.display(), step = saved.step, robots = saved.robots.len(),
         "resumed from the snapshot"

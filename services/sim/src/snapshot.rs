@@ -21,6 +21,11 @@ use serde::{Deserialize, Serialize};
 /// The largest snapshot file read back: far above what `max_robots` robots take.
 pub const MAX_SNAPSHOT_BYTES: u64 = 16 * 1024 * 1024;
 
+/// The latest step a snapshot may hold: a resume replays the world to it (blocks and
+/// walkers), so an absurd step from a damaged file must not hang the start. 10 million
+/// steps are 46 days at the default 0.4 s per step; a replay to it takes seconds.
+pub const MAX_SNAPSHOT_STEP: u64 = 10_000_000;
+
 /// The format tag in every snapshot file.
 const FORMAT: &str = "roam-sim-snapshot";
 
@@ -64,6 +69,8 @@ pub enum SnapshotError {
     Write { path: PathBuf, reason: String },
     #[error("cannot read the sim snapshot {path}: {reason}; fix or delete the file to start the sim at step 0")]
     Read { path: PathBuf, reason: String },
+    #[error("cannot resume from the sim snapshot {path}: {reason}; fix or delete the file to start the sim at step 0")]
+    Resume { path: PathBuf, reason: String },
 }
 
 /// Writes `snapshot` to `path` atomically (a temporary file renamed over it).
@@ -79,6 +86,9 @@ pub fn save(path: &Path, snapshot: &SimSnapshot) -> Result<(), SnapshotError> {
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".tmp");
     let tmp = PathBuf::from(tmp);
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(fail)?;
+    }
     {
         let mut file = std::fs::File::create(&tmp).map_err(fail)?;
         file.write_all(&bytes).map_err(fail)?;
@@ -114,6 +124,12 @@ pub fn load(path: &Path) -> Result<Option<SimSnapshot>, SnapshotError> {
             snapshot.format
         )));
     }
+    if snapshot.step > MAX_SNAPSHOT_STEP {
+        return Err(fail(format!(
+            "step {} is beyond {MAX_SNAPSHOT_STEP} (max_snapshot_step)",
+            snapshot.step
+        )));
+    }
     Ok(Some(snapshot))
 }
 
@@ -146,6 +162,17 @@ mod tests {
         );
         save(&path, &s).expect("save");
         assert_eq!(load(&path).expect("load"), Some(s));
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn a_step_beyond_the_limit_is_refused_and_a_new_folder_is_made() {
+        let d = dir("limit");
+        let path = d.join("state").join("sim.json");
+        let far = SimSnapshot::new("built-in", 0, MAX_SNAPSHOT_STEP + 1, Vec::new());
+        save(&path, &far).expect("the folder is made");
+        let e = load(&path).expect_err("too far");
+        assert!(e.to_string().contains("max_snapshot_step"), "{e}");
         let _ = std::fs::remove_dir_all(&d);
     }
 

@@ -92,6 +92,7 @@ impl Watch<'_> {
                 "the map server stopped answering {when}\n{}",
                 fleet.logs()
             );
+            tokio::time::sleep(Duration::from_millis(100)).await;
         };
         none_lost(&self.seen, &now).unwrap_or_else(|e| panic!("{when}: {e}\n{}", fleet.logs()));
         self.seen = now;
