@@ -107,7 +107,7 @@ pub fn read_bounded(path: &Path) -> std::io::Result<Vec<u8>> {
     if !meta.is_file() {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
-            "not a regular file (a folder, FIFO or device cannot be a map)",
+            "not a regular file (a folder, FIFO or device cannot be read whole)",
         ));
     }
     if meta.len() > MAX_FILE_BYTES {

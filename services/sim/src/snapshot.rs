@@ -16,10 +16,8 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use roam_map_server::ros_map::read_bounded;
 use serde::{Deserialize, Serialize};
-
-/// The largest snapshot file read back: far above what `max_robots` robots take.
-pub const MAX_SNAPSHOT_BYTES: u64 = 16 * 1024 * 1024;
 
 /// The latest step a snapshot may hold: a resume replays the world to it (blocks and
 /// walkers), so an absurd step from a damaged file must not hang the start. 10 million
@@ -106,17 +104,8 @@ pub fn load(path: &Path) -> Result<Option<SimSnapshot>, SnapshotError> {
     if !path.exists() {
         return Ok(None);
     }
-    let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
-    if !meta.is_file() {
-        return Err(fail("not a regular file".into()));
-    }
-    if meta.len() > MAX_SNAPSHOT_BYTES {
-        return Err(fail(format!(
-            "{} bytes; a snapshot is at most {MAX_SNAPSHOT_BYTES} (max_snapshot_bytes)",
-            meta.len()
-        )));
-    }
-    let bytes = std::fs::read(path).map_err(|e| fail(e.to_string()))?;
+    // Regular files only, and bounded (max_file_bytes), like every file roam reads.
+    let bytes = read_bounded(path).map_err(|e| fail(e.to_string()))?;
     let snapshot: SimSnapshot = serde_json::from_slice(&bytes).map_err(|e| fail(e.to_string()))?;
     if snapshot.format != FORMAT {
         return Err(fail(format!(

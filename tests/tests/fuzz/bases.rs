@@ -90,9 +90,9 @@ pub(crate) fn layer_bases(occupancy_version: u64) -> Vec<Vec<u8>> {
 }
 
 pub(crate) fn load_bases() -> Vec<Vec<u8>> {
-    // Never a device or a FIFO: the map server (and the sim's `load`) reads those
-    // without end today: a FIFO gets no reply and blocks a worker, /dev/zero grows
-    // without bound. Paths the fuzzer makes up are mapped to a missing file below.
+    // Never a real path: a load that succeeds replaces the map under the other
+    // services (devices and FIFOs are refused, tested in the map server's own tests).
+    // Paths the fuzzer makes up are mapped to a missing file below.
     [
         "/nonexistent/fuzz.yaml",
         "",
@@ -497,8 +497,8 @@ pub(crate) fn bounded(expects: Expects, bytes: Vec<u8>, robots_added: &AtomicU32
             Err(_) => bytes,
         },
         Expects::LoadMap => match decode::<LoadMap>(&bytes) {
-            // A load that succeeds replaces the map under the planner; a device or FIFO
-            // path is read without end. Neither is what this test is about.
+            // A load that succeeds replaces the map under the planner, which is not
+            // what this test is about.
             Ok(r) if !r.path.starts_with("/nonexistent") && !r.path.is_empty() => {
                 encode(&LoadMap {
                     path: "/nonexistent/fuzz.yaml".into(),
