@@ -4,7 +4,9 @@
 //! `v` is [`PROTOCOL_VERSION`]; a different one is refused before the body is read, so a
 //! newer client gets "unsupported version" rather than a confusing field error. `kind`
 //! names the message type, so a payload sent to the wrong key is refused by name.
-//! Anything after the closing brace other than whitespace is refused.
+//! Anything after the closing brace other than whitespace is refused. What a refusal
+//! quotes of the payload (the kind, the parser's complaint) is a bounded, escaped
+//! [`excerpt`](crate::excerpt), so a huge or forged field never comes back whole.
 //!
 //! Grid cells travel inside the JSON as base64 of their little-endian bytes (see
 //! [`crate::cells`]): a 1.7-million-cell layer is 2.3 MB and decodes in milliseconds,
@@ -15,6 +17,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 
 use crate::error::{ErrorCode, ErrorReply};
+use crate::excerpt::{excerpt, parser_reason};
 
 /// The protocol version every roam message carries.
 pub const PROTOCOL_VERSION: u32 = 1;
@@ -85,19 +88,19 @@ pub fn encode<T: Message>(message: &T) -> Vec<u8> {
 
 /// Decodes a message, refusing other protocol versions, other kinds and trailing bytes.
 pub fn decode<T: Message>(bytes: &[u8]) -> Result<T, DecodeError> {
-    let envelope: EnvelopeIn<'_> =
-        serde_json::from_slice(bytes).map_err(|e| DecodeError::Envelope(e.to_string()))?;
+    let envelope: EnvelopeIn<'_> = serde_json::from_slice(bytes)
+        .map_err(|e| DecodeError::Envelope(parser_reason(&e.to_string())))?;
     if envelope.v != PROTOCOL_VERSION {
         return Err(DecodeError::UnsupportedVersion { found: envelope.v });
     }
     if envelope.kind != T::KIND {
         return Err(DecodeError::WrongKind {
             expected: T::KIND,
-            found: envelope.kind,
+            found: excerpt(&envelope.kind).to_string(),
         });
     }
     serde_json::from_str(envelope.body.get()).map_err(|e| DecodeError::Body {
         kind: T::KIND,
-        reason: e.to_string(),
+        reason: parser_reason(&e.to_string()),
     })
 }

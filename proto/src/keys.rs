@@ -52,6 +52,16 @@ pub fn check_root(root: &str) -> Result<(), KeyError> {
     }
 }
 
+/// The robot a per-robot key names: `<root>/robot/<robot>/<leaf>` gives `<robot>` when
+/// it is a valid name ([`check_name`]) and the key has exactly that shape, `None`
+/// otherwise. Services take the robot from the key a message arrived on, never from its
+/// body: on a router with access control by key, the key is what was authorised.
+pub fn robot_of<'k>(root: &str, key: &'k str) -> Option<&'k str> {
+    let rest = key.strip_prefix(root)?.strip_prefix("/robot/")?;
+    let (robot, leaf) = rest.split_once('/')?;
+    (is_segment(robot) && is_segment(leaf)).then_some(robot)
+}
+
 /// `<root>/@live/<service>/<instance>`: a liveliness token each running service holds
 /// for as long as it runs. No payload. Watch `<root>/@live/**` to see who is up.
 pub fn liveliness(root: &str, service: &str, instance: &str) -> String {
@@ -269,6 +279,25 @@ mod tests {
         assert!(check_root("site-a/roam").is_ok());
         assert!(check_root("site-a//roam").is_err());
         assert!(check_root("roam/**").is_err());
+    }
+
+    #[test]
+    fn the_robot_comes_from_a_per_robot_key_only() {
+        assert_eq!(robot_of("roam", "roam/robot/r1/mission"), Some("r1"));
+        assert_eq!(
+            robot_of("site/roam", "site/roam/robot/r-2/ranges"),
+            Some("r-2")
+        );
+        for bad in [
+            "roam/robot/r1",
+            "roam/robot/r1/a/b",
+            "roam/robot/*/mission",
+            "roam/robot/a$b/mission",
+            "other/robot/r1/mission",
+            "roamx/robot/r1/mission",
+        ] {
+            assert_eq!(robot_of("roam", bad), None, "{bad}");
+        }
     }
 
     #[test]

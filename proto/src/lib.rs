@@ -10,6 +10,7 @@ pub mod cells;
 pub mod codec;
 pub mod controller;
 pub mod error;
+pub mod excerpt;
 pub mod keys;
 pub mod localization;
 pub mod map;
@@ -20,3 +21,4 @@ pub mod sim;
 
 pub use codec::{decode, encode, DecodeError, Message, PROTOCOL_VERSION};
 pub use error::{ErrorCode, ErrorReply, LimitHit};
+pub use excerpt::{excerpt, Excerpt};

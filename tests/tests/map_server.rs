@@ -5,6 +5,7 @@
 use std::time::Duration;
 
 use roam_map_server::store::{Limits, DEFAULT_LIMITS};
+use roam_map_server::MapServerConfig;
 use roam_proto::cells::Cells;
 use roam_proto::map::{CellWrite, Layer, LayerChange, LayerList, LayerUpdate, LoadMap, UpdateAck};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
@@ -346,55 +347,64 @@ async fn oversize_updates_are_refused_naming_the_limit() {
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
-async fn missing_and_corrupt_files_are_named_in_the_error() {
+async fn loads_read_only_the_load_directories_and_name_what_is_wrong() {
     let harness = Harness::start().await;
-    let server = harness.start_map_server(harness.map_server_config()).await;
+    let dir = tempfile::tempdir().expect("tmp");
+    let maps = concat!(env!("CARGO_MANIFEST_DIR"), "/../config/maps");
+    let server = harness
+        .start_map_server(MapServerConfig {
+            load_dirs: vec![dir.path().to_owned(), maps.into()],
+            ..harness.map_server_config()
+        })
+        .await;
     let client = harness.client().await;
     let key = keys::map_load(&harness.root);
-    let dir = tempfile::tempdir().expect("tmp");
+    let load = |path: &str, base_version: Option<u64>| LoadMap {
+        path: path.to_owned(),
+        base_version,
+    };
 
-    let missing_path = dir.path().join("missing.yaml");
-    let missing = refusal(client.request::<LoadMap, LayerList>(
-        &key,
-        Some(&LoadMap {
-            path: missing_path.display().to_string(),
-            base_version: None,
-        }),
-    ))
-    .await;
+    let missing =
+        refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("missing.yaml", None))))
+            .await;
     assert_eq!(missing.code, ErrorCode::NotFound);
     assert!(
-        missing.message.contains("missing.yaml"),
+        missing.message.contains("missing.yaml") && missing.message.contains("load directories"),
         "{}",
         missing.message
+    );
+    // Outside the directories: the same answer as a missing file, naming the directories.
+    let passwd =
+        refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("/etc/passwd", None)))).await;
+    assert_eq!(passwd.code, ErrorCode::NotFound);
+    assert!(!passwd.message.contains("root:"), "{}", passwd.message);
+    assert!(
+        passwd
+            .message
+            .contains(&dir.path().canonicalize().expect("c").display().to_string()),
+        "{}",
+        passwd.message
     );
 
     // A map whose image is truncated.
     std::fs::write(dir.path().join("bad.pgm"), b"P5\n10 10\n255\n\x00\x00").expect("pgm");
-    let yaml = dir.path().join("bad.yaml");
-    std::fs::write(&yaml, "image: bad.pgm\nresolution: 0.05\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.196\n").expect("yaml");
-    let corrupt = refusal(client.request::<LoadMap, LayerList>(
-        &key,
-        Some(&LoadMap {
-            path: yaml.display().to_string(),
-            base_version: None,
-        }),
-    ))
-    .await;
+    std::fs::write(dir.path().join("bad.yaml"), "image: bad.pgm\nresolution: 0.05\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.196\n").expect("yaml");
+    let corrupt =
+        refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("bad.yaml", None)))).await;
     assert_eq!(corrupt.code, ErrorCode::CorruptFile);
     assert!(corrupt.message.contains("bad.pgm"), "{}", corrupt.message);
 
+    // A map inside the directories whose image is outside them is refused like a
+    // missing file.
+    std::fs::write(dir.path().join("escape.yaml"), "image: /etc/passwd\nresolution: 0.05\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.196\n").expect("yaml");
+    let escape =
+        refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("escape.yaml", None)))).await;
+    assert_eq!(escape.code, ErrorCode::NotFound, "{}", escape.message);
+
     // A good map loads, bumps the versions and is served.
-    let depot = concat!(env!("CARGO_MANIFEST_DIR"), "/../config/maps/depot.yaml");
     let list: LayerList = within(
         "load",
-        client.request(
-            &key,
-            Some(&LoadMap {
-                path: depot.into(),
-                base_version: Some(1),
-            }),
-        ),
+        client.request(&key, Some(&load("depot.yaml", Some(1)))),
     )
     .await
     .expect("load depot");
@@ -405,16 +415,31 @@ async fn missing_and_corrupt_files_are_named_in_the_error() {
         .expect("occupancy");
     assert_eq!((occupancy.meta.width, occupancy.version), (604, 2));
     // A load based on an old version is stale.
-    let stale = refusal(client.request::<LoadMap, LayerList>(
-        &key,
+    let stale =
+        refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("depot.yaml", Some(1)))))
+            .await;
+    assert_eq!(stale.code, ErrorCode::StaleVersion);
+
+    server.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn without_load_directories_loads_are_off() {
+    let harness = Harness::start().await;
+    let server = harness.start_map_server(harness.map_server_config()).await;
+    let client = harness.client().await;
+    let depot = concat!(env!("CARGO_MANIFEST_DIR"), "/../config/maps/depot.yaml");
+    let off = refusal(client.request::<LoadMap, LayerList>(
+        &keys::map_load(&harness.root),
         Some(&LoadMap {
             path: depot.into(),
-            base_version: Some(1),
+            base_version: None,
         }),
     ))
     .await;
-    assert_eq!(stale.code, ErrorCode::StaleVersion);
-
+    assert_eq!(off.code, ErrorCode::InvalidRequest);
+    assert!(off.message.contains("loads are off"), "{}", off.message);
     server.stop().await.1.expect("clean stop");
     harness.close().await;
 }

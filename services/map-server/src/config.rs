@@ -5,6 +5,7 @@
 //! root: roam                     # key root
 //! map: config/maps/depot.yaml    # ROS map.yaml or roam scenario; absent: the built-in world
 //! data_dir: /var/lib/roam/map    # persistence; absent: layers live in memory only
+//! load_dirs: [/srv/roam/maps]    # where `<root>/map/load` may read; absent: loads are off
 //! robot_radius_m: 0.25           # overrides the scenario's
 //! heuristic_compression: 0.25    # paper 000 c_h
 //! lethal_threshold: 65           # occupancy value from which a cell is an obstacle
@@ -26,6 +27,9 @@ pub struct MapServerConfig {
     pub instance: Option<String>,
     pub map: Option<PathBuf>,
     pub data_dir: Option<PathBuf>,
+    /// The directories a `<root>/map/load` request may read from (names relative to
+    /// them; see [`crate::load_dirs`]). Empty: loads from the wire are off.
+    pub load_dirs: Vec<PathBuf>,
     pub robot_radius_m: Option<f64>,
     pub heuristic_compression: f64,
     pub lethal_threshold: i8,
@@ -41,6 +45,7 @@ impl Default for MapServerConfig {
             instance: None,
             map: None,
             data_dir: None,
+            load_dirs: Vec::new(),
             robot_radius_m: None,
             heuristic_compression: 0.25,
             lethal_threshold: 65,

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use roam_proto::{ErrorCode, ErrorReply};
 
 use crate::grid::Grid;
+use crate::load_dirs::{Access, LoadDirs, LoadRefused};
 use crate::ros_map::{self, RosMapError};
 use crate::scenario::{self, ScenarioError};
 
@@ -30,6 +31,8 @@ pub enum MapFileError {
     Ros(#[from] RosMapError),
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
+    #[error(transparent)]
+    Refused(LoadRefused),
 }
 
 impl MapFileError {
@@ -37,6 +40,13 @@ impl MapFileError {
     pub fn to_reply(&self) -> ErrorReply {
         let message = self.to_string();
         match self {
+            MapFileError::Refused(refused)
+            | MapFileError::Ros(RosMapError::Refused(refused))
+            | MapFileError::Scenario(ScenarioError::Refused(refused))
+            | MapFileError::Scenario(ScenarioError::Map {
+                source: RosMapError::Refused(refused),
+                ..
+            }) => refused.to_reply(),
             MapFileError::Ros(RosMapError::Missing { .. })
             | MapFileError::Scenario(ScenarioError::Missing { .. }) => ErrorReply::new(
                 ErrorCode::NotFound,
@@ -60,21 +70,37 @@ impl MapFileError {
     }
 }
 
-/// Reads a ROS map or a scenario, telling them apart by the ROS `image:` key.
+/// Reads the map file a load request names: only inside the load directories, and only
+/// following references that stay inside them ([`LoadDirs`]).
+pub fn read_requested(
+    requested: &str,
+    dirs: &LoadDirs,
+    max_cells: u64,
+) -> Result<MapContent, MapFileError> {
+    let path = dirs.resolve(requested).map_err(MapFileError::Refused)?;
+    read_with(&path, max_cells, Access::Within(dirs))
+}
+
+/// Reads a ROS map or a scenario the operator named, telling them apart by the ROS
+/// `image:` key.
 pub fn read(path: &Path, max_cells: u64) -> Result<MapContent, MapFileError> {
+    read_with(path, max_cells, Access::Anywhere)
+}
+
+fn read_with(path: &Path, max_cells: u64, access: Access<'_>) -> Result<MapContent, MapFileError> {
     let is_ros = ros_map::read_bounded_text(path)
         .ok()
         .and_then(|text| serde_yaml_ng::from_str::<serde_yaml_ng::Value>(&text).ok())
         .is_some_and(|v| v.get("image").is_some());
     if is_ros {
-        let map = ros_map::load(path, max_cells)?;
+        let map = ros_map::load_with(path, max_cells, access)?;
         return Ok(MapContent {
             occupancy: map.grid,
             information: None,
             robot_radius_m: None,
         });
     }
-    let scenario = scenario::load(path, max_cells)?;
+    let scenario = scenario::load_with(path, max_cells, access)?;
     Ok(from_scenario(scenario))
 }
 

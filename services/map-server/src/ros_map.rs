@@ -13,6 +13,10 @@
 
 use std::path::{Path, PathBuf};
 
+use roam_proto::excerpt::file_parse_reason;
+
+use crate::load_dirs::{Access, LoadRefused};
+
 use roam_proto::map::{GridMeta, Origin};
 use serde::Deserialize;
 
@@ -87,6 +91,8 @@ pub enum RosMapError {
     Invalid { path: PathBuf, reason: String },
     #[error("map image {path} cannot be decoded: {reason}")]
     Image { path: PathBuf, reason: String },
+    #[error(transparent)]
+    Refused(#[from] LoadRefused),
     #[error("map image {path} has {actual} cells; the limit max_layer_cells is {max}")]
     TooLarge {
         path: PathBuf,
@@ -153,12 +159,24 @@ fn io_error(path: &Path, e: std::io::Error) -> RosMapError {
 
 /// Reads a `map.yaml` and its image. The image path is relative to the yaml's folder.
 pub fn load(yaml_path: &Path, max_cells: u64) -> Result<RosMap, RosMapError> {
+    load_with(yaml_path, max_cells, Access::Anywhere)
+}
+
+/// [`load`], reading the image only where `access` allows (a load from the wire: inside
+/// the load directories). Parse errors give the position and what was expected, never
+/// the file's content ([`file_parse_reason`]).
+pub fn load_with(
+    yaml_path: &Path,
+    max_cells: u64,
+    access: Access<'_>,
+) -> Result<RosMap, RosMapError> {
     let text = read_bounded_text(yaml_path).map_err(|e| io_error(yaml_path, e))?;
     let invalid = |reason: String| RosMapError::Invalid {
         path: yaml_path.to_owned(),
         reason,
     };
-    let yaml: MapYaml = serde_yaml_ng::from_str(&text).map_err(|e| invalid(e.to_string()))?;
+    let yaml: MapYaml =
+        serde_yaml_ng::from_str(&text).map_err(|e| invalid(file_parse_reason(&e.to_string())))?;
     if !(yaml.resolution.is_finite() && yaml.resolution > 0.0) {
         return Err(invalid(format!(
             "resolution must be a positive number of metres per cell, got {}",
@@ -194,10 +212,12 @@ pub fn load(yaml_path: &Path, max_cells: u64) -> Result<RosMap, RosMapError> {
             return Err(invalid(format!("negate must be 0 or 1, got {other}")))
         }
     };
-    let image_path = yaml_path
-        .parent()
-        .unwrap_or_else(|| Path::new("."))
-        .join(&yaml.image);
+    let image_path = access.check(
+        &yaml_path
+            .parent()
+            .unwrap_or_else(|| Path::new("."))
+            .join(&yaml.image),
+    )?;
     let params = MapParams {
         image: image_path,
         mode: yaml.mode.unwrap_or(MapMode::Trinary),

@@ -9,11 +9,11 @@
 //! | `<root>/map/load` | queryable | `LoadMap` → `LayerList` |
 
 use std::collections::HashMap;
-use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard};
 
 use roam_proto::map::{LayerList, LayerUpdate, LoadMap};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
+use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, Service, ServiceError};
 use tokio_util::sync::CancellationToken;
 use zenoh::bytes::ZBytes;
@@ -23,6 +23,7 @@ use zenoh::query::Query;
 use zenoh::Session;
 
 use crate::config::MapServerConfig;
+use crate::load_dirs::LoadDirs;
 use crate::map_file::{self, MapFileError};
 use crate::persist::{DataDir, PersistError};
 use crate::store::{DerivedParams, LayerStore};
@@ -52,6 +53,9 @@ struct State {
     /// Each layer encoded once per version, shared by gets and publications.
     encoded: Mutex<HashMap<String, (u64, ZBytes)>>,
     robot_radius_override: Option<f64>,
+    load_dirs: LoadDirs,
+    /// Refused loads and updates, logged a few per source and window.
+    warnings: WarnLimiter,
     session: Session,
 }
 
@@ -143,6 +147,8 @@ pub async fn run(
     cancel: CancellationToken,
 ) -> Result<(), MapServerError> {
     let store = open_store(&config)?;
+    let load_dirs =
+        LoadDirs::new(&config.load_dirs).map_err(|e| MapServerError::Config(e.to_string()))?;
     let mut service = Service::start(
         SERVICE_NAME,
         &config.root,
@@ -156,6 +162,8 @@ pub async fn run(
         store: Mutex::new(store),
         encoded: Mutex::new(HashMap::new()),
         robot_radius_override: config.robot_radius_m,
+        load_dirs,
+        warnings: WarnLimiter::new(),
         session: service.session().clone(),
     });
     let root = config.root.as_str();
@@ -214,7 +222,7 @@ async fn answer_layer(state: &State, query: &Query) {
             ErrorCode::NotFound,
             format!(
                 "no layer matches '{}'; the map server holds: {}",
-                query.key_expr(),
+                roam_proto::excerpt(query.key_expr().as_str()),
                 names.join(", ")
             ),
         );
@@ -280,7 +288,10 @@ async fn answer_load(state: Arc<State>, query: &Query) {
             reply::send(query, &list).await;
             state.publish(&changed).await;
         }
-        Ok(Err(error)) => reply::send_error(query, &error).await,
+        Ok(Err(error)) => {
+            roam_runtime::limited_warn!(state.warnings, "load", %error, "refused a map load");
+            reply::send_error(query, &error).await
+        }
         Err(e) => {
             reply::send_error(
                 query,
@@ -293,7 +304,8 @@ async fn answer_load(state: Arc<State>, query: &Query) {
 
 fn load(state: &State, request: &LoadMap) -> Result<(LayerList, Vec<String>), ErrorReply> {
     let max_cells = state.store().limits().max_layer_cells;
-    let content = map_file::read(Path::new(&request.path), max_cells).map_err(|e| e.to_reply())?;
+    let content = map_file::read_requested(&request.path, &state.load_dirs, max_cells)
+        .map_err(|e| e.to_reply())?;
     let mut store = state.store();
     if let (None, Some(r)) = (state.robot_radius_override, content.robot_radius_m) {
         store.set_robot_radius(r);

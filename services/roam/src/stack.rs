@@ -28,6 +28,8 @@ pub struct StackOptions {
     pub map: Option<PathBuf>,
     /// Where the map server persists its layers; in memory when absent.
     pub data_dir: Option<PathBuf>,
+    /// Where the map server's and the sim's `load` requests may read; none: loads off.
+    pub load_dirs: Vec<PathBuf>,
     /// The router's endpoint, e.g. `tcp/127.0.0.1:7447`; a free loopback port when absent.
     pub listen: Option<String>,
     /// Planner instances to run (default 1).
@@ -109,6 +111,7 @@ impl Stack {
             root: root.clone(),
             map: options.map.clone(),
             data_dir: options.data_dir.clone(),
+            load_dirs: options.load_dirs.clone(),
             ..MapServerConfig::default()
         };
         spawn(
@@ -135,6 +138,7 @@ impl Stack {
         let sim_config = SimConfig {
             root: root.clone(),
             rate: Some(options.sim_rate.unwrap_or(1.0)),
+            load_dirs: options.load_dirs.clone(),
             ..SimConfig::default()
         };
         spawn(

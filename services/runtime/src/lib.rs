@@ -7,7 +7,8 @@
 //! - [`signals`]: SIGINT / SIGTERM as a cancellation;
 //! - [`config_file`]: reading a service's YAML/JSON config file with errors that name it;
 //! - [`reply`] and [`client`]: the two ends of a query, with roam's codec and error reply;
-//! - [`telemetry`]: tracing from `RUST_LOG`.
+//! - [`telemetry`]: tracing from `RUST_LOG`;
+//! - [`warn_limit`]: warnings about wire data, a few lines per source and a count.
 
 pub mod client;
 pub mod config_file;
@@ -16,6 +17,7 @@ pub mod service;
 pub mod session;
 pub mod signals;
 pub mod telemetry;
+pub mod warn_limit;
 
 pub use client::{ClientError, Requester};
 pub use service::{Service, ServiceError};

@@ -15,7 +15,7 @@ use std::future::Future;
 use std::sync::Arc;
 use std::time::Duration;
 
-use roam_proto::keys;
+use roam_proto::{excerpt, keys};
 use tokio::sync::Semaphore;
 use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
@@ -26,9 +26,15 @@ use zenoh::Session;
 
 use crate::reply;
 use crate::session::{self, SessionError};
+use crate::warn_limit::WarnLimiter;
 
 /// Queries one queryable handles at once (see [`Service::serve`]).
 pub const MAX_IN_FLIGHT: usize = 32;
+
+/// The largest sample [`Service::subscribe`] decodes: the largest layer the map server
+/// holds (16,777,216 f32 cells in base64) with room for its envelope. Subscribers of
+/// small messages pass their own, smaller limit to [`Service::subscribe_with`].
+pub const DEFAULT_MAX_SAMPLE_BYTES: usize = 96 * 1024 * 1024;
 
 /// How long [`Service::shutdown`] waits for in-flight work by default.
 pub const DEFAULT_GRACE: Duration = Duration::from_millis(1500);
@@ -227,9 +233,8 @@ impl Service {
     }
 
     /// Subscribes to `key` and hands every sample that decodes as `T` to
-    /// `handler(&state, message)` on a tracked task, until the service stops. Samples
-    /// that do not decode are logged and dropped: a subscriber has no one to answer.
-    /// Handlers run inline, so keep them light.
+    /// `handler(&state, message)`, with payloads of at most [`DEFAULT_MAX_SAMPLE_BYTES`];
+    /// see [`Service::subscribe_with`].
     pub async fn subscribe<T, S, F>(
         &self,
         key: &str,
@@ -241,6 +246,36 @@ impl Service {
         S: Send + Sync + 'static,
         F: Fn(&S, T) + Send + 'static,
     {
+        self.subscribe_with(
+            key,
+            DEFAULT_MAX_SAMPLE_BYTES,
+            state,
+            move |state: &S, _key: &str, message: T| handler(state, message),
+        )
+        .await
+    }
+
+    /// Subscribes to `key` and hands every sample that decodes as `T` to
+    /// `handler(&state, key, message)` on a tracked task, until the service stops; `key`
+    /// is the concrete key the sample arrived on (take routing names such as the robot
+    /// from it, never from the body: see [`roam_proto::keys::robot_of`]).
+    ///
+    /// A sample larger than `max_bytes` is dropped before it is decoded; one that does
+    /// not decode is dropped too. Both are logged with a bounded, escaped excerpt, at
+    /// most a few lines per key per window ([`crate::warn_limit`]): a subscriber has no
+    /// one to answer. Handlers run inline, so keep them light.
+    pub async fn subscribe_with<T, S, F>(
+        &self,
+        key: &str,
+        max_bytes: usize,
+        state: S,
+        handler: F,
+    ) -> Result<(), ServiceError>
+    where
+        T: roam_proto::Message,
+        S: Send + Sync + 'static,
+        F: Fn(&S, &str, T) + Send + 'static,
+    {
         let subscriber =
             self.session
                 .declare_subscriber(key)
@@ -251,17 +286,36 @@ impl Service {
                     reason: e.to_string(),
                 })?;
         let cancel = self.cancel.clone();
+        let warnings = WarnLimiter::new();
         self.tasks.spawn(async move {
             loop {
-                tokio::select! {
+                let sample = tokio::select! {
                     _ = cancel.cancelled() => break,
                     sample = subscriber.recv_async() => match sample {
-                        Ok(sample) => match roam_proto::decode::<T>(&sample.payload().to_bytes()) {
-                            Ok(message) => handler(&state, message),
-                            Err(e) => tracing::warn!(key = %sample.key_expr(), "ignoring a sample that does not decode: {e}"),
-                        },
+                        Ok(sample) => sample,
                         Err(_) => break,
                     },
+                };
+                let key = sample.key_expr().as_str();
+                let size = sample.payload().len();
+                if size > max_bytes {
+                    crate::limited_warn!(
+                        warnings,
+                        key,
+                        key = %excerpt(key),
+                        "dropping a {} sample of {size} bytes unread: over the limit of {max_bytes} bytes",
+                        T::KIND
+                    );
+                    continue;
+                }
+                match roam_proto::decode::<T>(&sample.payload().to_bytes()) {
+                    Ok(message) => handler(&state, key, message),
+                    Err(e) => crate::limited_warn!(
+                        warnings,
+                        key,
+                        key = %excerpt(key),
+                        "ignoring a sample that does not decode: {e}"
+                    ),
                 }
             }
         });

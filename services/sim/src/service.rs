@@ -18,11 +18,13 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
+use roam_map_server::load_dirs::{Access, LoadDirs};
 use roam_map_server::map_file::{BUILTIN_NAME, BUILTIN_SCENARIO};
 use roam_map_server::scenario::{self, Scenario, ScenarioError};
 use roam_map_server::store::DEFAULT_LIMITS;
 use roam_proto::sim::{RobotCommand, SimClock, SimControl, SimStatus};
 use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply, Message};
+use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, Service, ServiceError};
 use serde::Deserialize;
 use tokio::time::Instant;
@@ -37,10 +39,18 @@ use crate::snapshot::{self, SnapshotError};
 pub const SERVICE_NAME: &str = "sim";
 /// Steps one `step` request may ask for.
 pub const MAX_STEPS_PER_REQUEST: u32 = 100_000;
+/// Robot-steps (steps × robots) one `step` request may ask for: what bounds the work and
+/// the messages one request causes, whatever the number of robots.
+pub const MAX_ROBOT_STEPS_PER_REQUEST: u64 = 200_000;
 /// The fastest real-time factor `resume` accepts (0 means as fast as possible).
 pub const MAX_RATE: f64 = 1000.0;
+/// The slowest real-time factor `resume` accepts: slower would leave minutes between
+/// steps (a rate of 1e-6 once meant days).
+pub const MIN_RATE: f64 = 0.01;
 /// Largest control request, bytes.
 pub const MAX_REQUEST_BYTES: usize = 64 * 1024;
+/// Largest robot command, bytes (one is about 60).
+pub const MAX_COMMAND_BYTES: usize = 1024;
 /// How often a stepping sim writes its snapshot (wall time): what a crash can cost.
 pub const SNAPSHOT_PERIOD: Duration = Duration::from_millis(500);
 
@@ -65,6 +75,9 @@ pub struct SimConfig {
     /// [`SNAPSHOT_PERIOD`] while it steps); at start it resumes from the snapshot when
     /// it is of the same scenario and seed. Absent: a restart begins at step 0.
     pub state_file: Option<PathBuf>,
+    /// The directories a control `load` may read scenarios from (names relative to
+    /// them; see `roam_map_server::load_dirs`). Empty: loads from the wire are off.
+    pub load_dirs: Vec<PathBuf>,
     pub zenoh: Option<serde_json::Value>,
 }
 
@@ -77,6 +90,7 @@ impl Default for SimConfig {
             seed: 0,
             rate: Some(1.0),
             state_file: None,
+            load_dirs: Vec::new(),
             zenoh: None,
         }
     }
@@ -112,6 +126,15 @@ struct State {
     root: String,
     session: zenoh::Session,
     control: Mutex<Control>,
+    load_dirs: LoadDirs,
+    /// Held by whoever steps and publishes (the free run, one `step` request), so the
+    /// messages of two steps never interleave and two lock-step drivers cannot pile up.
+    stepper: tokio::sync::Mutex<()>,
+    /// Woken by every control request, so the free run sees a pause, a new rate or a
+    /// reset at once instead of after the sleep it was in.
+    wake: tokio::sync::Notify,
+    /// Refused commands, logged a few per robot and window.
+    warnings: WarnLimiter,
 }
 
 impl State {
@@ -151,13 +174,24 @@ pub fn load_scenario(path: Option<&Path>) -> Result<(String, Scenario), Scenario
 }
 
 fn check_rate(rate: f64) -> Result<(), ErrorReply> {
-    if rate.is_finite() && (0.0..=MAX_RATE).contains(&rate) {
+    if rate == 0.0 || (rate.is_finite() && (MIN_RATE..=MAX_RATE).contains(&rate)) {
         Ok(())
     } else {
         Err(ErrorReply::new(
             ErrorCode::InvalidRequest,
-            format!("rate {rate} is out of range; use 0 (as fast as possible) to {MAX_RATE} times real time"),
+            format!("rate {rate} is out of range; use 0 (as fast as possible) or {MIN_RATE} to {MAX_RATE} times real time"),
         ))
+    }
+}
+
+/// Wall time between free-running steps at `rate` (0: none). The rate was checked, so
+/// the period is at most `step_s / MIN_RATE`; a step_s the scenario check let through
+/// cannot make it panic either.
+fn step_period(step_s: f64, rate: f64) -> Duration {
+    if rate > 0.0 {
+        Duration::try_from_secs_f64(step_s / rate).unwrap_or(Duration::from_secs(60))
+    } else {
+        Duration::ZERO
     }
 }
 
@@ -170,6 +204,8 @@ pub async fn run(
     if let Some(rate) = config.rate {
         check_rate(rate).map_err(|e| SimServiceError::Config(e.message))?;
     }
+    let load_dirs =
+        LoadDirs::new(&config.load_dirs).map_err(|e| SimServiceError::Config(e.to_string()))?;
     let (name, scenario) = load_scenario(config.scenario.as_deref())?;
     let mut sim = Sim::new(&scenario, config.seed)?;
     if let Some(path) = &config.state_file {
@@ -195,6 +231,10 @@ pub async fn run(
             late_steps: 0,
             free_steps: 0,
         }),
+        load_dirs,
+        stepper: tokio::sync::Mutex::new(()),
+        wake: tokio::sync::Notify::new(),
+        warnings: WarnLimiter::new(),
     });
 
     // Commands: a callback, so a command is pending before any later query is handled.
@@ -297,11 +337,27 @@ async fn keep_snapshots(state: Arc<State>, path: PathBuf, cancel: CancellationTo
 /// Stores a command for the next step; commands for unknown robots or with non-finite
 /// values are dropped (logged), so the pending map never outgrows the robots.
 fn take_command(state: &State, key: &str, payload: &[u8]) {
-    let robot = key.rsplit('/').nth(1).unwrap_or_default();
+    let Some(robot) = keys::robot_of(&state.root, key) else {
+        return;
+    };
+    if payload.len() > MAX_COMMAND_BYTES {
+        return roam_runtime::limited_warn!(
+            state.warnings, robot, %robot, bytes = payload.len(),
+            "dropping a command over {MAX_COMMAND_BYTES} bytes unread"
+        );
+    }
     let command = match decode::<RobotCommand>(payload) {
         Ok(c) if c.u.iter().all(|v| v.is_finite()) => c,
-        Ok(c) => return tracing::warn!(%robot, u = ?c.u, "dropping a command that is not finite"),
-        Err(e) => return tracing::warn!(%robot, "dropping a command that does not decode: {e}"),
+        Ok(c) => {
+            return roam_runtime::limited_warn!(
+                state.warnings, robot, %robot, u = ?c.u, "dropping a command that is not finite"
+            )
+        }
+        Err(e) => {
+            return roam_runtime::limited_warn!(
+                state.warnings, robot, %robot, "dropping a command that does not decode: {e}"
+            )
+        }
     };
     let mut control = state.control();
     if control.sim.robot(robot).is_some() {
@@ -360,30 +416,33 @@ async fn publish(state: &State, clock: SimClock, robots: Vec<RobotMessages>) {
 
 /// Steps while running: every `step_s / rate` seconds of wall time, or back to back at
 /// rate 0. A step whose messages are not out before the next one is due counts as late.
+/// Every control request wakes it ([`State::wake`]), so a pause, a reset or a new rate
+/// takes effect at once, whatever the period was.
 async fn free_run(state: Arc<State>, cancel: CancellationToken) {
     let mut next = Instant::now();
     loop {
         let (running, period) = {
             let c = state.control();
-            let step_s = c.sim.params().time.step_s;
-            let period = if c.rate > 0.0 {
-                Duration::from_secs_f64(step_s / c.rate)
-            } else {
-                Duration::ZERO
-            };
-            (c.running, period)
+            (c.running, step_period(c.sim.params().time.step_s, c.rate))
         };
         if !running {
             tokio::select! {
                 _ = cancel.cancelled() => return,
-                _ = tokio::time::sleep(Duration::from_millis(10)) => {}
+                _ = state.wake.notified() => {}
+                _ = tokio::time::sleep(Duration::from_millis(100)) => {}
             }
             next = Instant::now();
             continue;
         }
-        match step_once(&state) {
-            Ok((clock, messages)) => publish(&state, clock, messages).await,
-            Err(e) => tracing::warn!("step failed: {e}"),
+        {
+            let _stepping = state.stepper.lock().await;
+            if !state.control().running {
+                continue;
+            }
+            match step_once(&state) {
+                Ok((clock, messages)) => publish(&state, clock, messages).await,
+                Err(e) => tracing::warn!("step failed: {e}"),
+            }
         }
         next += period;
         let now = Instant::now();
@@ -400,6 +459,7 @@ async fn free_run(state: Arc<State>, cancel: CancellationToken) {
         }
         tokio::select! {
             _ = cancel.cancelled() => return,
+            _ = state.wake.notified() => next = Instant::now(),
             _ = tokio::time::sleep_until(next) => {}
             _ = tokio::task::yield_now(), if period.is_zero() => {}
         }
@@ -420,6 +480,11 @@ fn sim_error(e: &SimError) -> ErrorReply {
 fn scenario_error(e: &ScenarioError) -> ErrorReply {
     let message = e.to_string();
     match e {
+        ScenarioError::Refused(refused)
+        | ScenarioError::Map {
+            source: roam_map_server::ros_map::RosMapError::Refused(refused),
+            ..
+        } => refused.to_reply(),
         ScenarioError::Missing { .. } => ErrorReply::new(ErrorCode::NotFound, message),
         ScenarioError::Io { .. } => ErrorReply::new(ErrorCode::Internal, message),
         ScenarioError::Map { .. } => ErrorReply::new(ErrorCode::CorruptFile, message),
@@ -432,16 +497,28 @@ async fn answer_control(state: Arc<State>, query: Query) {
         Ok(r) => r,
         Err(e) => return reply::send_error(&query, &e).await,
     };
+    let is_load = matches!(request, SimControl::Load { .. });
     let outcome = control(&state, request).await;
+    state.wake.notify_waiters();
+    if let (true, Err(error)) = (is_load, &outcome) {
+        roam_runtime::limited_warn!(state.warnings, "load", %error, "refused a scenario load");
+    }
     reply::send_result(&query, outcome.map(|()| state.status())).await;
 }
 
 async fn control(state: &Arc<State>, request: SimControl) -> Result<(), ErrorReply> {
     match request {
         SimControl::Load { path, seed } => {
+            let dirs = state.load_dirs.clone();
             let loaded = tokio::task::spawn_blocking(move || {
-                let (name, scenario) =
-                    load_scenario(Some(Path::new(&path))).map_err(|e| scenario_error(&e))?;
+                let file = dirs.resolve(&path).map_err(|e| e.to_reply())?;
+                let scenario = scenario::load_with(
+                    &file,
+                    DEFAULT_LIMITS.max_layer_cells,
+                    Access::Within(&dirs),
+                )
+                .map_err(|e| scenario_error(&e))?;
+                let name = file.display().to_string();
                 let sim = Sim::new(&scenario, seed).map_err(|e| sim_error(&e))?;
                 Ok::<_, ErrorReply>((name, sim))
             })
@@ -471,6 +548,25 @@ async fn control(state: &Arc<State>, request: SimControl) -> Result<(), ErrorRep
                     format!("ask for at most {MAX_STEPS_PER_REQUEST} steps per request"),
                 ));
             }
+            let robots = state.control().sim.robots().count().max(1) as u64;
+            let robot_steps = u64::from(n) * robots;
+            if robot_steps > MAX_ROBOT_STEPS_PER_REQUEST {
+                return Err(ErrorReply::limit(
+                    "max_robot_steps_per_request",
+                    MAX_ROBOT_STEPS_PER_REQUEST,
+                    robot_steps,
+                    format!(
+                        "{n} steps of {robots} robots is {robot_steps} robot-steps; ask for at most {} steps per request",
+                        MAX_ROBOT_STEPS_PER_REQUEST / robots
+                    ),
+                ));
+            }
+            let Ok(_stepping) = state.stepper.try_lock() else {
+                return Err(ErrorReply::new(
+                    ErrorCode::Busy,
+                    "another step request is running; wait for its reply, then step again",
+                ));
+            };
             if state.control().running {
                 return Err(ErrorReply::new(
                     ErrorCode::InvalidRequest,
@@ -478,6 +574,9 @@ async fn control(state: &Arc<State>, request: SimControl) -> Result<(), ErrorRep
                 ));
             }
             for _ in 0..n {
+                if state.control().running {
+                    break;
+                }
                 let (clock, messages) = step_once(state)?;
                 publish(state, clock, messages).await;
             }

@@ -6,6 +6,7 @@ use roam_proto::map::{GridMeta, Origin};
 
 use super::{GridSpec, InformationSpec};
 use crate::grid::{cell_center, occupancy, Grid};
+use crate::load_dirs::Access;
 
 pub(super) fn build_grid(spec: &GridSpec, max_cells: u64) -> Result<Grid<i8>, String> {
     let [wm, hm] = spec.size_m;
@@ -59,6 +60,7 @@ pub(super) fn build_information(
     meta: &GridMeta,
     base: &Path,
     max_cells: u64,
+    access: Access<'_>,
 ) -> Result<Grid<u8>, (String, String)> {
     if spec.default_score > 100 {
         return Err((
@@ -68,14 +70,13 @@ pub(super) fn build_information(
     }
     let mut grid = Grid::filled(*meta, spec.default_score);
     if let Some(image) = &spec.image {
-        let image_path = base.join(image);
-        let fail = |reason: String| {
-            (
-                "information.image".to_owned(),
-                format!("{}: {reason}", image_path.display()),
-            )
-        };
-        let decoded = image::open(&image_path)
+        let field = "information.image".to_owned();
+        let image_path = access
+            .check(&base.join(image))
+            .map_err(|refused| (field.clone(), refused.to_string()))?;
+        let fail = |reason: String| (field.clone(), format!("{}: {reason}", image_path.display()));
+        let bytes = crate::ros_map::read_bounded(&image_path).map_err(|e| fail(e.to_string()))?;
+        let decoded = image::load_from_memory(&bytes)
             .map_err(|e| fail(e.to_string()))?
             .to_luma8();
         if (decoded.width(), decoded.height()) != (meta.width, meta.height) {

@@ -45,9 +45,11 @@
 
 use std::path::{Path, PathBuf};
 
+use roam_proto::excerpt::file_parse_reason;
 use serde::Deserialize;
 
 use crate::grid::Grid;
+use crate::load_dirs::{Access, LoadRefused};
 use crate::ros_map::{self, RosMapError};
 
 mod build;
@@ -221,10 +223,22 @@ pub enum ScenarioError {
     },
     #[error("scenario file {path}: {source}")]
     Map { path: PathBuf, source: RosMapError },
+    #[error(transparent)]
+    Refused(#[from] LoadRefused),
 }
 
 /// Reads a scenario file and builds its grids.
 pub fn load(path: &Path, max_cells: u64) -> Result<Scenario, ScenarioError> {
+    load_with(path, max_cells, Access::Anywhere)
+}
+
+/// [`load`], following the files the scenario names only where `access` allows (a load
+/// from the wire: inside the load directories).
+pub fn load_with(
+    path: &Path,
+    max_cells: u64,
+    access: Access<'_>,
+) -> Result<Scenario, ScenarioError> {
     let text = crate::ros_map::read_bounded_text(path).map_err(|e| {
         if e.kind() == std::io::ErrorKind::NotFound {
             ScenarioError::Missing {
@@ -237,14 +251,25 @@ pub fn load(path: &Path, max_cells: u64) -> Result<Scenario, ScenarioError> {
             }
         }
     })?;
-    parse(path, &text, max_cells)
+    parse_with(path, &text, max_cells, access)
 }
 
 /// Parses scenario text; `path` names the file in errors and anchors relative paths.
 pub fn parse(path: &Path, text: &str, max_cells: u64) -> Result<Scenario, ScenarioError> {
+    parse_with(path, text, max_cells, Access::Anywhere)
+}
+
+/// [`parse`], following the files the scenario names only where `access` allows. Parse
+/// errors give the position and what was expected, never the file's content.
+pub fn parse_with(
+    path: &Path,
+    text: &str,
+    max_cells: u64,
+    access: Access<'_>,
+) -> Result<Scenario, ScenarioError> {
     let file: ScenarioFile = serde_yaml_ng::from_str(text).map_err(|e| ScenarioError::Invalid {
         path: path.to_owned(),
-        reason: e.to_string(),
+        reason: file_parse_reason(&e.to_string()),
     })?;
     let field = |field: &str, reason: String| ScenarioError::Field {
         path: path.to_owned(),
@@ -254,7 +279,7 @@ pub fn parse(path: &Path, text: &str, max_cells: u64) -> Result<Scenario, Scenar
     let base = path.parent().unwrap_or_else(|| Path::new("."));
     let occupancy = match &file.map {
         MapSource::Ros(map_yaml) => {
-            ros_map::load(&base.join(map_yaml), max_cells)
+            ros_map::load_with(&access.check(&base.join(map_yaml))?, max_cells, access)
                 .map_err(|source| ScenarioError::Map {
                     path: path.to_owned(),
                     source,
@@ -275,7 +300,7 @@ pub fn parse(path: &Path, text: &str, max_cells: u64) -> Result<Scenario, Scenar
     }
     let information = match &file.information {
         None => Grid::filled(occupancy.meta, 0),
-        Some(spec) => build_information(spec, &occupancy.meta, base, max_cells)
+        Some(spec) => build_information(spec, &occupancy.meta, base, max_cells, access)
             .map_err(|(f, reason)| field(&f, reason))?,
     };
     for (i, place) in file.places.iter().enumerate() {

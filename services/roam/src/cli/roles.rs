@@ -24,6 +24,10 @@ pub(crate) struct MapServerArgs {
     /// Persist layers and versions in this directory.
     #[arg(long, value_name = "DIR")]
     data_dir: Option<PathBuf>,
+    /// A directory `<root>/map/load` requests may read from (repeat for more; none:
+    /// loads from the wire are off).
+    #[arg(long = "load-dir", value_name = "DIR")]
+    load_dirs: Vec<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -52,6 +56,10 @@ pub(crate) struct StackArgs {
     /// Persist the map server's layers here.
     #[arg(long, value_name = "DIR")]
     data_dir: Option<PathBuf>,
+    /// A directory the map server's and the sim's `load` requests may read from
+    /// (repeat for more; none: loads from the wire are off).
+    #[arg(long = "load-dir", value_name = "DIR")]
+    load_dirs: Vec<PathBuf>,
     /// The in-process router's endpoint (default: a free port on 127.0.0.1).
     #[arg(long, value_name = "ENDPOINT")]
     listen: Option<String>,
@@ -73,6 +81,9 @@ pub(crate) async fn map_server(args: MapServerArgs) -> anyhow::Result<()> {
     }
     if args.data_dir.is_some() {
         config.data_dir = args.data_dir;
+    }
+    if !args.load_dirs.is_empty() {
+        config.load_dirs = args.load_dirs;
     }
     let zenoh = args.service.zenoh_config(&config)?;
     let cancel = signals::cancel_on_signal();
@@ -146,6 +157,7 @@ pub(crate) async fn stack(args: StackArgs) -> anyhow::Result<()> {
         root: args.root,
         map: args.map,
         data_dir: args.data_dir,
+        load_dirs: args.load_dirs,
         listen: args.listen,
         planners: args.planners,
         ..StackOptions::default()

@@ -50,6 +50,10 @@ struct SimRunArgs {
     /// Keep a snapshot of the clock and robots here and resume from it after a restart.
     #[arg(long, value_name = "FILE")]
     state_file: Option<PathBuf>,
+    /// A directory control `load` requests may read scenarios from (repeat for more;
+    /// none: loads from the wire are off).
+    #[arg(long = "load-dir", value_name = "DIR")]
+    load_dirs: Vec<PathBuf>,
 }
 
 pub(crate) async fn sim(args: SimArgs) -> anyhow::Result<()> {
@@ -73,6 +77,9 @@ async fn run(args: SimRunArgs) -> anyhow::Result<()> {
     }
     if args.state_file.is_some() {
         config.state_file = args.state_file;
+    }
+    if !args.load_dirs.is_empty() {
+        config.load_dirs = args.load_dirs;
     }
     if args.paused {
         config.rate = None;
