@@ -8,6 +8,14 @@ use crate::codec::Message;
 /// The most waypoints one mission may hold.
 pub const MAX_WAYPOINTS: usize = 10_000;
 
+/// The longest mission id, bytes: it is echoed in every status, so it stays short.
+pub const MAX_MISSION_ID_BYTES: usize = 128;
+
+/// The largest mission payload a receiver decodes, bytes: [`MAX_WAYPOINTS`] waypoints of
+/// two full-precision numbers (about 45 bytes each), with room. Receivers check the size
+/// before they parse, so a 60 MB mission costs nothing but its transfer.
+pub const MAX_MISSION_BYTES: usize = 1024 * 1024;
+
 /// A mission for one robot, put on `<root>/robot/<id>/mission`: visit the waypoints in
 /// order. A new mission replaces the current one at once; an empty one stops the robot.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -15,9 +23,12 @@ pub const MAX_WAYPOINTS: usize = 10_000;
 pub struct Mission {
     /// The robot, as in the key.
     pub robot: String,
-    /// The sender's name for the mission, echoed in every status.
+    /// The sender's name for the mission, echoed in every status; at most
+    /// [`MAX_MISSION_ID_BYTES`].
+    #[serde(deserialize_with = "crate::bounded::string::<MAX_MISSION_ID_BYTES, _>")]
     pub id: String,
-    /// World metres.
+    /// World metres; at most [`MAX_WAYPOINTS`] (the parse stops at one more).
+    #[serde(deserialize_with = "crate::bounded::vec::<_, MAX_WAYPOINTS, _>")]
     pub waypoints: Vec<[f64; 2]>,
 }
 

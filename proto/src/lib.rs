@@ -6,6 +6,7 @@
 //! trailing garbage), [`error`] is the structured reply every failing request gets, and
 //! the remaining modules are the message types grouped by the service that owns them.
 
+pub mod bounded;
 pub mod cells;
 pub mod codec;
 pub mod controller;

@@ -93,12 +93,21 @@ impl Message for LayerUpdate {
     const KIND: &'static str = "layer_update";
 }
 
+/// The most cell writes one `set_cells` can carry, whatever the map server's configured
+/// `max_cells_per_update` (which may only be lower).
+pub const MAX_WIRE_CELL_WRITES: usize = 1_048_576;
+
 /// What a [`LayerUpdate`] does.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "op", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LayerChange {
-    /// Set individual cells (grid indices, row 0 at the origin).
-    SetCells { cells: Vec<CellWrite> },
+    /// Set individual cells (grid indices, row 0 at the origin); at most
+    /// [`MAX_WIRE_CELL_WRITES`] on the wire (the parse stops at one more), and at most
+    /// the map server's `max_cells_per_update`.
+    SetCells {
+        #[serde(deserialize_with = "crate::bounded::vec::<_, MAX_WIRE_CELL_WRITES, _>")]
+        cells: Vec<CellWrite>,
+    },
     /// Replace the whole layer, possibly with another size or element type.
     Replace { meta: GridMeta, cells: Cells },
 }

@@ -258,12 +258,14 @@ impl Harness {
     }
 
     /// A sim config under this harness's root: `scenario` (the built-in world when
-    /// `None`), paused for lock-step.
+    /// `None`), paused for lock-step; `load` requests may read the shipped scenarios
+    /// (`config/scenarios`, by name).
     pub fn sim_config(&self, scenario: Option<&str>) -> SimConfig {
         SimConfig {
             root: self.root.clone(),
             scenario: scenario.map(repo_path),
             rate: None,
+            load_dirs: vec![repo_path("config/scenarios")],
             ..SimConfig::default()
         }
     }

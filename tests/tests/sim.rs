@@ -79,8 +79,10 @@ async fn stop(harness: Harness, sim: RunningService) {
     harness.close().await;
 }
 
+/// A shipped scenario, by its name in the sim's load directory (`config/scenarios`,
+/// [`Harness::sim_config`]).
 fn scenario(name: &str) -> String {
-    format!("{}/../config/scenarios/{name}", env!("CARGO_MANIFEST_DIR"))
+    name.to_owned()
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
@@ -262,7 +264,12 @@ async fn free_running_publishes_the_clock_and_pauses() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn bad_requests_get_errors_that_name_what_to_fix() {
-    let (harness, sim, client) = boot().await;
+    let harness = Harness::start().await;
+    let dir = tempfile::tempdir().expect("tmp");
+    let mut config = harness.sim_config(None);
+    config.load_dirs.push(dir.path().to_owned());
+    let sim = harness.start_sim(config).await;
+    let client = harness.client().await;
     let root = harness.root.clone();
     let missing = refused(
         &client,
@@ -275,15 +282,19 @@ async fn bad_requests_get_errors_that_name_what_to_fix() {
     .await;
     assert_eq!(missing.code, ErrorCode::NotFound);
     assert!(missing.message.contains("/nonexistent/world.yaml"));
+    assert!(
+        missing.message.contains("load directories"),
+        "{}",
+        missing.message
+    );
 
-    let dir = tempfile::tempdir().expect("tmp");
-    let bad = dir.path().join("bad.yaml");
-    std::fs::write(&bad, "name: bad\nmap: {grid: {size_m: [10, 10], resolution: 0.5}}\nrobots:\n  - { name: r, at: [50.0, 1.0] }\n").expect("write");
+    // A scenario in the load directory that is invalid names the file and the field.
+    std::fs::write(dir.path().join("bad.yaml"), "name: bad\nmap: {grid: {size_m: [10, 10], resolution: 0.5}}\nrobots:\n  - { name: r, at: [50.0, 1.0] }\n").expect("write");
     let invalid = refused(
         &client,
         &root,
         SimControl::Load {
-            path: bad.display().to_string(),
+            path: "bad.yaml".into(),
             seed: 0,
         },
     )

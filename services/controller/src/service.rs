@@ -12,9 +12,15 @@
 //! obstacle map, the anchors and the sensing model come from the configured scenario,
 //! like the localization service's.
 //!
+//! The robot is always the one the key names (a body that names another is refused). A
+//! mission is taken at once for a robot the scenario has or localization reported within
+//! `release_after_s`; one for any other robot waits, in a small bounded table, for that
+//! robot's first estimate, so missions for robots that do not exist hold no slot.
+//!
 //! **Safety** (not in paper 002): a robot whose estimates stop for `stale_after_s` (wall
 //! time) gets a zero command and the state `halted_stale`, repeated every
-//! `stale_after_s / 4` until estimates return; a PEB above the bound holds it
+//! `stale_after_s / 4` until estimates return (after `release_after_s` the robot is
+//! gone and its slot released); a PEB above the bound holds it
 //! (`halted_peb`); no progress over the controller's window ends the mission as `stuck`.
 //! The watchdog runs on wall time because a stalled estimate stream is exactly when sim
 //! time stops being informative.
@@ -26,11 +32,14 @@ use std::time::{Duration, Instant};
 
 use roam_localization::fim::FimOptions;
 use roam_localization::model::RangingModel;
-use roam_proto::controller::{ControllerStatus, Mission, MissionState, MAX_WAYPOINTS};
+use roam_proto::controller::{
+    ControllerStatus, Mission, MissionState, MAX_MISSION_BYTES, MAX_MISSION_ID_BYTES, MAX_WAYPOINTS,
+};
 use roam_proto::localization::PositionEstimate;
 use roam_proto::sim::RobotCommand;
-use roam_proto::{encode, keys, Message};
-use roam_runtime::{Service, ServiceError};
+use roam_proto::{encode, excerpt, keys, Message};
+use roam_runtime::warn_limit::WarnLimiter;
+use roam_runtime::{limited_warn, routing, Service, ServiceError};
 use roam_sim::service::load_scenario;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
@@ -45,6 +54,10 @@ use crate::params::ApfParams;
 pub const SERVICE_NAME: &str = "controller";
 /// Robots one controller instance drives at most.
 pub const MAX_ROBOTS: usize = 1000;
+/// Missions held for robots not yet heard of (see `State::hold`).
+pub const MAX_HELD_MISSIONS: usize = 64;
+/// Largest estimate decoded, bytes (one is a few hundred).
+pub const MAX_ESTIMATE_BYTES: usize = 64 * 1024;
 
 /// The controller service's config file (YAML).
 ///
@@ -52,6 +65,7 @@ pub const MAX_ROBOTS: usize = 1000;
 /// root: roam
 /// scenario: config/scenarios/es1.yaml   # obstacles, anchors, sensing; default: built-in world
 /// stale_after_s: 1.0                    # zero command when estimates stop this long
+/// release_after_s: 30.0                 # forget a robot whose estimates stopped this long
 /// robots: [r1]                          # drive only these robots; default: every robot
 /// apf:                                  # paper 002 §4's values are the defaults
 ///   scheme: linear                      # plain | fixed | cutoff | linear | sinusoidal
@@ -64,6 +78,12 @@ pub struct ControllerConfig {
     pub instance: Option<String>,
     pub scenario: Option<PathBuf>,
     pub stale_after_s: f64,
+    /// A robot whose estimates have stopped this long (wall time; at least twice
+    /// `stale_after_s`) is gone: its slot is released. A mission for a robot without an
+    /// estimate this recent waits (at most [`MAX_HELD_MISSIONS`] of them, each this
+    /// long) for the robot's first estimate, so missions for robots that do not exist
+    /// never take a slot.
+    pub release_after_s: f64,
     /// The robots this instance drives; empty: every robot that is given a mission. A
     /// controller on board a robot names its own, so it subscribes only to that robot's
     /// missions and estimates (nothing else crosses the robot's link) and never drives
@@ -80,6 +100,7 @@ impl Default for ControllerConfig {
             instance: None,
             scenario: None,
             stale_after_s: 1.0,
+            release_after_s: 30.0,
             robots: Vec::new(),
             apf: ApfParams::default(),
             zenoh: None,
@@ -114,14 +135,74 @@ struct State {
     obstacles: Arc<ObstacleField>,
     information: Arc<InformationField>,
     stale_after: Duration,
+    release_after: Duration,
     /// The robots this instance may drive; empty: any.
     allowed: Vec<String>,
     robots: Mutex<HashMap<String, Driven>>,
+    /// The robots the scenario has: a mission for one is taken at once.
+    scenario_robots: Vec<String>,
+    /// When each robot's last estimate came (robots without a mission too), at most
+    /// [`MAX_ROBOTS`]: with the scenario's robots, what "a robot the world has" means
+    /// to the controller.
+    seen: Mutex<HashMap<String, Instant>>,
+    /// Missions for robots not yet heard of, waiting for their first estimate: at most
+    /// [`MAX_HELD_MISSIONS`], the oldest dropped first, each for `release_after`.
+    held: Mutex<HashMap<String, (Instant, Mission)>>,
+    /// Refused missions and estimates, logged a few per key and window.
+    warnings: WarnLimiter,
 }
 
 impl State {
     fn robots(&self) -> MutexGuard<'_, HashMap<String, Driven>> {
         self.robots.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn seen(&self) -> MutexGuard<'_, HashMap<String, Instant>> {
+        self.seen.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Notes an estimate of `robot`; when [`MAX_ROBOTS`] robots are noted, the one
+    /// heard from longest ago makes room.
+    fn note_seen(&self, robot: &str) {
+        let mut seen = self.seen();
+        if !seen.contains_key(robot) && seen.len() >= MAX_ROBOTS {
+            if let Some(oldest) = seen.iter().min_by_key(|(_, t)| **t).map(|(r, _)| r.clone()) {
+                seen.remove(&oldest);
+            }
+        }
+        seen.insert(robot.to_owned(), Instant::now());
+    }
+
+    /// Holds a mission until the robot's first estimate.
+    fn hold(&self, robot: &str, mission: Mission) {
+        let mut held = self.held.lock().unwrap_or_else(|p| p.into_inner());
+        if !held.contains_key(robot) && held.len() >= MAX_HELD_MISSIONS {
+            if let Some(oldest) = held
+                .iter()
+                .min_by_key(|(_, (t, _))| *t)
+                .map(|(r, _)| r.clone())
+            {
+                held.remove(&oldest);
+            }
+        }
+        held.insert(robot.to_owned(), (Instant::now(), mission));
+    }
+
+    /// The mission held for `robot`, if one is and it has not expired.
+    fn take_held(&self, robot: &str) -> Option<Mission> {
+        let mut held = self.held.lock().unwrap_or_else(|p| p.into_inner());
+        let (at, mission) = held.remove(robot)?;
+        (at.elapsed() < self.release_after).then_some(mission)
+    }
+
+    /// Whether the world has `robot`: the scenario names it, or localization reported
+    /// it within `release_after`.
+    fn is_present(&self, robot: &str) -> bool {
+        self.scenario_robots.iter().any(|r| r == robot)
+            || self
+                .seen()
+                .get(robot)
+                .is_some_and(|t| t.elapsed() < self.release_after)
     }
 
     fn put<T: Message>(&self, key: &str, message: &T) {
@@ -178,7 +259,13 @@ fn status_of(
 
 /// Checks a mission before it replaces the robot's current one.
 fn check_mission(mission: &Mission) -> Result<(), String> {
-    keys::check_name("robot", &mission.robot).map_err(|e| e.to_string())?;
+    if mission.id.len() > MAX_MISSION_ID_BYTES {
+        return Err(format!(
+            "the id '{}' is {} bytes; at most {MAX_MISSION_ID_BYTES} (max_mission_id_bytes)",
+            excerpt(&mission.id),
+            mission.id.len()
+        ));
+    }
     if mission.waypoints.len() > MAX_WAYPOINTS {
         return Err(format!(
             "{} waypoints; a mission holds at most {MAX_WAYPOINTS} (max_waypoints)",
@@ -195,37 +282,53 @@ fn check_mission(mission: &Mission) -> Result<(), String> {
     Ok(())
 }
 
-fn on_mission(state: &State, mission: Mission) {
+fn on_mission(state: &State, key: &str, mission: Mission) {
+    let robot = match routing::robot_for(&state.root, key, &mission.robot) {
+        Ok(robot) => robot,
+        Err(e) => return limited_warn!(state.warnings, key, "mission refused: {e}"),
+    };
+    let id = excerpt(&mission.id);
     if let Err(e) = check_mission(&mission) {
-        return tracing::warn!(robot = %mission.robot, id = %mission.id, "mission refused: {e}");
+        return limited_warn!(state.warnings, key, %robot, %id, "mission refused: {e}");
     }
-    if !state.allowed.is_empty() && !state.allowed.contains(&mission.robot) {
-        return tracing::warn!(
-            robot = %mission.robot, id = %mission.id,
+    if !state.allowed.is_empty() && !state.allowed.iter().any(|r| r == robot) {
+        return limited_warn!(
+            state.warnings, key, %robot, %id,
             "mission refused: this controller drives only {:?} (robots)", state.allowed
         );
     }
+    if !state.is_present(robot) {
+        // Not in the scenario and not heard of yet (a robot just added to the sim, a
+        // real robot before its first scan): the mission waits for the robot's first estimate, in a small table of its own,
+        // so missions for robots that do not exist never take a driving slot.
+        tracing::debug!(%robot, %id, "mission held until the robot's first estimate");
+        state.hold(robot, mission);
+        return;
+    }
+    install_mission(state, robot, &mission);
+}
+
+/// Makes `mission` the robot's current one and publishes its first status.
+fn install_mission(state: &State, robot: &str, mission: &Mission) {
     let mut robots = state.robots();
-    if robots.len() >= MAX_ROBOTS && !robots.contains_key(&mission.robot) {
-        return tracing::warn!(
-            robot = %mission.robot,
+    if robots.len() >= MAX_ROBOTS && !robots.contains_key(robot) {
+        return limited_warn!(
+            state.warnings, robot, %robot,
             "mission refused: this controller already drives {MAX_ROBOTS} robots (max_robots)"
         );
     }
-    let driven = robots
-        .entry(mission.robot.clone())
-        .or_insert_with(|| Driven {
-            controller: Controller::new(
-                state.params.clone(),
-                state.obstacles.clone(),
-                state.information.clone(),
-            ),
-            mission: String::new(),
-            waypoints: 0,
-            last_estimate: Instant::now(),
-            stale: false,
-            last: None,
-        });
+    let driven = robots.entry(robot.to_owned()).or_insert_with(|| Driven {
+        controller: Controller::new(
+            state.params.clone(),
+            state.obstacles.clone(),
+            state.information.clone(),
+        ),
+        mission: String::new(),
+        waypoints: 0,
+        last_estimate: Instant::now(),
+        stale: false,
+        last: None,
+    });
     driven.controller.set_mission(mission.waypoints.clone());
     driven.mission = mission.id.clone();
     driven.waypoints = mission.waypoints.len();
@@ -237,7 +340,7 @@ fn on_mission(state: &State, mission: Mission) {
         MissionState::Active
     };
     let status = ControllerStatus {
-        robot: mission.robot.clone(),
+        robot: robot.to_owned(),
         mission: Some(mission.id.clone()),
         state: state_now,
         waypoint: (!mission.waypoints.is_empty()).then_some(0),
@@ -252,27 +355,32 @@ fn on_mission(state: &State, mission: Mission) {
     };
     driven.last = Some(status.clone());
     drop(robots);
-    tracing::info!(robot = %mission.robot, id = %mission.id, waypoints = mission.waypoints.len(), "mission set");
+    tracing::info!(%robot, id = %excerpt(&mission.id), waypoints = mission.waypoints.len(), "mission set");
     if mission.waypoints.is_empty() {
         // An empty mission stops the robot now, not at its next estimate.
-        state.command(&mission.robot, [0.0, 0.0], None);
+        state.command(robot, [0.0, 0.0], None);
     }
-    state.put(
-        &keys::robot_controller(&state.root, &mission.robot),
-        &status,
-    );
+    state.put(&keys::robot_controller(&state.root, robot), &status);
 }
 
-fn on_estimate(state: &State, estimate: PositionEstimate) {
+fn on_estimate(state: &State, key: &str, estimate: PositionEstimate) {
+    let robot = match routing::robot_for(&state.root, key, &estimate.robot) {
+        Ok(robot) => robot,
+        Err(e) => return limited_warn!(state.warnings, key, "ignoring an estimate: {e}"),
+    };
+    state.note_seen(robot);
+    if let Some(mission) = state.take_held(robot) {
+        install_mission(state, robot, &mission);
+    }
     let (status, u) = {
         let mut robots = state.robots();
-        let Some(driven) = robots.get_mut(&estimate.robot) else {
+        let Some(driven) = robots.get_mut(robot) else {
             return;
         };
         driven.last_estimate = Instant::now();
         driven.stale = false;
         let decision = driven.controller.update(estimate.position, estimate.peb_m);
-        let status = status_of(&estimate.robot, driven, &decision, Some(&estimate));
+        let status = status_of(robot, driven, &decision, Some(&estimate));
         driven.last = Some(status.clone());
         let u = match decision.status {
             MissionStatus::Idle => None,
@@ -281,15 +389,13 @@ fn on_estimate(state: &State, estimate: PositionEstimate) {
         (status, u)
     };
     if let Some(u) = u {
-        state.command(&estimate.robot, u, Some(estimate.step));
+        state.command(robot, u, Some(estimate.step));
     }
-    state.put(
-        &keys::robot_controller(&state.root, &estimate.robot),
-        &status,
-    );
+    state.put(&keys::robot_controller(&state.root, robot), &status);
 }
 
-/// Holds every robot whose estimates have stopped: a zero command and `halted_stale`.
+/// Holds every robot whose estimates have stopped: a zero command and `halted_stale`;
+/// forgets a robot whose estimates have stopped for `release_after_s` (it is gone).
 async fn watchdog(state: Arc<State>, cancel: CancellationToken) {
     let tick = (state.stale_after / 4).max(Duration::from_millis(5));
     loop {
@@ -297,6 +403,7 @@ async fn watchdog(state: Arc<State>, cancel: CancellationToken) {
             _ = cancel.cancelled() => return,
             _ = tokio::time::sleep(tick) => {}
         }
+        release_gone(&state);
         let halted: Vec<(String, ControllerStatus, bool)> = {
             let mut robots = state.robots();
             robots
@@ -324,6 +431,25 @@ async fn watchdog(state: Arc<State>, cancel: CancellationToken) {
     }
 }
 
+/// Releases the slots of robots not heard from for `release_after`: a robot removed from
+/// the world, or one that never was, stops costing a slot, commands and statuses.
+fn release_gone(state: &State) {
+    let release_after = state.release_after;
+    state.seen().retain(|_, t| t.elapsed() < release_after);
+    state
+        .held
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .retain(|_, (t, _)| t.elapsed() < release_after);
+    state.robots().retain(|robot, d| {
+        let keep = d.last_estimate.elapsed() < release_after;
+        if !keep {
+            tracing::info!(%robot, "no estimate for {release_after:?}: the robot is gone, its slot released");
+        }
+        keep
+    });
+}
+
 /// Runs the controller service until `cancel` is cancelled.
 pub async fn run(
     config: ControllerConfig,
@@ -338,6 +464,12 @@ pub async fn run(
         return Err(ControllerServiceError::Config(format!(
             "stale_after_s is {}; give a positive number of seconds",
             config.stale_after_s
+        )));
+    }
+    if !(config.release_after_s.is_finite() && config.release_after_s > 0.0) {
+        return Err(ControllerServiceError::Config(format!(
+            "release_after_s is {}; give a positive number of seconds",
+            config.release_after_s
         )));
     }
     for robot in &config.robots {
@@ -365,8 +497,21 @@ pub async fn run(
         obstacles,
         information,
         stale_after: Duration::from_secs_f64(config.stale_after_s),
+        // A robot is gone only well after it is stale: a halted robot keeps its slot.
+        release_after: Duration::from_secs_f64(
+            config.release_after_s.max(2.0 * config.stale_after_s),
+        ),
         allowed: config.robots.clone(),
         robots: Mutex::new(HashMap::new()),
+        scenario_robots: scenario
+            .file
+            .robots
+            .iter()
+            .map(|r| r.name.clone())
+            .collect(),
+        seen: Mutex::new(HashMap::new()),
+        held: Mutex::new(HashMap::new()),
+        warnings: WarnLimiter::new(),
     });
     let (mission_keys, estimate_keys): (Vec<String>, Vec<String>) = if config.robots.is_empty() {
         (
@@ -387,19 +532,23 @@ pub async fn run(
     };
     for key in &mission_keys {
         service
-            .subscribe(
+            .subscribe_with(
                 key,
+                MAX_MISSION_BYTES,
                 state.clone(),
-                |state: &Arc<State>, mission: Mission| on_mission(state, mission),
+                |state: &Arc<State>, key: &str, mission: Mission| on_mission(state, key, mission),
             )
             .await?;
     }
     for key in &estimate_keys {
         service
-            .subscribe(
+            .subscribe_with(
                 key,
+                MAX_ESTIMATE_BYTES,
                 state.clone(),
-                |state: &Arc<State>, estimate: PositionEstimate| on_estimate(state, estimate),
+                |state: &Arc<State>, key: &str, estimate: PositionEstimate| {
+                    on_estimate(state, key, estimate)
+                },
             )
             .await?;
     }

@@ -22,7 +22,8 @@ use roam_proto::localization::{CrbCells, PebAt, PebQuery, PebReply, PebWhere};
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
 use roam_proto::sim::{NamedPoint, RangeScan};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
-use roam_runtime::{reply, Requester, Service, ServiceError};
+use roam_runtime::warn_limit::WarnLimiter;
+use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
 use roam_sim::service::load_scenario;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
@@ -42,6 +43,9 @@ pub const SERVICE_NAME: &str = "localization";
 pub use crate::tracker::MAX_ROBOTS;
 /// Largest PEB query, bytes.
 pub const MAX_REQUEST_BYTES: usize = 4 * 1024 * 1024;
+/// Largest range scan decoded, bytes: a scan of [`MAX_ANCHORS`](crate::model::MAX_ANCHORS)
+/// anchors at about 100 bytes each, with room.
+pub const MAX_SCAN_BYTES: usize = 1024 * 1024;
 /// The name of the layer the service publishes to the map server.
 pub const PEB_LAYER: &str = "peb";
 
@@ -97,6 +101,8 @@ struct State {
     fim: FimOptions,
     /// Per-robot priors: the one estimation code path the batch episodes share.
     tracker: Mutex<Tracker>,
+    /// Refused scans, logged a few per key and window.
+    warnings: WarnLimiter,
 }
 
 fn model_of(
@@ -161,12 +167,14 @@ pub async fn run(
         map: scenario.occupancy.meta,
         fim,
         tracker: Mutex::new(Tracker::new(sensing, fim)),
+        warnings: WarnLimiter::new(),
     });
     service
-        .subscribe(
+        .subscribe_with(
             &keys::robot_ranges_any(&config.root),
+            MAX_SCAN_BYTES,
             state.clone(),
-            |state: &Arc<State>, scan: RangeScan| on_scan(state, scan),
+            |state: &Arc<State>, key: &str, scan: RangeScan| on_scan(state, key, scan),
         )
         .await?;
     let peb = service
@@ -186,8 +194,13 @@ pub async fn run(
     Ok(())
 }
 
-/// Estimates a robot's position from one scan ([`Tracker::on_scan`]) and publishes it.
-fn on_scan(state: &State, scan: RangeScan) {
+/// Estimates a robot's position from one scan ([`Tracker::on_scan`]) and publishes it on
+/// the robot's key: the robot is the one the scan's key names ([`routing`]).
+fn on_scan(state: &State, key: &str, scan: RangeScan) {
+    let robot = match routing::robot_for(&state.root, key, &scan.robot) {
+        Ok(robot) => robot,
+        Err(e) => return limited_warn!(state.warnings, key, "ignoring a scan: {e}"),
+    };
     let message = match state
         .tracker
         .lock()
@@ -195,9 +208,9 @@ fn on_scan(state: &State, scan: RangeScan) {
         .on_scan(&scan)
     {
         Ok(m) => m,
-        Err(e) => return tracing::warn!(robot = %scan.robot, "ignoring a scan: {e}"),
+        Err(e) => return limited_warn!(state.warnings, robot, %robot, "ignoring a scan: {e}"),
     };
-    let key = keys::robot_estimate(&state.root, &scan.robot);
+    let key = keys::robot_estimate(&state.root, robot);
     if let Err(e) = state.session.put(&key, encode(&message)).wait() {
         tracing::warn!(%key, "publishing the estimate failed: {e}");
     }
@@ -228,6 +241,7 @@ fn peb_reply(state: &State, request: &PebQuery) -> Result<PebReply, ErrorReply> 
         .map(|a| a.at)
         .collect();
     let model = model_of(&anchors, &state.sensing).map_err(|e| error_reply(&e))?;
+    check_peb_work(request, anchors.len())?;
     match &request.at {
         PebWhere::Points(points) => {
             let bounds = bounds_at(&model, points, &state.fim).map_err(|e| error_reply(&e))?;
@@ -277,6 +291,40 @@ fn peb_reply(state: &State, request: &PebQuery) -> Result<PebReply, ErrorReply> 
             })
         }
     }
+}
+
+/// The most point-anchor evaluations one PEB query may cost (a 1000 × 1000 field with
+/// 100 anchors, about a third of a CPU-second here): the cells and the anchors are each
+/// bounded, but not their product, and 4 M cells × 4,096 anchors cost 45 CPU-seconds.
+pub const MAX_PEB_WORK: u64 = 100_000_000;
+
+/// Evaluations of one point's FIM per query point: a gradient takes four more
+/// (central differences in x and y).
+const GRADIENT_EVALUATIONS: u64 = 5;
+
+/// Refuses a query whose cells (or points) × anchors is over [`MAX_PEB_WORK`], before any
+/// of it is computed.
+fn check_peb_work(request: &PebQuery, anchors: usize) -> Result<(), ErrorReply> {
+    let (points, per_point) = match &request.at {
+        PebWhere::Points(points) if request.gradient => (points.len() as u64, GRADIENT_EVALUATIONS),
+        PebWhere::Points(points) => (points.len() as u64, 1),
+        PebWhere::Region(meta) => (meta.cell_count(), 1),
+    };
+    let work = points
+        .saturating_mul(per_point)
+        .saturating_mul(anchors as u64);
+    if work > MAX_PEB_WORK {
+        return Err(ErrorReply::limit(
+            "max_peb_work",
+            MAX_PEB_WORK,
+            work,
+            format!(
+                "{points} points × {anchors} anchors{} is {work} evaluations, over max_peb_work = {MAX_PEB_WORK}; query fewer or coarser cells, or fewer anchors",
+                if per_point > 1 { " × 5 for the gradient" } else { "" }
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn region_of(meta: &GridMeta) -> GridRegion {

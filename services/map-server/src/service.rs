@@ -11,7 +11,7 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, MutexGuard};
 
-use roam_proto::map::{LayerList, LayerUpdate, LoadMap};
+use roam_proto::map::{LayerList, LayerUpdate, LoadMap, MAX_WIRE_CELL_WRITES};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, Service, ServiceError};
@@ -45,6 +45,9 @@ pub enum MapServerError {
     #[error("invalid config: {0}")]
     Config(String),
 }
+
+/// Largest load request, bytes: a file name.
+pub const MAX_LOAD_REQUEST_BYTES: usize = 64 * 1024;
 
 /// What the query handlers share.
 struct State {
@@ -108,6 +111,12 @@ pub fn open_store(config: &MapServerConfig) -> Result<LayerStore, MapServerError
         return Err(MapServerError::Config(format!(
             "heuristic_compression must be in (0, 1], got {}",
             config.heuristic_compression
+        )));
+    }
+    if config.limits.max_cells_per_update > MAX_WIRE_CELL_WRITES as u64 {
+        return Err(MapServerError::Config(format!(
+            "limits.max_cells_per_update is {}; at most {MAX_WIRE_CELL_WRITES} cells travel in one update",
+            config.limits.max_cells_per_update
         )));
     }
     let data = config.data_dir.as_deref().map(DataDir::open).transpose()?;
@@ -276,8 +285,7 @@ async fn answer_update(state: Arc<State>, query: &Query) {
 }
 
 async fn answer_load(state: Arc<State>, query: &Query) {
-    let max = state.store().limits().max_request_bytes as usize;
-    let request = match reply::decode_request::<LoadMap>(query, max) {
+    let request = match reply::decode_request::<LoadMap>(query, MAX_LOAD_REQUEST_BYTES) {
         Ok(r) => r,
         Err(e) => return reply::send_error(query, &e).await,
     };

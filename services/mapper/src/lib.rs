@@ -20,6 +20,7 @@
 //! - [`learner`]: strategies, modes, the tile coder, V_S, its update and the softmax.
 //! - [`goals`]: goal sampling from the patch-averaged weights.
 //! - [`wavefront`]: the wavefront planner with hill climbing and "as close as possible".
+//! - [`epoch`]: observation times against the sim clock; sim resets as epochs.
 //! - [`explorer`]: the per-robot loop: episodes, navigation, local exploration, reward.
 //! - [`truth`]: the true change rates of a scripted world, for scoring.
 //! - [`experiment`], [`plot`]: paper 004 §5 on grid004, its table and its Fig. 3.
@@ -109,6 +110,7 @@
 
 pub mod bench;
 pub mod change_map;
+pub mod epoch;
 pub mod error;
 pub mod experiment;
 pub mod explorer;

@@ -9,6 +9,9 @@
 //! | `<root>/robot/<id>/goal` | publication, when the learner picks a goal | `exploration_goal` |
 //! | `<root>/mapper/status` | queryable | → `mapper_status` |
 //!
+//! The robot is the one the observation's key names; observation times are checked
+//! against the sim clock, and a sim reset starts a new epoch ([`crate::epoch`]).
+//!
 //! Every robot's observations merge into one map. The layers are computed and sent at
 //! most once per `publish_period_s` (wall time), and only when something was observed
 //! since the last send: a map server is never flooded, whatever the robots' rate.
@@ -26,9 +29,10 @@ use roam_proto::mapper::{
     ExplorationGoal, ExplorerStatus, MapperStatus, CHANGE_INFORMATION_LAYER,
     CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER, RECENCY_LAYER,
 };
-use roam_proto::sim::{LocalObservation, RobotCommand};
+use roam_proto::sim::{LocalObservation, RobotCommand, SimClock};
 use roam_proto::{encode, keys, ErrorReply, Message};
-use roam_runtime::{reply, Requester, Service, ServiceError};
+use roam_runtime::warn_limit::WarnLimiter;
+use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
 use roam_sim::service::load_scenario;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
@@ -37,11 +41,16 @@ use zenoh::query::Query;
 use zenoh::Wait;
 
 use crate::change_map::{ChangeMap, MapParams, ObservationWindow};
+use crate::epoch::Epochs;
 use crate::explorer::{Explorer, ExplorerParams, Mode};
 
 pub const SERVICE_NAME: &str = "mapper";
 /// Robots the learner drives at most.
 pub const MAX_EXPLORERS: usize = 64;
+/// Largest observation decoded, bytes: a window of about three million cells.
+pub const MAX_OBSERVATION_BYTES: usize = 4 * 1024 * 1024;
+/// Largest sim clock decoded, bytes (one is about 60).
+const MAX_CLOCK_BYTES: usize = 1024;
 
 /// The mapper's config file (YAML).
 ///
@@ -101,11 +110,13 @@ struct Mapping {
     observations: u64,
     map_changes: u64,
     features: (f64, f64),
-    /// Sim time of the newest observation.
+    /// Mapper time ([`Epochs`]) of the newest observation.
     now_s: f64,
     /// Something was observed since the layers were last sent.
     dirty: bool,
     layers_sent: u64,
+    /// Observation times against the sim clock; resets as epochs.
+    epochs: Epochs,
 }
 
 struct State {
@@ -113,6 +124,8 @@ struct State {
     session: zenoh::Session,
     meta: MapMeta,
     mapping: Mutex<Mapping>,
+    /// Refused observations, logged a few per key and window.
+    warnings: WarnLimiter,
 }
 
 impl State {
@@ -171,9 +184,13 @@ fn cell_centre(meta: &MapMeta, (x, y): (u32, u32)) -> [f64; 2] {
     ]
 }
 
-fn on_observation(state: &State, o: LocalObservation) {
+fn on_observation(state: &State, key: &str, o: LocalObservation) {
+    let robot = match routing::robot_for(&state.root, key, &o.robot) {
+        Ok(robot) => robot,
+        Err(e) => return limited_warn!(state.warnings, key, "ignoring an observation: {e}"),
+    };
     if let Err(e) = check_observation(&state.meta, &o) {
-        return tracing::warn!(robot = %o.robot, step = o.step, "ignoring an observation: {e}");
+        return limited_warn!(state.warnings, robot, %robot, step = o.step, "ignoring an observation: {e}");
     }
     let Cells::I8(cells) = &o.cells else {
         return;
@@ -188,33 +205,40 @@ fn on_observation(state: &State, o: LocalObservation) {
     let out = {
         let mut guard = state.mapping();
         let m = &mut *guard;
-        let update = match m.map.observe(&window, o.time_s) {
-            Ok(u) => u,
+        let t = match m.epochs.observation_time(o.time_s) {
+            Ok(t) => t,
             Err(e) => {
-                return tracing::warn!(robot = %o.robot, "ignoring an observation: {e}");
+                return limited_warn!(state.warnings, robot, %robot, "ignoring an observation: {e}");
             }
         };
+        let update = match m.map.observe(&window, t) {
+            Ok(u) => u,
+            Err(e) => {
+                return limited_warn!(state.warnings, robot, %robot, "ignoring an observation: {e}");
+            }
+        };
+        m.epochs.accepted(t);
         m.observations += 1;
         m.map_changes += update.map_changes(true) as u64;
-        m.now_s = m.now_s.max(o.time_s);
+        m.now_s = m.now_s.max(t);
         m.dirty = true;
-        let features = m.map.features(o.time_s);
+        let features = m.map.features(t);
         m.features = (features.p, features.r);
-        match (m.explorers.get_mut(&o.robot), m.map.cell_of(o.at)) {
+        match (m.explorers.get_mut(robot), m.map.cell_of(o.at)) {
             (Some(explorer), Some(cell)) => {
-                match explorer.on_update(&mut m.map, &update, cell, o.time_s) {
+                match explorer.on_update(&mut m.map, &update, cell, t) {
                     Ok(step) => {
                         let at = cell_centre(&state.meta, step.episode_goal);
                         let strategy = step.strategy.as_str().to_owned();
                         let episodes = explorer.episodes_ended();
-                        let fresh = m.goals.get(&o.robot).is_none_or(|(goal, s, e)| {
+                        let fresh = m.goals.get(robot).is_none_or(|(goal, s, e)| {
                             *goal != at || *s != strategy || *e != episodes
                         });
                         let goal = fresh.then(|| {
                             m.goals
-                                .insert(o.robot.clone(), (at, strategy.clone(), episodes));
+                                .insert(robot.to_owned(), (at, strategy.clone(), episodes));
                             ExplorationGoal {
-                                robot: o.robot.clone(),
+                                robot: robot.to_owned(),
                                 step: o.step,
                                 time_s: o.time_s,
                                 goal: at,
@@ -225,7 +249,7 @@ fn on_observation(state: &State, o: LocalObservation) {
                         Some((step.u, goal))
                     }
                     Err(e) => {
-                        tracing::warn!(robot = %o.robot, "no exploration step: {e}");
+                        limited_warn!(state.warnings, robot, %robot, "no exploration step: {e}");
                         None
                     }
                 }
@@ -235,14 +259,14 @@ fn on_observation(state: &State, o: LocalObservation) {
     };
     if let Some((u, goal)) = out {
         state.put(
-            &keys::robot_command(&state.root, &o.robot),
+            &keys::robot_command(&state.root, robot),
             &RobotCommand {
                 u,
                 step: Some(o.step),
             },
         );
         if let Some(goal) = goal {
-            state.put(&keys::robot_goal(&state.root, &o.robot), &goal);
+            state.put(&keys::robot_goal(&state.root, robot), &goal);
         }
     }
 }
@@ -437,13 +461,26 @@ pub async fn run(
             now_s: 0.0,
             dirty: false,
             layers_sent: 0,
+            epochs: Epochs::default(),
         }),
+        warnings: WarnLimiter::new(),
     });
     service
-        .subscribe(
-            &keys::robot_observation_any(&config.root),
+        .subscribe_with(
+            &keys::sim_clock(&config.root),
+            MAX_CLOCK_BYTES,
             state.clone(),
-            |state: &Arc<State>, o: LocalObservation| on_observation(state, o),
+            |state: &Arc<State>, _key: &str, clock: SimClock| {
+                state.mapping().epochs.on_clock(clock.time_s)
+            },
+        )
+        .await?;
+    service
+        .subscribe_with(
+            &keys::robot_observation_any(&config.root),
+            MAX_OBSERVATION_BYTES,
+            state.clone(),
+            |state: &Arc<State>, key: &str, o: LocalObservation| on_observation(state, key, o),
         )
         .await?;
     let status_queryable = service

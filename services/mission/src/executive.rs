@@ -21,11 +21,10 @@ use std::time::{Duration, Instant};
 use roam_planner::client::PlannerClient;
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
-use roam_proto::controller::{ControllerStatus, Mission, MissionState};
-use roam_proto::localization::PositionEstimate;
+use roam_proto::controller::{Mission, MissionState};
 use roam_proto::mission::WindowReport;
 use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
-use roam_proto::{decode, encode, keys};
+use roam_proto::{encode, keys};
 use roam_runtime::{ClientError, Requester};
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
@@ -344,7 +343,7 @@ impl Run<'_> {
                 }
                 sample = self.inputs.estimates.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
-                    if let Ok(e) = decode::<PositionEstimate>(&sample.payload().to_bytes()) {
+                    if let Some(e) = self.inputs.estimate(&sample) {
                         if !e.degraded {
                             self.position = Some(e.position);
                             return Ok(e.position);
@@ -443,7 +442,7 @@ impl Run<'_> {
                 }
                 sample = self.inputs.estimates.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
-                    let Ok(e) = decode::<PositionEstimate>(&sample.payload().to_bytes()) else { continue };
+                    let Some(e) = self.inputs.estimate(&sample) else { continue };
                     if e.degraded {
                         continue;
                     }
@@ -458,7 +457,7 @@ impl Run<'_> {
                 }
                 sample = self.inputs.statuses.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
-                    let Ok(s) = decode::<ControllerStatus>(&sample.payload().to_bytes()) else { continue };
+                    let Some(s) = self.inputs.status(&sample) else { continue };
                     if s.mission.as_deref() != Some(mission.as_str()) {
                         continue;
                     }

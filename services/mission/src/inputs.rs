@@ -10,12 +10,15 @@ use roam_map_server::store::{INFLATED, INFORMATION};
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
 use roam_proto::cells::Cells;
+use roam_proto::controller::ControllerStatus;
+use roam_proto::localization::PositionEstimate;
 use roam_proto::map::Layer;
 use roam_proto::sim::SimClock;
 use roam_proto::ErrorCode;
 use roam_proto::{decode, keys};
 use roam_runtime::{ClientError, Requester};
 use tokio_util::sync::CancellationToken;
+use zenoh::sample::Sample;
 
 use crate::executive::ExecutiveError;
 
@@ -134,6 +137,36 @@ pub(crate) struct Inputs {
     pub(crate) statuses:
         zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
     _clock: zenoh::pubsub::Subscriber<()>,
+    robot: String,
+    estimate_key: String,
+    status_key: String,
+}
+
+/// Largest estimate or controller status decoded, bytes (each is a few hundred).
+const MAX_INPUT_BYTES: usize = 64 * 1024;
+
+impl Inputs {
+    /// The estimate in `sample` when it is this robot's: heard on exactly the robot's
+    /// key (not a wildcard a stranger put on, such as `robot/**/estimate`) and naming
+    /// the robot in its body. Anything else is ignored.
+    pub(crate) fn estimate(&self, sample: &Sample) -> Option<PositionEstimate> {
+        let e: PositionEstimate = own(sample, &self.estimate_key)?;
+        (e.robot == self.robot).then_some(e)
+    }
+
+    /// The controller's status in `sample` when it is on this robot, as
+    /// [`Inputs::estimate`].
+    pub(crate) fn status(&self, sample: &Sample) -> Option<ControllerStatus> {
+        let s: ControllerStatus = own(sample, &self.status_key)?;
+        (s.robot == self.robot).then_some(s)
+    }
+}
+
+fn own<T: roam_proto::Message>(sample: &Sample, key: &str) -> Option<T> {
+    if sample.key_expr().as_str() != key || sample.payload().len() > MAX_INPUT_BYTES {
+        return None;
+    }
+    decode(&sample.payload().to_bytes()).ok()
 }
 
 pub(crate) async fn listen(
@@ -159,12 +192,14 @@ pub(crate) async fn listen(
         })
         .await
         .map_err(|e| ExecutiveError::Zenoh(e.to_string()))?;
+    let estimate_key = keys::robot_estimate(root, robot);
+    let status_key = keys::robot_controller(root, robot);
     let estimates = session
-        .declare_subscriber(keys::robot_estimate(root, robot))
+        .declare_subscriber(&estimate_key)
         .await
         .map_err(|e| ExecutiveError::Zenoh(e.to_string()))?;
     let statuses = session
-        .declare_subscriber(keys::robot_controller(root, robot))
+        .declare_subscriber(&status_key)
         .await
         .map_err(|e| ExecutiveError::Zenoh(e.to_string()))?;
     Ok(Inputs {
@@ -172,5 +207,8 @@ pub(crate) async fn listen(
         estimates,
         statuses,
         _clock: clock_sub,
+        robot: robot.to_owned(),
+        estimate_key,
+        status_key,
     })
 }

@@ -7,12 +7,14 @@
 //! - [`signals`]: SIGINT / SIGTERM as a cancellation;
 //! - [`config_file`]: reading a service's YAML/JSON config file with errors that name it;
 //! - [`reply`] and [`client`]: the two ends of a query, with roam's codec and error reply;
+//! - [`routing`]: the robot a message is for is the one its key names;
 //! - [`telemetry`]: tracing from `RUST_LOG`;
 //! - [`warn_limit`]: warnings about wire data, a few lines per source and a count.
 
 pub mod client;
 pub mod config_file;
 pub mod reply;
+pub mod routing;
 pub mod service;
 pub mod session;
 pub mod signals;
