@@ -1,0 +1,116 @@
+//! Bounded, escaped echoes: a huge field comes back as a short excerpt, a flood of bad
+//! puts makes a few log lines, and a name with a newline or a terminal escape cannot
+//! forge a log line.
+
+use roam_proto::controller::Mission;
+use roam_proto::map::UpdateAck;
+use roam_proto::{encode, keys};
+use roam_runtime::{ClientError, Requester};
+use roam_tests::{within, Harness};
+
+use crate::logs::Captured;
+
+/// The largest error reply an echo attack may get back, bytes.
+pub(crate) const MAX_ECHO_REPLY_BYTES: usize = 1024;
+/// How much twenty one-megabyte bad puts to each subscriber may grow the log, bytes.
+pub(crate) const MAX_FLOOD_LOG_BYTES: usize = 64 * 1024;
+
+/// A line a forged robot name would start if it reached the log raw.
+const FORGED_LINE: &str = "2026-01-01T00:00:00.000000Z  INFO roam: forged";
+
+async fn refused_bytes(client: &Requester, key: &str, payload: Vec<u8>) -> usize {
+    match client.request_raw::<UpdateAck>(key, Some(payload)).await {
+        Err(ClientError::Refused(reply)) => encode(&reply).len(),
+        other => panic!("expected a refusal, got {other:?}"),
+    }
+}
+
+/// Replies to huge fields stay small.
+pub(crate) async fn replies(harness: &Harness, client: &Requester) {
+    let server = harness.start_map_server(harness.map_server_config()).await;
+    let key = keys::map_update(&harness.root, "occupancy");
+    let kind = "k".repeat(5_000_000);
+    let huge_kind = format!(r#"{{"v":1,"kind":"{kind}","body":{{}}}}"#).into_bytes();
+    let size = within("huge kind", refused_bytes(client, &key, huge_kind)).await;
+    assert!(
+        size <= MAX_ECHO_REPLY_BYTES,
+        "a 5 MB kind came back in {size} bytes"
+    );
+    let quoted = "x".repeat(1_000_000);
+    let huge_value = format!(
+        r#"{{"v":1,"kind":"layer_update","body":{{"base_version":"{quoted}","change":{{}}}}}}"#
+    )
+    .into_bytes();
+    let size = within("huge value", refused_bytes(client, &key, huge_value)).await;
+    assert!(
+        size <= MAX_ECHO_REPLY_BYTES,
+        "a 1 MB string came back in {size} bytes"
+    );
+    server.stop().await.1.expect("clean stop");
+}
+
+/// Floods of bad puts make a bounded log, and forged names stay on one escaped line.
+pub(crate) async fn logs(harness: &Harness, client: &Requester, log: &Captured) {
+    let localization = harness.start_localization(None).await;
+    let controller = harness.start_controller(harness.controller_config()).await;
+    let mapper = harness.start_mapper(harness.mapper_config()).await;
+    let root = harness.root.clone();
+    let session = client.session();
+
+    let before = log.len();
+    let kind = "k".repeat(1_000_000);
+    let huge_kind = format!(r#"{{"v":1,"kind":"{kind}","body":{{}}}}"#);
+    let long_id = Mission {
+        robot: "robot".into(),
+        id: "i".repeat(1_000_000),
+        waypoints: vec![[1.0, 1.0]],
+    };
+    for _ in 0..20 {
+        for leaf in ["mission", "ranges", "observation", "estimate"] {
+            let key = format!("{root}/robot/robot/{leaf}");
+            within("put", session.put(&key, huge_kind.as_bytes().to_vec()))
+                .await
+                .expect("put");
+        }
+        within(
+            "put",
+            session.put(keys::robot_mission(&root, "robot"), encode(&long_id)),
+        )
+        .await
+        .expect("put");
+    }
+    // A forged name, then a valid put on the same keys so the flood has been handled
+    // when the check runs (each subscriber handles its samples in order).
+    let forged = Mission {
+        robot: format!("robot\n{FORGED_LINE}\u{1b}[31m"),
+        id: format!("id\n{FORGED_LINE}"),
+        waypoints: vec![],
+    };
+    within(
+        "put",
+        session.put(keys::robot_mission(&root, "robot"), encode(&forged)),
+    )
+    .await
+    .expect("put");
+    log.wait_for(before, "the body names robot 'robot\\n2026").await;
+    mapper.stop().await.1.expect("clean stop");
+    controller.stop().await.1.expect("clean stop");
+    localization.stop().await.1.expect("clean stop");
+
+    let grown = log.len() - before;
+    let text = log.since(before);
+    assert!(
+        grown <= MAX_FLOOD_LOG_BYTES,
+        "100 one-megabyte bad puts grew the log by {grown} bytes:\n{}",
+        &text[..text.len().min(2000)]
+    );
+    assert!(
+        !text.contains(&format!("\n{FORGED_LINE}")),
+        "a forged name started a log line"
+    );
+    assert!(!text.contains('\u{1b}'), "a terminal escape reached the log");
+    assert!(
+        text.contains("mission refused"),
+        "the refusals are logged:\n{text}"
+    );
+}

@@ -1,0 +1,44 @@
+//! The attack test: what a stranger on an open router (or a low-privilege role) tried
+//! against running stacks, repeated against real services through Zenoh, with what must
+//! hold asserted:
+//!
+//! - loads read no file outside the load directories, answer a forbidden file as a
+//!   missing one (no existence oracle) and never quote a file, in a reply or a log
+//!   ([`files`]);
+//! - keys decide: a body naming another robot is refused, nothing is published on a key
+//!   a body chose, a forged mission or scan moves nothing ([`routing`]);
+//! - echoes are bounded and escaped: replies to megabyte fields stay under
+//!   [`echo::MAX_ECHO_REPLY_BYTES`], a flood of bad puts grows the log by at most
+//!   [`echo::MAX_FLOOD_LOG_BYTES`], and names with newlines or terminal escapes forge no
+//!   log line ([`echo`]).
+//!
+//! The phases run one after another in one test, because the log is the process's and
+//! its growth is measured. The secure site's version of the file attack (the operator
+//! loading the router's user dictionary) is in the access-control test.
+
+mod echo;
+mod files;
+mod logs;
+mod routing;
+
+use roam_tests::Harness;
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn attacks_on_a_running_stack_find_nothing() {
+    let log = logs::capture();
+    let harness = Harness::start().await;
+    let client = harness.client().await;
+
+    let files = files::Files::new();
+    let from = log.len();
+    files::map_loads(&harness, &client, &files).await;
+    files::sim_loads(&harness, &client, &files).await;
+    files::check_log(&log, from);
+
+    routing::keys_decide(&harness, &client).await;
+
+    echo::replies(&harness, &client).await;
+    echo::logs(&harness, &client, &log).await;
+
+    harness.close().await;
+}
