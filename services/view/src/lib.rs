@@ -8,12 +8,16 @@
 //!
 //! - [`convert`]: roam messages as Foxglove messages (pure functions);
 //! - `follow`: the Zenoh subscriptions and queries, and what is logged where;
+//! - `wire`: the caps on what is read from Zenoh and the escaping of what is shown;
+//! - `roster`: per-robot state for a bounded number of robots;
 //! - `output`: the WebSocket server, the MCAP file and the latch that lets a client that
 //!   connects late see the maps.
 
 pub mod convert;
 mod follow;
 mod output;
+mod roster;
+pub mod wire;
 
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -23,8 +27,8 @@ use tokio::task::JoinHandle;
 use tokio_util::sync::CancellationToken;
 
 pub use follow::{
-    ANCHORS_TOPIC, DRIVEN_POINTS, DRIVEN_TOPIC, ESTIMATE_TOPIC, MAX_LAYERS, MAX_ROBOTS,
-    MISSION_TOPIC, REFRESH_PERIOD, TRUTH_TOPIC,
+    ANCHORS_TOPIC, DRIVEN_POINTS, DRIVEN_TOPIC, ESTIMATE_TOPIC, MAX_LAYERS, MAX_LAYER_BYTES_SHOWN,
+    MAX_LAYER_CELLS, MAX_ROBOTS, MISSION_TOPIC, REFRESH_PERIOD, TRUTH_TOPIC,
 };
 pub use output::{ViewStats, CLIENT_BACKLOG};
 
@@ -67,6 +71,7 @@ pub enum ViewError {
 pub struct ViewHandle {
     listening: Option<SocketAddr>,
     mcap: Option<PathBuf>,
+    counters: Arc<output::Counters>,
     task: JoinHandle<Result<ViewStats, ViewError>>,
 }
 
@@ -79,6 +84,11 @@ impl ViewHandle {
     /// The URL to give the Foxglove app: `ws://HOST:PORT`.
     pub fn websocket_url(&self) -> Option<String> {
         self.listening.map(|addr| format!("ws://{addr}"))
+    }
+
+    /// What the view has done so far.
+    pub fn stats(&self) -> ViewStats {
+        self.counters.stats()
     }
 
     /// The MCAP file being recorded.
@@ -116,6 +126,7 @@ pub async fn run(
         tracing::info!(root = %config.root, "roam view: recording to {}", path.display());
     }
     let root = config.root.clone();
+    let counters = out.counters.clone();
     let task = tokio::spawn(async move {
         follow::follow(session, root, subscriptions, out.clone(), cancel).await;
         out.stop().await?;
@@ -123,6 +134,7 @@ pub async fn run(
         tracing::info!(
             logged = stats.logged,
             dropped = stats.dropped,
+            oversized = stats.oversized,
             "roam view stopped"
         );
         Ok(stats)
@@ -130,6 +142,7 @@ pub async fn run(
     Ok(ViewHandle {
         listening,
         mcap: config.mcap,
+        counters,
         task,
     })
 }
