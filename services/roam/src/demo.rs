@@ -162,6 +162,7 @@ async fn start_view(
         root: stack.root.clone(),
         listen: options.view,
         mcap: options.record.clone(),
+        access: roam_view::Access::default(),
     };
     let view = roam_view::run(stack.router.session.clone(), config, cancel.clone()).await?;
     if let Some(url) = view.websocket_url() {

@@ -7,11 +7,14 @@
 //! each client that subscribes, to that client alone: one message per topic, or on the
 //! per-robot topics one per robot (at most [`MAX_LATCHED_KEYS`]), so the memory is bounded
 //! by the number of topics and robots.
+//!
+//! The SDK's WebSocket server listens only on a private loopback port ([`INNER_PORTS`]);
+//! clients reach it through the gate (`gate.rs`), which checks who they are.
 
 use std::collections::{BTreeMap, HashMap};
 use std::fs::File;
 use std::io::BufWriter;
-use std::net::SocketAddr;
+use std::net::{Ipv4Addr, SocketAddr};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -31,6 +34,17 @@ pub const CLIENT_BACKLOG: usize = 256;
 
 /// How long a stop waits for the WebSocket server's clients to close.
 const STOP_GRACE: Duration = Duration::from_secs(2);
+
+/// The loopback ports tried, in order, for the SDK's own server behind the gate. The
+/// SDK's server checks nobody, and a web page can open a WebSocket to any loopback port
+/// it guesses, so these are ports that browsers refuse to connect to at all (the "bad
+/// ports" of the Fetch standard, which WebSocket connections obey): a page cannot reach
+/// the SDK's server around the gate. These eleven are on the lists of Chromium, Firefox
+/// and WebKit alike. Local programs can still reach it, as they can reach Zenoh. When
+/// every one is taken an ephemeral port is used, with a warning.
+pub const INNER_PORTS: [u16; 11] = [
+    6665, 6666, 6667, 6668, 6669, 6697, 3659, 6566, 1719, 1720, 10080,
+];
 
 /// The most per-robot messages kept on one latched topic.
 pub const MAX_LATCHED_KEYS: usize = MAX_ROBOTS;
@@ -199,26 +213,55 @@ pub(crate) struct Outputs {
     pub(crate) counters: Arc<Counters>,
     server: Mutex<Option<WebSocketServerHandle>>,
     mcap: Mutex<Option<(PathBuf, McapWriterHandle<BufWriter<File>>)>>,
-    /// Where the WebSocket server listens (the port it got when asked for 0).
-    pub(crate) listening: Option<SocketAddr>,
+    /// Where the SDK's WebSocket server listens, on loopback behind the gate.
+    pub(crate) inner: Option<SocketAddr>,
 }
 
 impl std::fmt::Debug for Outputs {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Outputs")
-            .field("listening", &self.listening)
+            .field("inner", &self.inner)
             .field("counters", &self.counters)
             .finish_non_exhaustive()
     }
 }
 
+/// Starts the SDK's WebSocket server on the first free port of [`INNER_PORTS`] on
+/// 127.0.0.1, else on an ephemeral one.
+async fn start_inner(
+    context: &Arc<Context>,
+    latch: &Arc<Latch>,
+) -> Result<WebSocketServerHandle, ViewError> {
+    let start = |port: u16| {
+        context
+            .websocket_server()
+            .name("roam")
+            .bind(Ipv4Addr::LOCALHOST.to_string(), port)
+            .message_backlog_size(CLIENT_BACKLOG)
+            .listener(Arc::new(Replay(latch.clone())))
+            .start()
+    };
+    for port in INNER_PORTS {
+        if let Ok(handle) = start(port).await {
+            return Ok(handle);
+        }
+    }
+    let handle = start(0).await.map_err(|e| ViewError::Listen {
+        addr: SocketAddr::from((Ipv4Addr::LOCALHOST, 0)),
+        reason: e.to_string(),
+    })?;
+    tracing::warn!(
+        "roam view: every browser-blocked loopback port is taken; the WebSocket server behind \
+         the gate listens on 127.0.0.1:{}, which a web page that finds it can reach",
+        handle.port()
+    );
+    Ok(handle)
+}
+
 impl Outputs {
-    /// Starts the WebSocket server on `listen` and the MCAP file at `mcap` (replacing a file
-    /// that is there), each when asked for.
-    pub(crate) async fn start(
-        listen: Option<SocketAddr>,
-        mcap: Option<&Path>,
-    ) -> Result<Outputs, ViewError> {
+    /// Starts the SDK's WebSocket server (on loopback, for the gate) when `serve`, and the
+    /// MCAP file at `mcap` (replacing a file that is there) when asked for.
+    pub(crate) async fn start(serve: bool, mcap: Option<&Path>) -> Result<Outputs, ViewError> {
         let context = Context::new();
         let latch = Arc::new(Latch::default());
         let recording = match mcap {
@@ -238,24 +281,12 @@ impl Outputs {
             }
             None => None,
         };
-        let (server, listening) = match listen {
-            Some(addr) => {
-                let handle = context
-                    .websocket_server()
-                    .name("roam")
-                    .bind(addr.ip().to_string(), addr.port())
-                    .message_backlog_size(CLIENT_BACKLOG)
-                    .listener(Arc::new(Replay(latch.clone())))
-                    .start()
-                    .await
-                    .map_err(|e| ViewError::Listen {
-                        addr,
-                        reason: e.to_string(),
-                    })?;
-                let bound = SocketAddr::new(addr.ip(), handle.port());
-                (Some(handle), Some(bound))
-            }
-            None => (None, None),
+        let (server, inner) = if serve {
+            let handle = start_inner(&context, &latch).await?;
+            let inner = SocketAddr::from((Ipv4Addr::LOCALHOST, handle.port()));
+            (Some(handle), Some(inner))
+        } else {
+            (None, None)
         };
         Ok(Outputs {
             context,
@@ -263,7 +294,7 @@ impl Outputs {
             counters: Arc::new(Counters::default()),
             server: Mutex::new(server),
             mcap: Mutex::new(recording),
-            listening,
+            inner,
         })
     }
 

@@ -19,7 +19,7 @@ use roam_proto::map::{CellWrite, Layer, LayerChange, LayerUpdate, UpdateAck};
 use roam_proto::{encode, keys};
 use roam_runtime::{Requester, SessionArgs};
 use roam_sim::service::SimConfig;
-use roam_view::{ViewConfig, ViewError};
+use roam_view::{Access, ViewConfig, ViewError};
 use serde_json::Value;
 use tokio::task::JoinHandle;
 use tokio_tungstenite::tungstenite::client::IntoClientRequest;
@@ -299,6 +299,7 @@ async fn a_foxglove_client_sees_the_channels_and_receives_the_map() {
                 root: stack.root.clone(),
                 listen: Some("127.0.0.1:0".parse().expect("addr")),
                 mcap: None,
+                access: Access::default(),
             },
             cancel.clone(),
         ),
@@ -407,6 +408,7 @@ async fn an_mcap_recording_of_a_short_run_holds_the_map_robots_and_anchors() {
                 root: stack.root.clone(),
                 listen: None,
                 mcap: Some(path.clone()),
+                access: Access::default(),
             },
             cancel.clone(),
         ),
@@ -518,6 +520,7 @@ async fn a_view_needs_an_output_and_a_valid_root() {
             root: stack.root.clone(),
             listen: None,
             mcap: None,
+            access: Access::default(),
         },
         CancellationToken::new(),
     )
@@ -529,6 +532,7 @@ async fn a_view_needs_an_output_and_a_valid_root() {
             root: "roam/**".into(),
             listen: Some("127.0.0.1:0".parse().expect("addr")),
             mcap: None,
+            access: Access::default(),
         },
         CancellationToken::new(),
     )

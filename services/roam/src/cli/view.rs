@@ -38,6 +38,7 @@ pub(crate) async fn view(args: ViewArgs) -> anyhow::Result<()> {
         root: args.client.root.clone(),
         listen: (!args.no_ws).then_some(args.ws),
         mcap: args.mcap,
+        access: roam_view::Access::default(),
     };
     let view = roam_view::run(session.clone(), config, cancel).await?;
     if let Some(url) = view.websocket_url() {
