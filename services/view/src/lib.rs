@@ -128,6 +128,16 @@ impl ViewHandle {
     }
 }
 
+/// Refuses to serve the view on an address other than loopback without a token (what
+/// [`run`] checks first; callers that do much before starting the view check it early).
+pub fn check_exposure(listen: SocketAddr, access: &Access) -> Result<(), ViewError> {
+    if listen.ip().is_loopback() || access.needs_token() {
+        Ok(())
+    } else {
+        Err(ViewError::OpenWithoutToken(listen))
+    }
+}
+
 /// Starts the view on `session`: the WebSocket server and the MCAP file are open and the
 /// subscriptions declared when this returns. It runs until `cancel`.
 pub async fn run(
@@ -140,9 +150,7 @@ pub async fn run(
         return Err(ViewError::NoOutput);
     }
     if let Some(addr) = config.listen {
-        if !addr.ip().is_loopback() && !config.access.needs_token() {
-            return Err(ViewError::OpenWithoutToken(addr));
-        }
+        check_exposure(addr, &config.access)?;
     }
     // The public address first, so that a taken one is reported as such.
     let public = match config.listen {
