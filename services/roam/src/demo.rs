@@ -43,6 +43,8 @@ pub struct DemoOptions {
     pub view: Option<std::net::SocketAddr>,
     /// Record the run to this MCAP file.
     pub record: Option<PathBuf>,
+    /// Who may connect to the live view.
+    pub view_access: roam_view::Access,
 }
 
 impl Default for DemoOptions {
@@ -54,6 +56,7 @@ impl Default for DemoOptions {
             root: None,
             view: None,
             record: None,
+            view_access: roam_view::Access::default(),
         }
     }
 }
@@ -162,6 +165,7 @@ async fn start_view(
         root: stack.root.clone(),
         listen: options.view,
         mcap: options.record.clone(),
+        access: options.view_access.clone(),
     };
     let view = roam_view::run(stack.router.session.clone(), config, cancel.clone()).await?;
     if let Some(url) = view.websocket_url() {

@@ -3,6 +3,10 @@
 //! Everything is drawn in one frame, [`FRAME`], whose axes are roam's world metres (the
 //! frame the map's `origin` is given in), with z up. Grids keep roam's cell values
 //! exactly; scene entities get one colour per kind, the colours of `roam demo`'s picture.
+//!
+//! Names and ids from the messages become entity ids, labels and metadata only through
+//! [`shown`] (escaped, cut), and lists from them are drawn up to a bound, so a message
+//! cannot put control characters in the app or make a drawing without end.
 
 use std::collections::VecDeque;
 
@@ -14,10 +18,12 @@ use foxglove::messages::{
     SpherePrimitive, TextPrimitive, Timestamp, Vector2, Vector3,
 };
 use roam_proto::cells::Dtype;
-use roam_proto::controller::Mission;
+use roam_proto::controller::{Mission, MAX_WAYPOINTS};
 use roam_proto::localization::PositionEstimate;
 use roam_proto::map::{GridMeta, Layer};
 use roam_proto::sim::{GroundTruth, NamedPoint};
+
+use crate::wire::shown;
 
 /// The frame every roam message is drawn in: world metres, z up.
 pub const FRAME: &str = "map";
@@ -57,6 +63,13 @@ const LINE_PX: f64 = 3.0;
 pub const ELLIPSE_SIGMAS: f64 = 2.0;
 /// The largest ellipse diameter drawn, metres (a nearly singular CRB would fill the scene).
 pub const ELLIPSE_MAX_M: f64 = 50.0;
+/// The most waypoint cubes drawn for one mission: a longer mission gets a cube at every
+/// k-th waypoint (k as small as keeps it within this), its line through all of them.
+pub const MISSION_CUBES: usize = 1000;
+/// The most anchors drawn.
+pub const MAX_ANCHORS: usize = 256;
+/// The most anchor names listed in an estimate's `anchors_used`.
+pub const ANCHORS_LISTED: usize = 32;
 
 /// The Foxglove topic of a map layer.
 pub fn layer_topic(layer: &str) -> String {
@@ -208,10 +221,11 @@ fn delete(id: String, timestamp: Timestamp) -> SceneEntityDeletion {
 
 /// A robot's true position (`/robots/truth`): entity `truth/<robot>`, a sphere and its name.
 pub fn truth(t: &GroundTruth, timestamp: Timestamp) -> SceneUpdate {
-    let mut e = entity(format!("truth/{}", t.robot), timestamp);
+    let robot = shown(&t.robot);
+    let mut e = entity(format!("truth/{robot}"), timestamp);
     e.spheres.push(sphere(t.at, ROBOT_SIZE_M, DRIVEN));
     e.texts.push(label(
-        &t.robot,
+        &robot,
         t.at,
         ROBOT_SIZE_M + 0.3,
         with_alpha(DRIVEN, 1.0),
@@ -246,7 +260,7 @@ pub fn covariance_ellipse(cov: [[f64; 2]; 2], sigmas: f64) -> Option<(f64, f64, 
 /// sphere at the estimate and, when the CRB is known, its [`ELLIPSE_SIGMAS`]-σ ellipse
 /// (the CRB is the estimate's covariance). A degraded estimate is drawn faint.
 pub fn estimate(p: &PositionEstimate, timestamp: Timestamp) -> SceneUpdate {
-    let mut e = entity(format!("estimate/{}", p.robot), timestamp);
+    let mut e = entity(format!("estimate/{}", shown(&p.robot)), timestamp);
     let color = if p.degraded {
         with_alpha(ESTIMATE, 0.35)
     } else {
@@ -273,66 +287,85 @@ pub fn estimate(p: &PositionEstimate, timestamp: Timestamp) -> SceneUpdate {
                 .map_or("unbounded".to_owned(), |v| format!("{v:.4}")),
         ),
         ("degraded", p.degraded.to_string()),
-        ("anchors_used", p.anchors_used.join(",")),
+        ("anchors_used", listed(&p.anchors_used, ANCHORS_LISTED)),
     ]);
     SceneUpdate {
         entities: vec![e],
+        ..SceneUpdate::default()
+    }
+}
+
+/// Up to `max` names, each [`shown`], comma-separated, and how many more there were.
+fn listed(names: &[String], max: usize) -> String {
+    let mut text = names
+        .iter()
+        .take(max)
+        .map(|n| shown(n))
+        .collect::<Vec<_>>()
+        .join(",");
+    if names.len() > max {
+        text.push_str(&format!(" (+{} more)", names.len() - max));
+    }
+    text
+}
+
+/// The entity id of a robot's mission.
+pub fn mission_id(robot: &str) -> String {
+    format!("mission/{}", shown(robot))
+}
+
+/// Deletes the entity of a robot's mission (stopped, or no longer kept).
+pub fn mission_deleted(robot: &str, timestamp: Timestamp) -> SceneUpdate {
+    SceneUpdate {
+        deletions: vec![delete(mission_id(robot), timestamp)],
         ..SceneUpdate::default()
     }
 }
 
 /// A robot's planned path (`/robots/mission`): entity `mission/<robot>`, a line through
-/// its waypoints and a small cube at each. An empty mission (the robot is stopped)
-/// deletes the entity.
+/// its waypoints (at most [`MAX_WAYPOINTS`], the controller's limit) and a small cube at
+/// each, or at every k-th when there are more than [`MISSION_CUBES`] (metadata
+/// `cube_every`). An empty mission (the robot is stopped) deletes the entity.
 pub fn mission(m: &Mission, timestamp: Timestamp) -> SceneUpdate {
-    let id = format!("mission/{}", m.robot);
     if m.waypoints.is_empty() {
-        return SceneUpdate {
-            deletions: vec![delete(id, timestamp)],
-            ..SceneUpdate::default()
-        };
+        return mission_deleted(&m.robot, timestamp);
     }
-    let mut e = entity(id, timestamp);
-    e.lines
-        .push(line(m.waypoints.iter().copied(), 0.03, PLANNED));
-    e.cubes.extend(m.waypoints.iter().map(|w| CubePrimitive {
-        pose: Some(pose(w[0], w[1], 0.03, 0.0)),
-        size: Some(vector3(0.1, 0.1, 0.1)),
-        color: Some(PLANNED),
-    }));
-    e.metadata = metadata(&[
-        ("mission", m.id.clone()),
+    let waypoints = &m.waypoints[..m.waypoints.len().min(MAX_WAYPOINTS)];
+    let mut e = entity(mission_id(&m.robot), timestamp);
+    e.lines.push(line(waypoints.iter().copied(), 0.03, PLANNED));
+    let every = waypoints.len().div_ceil(MISSION_CUBES);
+    e.cubes
+        .extend(waypoints.iter().step_by(every).map(|w| CubePrimitive {
+            pose: Some(pose(w[0], w[1], 0.03, 0.0)),
+            size: Some(vector3(0.1, 0.1, 0.1)),
+            color: Some(PLANNED),
+        }));
+    let mut meta = vec![
+        ("mission", shown(&m.id)),
         ("waypoints", m.waypoints.len().to_string()),
-    ]);
+    ];
+    if every > 1 {
+        meta.push(("cube_every", every.to_string()));
+    }
+    e.metadata = metadata(&meta);
     SceneUpdate {
         entities: vec![e],
         ..SceneUpdate::default()
     }
 }
 
-/// Every robot's planned path in one update (what `/robots/mission` latches, so a
-/// viewer that connects later sees them all): [`mission`] of each.
-pub fn missions<'a>(all: impl Iterator<Item = &'a Mission>, timestamp: Timestamp) -> SceneUpdate {
-    let mut update = SceneUpdate::default();
-    for m in all {
-        let one = mission(m, timestamp);
-        update.entities.extend(one.entities);
-        update.deletions.extend(one.deletions);
-    }
-    update
-}
-
-/// The anchors (`/anchors`): entity `anchors`, a cube and a name at each.
+/// The anchors (`/anchors`): entity `anchors`, a cube and a name at each (at most
+/// [`MAX_ANCHORS`]).
 pub fn anchors(points: &[NamedPoint], timestamp: Timestamp) -> SceneUpdate {
     let mut e = entity("anchors".to_owned(), timestamp);
-    for a in points {
+    for a in points.iter().take(MAX_ANCHORS) {
         e.cubes.push(CubePrimitive {
             pose: Some(pose(a.at[0], a.at[1], ANCHOR_SIZE_M / 2.0, 0.0)),
             size: Some(vector3(ANCHOR_SIZE_M, ANCHOR_SIZE_M, ANCHOR_SIZE_M)),
             color: Some(ANCHOR),
         });
         e.texts
-            .push(label(&a.name, a.at, ANCHOR_SIZE_M + 0.3, ANCHOR));
+            .push(label(&shown(&a.name), a.at, ANCHOR_SIZE_M + 0.3, ANCHOR));
     }
     SceneUpdate {
         entities: vec![e],
@@ -388,6 +421,14 @@ impl DrivenPath {
     }
 }
 
+/// Deletes the entity of a robot's driven path (no longer kept).
+pub fn driven_deleted(robot: &str, timestamp: Timestamp) -> SceneUpdate {
+    SceneUpdate {
+        deletions: vec![delete(format!("driven/{}", shown(robot)), timestamp)],
+        ..SceneUpdate::default()
+    }
+}
+
 /// The driven paths (`/robots/driven`): entity `driven/<robot>` per robot, a line.
 pub fn driven<'a>(
     paths: impl Iterator<Item = (&'a str, &'a DrivenPath)>,
@@ -396,7 +437,7 @@ pub fn driven<'a>(
     let entities = paths
         .filter(|(_, path)| !path.is_empty())
         .map(|(robot, path)| {
-            let mut e = entity(format!("driven/{robot}"), timestamp);
+            let mut e = entity(format!("driven/{}", shown(robot)), timestamp);
             e.lines.push(line(path.points(), 0.02, DRIVEN));
             e
         })
@@ -612,6 +653,82 @@ mod tests {
         );
         assert!(stop.entities.is_empty());
         assert_eq!(stop.deletions[0].id, "mission/r1");
+    }
+
+    #[test]
+    fn a_long_mission_is_drawn_within_the_bounds() {
+        let m = Mission {
+            robot: "r1".into(),
+            id: "x".repeat(1 << 20),
+            waypoints: (0..MAX_WAYPOINTS + 5).map(|i| [i as f64, 0.0]).collect(),
+        };
+        let e = &mission(&m, stamp()).entities[0];
+        assert_eq!(e.lines[0].points.len(), MAX_WAYPOINTS);
+        assert!(e.cubes.len() <= MISSION_CUBES, "{}", e.cubes.len());
+        assert!(e.cubes.len() > MISSION_CUBES / 2, "{}", e.cubes.len());
+        let meta: Vec<(&str, &str)> = e
+            .metadata
+            .iter()
+            .map(|kv| (kv.key.as_str(), kv.value.as_str()))
+            .collect();
+        assert!(meta.contains(&("waypoints", "10005")), "{meta:?}");
+        assert!(meta.contains(&("cube_every", "10")), "{meta:?}");
+        let id = meta.iter().find(|(k, _)| *k == "mission").expect("id").1;
+        assert!(id.len() < 100 && id.ends_with("(1048576 bytes)"), "{id}");
+    }
+
+    #[test]
+    fn names_from_the_wire_are_escaped_in_ids_labels_and_metadata() {
+        let evil = "r1\n\u{1b}[31mred".to_owned();
+        let t = truth(
+            &GroundTruth {
+                robot: evil.clone(),
+                step: 1,
+                time_s: 0.1,
+                at: [0.0, 0.0],
+            },
+            stamp(),
+        );
+        let p = PositionEstimate {
+            robot: evil.clone(),
+            step: 1,
+            time_s: 0.4,
+            position: [1.0, 1.0],
+            crb: None,
+            peb_m: None,
+            anchors_used: vec![evil.clone(); 100],
+            degraded: false,
+        };
+        let m = Mission {
+            robot: evil.clone(),
+            id: evil.clone(),
+            waypoints: vec![[0.0, 0.0]],
+        };
+        let a = anchors(
+            &[NamedPoint {
+                name: evil.clone(),
+                at: [0.0, 0.0],
+            }],
+            stamp(),
+        );
+        let mut path = DrivenPath::new(4, 0.0);
+        path.push([0.0, 0.0]);
+        let d = driven([(evil.as_str(), &path)].into_iter(), stamp());
+        for update in [t, estimate(&p, stamp()), mission(&m, stamp()), a, d] {
+            let e = &update.entities[0];
+            let mut texts = vec![e.id.clone()];
+            texts.extend(e.texts.iter().map(|t| t.text.clone()));
+            texts.extend(e.metadata.iter().map(|kv| kv.value.clone()));
+            for text in texts {
+                assert!(
+                    !text.contains('\n') && !text.contains('\u{1b}'),
+                    "{text:?} in {}",
+                    e.id
+                );
+            }
+        }
+        let listed = &estimate(&p, stamp()).entities[0].metadata[4].value;
+        assert!(listed.ends_with("(+68 more)"), "{listed}");
     }
 
     #[test]

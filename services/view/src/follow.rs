@@ -5,21 +5,29 @@
 //! [`REFRESH_PERIOD`], fetching every layer whose version it has not shown: a view
 //! started after the map server, or a map server restarted, is caught up) and asks the sim
 //! for its anchors and robots on the same period. The *robots* loop follows the true
-//! positions, the estimates and the missions. Every queue is bounded: the subscribers are
-//! ring buffers (the oldest sample goes when one is full), and the per-robot state holds
-//! at most [`MAX_ROBOTS`] robots and [`DRIVEN_POINTS`] points per driven path.
+//! positions, the estimates and the missions.
+//!
+//! Nothing from the wire is trusted (see `wire`): every payload is checked against its
+//! kind's cap before it is decoded, robot and layer names must be key segments and match
+//! the key they came on, missions are held to the controller's limits, and every queue
+//! and table is bounded: the subscribers are ring buffers (the oldest sample goes when
+//! one is full), at most [`MAX_LAYERS`] layers of [`MAX_LAYER_BYTES_SHOWN`] together are
+//! shown, and per-robot state (missions, driven paths) is kept for at most [`MAX_ROBOTS`]
+//! robots each (see `roster`: the sim's own robots are never evicted by strangers).
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Duration;
 
 use foxglove::messages::{Grid, SceneUpdate, Timestamp};
-use roam_proto::controller::Mission;
+use roam_map_server::store::DEFAULT_LIMITS;
+use roam_proto::controller::{Mission, MAX_WAYPOINTS};
 use roam_proto::localization::PositionEstimate;
 use roam_proto::map::{Layer, LayerList};
 use roam_proto::sim::{GroundTruth, NamedPoint, SimControl, SimStatus};
-use roam_proto::{decode, keys, Message};
-use roam_runtime::Requester;
+use roam_proto::{keys, Message};
+use tokio::sync::watch;
 use tokio::time::{Instant, MissedTickBehavior};
 use tokio_util::sync::CancellationToken;
 use zenoh::handlers::{RingChannel, RingChannelHandler};
@@ -29,11 +37,18 @@ use zenoh::Session;
 
 use crate::convert::{self, DrivenPath};
 use crate::output::{Outputs, Topic};
+use crate::roster::{Roster, Touched};
+use crate::wire::{self, clipped, decode_bounded, shown};
 use crate::ViewError;
 
-/// The most map layers shown (the map server's own default limit).
-pub const MAX_LAYERS: usize = 64;
-/// The most robots whose missions and driven paths are kept.
+/// The most map layers shown (the map server's own default limit, `max_layers`).
+pub const MAX_LAYERS: usize = DEFAULT_LIMITS.max_layers as usize;
+/// The most cells of one layer shown (the map server's `max_layer_cells`).
+pub const MAX_LAYER_CELLS: u64 = DEFAULT_LIMITS.max_layer_cells;
+/// The most bytes of grid cells kept for the layers shown, together (their latched
+/// messages): nine full-size layers of f32 fit, 64 of them do not.
+pub const MAX_LAYER_BYTES_SHOWN: usize = 1 << 30;
+/// The most robots whose missions are kept, and the most whose driven paths are.
 pub const MAX_ROBOTS: usize = 256;
 /// Samples a robot subscription holds before the oldest go.
 pub const ROBOT_QUEUE: usize = 256;
@@ -58,6 +73,9 @@ pub const DRIVEN_TOPIC: &str = "/robots/driven";
 pub const ANCHORS_TOPIC: &str = "/anchors";
 
 type Ring = Subscriber<RingChannelHandler<Sample>>;
+
+/// The names of the robots in the sim's last status.
+type SimRobots = Arc<BTreeSet<String>>;
 
 /// The subscriptions, declared before `run` returns so nothing published after is missed.
 pub(crate) struct Subscriptions {
@@ -89,14 +107,38 @@ impl Subscriptions {
     }
 }
 
-fn decode_sample<T: Message>(out: &Outputs, sample: &Sample) -> Option<T> {
-    match decode::<T>(&sample.payload().to_bytes()) {
+/// Decodes a sample's payload of at most `max` bytes, or counts it dropped.
+fn decode_sample<T: Message>(out: &Outputs, sample: &Sample, max: usize) -> Option<T> {
+    match decode_bounded::<T>(sample.payload(), max) {
         Ok(message) => Some(message),
         Err(e) => {
-            out.counters.dropped(sample.key_expr().as_str(), &e);
+            out.counters.unread(sample.key_expr().as_str(), &e);
             None
         }
     }
+}
+
+/// Checks that `robot` is a valid robot name and the one `key` (`<root>/robot/<id>/…`)
+/// is for: a message about robot A put on robot B's key is not believed.
+fn check_robot(root: &str, key: &str, robot: &str) -> Result<(), String> {
+    if keys::check_name("robot", robot).is_err() {
+        return Err(format!(
+            "the robot name \"{}\" is not a key segment (1 to {} of a-z, A-Z, 0-9, '_', '-')",
+            shown(robot),
+            keys::MAX_SEGMENT_LEN
+        ));
+    }
+    let named = key
+        .strip_prefix(root)
+        .and_then(|k| k.strip_prefix("/robot/"))
+        .and_then(|k| k.split('/').next());
+    if named != Some(robot) {
+        return Err(format!(
+            "a message about robot \"{}\" on another robot's key",
+            shown(robot)
+        ));
+    }
+    Ok(())
 }
 
 /// The fixed robot topics.
@@ -134,24 +176,27 @@ pub(crate) async fn follow(
     } = subscriptions;
     let robots = RobotTopics::new(&out);
     let anchors = out.topic::<SceneUpdate>(ANCHORS_TOPIC, true);
-    let requester = Requester::new(session, QUERY_TIMEOUT);
+    let (sim_tx, sim_rx) = watch::channel(SimRobots::default());
     let world = World {
         out: out.clone(),
-        root,
-        requester,
+        root: root.clone(),
+        session,
         layers: BTreeMap::new(),
+        layer_bytes: 0,
         anchors_topic: anchors,
         truth_topic: robots.truth.clone(),
         anchors: None,
         robots: None,
+        sim: sim_tx,
     };
     let robots = Robots {
         out,
+        root,
         topics: robots,
-        missions: BTreeMap::new(),
-        driven: BTreeMap::new(),
+        missions: Roster::new(MAX_ROBOTS),
+        driven: Roster::new(MAX_ROBOTS),
         driven_dirty: false,
-        full_warned: false,
+        sim: sim_rx,
     };
     tokio::join!(
         world.run(layers, cancel.clone()),
@@ -159,17 +204,26 @@ pub(crate) async fn follow(
     );
 }
 
+/// A layer shown: its topic, the version shown and the bytes its cells take.
+struct Shown {
+    topic: Topic,
+    version: u64,
+    bytes: usize,
+}
+
 /// The map layers, the anchors and the sim's robot list.
 struct World {
     out: Arc<Outputs>,
     root: String,
-    requester: Requester,
-    /// Per layer: its topic and the version last shown.
-    layers: BTreeMap<String, (Topic, u64)>,
+    session: Session,
+    layers: BTreeMap<String, Shown>,
+    /// The bytes of cells of every layer shown.
+    layer_bytes: usize,
     anchors_topic: Topic,
     truth_topic: Topic,
     anchors: Option<Vec<NamedPoint>>,
     robots: Option<Vec<NamedPoint>>,
+    sim: watch::Sender<SimRobots>,
 }
 
 impl World {
@@ -181,11 +235,7 @@ impl World {
                 biased;
                 _ = cancel.cancelled() => break,
                 sample = layers.recv_async() => match sample {
-                    Ok(sample) => {
-                        if let Some(layer) = decode_sample::<Layer>(&self.out, &sample) {
-                            self.show_layer(&layer, true);
-                        }
-                    }
+                    Ok(sample) => self.on_layer(&sample),
                     Err(_) => break,
                 },
                 _ = refresh.tick() => {
@@ -198,87 +248,158 @@ impl World {
         }
     }
 
-    /// Shows a layer unless this version is already shown. A published layer is always
-    /// news; a fetched one only when its version differs from the one shown.
-    fn show_layer(&mut self, layer: &Layer, published: bool) {
-        if let Some((_, shown)) = self.layers.get(&layer.name) {
-            if *shown == layer.version && !published {
-                return;
-            }
-        } else if self.layers.len() >= MAX_LAYERS {
+    fn on_layer(&mut self, sample: &Sample) {
+        let key = sample.key_expr().as_str();
+        let Some(layer) = decode_sample::<Layer>(&self.out, sample, wire::MAX_LAYER_BYTES) else {
+            return;
+        };
+        if key != keys::map_layer(&self.root, &layer.name) {
             self.out.counters.dropped(
-                &keys::map_layer(&self.root, &layer.name),
-                &format!("more than {MAX_LAYERS} layers; this one is not shown"),
+                key,
+                &format!("a layer named \"{}\" on another key", shown(&layer.name)),
             );
             return;
         }
-        let grid = match convert::grid(layer, Timestamp::now()) {
-            Ok(grid) => grid,
-            Err(e) => {
-                self.out
-                    .counters
-                    .dropped(&keys::map_layer(&self.root, &layer.name), &e);
+        self.show_layer(&layer, true);
+    }
+
+    /// Shows a layer unless this version is already shown. A published layer is always
+    /// news; a fetched one only when its version differs from the one shown.
+    fn show_layer(&mut self, layer: &Layer, published: bool) {
+        let key = keys::map_layer(&self.root, &layer.name);
+        let shown_before = self.layers.get(&layer.name);
+        if let Some(before) = shown_before {
+            if before.version == layer.version && !published {
                 return;
             }
+        }
+        let refusal = if keys::check_name("layer", &layer.name).is_err() {
+            Some(format!(
+                "the layer name \"{}\" is not a key segment",
+                shown(&layer.name)
+            ))
+        } else if shown_before.is_none() && self.layers.len() >= MAX_LAYERS {
+            Some(format!(
+                "more than {MAX_LAYERS} layers; this one is not shown"
+            ))
+        } else if layer.meta.cell_count() > MAX_LAYER_CELLS {
+            Some(format!(
+                "{} cells; a layer is shown up to {MAX_LAYER_CELLS} (max_layer_cells)",
+                layer.meta.cell_count()
+            ))
+        } else {
+            None
+        };
+        let bytes = layer.cells.len() * layer.cells.dtype().size();
+        let others = self.layer_bytes - shown_before.map_or(0, |s| s.bytes);
+        let refusal = refusal.or_else(|| {
+            (others + bytes > MAX_LAYER_BYTES_SHOWN).then(|| {
+                format!("the layers shown would hold more than {MAX_LAYER_BYTES_SHOWN} bytes")
+            })
+        });
+        if let Some(reason) = refusal {
+            return self.out.counters.dropped(&key, &reason);
+        }
+        let grid = match convert::grid(layer, Timestamp::now()) {
+            Ok(grid) => grid,
+            Err(e) => return self.out.counters.dropped(&key, &e),
         };
         let out = &self.out;
-        let (topic, shown) = self.layers.entry(layer.name.clone()).or_insert_with(|| {
-            (
-                out.topic::<Grid>(&convert::layer_topic(&layer.name), true),
-                0,
-            )
-        });
-        out.log(topic, &grid);
-        *shown = layer.version;
+        let entry = self
+            .layers
+            .entry(layer.name.clone())
+            .or_insert_with(|| Shown {
+                topic: out.topic::<Grid>(&convert::layer_topic(&layer.name), true),
+                version: 0,
+                bytes: 0,
+            });
+        out.log(&entry.topic, &grid);
+        entry.version = layer.version;
+        entry.bytes = bytes;
+        self.layer_bytes = others + bytes;
         tracing::debug!(layer = %layer.name, version = layer.version, "roam view: layer shown");
     }
 
     /// Fetches every layer not shown at its current version, and the sim's status.
     async fn refresh(&mut self) {
-        match self
-            .requester
-            .request::<Layer, LayerList>(&keys::map_index(&self.root), None)
-            .await
+        let index = keys::map_index(&self.root);
+        match wire::query::<Layer, LayerList>(
+            &self.session,
+            &index,
+            None,
+            wire::MAX_LAYER_LIST_BYTES,
+            QUERY_TIMEOUT,
+        )
+        .await
         {
             Ok(list) => {
-                for info in list.layers {
-                    let shown = self.layers.get(&info.name).map(|(_, v)| *v);
-                    if shown == Some(info.version) {
+                for info in list.layers.iter().take(MAX_LAYERS) {
+                    // A name that is not a key segment would make a key of its own
+                    // (a wildcard, say) for the query below.
+                    if keys::check_name("layer", &info.name).is_err() {
+                        let reason = format!("a layer named \"{}\"", shown(&info.name));
+                        self.out.counters.dropped(&index, &reason);
+                        continue;
+                    }
+                    let version = self.layers.get(&info.name).map(|s| s.version);
+                    if version == Some(info.version) {
                         continue;
                     }
                     let key = keys::map_layer(&self.root, &info.name);
-                    match self.requester.request::<Layer, Layer>(&key, None).await {
-                        Ok(layer) => self.show_layer(&layer, false),
-                        Err(e) => tracing::debug!("roam view: {e}"),
+                    let fetched = wire::query::<Layer, Layer>(
+                        &self.session,
+                        &key,
+                        None,
+                        wire::MAX_LAYER_BYTES,
+                        QUERY_TIMEOUT,
+                    )
+                    .await;
+                    match fetched {
+                        Ok(layer) if layer.name == info.name => self.show_layer(&layer, false),
+                        Ok(layer) => self
+                            .out
+                            .counters
+                            .dropped(&key, &format!("a layer named \"{}\"", shown(&layer.name))),
+                        Err(e) => self.out.counters.unread(&key, &e),
                     }
                 }
             }
-            Err(e) => tracing::debug!("roam view: no layer index yet: {e}"),
+            Err(e) => tracing::debug!("roam view: no layer index yet: {}", clipped(&e.to_string())),
         }
-        match self
-            .requester
-            .request::<SimControl, SimStatus>(
-                &keys::sim_control(&self.root),
-                Some(&SimControl::Status),
-            )
-            .await
+        match wire::query::<SimControl, SimStatus>(
+            &self.session,
+            &keys::sim_control(&self.root),
+            Some(&SimControl::Status),
+            wire::MAX_SIM_STATUS_BYTES,
+            QUERY_TIMEOUT,
+        )
+        .await
         {
             Ok(status) => self.show_status(status),
-            Err(e) => tracing::debug!("roam view: no sim status yet: {e}"),
+            Err(e) => tracing::debug!("roam view: no sim status yet: {}", clipped(&e.to_string())),
         }
     }
 
     fn show_status(&mut self, status: SimStatus) {
         let now = Timestamp::now();
-        if self.anchors.as_ref() != Some(&status.anchors) {
-            self.out
-                .log(&self.anchors_topic, &convert::anchors(&status.anchors, now));
-            self.anchors = Some(status.anchors);
-        }
-        // The robots where the sim has them: seen even when the sim is paused (it then
-        // publishes no true positions).
         if self.robots.as_ref() != Some(&status.robots) {
-            for robot in status.robots.iter().take(MAX_ROBOTS) {
+            let key = keys::sim_control(&self.root);
+            let mut named = BTreeSet::new();
+            for robot in &status.robots {
+                if keys::check_name("robot", &robot.name).is_err() {
+                    let reason = format!("the sim names a robot \"{}\"", shown(&robot.name));
+                    self.out.counters.dropped(&key, &reason);
+                } else if named.len() < MAX_ROBOTS {
+                    named.insert(robot.name.clone());
+                }
+            }
+            self.out
+                .counters
+                .sim_robots
+                .store(named.len(), Ordering::Relaxed);
+            // The robots where the sim has them: seen even when the sim is paused (it then
+            // publishes no true positions).
+            for robot in status.robots.iter().filter(|r| named.contains(&r.name)) {
                 let truth = GroundTruth {
                     robot: robot.name.clone(),
                     step: status.step,
@@ -288,19 +409,33 @@ impl World {
                 self.out
                     .log(&self.truth_topic, &convert::truth(&truth, now));
             }
+            self.sim.send_replace(Arc::new(named));
             self.robots = Some(status.robots);
         }
+        if self.anchors.as_ref() != Some(&status.anchors) {
+            self.out
+                .log(&self.anchors_topic, &convert::anchors(&status.anchors, now));
+            self.anchors = Some(status.anchors);
+        }
     }
+}
+
+/// One robot's driven path and whether it changed since it was last logged.
+struct Driven {
+    path: DrivenPath,
+    dirty: bool,
 }
 
 /// True positions, estimates, missions and driven paths.
 struct Robots {
     out: Arc<Outputs>,
+    root: String,
     topics: RobotTopics,
-    missions: BTreeMap<String, Mission>,
-    driven: BTreeMap<String, DrivenPath>,
+    /// The robots whose missions are drawn (the drawings are kept in the latch).
+    missions: Roster<()>,
+    driven: Roster<Driven>,
     driven_dirty: bool,
-    full_warned: bool,
+    sim: watch::Receiver<SimRobots>,
 }
 
 impl Robots {
@@ -321,11 +456,7 @@ impl Robots {
                     Err(_) => break,
                 },
                 sample = estimate.recv_async() => match sample {
-                    Ok(sample) => {
-                        if let Some(p) = decode_sample::<PositionEstimate>(&self.out, &sample) {
-                            self.out.log(&self.topics.estimate, &convert::estimate(&p, Timestamp::now()));
-                        }
-                    }
+                    Ok(sample) => self.on_estimate(&sample),
                     Err(_) => break,
                 },
                 _ = flush.tick() => {}
@@ -340,60 +471,176 @@ impl Robots {
         }
     }
 
-    /// Whether a robot may get per-robot state (a new one only below [`MAX_ROBOTS`]).
-    fn admits(&mut self, robot: &str, known: bool, key: &str) -> bool {
-        if known {
-            return true;
+    /// Counts the robots with per-robot state, for [`crate::ViewStats`].
+    fn count_robots(&self) {
+        let missions = &self.missions;
+        let only_driven = self
+            .driven
+            .names()
+            .filter(|robot| !missions.contains(robot))
+            .count();
+        self.out
+            .counters
+            .robots
+            .store(missions.len() + only_driven, Ordering::Relaxed);
+    }
+
+    /// Whether the message about `robot` on `key` is believed (else it is counted dropped).
+    fn believed(&self, key: &str, robot: &str) -> bool {
+        match check_robot(&self.root, key, robot) {
+            Ok(()) => true,
+            Err(reason) => {
+                self.out.counters.dropped(key, &reason);
+                false
+            }
         }
-        if self.missions.len().max(self.driven.len()) < MAX_ROBOTS {
-            return true;
-        }
-        if !self.full_warned {
-            self.full_warned = true;
-            self.out.counters.dropped(
-                key,
-                &format!("more than {MAX_ROBOTS} robots; robot '{robot}' has no path drawn"),
-            );
-        }
-        false
     }
 
     fn on_truth(&mut self, sample: &Sample) {
-        let Some(t) = decode_sample::<GroundTruth>(&self.out, sample) else {
+        let key = sample.key_expr().as_str();
+        let Some(t) = decode_sample::<GroundTruth>(&self.out, sample, wire::MAX_TRUTH_BYTES) else {
             return;
         };
+        if !self.believed(key, &t.robot) {
+            return;
+        }
         self.out
             .log(&self.topics.truth, &convert::truth(&t, Timestamp::now()));
-        let known = self.driven.contains_key(&t.robot);
-        if self.admits(&t.robot, known, sample.key_expr().as_str()) {
-            let path = self
-                .driven
-                .entry(t.robot.clone())
-                .or_insert_with(|| DrivenPath::new(DRIVEN_POINTS, DRIVEN_STEP_M));
-            self.driven_dirty |= path.push(t.at);
+        let sim = self.sim.borrow().clone();
+        let touched = self.driven.touch(
+            &t.robot,
+            |r| sim.contains(r),
+            || Driven {
+                path: DrivenPath::new(DRIVEN_POINTS, DRIVEN_STEP_M),
+                dirty: false,
+            },
+        );
+        match touched {
+            Touched::Refused => return self.out.counters.dropped(key, &full(&t.robot)),
+            Touched::Evicted(gone) => {
+                let update = convert::driven_deleted(&gone, Timestamp::now());
+                self.out.log(&self.topics.driven, &update);
+                self.out.forget_robot(&self.topics.driven, &gone);
+            }
+            Touched::Kept => {}
+        }
+        if let Some(driven) = self.driven.get_mut(&t.robot) {
+            let moved = driven.path.push(t.at);
+            driven.dirty |= moved;
+            self.driven_dirty |= moved;
+        }
+        self.count_robots();
+    }
+
+    fn on_estimate(&mut self, sample: &Sample) {
+        let key = sample.key_expr().as_str();
+        let max = wire::MAX_ESTIMATE_BYTES;
+        let Some(p) = decode_sample::<PositionEstimate>(&self.out, sample, max) else {
+            return;
+        };
+        if self.believed(key, &p.robot) {
+            let update = convert::estimate(&p, Timestamp::now());
+            self.out.log(&self.topics.estimate, &update);
         }
     }
 
     fn on_mission(&mut self, sample: &Sample) {
-        let Some(m) = decode_sample::<Mission>(&self.out, sample) else {
+        let key = sample.key_expr().as_str();
+        let max = wire::MAX_MISSION_BYTES;
+        let Some(m) = decode_sample::<Mission>(&self.out, sample, max) else {
             return;
         };
-        let known = self.missions.contains_key(&m.robot);
-        if !self.admits(&m.robot, known, sample.key_expr().as_str()) {
+        if !self.believed(key, &m.robot) {
             return;
         }
-        self.missions.insert(m.robot.clone(), m);
-        // The whole state, so the latched message alone shows every robot's mission.
-        let update = convert::missions(self.missions.values(), Timestamp::now());
-        self.out.log(&self.topics.mission, &update);
+        // Held to the controller's own checks: the view draws what a robot would drive.
+        if m.waypoints.len() > MAX_WAYPOINTS {
+            let reason = format!(
+                "{} waypoints; a mission holds at most {MAX_WAYPOINTS}",
+                m.waypoints.len()
+            );
+            return self.out.counters.dropped(key, &reason);
+        }
+        if m.waypoints
+            .iter()
+            .any(|w| !(w[0].is_finite() && w[1].is_finite()))
+        {
+            return self
+                .out
+                .counters
+                .dropped(key, &"a waypoint is not a finite point");
+        }
+        let now = Timestamp::now();
+        if m.waypoints.is_empty() {
+            // Stopped: the drawing goes, and so does the robot's place in the roster.
+            self.missions.remove(&m.robot);
+            self.out.forget_robot(&self.topics.mission, &m.robot);
+            self.out.log(
+                &self.topics.mission,
+                &convert::mission_deleted(&m.robot, now),
+            );
+            return self.count_robots();
+        }
+        let sim = self.sim.borrow().clone();
+        match self.missions.touch(&m.robot, |r| sim.contains(r), || ()) {
+            Touched::Refused => return self.out.counters.dropped(key, &full(&m.robot)),
+            Touched::Evicted(gone) => {
+                self.out.forget_robot(&self.topics.mission, &gone);
+                self.out
+                    .log(&self.topics.mission, &convert::mission_deleted(&gone, now));
+            }
+            Touched::Kept => {}
+        }
+        self.out
+            .log_robot(&self.topics.mission, &m.robot, &convert::mission(&m, now));
+        self.count_robots();
     }
 
+    /// Logs the path of each robot that moved since the last time (each robot's is kept
+    /// for clients that subscribe later).
     fn log_driven(&mut self) {
-        let update = convert::driven(
-            self.driven.iter().map(|(r, p)| (r.as_str(), p)),
-            Timestamp::now(),
-        );
-        self.out.log(&self.topics.driven, &update);
+        let now = Timestamp::now();
+        let (out, topic) = (&self.out, &self.topics.driven);
+        for (robot, driven) in self.driven.iter_mut() {
+            if driven.dirty {
+                let update = convert::driven([(robot, &driven.path)].into_iter(), now);
+                out.log_robot(topic, robot, &update);
+                driven.dirty = false;
+            }
+        }
         self.driven_dirty = false;
+    }
+}
+
+fn full(robot: &str) -> String {
+    format!(
+        "more than {MAX_ROBOTS} robots, all named by the sim; robot \"{}\" is not drawn",
+        shown(robot)
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_robot_must_be_a_key_segment_and_the_key_s_robot() {
+        let root = "roam/site-1";
+        assert_eq!(
+            check_robot(root, "roam/site-1/robot/r1/mission", "r1"),
+            Ok(())
+        );
+        let other = check_robot(root, "roam/site-1/robot/r2/mission", "r1");
+        assert!(other.is_err_and(|e| e.contains("another robot's key")));
+        let evil = "r1\n\u{1b}[2J";
+        let refused = check_robot(root, "roam/site-1/robot/r1/mission", evil).expect_err("evil");
+        assert!(
+            !refused.contains('\n') && !refused.contains('\u{1b}'),
+            "{refused}"
+        );
+        let long = "r".repeat(1 << 20);
+        let refused = check_robot(root, "roam/site-1/robot/r/mission", &long).expect_err("long");
+        assert!(refused.len() < 300, "{} bytes", refused.len());
+        assert!(check_robot(root, "other/robot/r1/mission", "r1").is_err());
     }
 }

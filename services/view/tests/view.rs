@@ -3,281 +3,26 @@
 //! client speaking the Foxglove protocol as the Foxglove app does, and an MCAP recording
 //! read back with the `mcap` crate.
 
+mod common;
+
 use std::collections::BTreeMap;
-use std::future::IntoFuture;
-use std::net::{SocketAddr, TcpListener};
-use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Duration;
 
+use common::{within, FoxgloveClient, Stack};
 use foxglove::messages::{Grid, SceneUpdate};
 use foxglove::Decode;
-use futures_util::{SinkExt, StreamExt};
-use roam_map_server::MapServerConfig;
 use roam_proto::cells::Cells;
 use roam_proto::controller::Mission;
 use roam_proto::map::{CellWrite, Layer, LayerChange, LayerUpdate, UpdateAck};
 use roam_proto::{encode, keys};
-use roam_runtime::{Requester, SessionArgs};
-use roam_sim::service::SimConfig;
-use roam_view::{ViewConfig, ViewError};
-use serde_json::Value;
-use tokio::task::JoinHandle;
-use tokio_tungstenite::tungstenite::client::IntoClientRequest;
-use tokio_tungstenite::tungstenite::http::HeaderValue;
-use tokio_tungstenite::tungstenite::Message as WsMessage;
+use roam_runtime::Requester;
+use roam_view::{Access, ViewConfig, ViewError};
 use tokio_util::sync::CancellationToken;
-
-/// How long any single step may take before the test fails.
-const STEP: Duration = Duration::from_secs(10);
-
-/// The WebSocket subprotocol of the Foxglove SDK's server: the Foxglove WebSocket
-/// protocol v1 under its current name (the protocol's messages are those of
-/// `foxglove.websocket.v1`).
-const SUBPROTOCOL: &str = "foxglove.sdk.v1";
-
-async fn within<F: IntoFuture>(what: &str, future: F) -> F::Output {
-    match tokio::time::timeout(STEP, future).await {
-        Ok(value) => value,
-        Err(_) => panic!("timed out after {STEP:?}: {what}"),
-    }
-}
-
-static NEXT_ROOT: AtomicU32 = AtomicU32::new(0);
-
-/// A router on a free loopback port (multicast off), a unique key root, and the services
-/// started on it.
-struct Stack {
-    router: zenoh::Session,
-    endpoint: String,
-    root: String,
-    cancel: CancellationToken,
-    services: Vec<JoinHandle<Result<(), String>>>,
-}
-
-impl Stack {
-    async fn start() -> Stack {
-        let mut last = None;
-        for _ in 0..5 {
-            let port = TcpListener::bind("127.0.0.1:0")
-                .and_then(|l| l.local_addr())
-                .expect("a free port")
-                .port();
-            let endpoint = format!("tcp/127.0.0.1:{port}");
-            let config = SessionArgs::router_on(&endpoint)
-                .zenoh_config(None)
-                .expect("router config");
-            match within("router", roam_runtime::session::open(config)).await {
-                Ok(router) => {
-                    return Stack {
-                        router,
-                        endpoint,
-                        root: format!(
-                            "view-test-{}-{}",
-                            std::process::id(),
-                            NEXT_ROOT.fetch_add(1, Ordering::Relaxed)
-                        ),
-                        cancel: CancellationToken::new(),
-                        services: Vec::new(),
-                    }
-                }
-                Err(e) => last = Some(e),
-            }
-        }
-        panic!("no router: {last:?}");
-    }
-
-    fn client_config(&self) -> zenoh::Config {
-        SessionArgs::client_of(&self.endpoint)
-            .zenoh_config(None)
-            .expect("client config")
-    }
-
-    async fn client(&self) -> zenoh::Session {
-        within("client", roam_runtime::session::open(self.client_config()))
-            .await
-            .expect("client session")
-    }
-
-    /// Waits until a liveliness token matching `key` exists.
-    async fn wait_live(&self, key: String) {
-        let tokens = within(
-            "liveliness subscriber",
-            self.router
-                .liveliness()
-                .declare_subscriber(key)
-                .history(true),
-        )
-        .await
-        .expect("liveliness subscriber");
-        within("a service's liveliness token", tokens.recv_async())
-            .await
-            .expect("token");
-    }
-
-    async fn start_map_server(&mut self) {
-        let config = MapServerConfig {
-            root: self.root.clone(),
-            ..MapServerConfig::default()
-        };
-        let run = roam_map_server::run(config, self.client_config(), self.cancel.child_token());
-        self.services.push(tokio::spawn(
-            async move { run.await.map_err(|e| e.to_string()) },
-        ));
-        self.wait_live(keys::liveliness_of(
-            &self.root,
-            roam_map_server::SERVICE_NAME,
-        ))
-        .await;
-    }
-
-    /// The sim on the built-in world, free-running at `rate` times real time.
-    async fn start_sim(&mut self, rate: f64) {
-        let config = SimConfig {
-            root: self.root.clone(),
-            rate: Some(rate),
-            ..SimConfig::default()
-        };
-        let run = roam_sim::service::run(config, self.client_config(), self.cancel.child_token());
-        self.services.push(tokio::spawn(
-            async move { run.await.map_err(|e| e.to_string()) },
-        ));
-        self.wait_live(keys::liveliness_of(
-            &self.root,
-            roam_sim::service::SERVICE_NAME,
-        ))
-        .await;
-    }
-
-    async fn occupancy(&self, requester: &Requester) -> Layer {
-        within(
-            "get occupancy",
-            requester.request::<Layer, Layer>(&keys::map_layer(&self.root, "occupancy"), None),
-        )
-        .await
-        .expect("occupancy")
-    }
-
-    async fn stop(self) {
-        self.cancel.cancel();
-        for service in self.services {
-            let outcome = within("service stop", service).await.expect("join");
-            outcome.expect("the service stopped cleanly");
-        }
-        let _ = within("router close", self.router.close()).await;
-    }
-}
 
 fn occupancy_cells(layer: &Layer) -> &[i8] {
     match &layer.cells {
         Cells::I8(cells) => cells,
         other => panic!("occupancy is not i8: {other:?}"),
-    }
-}
-
-/// The Foxglove WebSocket client's side of one connection.
-struct FoxgloveClient {
-    ws: tokio_tungstenite::WebSocketStream<
-        tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>,
-    >,
-    server_info: Option<Value>,
-    /// Advertised channels by topic.
-    channels: BTreeMap<String, Value>,
-}
-
-impl FoxgloveClient {
-    async fn connect(addr: SocketAddr) -> FoxgloveClient {
-        let mut request = format!("ws://{addr}")
-            .into_client_request()
-            .expect("request");
-        request.headers_mut().insert(
-            "sec-websocket-protocol",
-            HeaderValue::from_static(SUBPROTOCOL),
-        );
-        let (ws, response) = within(
-            "WebSocket connect",
-            tokio_tungstenite::connect_async(request),
-        )
-        .await
-        .expect("the view accepts a Foxglove client");
-        assert_eq!(
-            response
-                .headers()
-                .get("sec-websocket-protocol")
-                .map(|v| v.to_str().unwrap_or_default()),
-            Some(SUBPROTOCOL)
-        );
-        FoxgloveClient {
-            ws,
-            server_info: None,
-            channels: BTreeMap::new(),
-        }
-    }
-
-    /// The next message: JSON ones (serverInfo, advertise, …) are recorded and returned as
-    /// `Err(op)`; a binary one is returned as `Ok(bytes)`.
-    async fn next(&mut self) -> Result<Vec<u8>, String> {
-        loop {
-            let message = within("a WebSocket message", self.ws.next())
-                .await
-                .expect("the connection stays open")
-                .expect("a message");
-            match message {
-                WsMessage::Text(text) => {
-                    let json: Value = serde_json::from_str(&text).expect("JSON");
-                    let op = json["op"].as_str().unwrap_or_default().to_owned();
-                    match op.as_str() {
-                        "serverInfo" => self.server_info = Some(json),
-                        "advertise" => {
-                            for channel in json["channels"].as_array().expect("channels") {
-                                let topic = channel["topic"].as_str().expect("topic").to_owned();
-                                self.channels.insert(topic, channel.clone());
-                            }
-                        }
-                        _ => {}
-                    }
-                    return Err(op);
-                }
-                WsMessage::Binary(bytes) => return Ok(bytes.to_vec()),
-                _ => continue,
-            }
-        }
-    }
-
-    /// Reads until `topic` is advertised; returns its channel.
-    async fn until_advertised(&mut self, topic: &str) -> Value {
-        loop {
-            if let Some(channel) = self.channels.get(topic) {
-                return channel.clone();
-            }
-            let _ = self.next().await;
-        }
-    }
-
-    async fn subscribe(&mut self, subscription: u32, channel: u64) {
-        let request = serde_json::json!({
-            "op": "subscribe",
-            "subscriptions": [{"id": subscription, "channelId": channel}],
-        });
-        within(
-            "subscribe",
-            self.ws.send(WsMessage::Text(request.to_string().into())),
-        )
-        .await
-        .expect("subscribe sent");
-    }
-
-    /// The next `messageData` (opcode 1): its subscription id and payload.
-    async fn next_message_data(&mut self) -> (u32, Vec<u8>) {
-        loop {
-            if let Ok(bytes) = self.next().await {
-                // opcode (1), subscription id (u32 LE), log time (u64 LE), payload
-                assert!(bytes.len() >= 13, "a short binary message");
-                if bytes[0] == 1 {
-                    let id = u32::from_le_bytes([bytes[1], bytes[2], bytes[3], bytes[4]]);
-                    return (id, bytes[13..].to_vec());
-                }
-            }
-        }
     }
 }
 
@@ -299,6 +44,7 @@ async fn a_foxglove_client_sees_the_channels_and_receives_the_map() {
                 root: stack.root.clone(),
                 listen: Some("127.0.0.1:0".parse().expect("addr")),
                 mcap: None,
+                access: Access::default(),
             },
             cancel.clone(),
         ),
@@ -407,6 +153,7 @@ async fn an_mcap_recording_of_a_short_run_holds_the_map_robots_and_anchors() {
                 root: stack.root.clone(),
                 listen: None,
                 mcap: Some(path.clone()),
+                access: Access::default(),
             },
             cancel.clone(),
         ),
@@ -518,6 +265,7 @@ async fn a_view_needs_an_output_and_a_valid_root() {
             root: stack.root.clone(),
             listen: None,
             mcap: None,
+            access: Access::default(),
         },
         CancellationToken::new(),
     )
@@ -529,6 +277,7 @@ async fn a_view_needs_an_output_and_a_valid_root() {
             root: "roam/**".into(),
             listen: Some("127.0.0.1:0".parse().expect("addr")),
             mcap: None,
+            access: Access::default(),
         },
         CancellationToken::new(),
     )

@@ -71,6 +71,8 @@ ENVIRONMENT
   RUST_LOG      Log filter (default: info, Zenoh at warn), e.g. RUST_LOG=debug.
   ROAM_ROOT     The key root (default `roam`); two stacks with different roots never
                 see each other.
+  ROAM_VIEW_TOKEN  The token the live view (`roam view`, `roam demo --view`) requires
+                of its clients, instead of --token-file.
 
 EXAMPLES
   roam demo                                  roam's main job on the built-in world, with a report
@@ -80,7 +82,9 @@ EXAMPLES
   roam map layers --connect tcp/10.0.0.5:7447
   roam plan --connect tcp/10.0.0.5:7447 --start -8,-8 --goal 6,-7 --budget 60 --png plan.png
   roam map inspect config/maps/depot.yaml --json
-  roam view --connect tcp/127.0.0.1:7447      then open ws://127.0.0.1:8765 in the Foxglove app";
+  roam view --connect tcp/127.0.0.1:7447      then open ws://127.0.0.1:8765 in the Foxglove app
+  roam view --connect tcp/127.0.0.1:7447 --ws 0.0.0.0:8765 --token-file view.token
+                                             then ws://HOST:8765/?token=TOKEN from another machine";
 
 #[derive(Debug, Parser)]
 #[command(name = "roam", version, about = ABOUT, long_about = LONG_ABOUT)]

@@ -330,12 +330,16 @@ pub(crate) struct DemoArgs {
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Serve the live view here while the demo runs: open ws://ADDR in the Foxglove app
-    /// (e.g. 127.0.0.1:8765; --rate 1 to watch at a human pace).
+    /// (e.g. 127.0.0.1:8765; --rate 1 to watch at a human pace). An address other than
+    /// loopback needs --token-file.
     #[arg(long, value_name = "ADDR")]
     view: Option<std::net::SocketAddr>,
     /// Record the run to this MCAP file (opens in the Foxglove app).
     #[arg(long, value_name = "FILE")]
     record: Option<PathBuf>,
+    /// Who may connect to the live view (--view).
+    #[command(flatten)]
+    view_access: super::view::AccessArgs,
 }
 
 pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
@@ -349,6 +353,16 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
         root: None,
         view: args.view,
         record: args.record,
+        // Read (and checked) only when there is a live view to guard, and before the
+        // stack boots.
+        view_access: match args.view {
+            Some(addr) => {
+                let access = args.view_access.access()?;
+                roam_view::check_exposure(addr, &access)?;
+                access
+            }
+            None => roam_view::Access::default(),
+        },
     };
     let say = |line: &str| eprintln!("roam demo: {line}");
     let report = roam::demo::run(&options, &say).await?;
