@@ -11,10 +11,16 @@ pub const MAX_WAYPOINTS: usize = 10_000;
 /// The longest mission id, bytes: it is echoed in every status, so it stays short.
 pub const MAX_MISSION_ID_BYTES: usize = 128;
 
-/// The largest mission payload a receiver decodes, bytes: [`MAX_WAYPOINTS`] waypoints of
-/// two full-precision numbers (about 45 bytes each), with room. Receivers check the size
-/// before they parse, so a 60 MB mission costs nothing but its transfer.
-pub const MAX_MISSION_BYTES: usize = 1024 * 1024;
+/// The longest JSON of one waypoint `[x,y],` as the codec writes it: two shortest
+/// round-trip f64s (at most 24 characters each, e.g. `-2.2250738585072014e-308`) and
+/// three separators.
+const WAYPOINT_JSON_BYTES: usize = 2 * 24 + 4;
+
+/// The largest mission payload a receiver decodes, bytes: [`MAX_WAYPOINTS`] waypoints at
+/// their longest and 64 KiB for the envelope, the robot and the id (585,536 bytes).
+/// Receivers (the controller, the view) check the size before they parse, so a 60 MB
+/// mission costs nothing but its transfer.
+pub const MAX_MISSION_BYTES: usize = MAX_WAYPOINTS * WAYPOINT_JSON_BYTES + 64 * 1024;
 
 /// A mission for one robot, put on `<root>/robot/<id>/mission`: visit the waypoints in
 /// order. A new mission replaces the current one at once; an empty one stops the robot.

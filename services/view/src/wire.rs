@@ -8,33 +8,28 @@
 //! [`shown`] (a short escaped prefix and the length), so a name with a newline or an ANSI
 //! escape cannot forge log lines or recolour a terminal.
 
-use std::fmt::Write as _;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 
 use roam_map_server::store::DEFAULT_LIMITS;
-use roam_proto::controller::MAX_WAYPOINTS;
+use roam_proto::excerpt::excerpt_n;
 use roam_proto::{decode, DecodeError, ErrorReply, Message};
 use zenoh::bytes::ZBytes;
 use zenoh::Session;
 
 /// Characters of a string from the wire that are shown (escaped) before it is cut.
-pub const SHOWN_CHARS: usize = 64;
+pub const SHOWN_CHARS: usize = roam_proto::excerpt::MAX_EXCERPT_CHARS;
 /// Characters of an error's text that are logged (its control characters escaped).
 const CLIPPED_CHARS: usize = 256;
 
-/// The longest JSON of one waypoint `[x,y],` as the codec writes it: two shortest
-/// round-trip f64s (at most 24 characters each, e.g. `-2.2250738585072014e-308`) and
-/// three separators.
-const WAYPOINT_JSON_BYTES: usize = 2 * 24 + 4;
 /// Room for a message's envelope and its fields other than the bulk (names, ids,
 /// numbers).
 const ENVELOPE_BYTES: usize = 64 * 1024;
 
-/// The largest mission payload read: a mission of [`MAX_WAYPOINTS`] waypoints (the
-/// controller's limit) at their longest, and the envelope (585,536 bytes). A larger one
-/// cannot be a mission any controller drives.
-pub const MAX_MISSION_BYTES: usize = MAX_WAYPOINTS * WAYPOINT_JSON_BYTES + ENVELOPE_BYTES;
+/// The largest mission payload read: the controller's own limit (a mission of
+/// `MAX_WAYPOINTS` waypoints at their longest). A larger one cannot be a mission any
+/// controller drives.
+pub use roam_proto::controller::MAX_MISSION_BYTES;
 /// The largest position estimate read (a robot, numbers and the anchors used).
 pub const MAX_ESTIMATE_BYTES: usize = 64 * 1024;
 /// The largest true position read (a robot name and four numbers).
@@ -59,33 +54,13 @@ const fn base64_len(bytes: usize) -> usize {
 /// quotes and invisible characters written out), then `… (N bytes)` when it is longer.
 /// A name that is a valid key segment is shown unchanged.
 pub fn shown(text: &str) -> String {
-    let mut out = String::with_capacity(text.len().min(SHOWN_CHARS) + 16);
-    let mut chars = text.chars();
-    for c in chars.by_ref().take(SHOWN_CHARS) {
-        out.extend(c.escape_debug());
-    }
-    if chars.next().is_some() {
-        let _ = write!(out, "… ({} bytes)", text.len());
-    }
-    out
+    excerpt_n(text, SHOWN_CHARS).to_string()
 }
 
 /// An error's text (which may quote what it failed on) as it may appear in a log line:
 /// control characters escaped, cut at 256 characters.
 pub fn clipped(text: &str) -> String {
-    let mut out = String::with_capacity(text.len().min(CLIPPED_CHARS) + 16);
-    let mut chars = text.chars();
-    for c in chars.by_ref().take(CLIPPED_CHARS) {
-        if c.is_control() {
-            out.extend(c.escape_debug());
-        } else {
-            out.push(c);
-        }
-    }
-    if chars.next().is_some() {
-        let _ = write!(out, "… ({} bytes)", text.len());
-    }
-    out
+    excerpt_n(text, CLIPPED_CHARS).to_string()
 }
 
 /// Lets the first few warnings of a kind through, then every thousandth, so a stream of
@@ -173,6 +148,7 @@ pub(crate) async fn query<Q: Message, R: Message>(
 mod tests {
     use super::*;
     use roam_proto::controller::Mission;
+    use roam_proto::controller::MAX_WAYPOINTS;
     use roam_proto::encode;
 
     #[test]
@@ -207,7 +183,7 @@ mod tests {
         let extreme = -2.225_073_858_507_201_4e-308;
         let mission = Mission {
             robot: "r".repeat(roam_proto::keys::MAX_SEGMENT_LEN),
-            id: "i".repeat(1024),
+            id: "i".repeat(roam_proto::controller::MAX_MISSION_ID_BYTES),
             waypoints: vec![[extreme, extreme]; MAX_WAYPOINTS],
         };
         let bytes = encode(&mission);

@@ -92,7 +92,8 @@ pub(crate) async fn logs(harness: &Harness, client: &Requester, log: &Captured) 
     )
     .await
     .expect("put");
-    log.wait_for(before, "the body names robot 'robot\\n2026").await;
+    log.wait_for(before, "the body names robot 'robot\\n2026")
+        .await;
     mapper.stop().await.1.expect("clean stop");
     controller.stop().await.1.expect("clean stop");
     localization.stop().await.1.expect("clean stop");
@@ -108,7 +109,10 @@ pub(crate) async fn logs(harness: &Harness, client: &Requester, log: &Captured) 
         !text.contains(&format!("\n{FORGED_LINE}")),
         "a forged name started a log line"
     );
-    assert!(!text.contains('\u{1b}'), "a terminal escape reached the log");
+    assert!(
+        !text.contains('\u{1b}'),
+        "a terminal escape reached the log"
+    );
     assert!(
         text.contains("mission refused"),
         "the refusals are logged:\n{text}"

@@ -40,8 +40,11 @@ impl Files {
             format!("image: {}\n{yaml}", secret.display()),
         )
         .expect("yaml");
-        std::fs::write(maps.join("dotdot.yaml"), format!("image: ../users.txt\n{yaml}"))
-            .expect("yaml");
+        std::fs::write(
+            maps.join("dotdot.yaml"),
+            format!("image: ../users.txt\n{yaml}"),
+        )
+        .expect("yaml");
         // A file in the directory that is not a map and holds a secret.
         std::fs::write(maps.join("notes.yaml"), format!("- {MARKER}: root:x:0:0\n"))
             .expect("notes");
@@ -146,7 +149,12 @@ pub(crate) async fn map_loads(harness: &Harness, client: &Requester, files: &Fil
                 .await,
             requested,
         );
-        assert_eq!(reply.code, ErrorCode::NotFound, "{requested}: {}", reply.message);
+        assert_eq!(
+            reply.code,
+            ErrorCode::NotFound,
+            "{requested}: {}",
+            reply.message
+        );
         assert_no_content(&reply, requested);
     }
     // Inside the directory and not a map: named as corrupt, without its content.
@@ -162,7 +170,10 @@ pub(crate) async fn map_loads(harness: &Harness, client: &Requester, files: &Fil
         .request(&key, Some(&load("ok.yaml")))
         .await
         .expect("a map in the load directory loads");
-    assert!(list.layers.iter().any(|l| l.name == "occupancy" && l.meta.width == 4));
+    assert!(list
+        .layers
+        .iter()
+        .any(|l| l.name == "occupancy" && l.meta.width == 4));
     server.stop().await.1.expect("clean stop");
 }
 
@@ -196,7 +207,11 @@ pub(crate) async fn sim_loads(harness: &Harness, client: &Requester, files: &Fil
         );
         assert_no_content(&reply, &requested);
         if files.forbidden().contains(&requested) && !requested.is_empty() {
-            assert_eq!(shape(&reply, &requested), missing_shape, "sim: '{requested}'");
+            assert_eq!(
+                shape(&reply, &requested),
+                missing_shape,
+                "sim: '{requested}'"
+            );
         }
     }
     sim.stop().await.1.expect("clean stop");

@@ -88,9 +88,12 @@ pub(crate) async fn keys_decide(harness: &Harness, client: &Requester) {
     // on the real robot's key, and nothing was commanded.
     let mut estimates = 0;
     loop {
-        let sample = within("samples up to the last step's estimate", everything.recv_async())
-            .await
-            .expect("sample");
+        let sample = within(
+            "samples up to the last step's estimate",
+            everything.recv_async(),
+        )
+        .await
+        .expect("sample");
         let key = sample.key_expr().as_str().to_owned();
         if key.ends_with("/cmd") || key.ends_with("/controller") {
             panic!("the forged mission was acted on: '{key}'");
@@ -110,7 +113,10 @@ pub(crate) async fn keys_decide(harness: &Harness, client: &Requester) {
             break;
         }
     }
-    assert!(estimates >= 40, "the real robot's estimates flow ({estimates})");
+    assert!(
+        estimates >= 40,
+        "the real robot's estimates flow ({estimates})"
+    );
     controller.stop().await.1.expect("clean stop");
     localization.stop().await.1.expect("clean stop");
     sim.stop().await.1.expect("clean stop");
