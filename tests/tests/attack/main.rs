@@ -10,7 +10,8 @@
 //! - echoes are bounded and escaped: replies to megabyte fields stay under
 //!   [`echo::MAX_ECHO_REPLY_BYTES`], a flood of bad puts grows the log by at most
 //!   [`echo::MAX_FLOOD_LOG_BYTES`], and names with newlines or terminal escapes forge no
-//!   log line ([`echo`]).
+//!   log line ([`echo`]);
+//! - the live view refuses a page from a foreign Origin ([`view`]).
 //!
 //! The phases run one after another in one test, because the log is the process's and
 //! its growth is measured. The secure site's version of the file attack (the operator
@@ -20,6 +21,7 @@ mod echo;
 mod files;
 mod logs;
 mod routing;
+mod view;
 
 use roam_tests::Harness;
 
@@ -39,6 +41,8 @@ async fn attacks_on_a_running_stack_find_nothing() {
 
     echo::replies(&harness, &client).await;
     echo::logs(&harness, &client, &log).await;
+
+    view::origins(&harness).await;
 
     harness.close().await;
 }
