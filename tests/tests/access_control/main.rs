@@ -18,7 +18,8 @@ use roam_controller::service::ControllerConfig;
 use roam_mission::service::MissionConfig;
 use roam_proto::cells::Cells;
 use roam_proto::localization::{PebQuery, PebReply, PebWhere};
-use roam_proto::map::{Layer, LayerChange, LayerList, LayerUpdate, UpdateAck};
+use roam_map_server::MapServerConfig;
+use roam_proto::map::{Layer, LayerChange, LayerList, LayerUpdate, LoadMap, UpdateAck};
 use roam_proto::mapper::MapperStatus;
 use roam_proto::mission::WindowReport;
 use roam_proto::sim::RobotCommand;
@@ -179,6 +180,64 @@ async fn only_the_controller_drives_and_only_map_writers_change_the_map() {
 
 async fn stop(service: RunningService) {
     service.stop().await.1.expect("the service stops cleanly");
+}
+
+/// The escalation an attack run found: the operator, who may load maps, asked the map
+/// server to load the router's user dictionary and got every role's password back in
+/// the parse error. Loads now read only inside the map server's load directories: the
+/// dictionary is refused like a missing file, no password is in any reply, and a map
+/// in the directory still loads.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_map_writer_cannot_read_the_routers_secrets_through_a_load() {
+    let (secrets, harness) = secure_site().await;
+    let map_server = harness
+        .start_map_server(MapServerConfig {
+            load_dirs: vec![roam_tests::repo_path("config/maps")],
+            ..harness.map_server_config()
+        })
+        .await;
+    let operator = harness.client_as("operator").await;
+    let users = secrets.users.display().to_string();
+    let relative = format!("../../../../../../../../..{users}");
+    for requested in [users.as_str(), relative.as_str(), "/etc/passwd"] {
+        let outcome = within(
+            "operator load",
+            operator.request::<LoadMap, LayerList>(
+                &keys::map_load(ROOT),
+                Some(&LoadMap {
+                    path: requested.to_owned(),
+                    base_version: None,
+                }),
+            ),
+        )
+        .await;
+        let Err(ClientError::Refused(reply)) = outcome else {
+            panic!("loading {requested}: expected a refusal, got {outcome:?}");
+        };
+        assert_eq!(reply.code, ErrorCode::NotFound, "{requested}: {}", reply.message);
+        for password in secrets.passwords.values() {
+            assert!(
+                !reply.message.contains(password.as_str()),
+                "a password came back: {}",
+                reply.message
+            );
+        }
+    }
+    let list: LayerList = within(
+        "operator loads a shipped map",
+        operator.request(
+            &keys::map_load(ROOT),
+            Some(&LoadMap {
+                path: "depot.yaml".into(),
+                base_version: None,
+            }),
+        ),
+    )
+    .await
+    .expect("a map in the load directory loads");
+    assert!(list.layers.iter().any(|l| l.name == "occupancy"));
+    stop(map_server).await;
+    harness.close().await;
 }
 
 /// The policy is complete: every role, run as itself, does its whole job through the

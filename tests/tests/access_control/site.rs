@@ -37,7 +37,7 @@ pub(crate) struct Secrets {
     ca: PathBuf,
     router_cert: PathBuf,
     router_key: PathBuf,
-    users: PathBuf,
+    pub(crate) users: PathBuf,
     pub(crate) passwords: BTreeMap<String, String>,
 }
 
