@@ -14,7 +14,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use roam_proto::map::{LayerList, LayerUpdate, LoadMap, MAX_WIRE_CELL_WRITES};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
-use roam_runtime::{reply, Service, ServiceError};
+use roam_runtime::{reply, PayloadBudget, Service, ServiceError};
 use tokio_util::sync::CancellationToken;
 use zenoh::bytes::ZBytes;
 use zenoh::key_expr::KeyExpr;
@@ -191,7 +191,10 @@ pub async fn run(
     service.serve(layer_q, state.clone(), |s, q| async move {
         answer_layer(&s, &q).await
     });
-    service.serve(update_q, state.clone(), |s, q| async move {
+    // One maximal update in work at a time (smaller ones share the room): decoding,
+    // checking, storing and publishing a layer costs a few times its payload.
+    let budget = PayloadBudget::new(config.limits.max_request_bytes as usize);
+    service.serve_within(update_q, Some(budget), state.clone(), |s, q| async move {
         answer_update(s, &q).await
     });
     service.serve(index_q, state.clone(), |s, q| async move {

@@ -22,5 +22,5 @@ pub mod telemetry;
 pub mod warn_limit;
 
 pub use client::{ClientError, Requester};
-pub use service::{Service, ServiceError};
+pub use service::{PayloadBudget, Service, ServiceError};
 pub use session::{SessionArgs, SessionError};

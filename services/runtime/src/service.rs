@@ -36,6 +36,36 @@ pub const MAX_IN_FLIGHT: usize = 32;
 /// small messages pass their own, smaller limit to [`Service::subscribe_with`].
 pub const DEFAULT_MAX_SAMPLE_BYTES: usize = 96 * 1024 * 1024;
 
+/// Payload bytes a queryable works on at once ([`Service::serve_within`]).
+#[derive(Debug, Clone)]
+pub struct PayloadBudget {
+    /// One permit per KiB.
+    kib: Arc<Semaphore>,
+    total_kib: u32,
+}
+
+impl PayloadBudget {
+    /// A budget of `bytes` (at least 1 KiB, at most 4 TiB).
+    pub fn new(bytes: usize) -> PayloadBudget {
+        let total_kib = u32::try_from(bytes.div_ceil(1024))
+            .unwrap_or(u32::MAX)
+            .max(1);
+        PayloadBudget {
+            kib: Arc::new(Semaphore::new(total_kib as usize)),
+            total_kib,
+        }
+    }
+
+    /// Waits until `bytes` fit in what is left (all of it for a payload above the whole
+    /// budget); the room is given back when the returned permit drops.
+    async fn take(&self, bytes: usize) -> Option<tokio::sync::OwnedSemaphorePermit> {
+        let kib = u32::try_from(bytes.div_ceil(1024))
+            .unwrap_or(u32::MAX)
+            .min(self.total_kib);
+        self.kib.clone().acquire_many_owned(kib).await.ok()
+    }
+}
+
 /// How long [`Service::shutdown`] waits for in-flight work by default.
 pub const DEFAULT_GRACE: Duration = Duration::from_millis(1500);
 
@@ -199,6 +229,26 @@ impl Service {
         F: Fn(S, Query) -> Fut + Send + Sync + 'static,
         Fut: Future<Output = ()> + Send + 'static,
     {
+        self.serve_within(queryable, None, state, handler)
+    }
+
+    /// [`Service::serve`], with the payloads of the queries being handled at once
+    /// bounded by `budget`: a query waits (in Zenoh's channel) until the payloads in work
+    /// leave room for its own. Decoding, checking and answering a request costs a few
+    /// times its payload, so for a queryable that takes large requests (the map server's
+    /// updates, up to `max_request_bytes`) this is what bounds the service's memory under
+    /// concurrent large requests. A payload above the whole budget waits for all of it.
+    pub fn serve_within<S, F, Fut>(
+        &self,
+        queryable: Queryable<FifoChannelHandler<Query>>,
+        budget: Option<PayloadBudget>,
+        state: S,
+        handler: F,
+    ) where
+        S: Clone + Send + Sync + 'static,
+        F: Fn(S, Query) -> Fut + Send + Sync + 'static,
+        Fut: Future<Output = ()> + Send + 'static,
+    {
         let cancel = self.cancel.clone();
         let tracker = self.tasks.clone();
         let name = self.name;
@@ -212,19 +262,32 @@ impl Service {
                         Err(_) => break,
                     },
                 };
-                tokio::select! {
+                let query = tokio::select! {
                     _ = cancel.cancelled() => break,
                     next = queryable.recv_async() => match next {
-                        Ok(query) => {
-                            let work = handler(state.clone(), query);
-                            tracker.spawn(async move {
-                                work.await;
-                                drop(permit);
-                            });
-                        }
+                        Ok(query) => query,
                         Err(_) => break,
                     },
-                }
+                };
+                let room = match &budget {
+                    Some(budget) => {
+                        let size = query.payload().map_or(0, |p| p.len());
+                        tokio::select! {
+                            _ = cancel.cancelled() => {
+                                reply::refuse_stopping(&query, name).await;
+                                break;
+                            }
+                            room = budget.take(size) => room,
+                        }
+                    }
+                    None => None,
+                };
+                let work = handler(state.clone(), query);
+                tracker.spawn(async move {
+                    work.await;
+                    drop(room);
+                    drop(permit);
+                });
             }
             while let Ok(Some(query)) = queryable.try_recv() {
                 reply::refuse_stopping(&query, name).await;

@@ -15,10 +15,10 @@
 use std::time::Duration;
 
 use roam_controller::service::ControllerConfig;
+use roam_map_server::MapServerConfig;
 use roam_mission::service::MissionConfig;
 use roam_proto::cells::Cells;
 use roam_proto::localization::{PebQuery, PebReply, PebWhere};
-use roam_map_server::MapServerConfig;
 use roam_proto::map::{Layer, LayerChange, LayerList, LayerUpdate, LoadMap, UpdateAck};
 use roam_proto::mapper::MapperStatus;
 use roam_proto::mission::WindowReport;
@@ -214,7 +214,12 @@ async fn a_map_writer_cannot_read_the_routers_secrets_through_a_load() {
         let Err(ClientError::Refused(reply)) = outcome else {
             panic!("loading {requested}: expected a refusal, got {outcome:?}");
         };
-        assert_eq!(reply.code, ErrorCode::NotFound, "{requested}: {}", reply.message);
+        assert_eq!(
+            reply.code,
+            ErrorCode::NotFound,
+            "{requested}: {}",
+            reply.message
+        );
         for password in secrets.passwords.values() {
             assert!(
                 !reply.message.contains(password.as_str()),

@@ -20,7 +20,9 @@ async fn upgrade_status(addr: std::net::SocketAddr, origin: &str) -> String {
         .await
         .expect("send");
     let mut head = vec![0u8; 256];
-    let n = within("status", stream.read(&mut head)).await.expect("read");
+    let n = within("status", stream.read(&mut head))
+        .await
+        .expect("read");
     let text = String::from_utf8_lossy(&head[..n]).into_owned();
     text.lines().next().unwrap_or_default().to_owned()
 }
