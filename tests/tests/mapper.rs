@@ -208,3 +208,92 @@ async fn fetch(client: &roam_runtime::Requester, root: &str, name: &str) -> Opti
         .await
         .ok()
 }
+
+/// Asks the mapper how many observations it has merged.
+async fn observations(client: &roam_runtime::Requester, root: &str) -> u64 {
+    let status: MapperStatus = within(
+        "mapper status",
+        client.request::<MapperStatus, MapperStatus>(&keys::mapper_status(root), None),
+    )
+    .await
+    .expect("status");
+    status.observations
+}
+
+/// Steps the sim and waits until the mapper has merged more than `than` observations.
+async fn step_until_merged(client: &roam_runtime::Requester, root: &str, than: u64) -> u64 {
+    let until = Instant::now() + Duration::from_secs(10);
+    loop {
+        let _: SimStatus = within(
+            "step",
+            client.request(&keys::sim_control(root), Some(&SimControl::Step { n: 1 })),
+        )
+        .await
+        .expect("step");
+        let merged = observations(client, root).await;
+        if merged > than {
+            return merged;
+        }
+        assert!(
+            Instant::now() < until,
+            "the mapper stopped merging observations ({merged})"
+        );
+    }
+}
+
+/// One forged observation stamped far in the future once stopped the mapper for good
+/// (every later one was "time going back"), and a sim reset stalled it until sim time
+/// passed the old maximum. Observation times are now checked against the sim clock, and
+/// a reset starts a new epoch: the mapper goes on merging after both.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_forged_time_and_a_sim_reset_do_not_stop_the_mapper() {
+    let harness = Harness::start().await;
+    let _sim = harness.start_sim(harness.sim_config(Some(GRID004))).await;
+    let _mapper = harness
+        .start_mapper(MapperConfig {
+            scenario: Some(repo_path(GRID004)),
+            ..harness.mapper_config()
+        })
+        .await;
+    let client = harness.client().await;
+    let root = harness.root.clone();
+    let observations_key = keys::robot_observation(&root, "robot");
+    let seen = within(
+        "subscribe",
+        client.session().declare_subscriber(&observations_key),
+    )
+    .await
+    .expect("subscriber");
+    let merged = step_until_merged(&client, &root, 0).await;
+
+    // A real observation, restamped 1e300 s, put on the robot's key.
+    let sample = within("an observation", seen.recv_async())
+        .await
+        .expect("sample");
+    let mut forged: roam_proto::sim::LocalObservation =
+        decode(&sample.payload().to_bytes()).expect("observation");
+    forged.time_s = 1e300;
+    within(
+        "put",
+        client
+            .session()
+            .put(&observations_key, roam_proto::encode(&forged)),
+    )
+    .await
+    .expect("put");
+    let merged = step_until_merged(&client, &root, merged).await;
+
+    // A reset: the sim's clock goes back to 0 and the mapper goes on.
+    let _: SimStatus = within(
+        "reset",
+        client.request(
+            &keys::sim_control(&root),
+            Some(&SimControl::Reset { seed: 2 }),
+        ),
+    )
+    .await
+    .expect("reset");
+    // The first step after the reset may be refused (its observation comes before its
+    // clock); the ones after it are merged.
+    let _ = step_until_merged(&client, &root, merged + 1).await;
+}
