@@ -40,7 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut store = LayerStore::new(
         DEFAULT_LIMITS,
         DerivedParams::default(),
-        Some(DataDir::open(&dir)?),
+        Some(DataDir::open(&dir, DEFAULT_LIMITS.max_layer_cells)?),
     );
     store.load_map(Grid::filled(meta, occupancy::FREE), None, None)?;
     let create = LayerUpdate {

@@ -2,12 +2,16 @@
 //!
 //! The algorithm side is plain Rust: [`ros_map`] reads and writes ROS `map_server`
 //! maps as Nav2 does, [`scenario`] reads roam's scenario files, [`layers`] computes the
-//! inflated and heuristic layers, [`store`] holds versioned layers and the rules for
-//! changing them, and [`persist`] keeps them on disk. [`service`] is the thin Zenoh
-//! adapter around the store.
+//! inflated and heuristic layers and [`derived`] keeps them in step with a few cell
+//! edits, [`store`] holds versioned layers and the rules for changing them, [`edits`]
+//! is the checked form of a `set_cells` change, and [`persist`] keeps the layers on
+//! disk (snapshots and change logs, see the crate's README). [`service`] is the thin
+//! Zenoh adapter around the store.
 
 pub mod config;
+pub mod derived;
 pub mod distance;
+pub mod edits;
 pub mod grid;
 pub mod layers;
 pub mod map_file;
