@@ -68,15 +68,18 @@ pub fn inflated_changes(
     if !radius_cells.is_finite() {
         return None;
     }
-    let reach = radius_cells.ceil() as u64 + 1;
+    // Saturating: a radius of any size (from a scenario, say) only widens the window.
+    let reach = (radius_cells.ceil() as u64).saturating_add(1);
     let grow = |lo: u32, hi: u32, by: u64, size: u32| {
         (
             u64::from(lo).saturating_sub(by),
-            (u64::from(hi) + by).min(u64::from(size) - 1),
+            u64::from(hi)
+                .saturating_add(by)
+                .min(u64::from(size).saturating_sub(1)),
         )
     };
-    let (wx0, wx1) = grow(x0, x1, 2 * reach, meta.width);
-    let (wy0, wy1) = grow(y0, y1, 2 * reach, meta.height);
+    let (wx0, wx1) = grow(x0, x1, reach.saturating_mul(2), meta.width);
+    let (wy0, wy1) = grow(y0, y1, reach.saturating_mul(2), meta.height);
     let (ww, wh) = (wx1 - wx0 + 1, wy1 - wy0 + 1);
     if ww * wh > meta.cell_count() / WINDOW_SHARE {
         return None;
@@ -233,6 +236,13 @@ mod tests {
         assert!(
             inflated_changes(&grid.meta, &grid.cells, &before.cells, &edits, 0.2, 65).is_none()
         );
+        // A radius of any size, even one no window can hold, asks for it too.
+        let one = edits_of(&[(5, 5, 100)]);
+        for radius in [1e9, 1e300, f64::MAX] {
+            let changes =
+                inflated_changes(&grid.meta, &grid.cells, &before.cells, &one, radius, 65);
+            assert!(changes.is_none(), "radius {radius}");
+        }
     }
 
     #[test]

@@ -56,6 +56,19 @@ pub fn value_range(name: &str, dtype: Dtype) -> (f64, f64) {
     }
 }
 
+impl EditError {
+    /// What is wrong, without the positions and values (for edits read from a file,
+    /// whose content a message never quotes).
+    pub fn short(&self) -> &'static str {
+        match self {
+            EditError::Outside { .. } => "a cell outside the layer",
+            EditError::Value { .. } => "a value out of the layer's range",
+            EditError::Dtype { .. } => "values of another element type",
+            EditError::Count { .. } => "not one value per position",
+        }
+    }
+}
+
 impl CellEdits {
     /// No edit, for a layer of `dtype`.
     pub fn empty(dtype: Dtype) -> Self {

@@ -189,7 +189,7 @@ fn a_header_must_name_its_own_layer() {
     assert!(
         err.error
             .to_string()
-            .contains("names layer 'occupancy_copy', not 'peb'"),
+            .contains("names another layer, not 'peb'"),
         "{}",
         err.error
     );
@@ -203,6 +203,23 @@ fn a_header_must_name_its_own_layer() {
     assert!(
         !message.contains("/**/"),
         "file content is not quoted: {message}"
+    );
+    // The same for a change log.
+    data.append("occupancy_copy", 2, 0, &one_cell(0, 0, 1.0))
+        .expect("append");
+    fs::copy(
+        data.log_path_of("occupancy_copy"),
+        data.log_path_of("other"),
+    )
+    .expect("copy");
+    let loaded = open(dir.path()).load_all();
+    assert!(
+        loaded
+            .warnings
+            .iter()
+            .any(|w| w.contains("other.log is corrupt: its header names another layer")),
+        "{:?}",
+        loaded.warnings
     );
     // A file whose name is not a layer name is ignored with a warning.
     fs::write(dir.path().join("layers/a b.layer"), b"x").expect("write");

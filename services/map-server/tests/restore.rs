@@ -453,3 +453,46 @@ fn deleting_a_layer_frees_its_slot() {
     store.delete("a", 1).expect("delete");
     store.apply("b", &full).expect("a slot again");
 }
+
+/// A change one of whose layers cannot be persisted is refused, not applied, and what
+/// was already written for the others is undone: the files never hold it.
+#[test]
+fn a_change_that_cannot_be_persisted_is_refused_and_leaves_no_trace() {
+    use roam_map_server::persist::log;
+
+    let dir = tempfile::tempdir().expect("tmp");
+    let mut store = store_on(dir.path());
+    store
+        .load_map(Grid::filled(meta(40, 30), occupancy::FREE), None, None)
+        .expect("load");
+    store
+        .apply(OCCUPANCY, &set(1, &[(10, 10, 100.0)]))
+        .expect("v2");
+    // inflated's log cannot be appended to any more.
+    let inflated_log = layers_dir(dir.path()).join("inflated.log");
+    fs::remove_file(&inflated_log).expect("remove");
+    fs::create_dir(&inflated_log).expect("a folder in its place");
+
+    let err = store
+        .apply(OCCUPANCY, &set(2, &[(20, 20, 100.0)]))
+        .expect_err("refused");
+    assert_eq!(err.to_reply().code, ErrorCode::Internal);
+    assert!(err.to_string().contains("could not be persisted"), "{err}");
+    assert_eq!(store.version(OCCUPANCY), 2, "not applied");
+    let at = |s: &LayerStore| s.get(OCCUPANCY).and_then(|l| l.cells.get_f64(20 * 40 + 20));
+    assert_eq!(at(&store), Some(0.0));
+    let occupancy_log = layers_dir(dir.path()).join("occupancy.log");
+    let scan = log::scan(&occupancy_log, OCCUPANCY, u64::MAX, u64::MAX).expect("scan");
+    assert_eq!(
+        scan.records.iter().map(|r| r.version).collect::<Vec<_>>(),
+        [2],
+        "occupancy's record of the refused change was cut off again"
+    );
+
+    fs::remove_dir(&inflated_log).expect("folder");
+    drop(store);
+    let store = restarted(dir.path());
+    assert_eq!(store.version(OCCUPANCY), 2);
+    assert_eq!(at(&store), Some(0.0));
+    assert_in_step(&store);
+}

@@ -254,12 +254,7 @@ pub fn scan(
     }
     if header.name != name {
         return Err(corrupt(format!(
-            "its header names layer '{}', not '{name}'",
-            if roam_proto::keys::check_name("layer", &header.name).is_ok() {
-                header.name.as_str()
-            } else {
-                "(not a layer name)"
-            }
+            "its header names another layer, not '{name}'"
         )));
     }
     let mut offset = line.len() as u64 + 1;

@@ -212,9 +212,10 @@ pub(super) fn recover(
         }
         if let Err(e) = record.edits.check(&content) {
             warnings.push(format!(
-                "{}: the record of version {} does not fit the layer ({e}); the records from it on are not used",
+                "{}: the record of version {} does not fit the layer ({}); the records from it on are not used",
                 dir.log_path_of(name).display(),
-                record.version
+                record.version,
+                e.short()
             ));
             recovered.rewrite = true;
             break;

@@ -223,10 +223,7 @@ fn check_header_names(header: &Header, name: &str) -> Result<(), String> {
         return Err("its header names no valid layer".into());
     }
     if header.name != name {
-        return Err(format!(
-            "its header names layer '{}', not '{name}'",
-            header.name
-        ));
+        return Err(format!("its header names another layer, not '{name}'"));
     }
     let source = crate::store::derived_source(name);
     if header.derived_from.as_deref() != source {
