@@ -104,6 +104,20 @@ pub fn map_update_any(root: &str) -> String {
     format!("{root}/map/update/*")
 }
 
+/// `<root>/map/delete/<layer>`: the map server answers a `get` carrying a
+/// [`DeleteLayer`](crate::map::DeleteLayer) by deleting that free layer, with a
+/// [`LayerDeleted`](crate::map::LayerDeleted), or an error reply (stale version, a base
+/// layer, no such layer). The roles that may update layers may delete them. Nothing is
+/// published when a layer is deleted: a `get` then answers `not_found`.
+pub fn map_delete(root: &str, layer: &str) -> String {
+    format!("{root}/map/delete/{layer}")
+}
+
+/// `<root>/map/delete/*`: the map server's delete queryable declaration.
+pub fn map_delete_any(root: &str) -> String {
+    format!("{root}/map/delete/*")
+}
+
 /// `<root>/map/layers`: the map server answers a `get` (no payload) with a
 /// [`LayerList`](crate::map::LayerList): every layer's name, version, size and warnings.
 pub fn map_index(root: &str) -> String {
@@ -308,6 +322,8 @@ mod tests {
         );
         assert_eq!(map_layer("r", "occupancy"), "r/map/layer/occupancy");
         assert_eq!(map_update("r", "peb"), "r/map/update/peb");
+        assert_eq!(map_delete("r", "peb"), "r/map/delete/peb");
+        assert_eq!(map_delete_any("r"), "r/map/delete/*");
         assert_eq!(map_index("r"), "r/map/layers");
         assert_eq!(map_load("r"), "r/map/load");
     }

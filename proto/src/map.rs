@@ -150,3 +150,37 @@ pub struct LoadMap {
 impl Message for LoadMap {
     const KIND: &'static str = "load_map";
 }
+
+/// Ask the map server to delete a layer, based on the version the writer last saw
+/// (refused with `stale_version` when the layer has moved on, like an update). Only
+/// free layers can be deleted: `occupancy`, `information` and their derived `inflated`
+/// and `heuristic` are refused with `invalid_request`, a layer that does not exist
+/// with `not_found`.
+///
+/// What followers see: nothing is published on `<root>/map/layer/<name>` (no
+/// tombstone); from the reply on, a `get` of the layer answers `not_found` and
+/// `<root>/map/layers` no longer lists it. A layer created again under the same name
+/// (a replace based on version 0) goes on from the deleted one's version (it gets
+/// `version + 1`), so a follower that keeps the newest version takes it, and a writer
+/// still holding a version of the deleted layer is refused as stale.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeleteLayer {
+    pub base_version: u64,
+}
+
+impl Message for DeleteLayer {
+    const KIND: &'static str = "delete_layer";
+}
+
+/// The answer to an accepted [`DeleteLayer`]: the layer and the version it had.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayerDeleted {
+    pub layer: String,
+    pub version: u64,
+}
+
+impl Message for LayerDeleted {
+    const KIND: &'static str = "layer_deleted";
+}

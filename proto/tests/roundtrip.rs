@@ -4,8 +4,8 @@
 use proptest::prelude::*;
 use roam_proto::cells::Cells;
 use roam_proto::map::{
-    CellWrite, GridMeta, Layer, LayerChange, LayerInfo, LayerList, LayerUpdate, LoadMap, Origin,
-    UpdateAck,
+    CellWrite, DeleteLayer, GridMeta, Layer, LayerChange, LayerDeleted, LayerInfo, LayerList,
+    LayerUpdate, LoadMap, Origin, UpdateAck,
 };
 use roam_proto::{decode, encode, DecodeError, ErrorCode, ErrorReply, LimitHit, Message};
 
@@ -172,6 +172,12 @@ proptest! {
     #[test]
     fn update_ack_round_trips(layer in name(), version in any::<u64>(), derived in prop::collection::vec(info(), 0..3)) {
         round_trips(&UpdateAck { layer, version, derived });
+    }
+
+    #[test]
+    fn delete_layer_round_trips(base_version in any::<u64>(), layer in name(), version in any::<u64>()) {
+        round_trips(&DeleteLayer { base_version });
+        round_trips(&LayerDeleted { layer, version });
     }
 
     #[test]

@@ -7,7 +7,10 @@ use std::time::Duration;
 use roam_map_server::store::{Limits, DEFAULT_LIMITS};
 use roam_map_server::MapServerConfig;
 use roam_proto::cells::Cells;
-use roam_proto::map::{CellWrite, Layer, LayerChange, LayerList, LayerUpdate, LoadMap, UpdateAck};
+use roam_proto::map::{
+    CellWrite, DeleteLayer, Layer, LayerChange, LayerDeleted, LayerList, LayerUpdate, LoadMap,
+    UpdateAck,
+};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::{ClientError, Requester};
 use roam_tests::{within, Harness};
@@ -444,6 +447,10 @@ async fn without_load_directories_loads_are_off() {
     harness.close().await;
 }
 
+/// The newest snapshot of occupancy is cut in half on disk: the server falls back to
+/// the previous copy and the change logged on top of it, serves that above the lost
+/// version (so followers that keep the newest take it), and computes `inflated` again
+/// from it; the information map, of the lost map's size, is loaded again.
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_corrupt_persisted_layer_is_reported_and_the_last_good_copy_served() {
     let harness = Harness::start().await;
@@ -460,7 +467,21 @@ async fn a_corrupt_persisted_layer_is_reported_and_the_last_good_copy_served() {
         client.request::<LayerUpdate, UpdateAck>(&key, Some(&set(1, 5, 5, 100.0))),
     )
     .await
-    .expect("v2");
+    .expect("v2, in the change log");
+    let before_load = get_layer(&client, &harness.root, "occupancy").await;
+    let depot = concat!(env!("CARGO_MANIFEST_DIR"), "/../config/maps/depot.yaml");
+    within(
+        "load",
+        client.request::<LoadMap, LayerList>(
+            &keys::map_load(&harness.root),
+            Some(&LoadMap {
+                path: depot.into(),
+                base_version: Some(2),
+            }),
+        ),
+    )
+    .await
+    .expect("v3, a new snapshot");
     server.stop().await.1.expect("clean stop");
 
     let file = data.path().join("layers/occupancy.layer");
@@ -480,12 +501,222 @@ async fn a_corrupt_persisted_layer_is_reported_and_the_last_good_copy_served() {
         "{warnings}"
     );
     assert!(warnings.contains("last good copy"), "{warnings}");
+    assert!(warnings.contains("served as version 4"), "{warnings}");
     let occupancy = get_layer(&client, &harness.root, "occupancy").await;
-    assert_eq!(occupancy.version, 1, "the previous good copy");
+    assert_eq!(
+        (occupancy.version, &occupancy.cells),
+        (4, &before_load.cells),
+        "the previous copy with its logged change, above the lost version 3"
+    );
+    let inflated = get_layer(&client, &harness.root, "inflated").await;
+    assert_eq!(inflated.meta, occupancy.meta, "inflated follows it");
+    assert!(inflated.version >= 4, "never back: {}", inflated.version);
+    let information = get_layer(&client, &harness.root, "information").await;
+    assert_eq!(information.meta, occupancy.meta, "{warnings}");
     assert!(
         data.path().join("layers/occupancy.layer.corrupt").exists(),
         "the corrupt file is kept"
     );
+
+    server.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
+
+/// A SIGKILL between the save of occupancy and the save of inflated, and one during
+/// the next append: the files as such a crash leaves them (occupancy's log has the
+/// last acknowledged change, inflated's does not; occupancy's ends in a torn record).
+/// The restarted server computes `inflated` again, and every obstacle of the
+/// `occupancy` it serves is occupied in the `inflated` it serves.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn inflated_always_matches_occupancy_after_a_kill_between_saves() {
+    use roam_map_server::persist::log;
+
+    let harness = Harness::start().await;
+    let data = tempfile::tempdir().expect("tmp");
+    let config = roam_map_server::MapServerConfig {
+        data_dir: Some(data.path().to_owned()),
+        ..harness.map_server_config()
+    };
+    let server = harness.start_map_server(config.clone()).await;
+    let client = harness.client().await;
+    let key = keys::map_update(&harness.root, "occupancy");
+    for (base, x) in [(1, 30), (2, 60)] {
+        within(
+            "update",
+            client.request::<LayerUpdate, UpdateAck>(&key, Some(&set(base, x, 40, 100.0))),
+        )
+        .await
+        .expect("update");
+    }
+    server.stop().await.1.expect("clean stop");
+
+    let layers = data.path().join("layers");
+    // Inflated's last record (version 3) never reached the disk.
+    let inflated_log = layers.join("inflated.log");
+    let scan = log::scan(&inflated_log, "inflated", u64::MAX, u64::MAX).expect("scan");
+    let last = scan.records.last().expect("a record");
+    assert_eq!(last.version, 3);
+    let cut = scan.good_bytes - log::record_bytes(last.edits.len(), last.edits.values.dtype());
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&inflated_log)
+        .and_then(|f| f.set_len(cut))
+        .expect("cut");
+    // And half of an unacknowledged version 4 of occupancy.
+    let torn = log::encode(
+        4,
+        0,
+        &roam_map_server::edits::CellEdits {
+            positions: vec![(80, 40)],
+            values: Cells::I8(vec![100]),
+        },
+    );
+    std::fs::OpenOptions::new()
+        .append(true)
+        .open(layers.join("occupancy.log"))
+        .and_then(|mut f| std::io::Write::write_all(&mut f, &torn[..torn.len() / 2]))
+        .expect("torn append");
+
+    let server = harness.start_map_server(config).await;
+    let occupancy = get_layer(&client, &harness.root, "occupancy").await;
+    let inflated = get_layer(&client, &harness.root, "inflated").await;
+    assert_eq!(occupancy.version, 3, "every acknowledged change, no more");
+    let at = |x: usize| occupancy.cells.get_f64(40 * 100 + x);
+    assert_eq!(
+        (at(30), at(60), at(80)),
+        (Some(100.0), Some(100.0), Some(0.0))
+    );
+    assert!(inflated.version >= 3, "never back: {}", inflated.version);
+    let mut obstacles = 0;
+    for i in 0..occupancy.cells.len() {
+        if occupancy.cells.get_f64(i).is_some_and(|c| c >= 65.0) {
+            obstacles += 1;
+            assert_eq!(
+                inflated.cells.get_f64(i),
+                Some(100.0),
+                "obstacle cell {i} is free in inflated"
+            );
+        }
+    }
+    assert!(obstacles > 2, "the world has obstacles: {obstacles}");
+    let Cells::I8(cells) = &occupancy.cells else {
+        panic!("occupancy is i8");
+    };
+    let list: LayerList = within(
+        "index",
+        client.request::<LayerList, LayerList>(&keys::map_index(&harness.root), None),
+    )
+    .await
+    .expect("list");
+    let warnings = list.warnings.join("\n");
+    assert!(warnings.contains("'inflated' computed again"), "{warnings}");
+    assert!(warnings.contains("incomplete last record"), "{warnings}");
+    // Exactly what inflating this occupancy gives, with the built-in world's radius.
+    let radius = roam_map_server::map_file::builtin(DEFAULT_LIMITS.max_layer_cells)
+        .expect("built-in world")
+        .robot_radius_m
+        .unwrap_or(0.2);
+    let expected = roam_map_server::layers::inflate(
+        &roam_map_server::grid::Grid {
+            meta: occupancy.meta,
+            cells: cells.clone(),
+        },
+        radius,
+        65,
+    );
+    assert_eq!(inflated.cells, Cells::I8(expected.cells));
+
+    server.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
+
+/// Deleting a free layer through Zenoh: stale and protected deletions refused with a
+/// structured error, then the layer gone from `get` and the list, and a layer created
+/// again under its name going on from its version.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_free_layer_is_deleted_and_base_layers_are_refused() {
+    let harness = Harness::start().await;
+    let server = harness.start_map_server(harness.map_server_config()).await;
+    let client = harness.client().await;
+    let root = harness.root.as_str();
+    let create = |base_version| LayerUpdate {
+        base_version,
+        change: LayerChange::Replace {
+            meta: roam_proto::map::GridMeta {
+                width: 4,
+                height: 4,
+                resolution: 0.5,
+                origin: Default::default(),
+            },
+            cells: Cells::F32(vec![0.5; 16]),
+        },
+    };
+    let ack: UpdateAck = within(
+        "create",
+        client.request(&keys::map_update(root, "scratch"), Some(&create(0))),
+    )
+    .await
+    .expect("created");
+    assert_eq!(ack.version, 1);
+    let delete = |name: &str, base_version| {
+        let key = keys::map_delete(root, name);
+        let client = &client;
+        async move {
+            client
+                .request::<DeleteLayer, LayerDeleted>(&key, Some(&DeleteLayer { base_version }))
+                .await
+        }
+    };
+
+    let stale = refusal(delete("scratch", 0)).await;
+    assert_eq!(stale.code, ErrorCode::StaleVersion);
+    assert!(stale.message.contains("at version 1"), "{}", stale.message);
+    for base in ["occupancy", "inflated", "information", "heuristic"] {
+        let refused = refusal(delete(base, 1)).await;
+        assert_eq!(refused.code, ErrorCode::InvalidRequest, "{base}");
+        assert!(
+            refused.message.contains("cannot be deleted"),
+            "{}",
+            refused.message
+        );
+    }
+    let wildcard = refusal(client.request::<DeleteLayer, LayerDeleted>(
+        &keys::map_delete_any(root),
+        Some(&DeleteLayer { base_version: 1 }),
+    ))
+    .await;
+    assert_eq!(wildcard.code, ErrorCode::InvalidRequest);
+
+    let deleted = within("delete", delete("scratch", 1))
+        .await
+        .expect("deleted");
+    assert_eq!(
+        deleted,
+        LayerDeleted {
+            layer: "scratch".into(),
+            version: 1
+        }
+    );
+    let gone =
+        refusal(client.request::<Layer, Layer>(&keys::map_layer(root, "scratch"), None)).await;
+    assert_eq!(gone.code, ErrorCode::NotFound);
+    let list: LayerList = within(
+        "index",
+        client.request::<LayerList, LayerList>(&keys::map_index(root), None),
+    )
+    .await
+    .expect("list");
+    assert!(!list.layers.iter().any(|l| l.name == "scratch"), "{list:?}");
+    let again = refusal(delete("scratch", 1)).await;
+    assert_eq!(again.code, ErrorCode::NotFound);
+
+    let ack: UpdateAck = within(
+        "create again",
+        client.request(&keys::map_update(root, "scratch"), Some(&create(0))),
+    )
+    .await
+    .expect("created again");
+    assert_eq!(ack.version, 2, "goes on from the deleted layer's version");
 
     server.stop().await.1.expect("clean stop");
     harness.close().await;

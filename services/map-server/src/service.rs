@@ -5,13 +5,14 @@
 //! |---|---|---|
 //! | `<root>/map/layer/<name>` | queryable + publication | [`Layer`](roam_proto::map::Layer) |
 //! | `<root>/map/update/<name>` | queryable | `LayerUpdate` → `UpdateAck` |
+//! | `<root>/map/delete/<name>` | queryable | `DeleteLayer` → `LayerDeleted` |
 //! | `<root>/map/layers` | queryable | → `LayerList` |
 //! | `<root>/map/load` | queryable | `LoadMap` → `LayerList` |
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, MutexGuard};
 
-use roam_proto::map::{LayerList, LayerUpdate, LoadMap, MAX_WIRE_CELL_WRITES};
+use roam_proto::map::{DeleteLayer, Layer, LayerList, LayerUpdate, LoadMap, MAX_WIRE_CELL_WRITES};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, PayloadBudget, Service, ServiceError};
@@ -26,7 +27,7 @@ use crate::config::MapServerConfig;
 use crate::load_dirs::LoadDirs;
 use crate::map_file::{self, MapFileError};
 use crate::persist::{DataDir, PersistError};
-use crate::store::{DerivedParams, LayerStore};
+use crate::store::{DerivedParams, LayerStore, OCCUPANCY};
 
 /// The service name in liveliness tokens and logs.
 pub const SERVICE_NAME: &str = "map-server";
@@ -71,19 +72,34 @@ impl State {
             .unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
-    /// The encoded layer, from the cache when its version is current.
+    fn cache(&self) -> MutexGuard<'_, HashMap<String, (u64, ZBytes)>> {
+        self.encoded.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The encoded layer (as the store holds it now), from the cache when its version
+    /// is current.
     fn encoded(&self, name: &str) -> Option<ZBytes> {
-        let store = self.store();
-        let layer = store.get(name)?;
-        let mut cache = self.encoded.lock().unwrap_or_else(|p| p.into_inner());
-        if let Some((version, bytes)) = cache.get(name) {
+        let layer = self.store().get_shared(name)?;
+        Some(self.encode(&layer))
+    }
+
+    /// Encodes a layer taken from the store, outside the store's lock: a large layer
+    /// takes milliseconds to encode, during which updates and `map/layers` go on.
+    fn encode(&self, layer: &Layer) -> ZBytes {
+        if let Some((version, bytes)) = self.cache().get(&layer.name) {
             if *version == layer.version {
-                return Some(bytes.clone());
+                return bytes.clone();
             }
         }
         let bytes = ZBytes::from(encode(layer));
-        cache.insert(name.to_owned(), (layer.version, bytes.clone()));
-        Some(bytes)
+        let mut cache = self.cache();
+        let newer = cache
+            .get(&layer.name)
+            .is_some_and(|(version, _)| *version > layer.version);
+        if !newer {
+            cache.insert(layer.name.clone(), (layer.version, bytes.clone()));
+        }
+        bytes
     }
 
     async fn publish(&self, names: &[String]) {
@@ -119,7 +135,11 @@ pub fn open_store(config: &MapServerConfig) -> Result<LayerStore, MapServerError
             config.limits.max_cells_per_update
         )));
     }
-    let data = config.data_dir.as_deref().map(DataDir::open).transpose()?;
+    let data = config
+        .data_dir
+        .as_deref()
+        .map(|dir| DataDir::open(dir, config.limits.max_layer_cells))
+        .transpose()?;
     let mut derived = DerivedParams {
         heuristic_compression: config.heuristic_compression,
         lethal_threshold: config.lethal_threshold,
@@ -129,24 +149,52 @@ pub fn open_store(config: &MapServerConfig) -> Result<LayerStore, MapServerError
         derived.robot_radius_m = r;
     }
     let mut store = LayerStore::new(config.limits, derived, data);
-    if store.restore() {
+    let restored = store
+        .restore(config.robot_radius_m.is_some())
+        .map_err(|e| MapServerError::Store(e.to_string()))?;
+    if restored.found && restored.lost_sources.is_empty() {
         tracing::info!(
             layers = store.names().count(),
             "restored the layers and their versions from the data dir"
         );
         return Ok(store);
     }
-    let content = match &config.map {
-        Some(path) => map_file::read(path, config.limits.max_layer_cells)?,
-        None => map_file::builtin(config.limits.max_layer_cells)?,
-    };
-    if let (None, Some(r)) = (config.robot_radius_m, content.robot_radius_m) {
+    let content = configured_map(config)?;
+    let radius_follows_map = restored.lost_sources.contains(&OCCUPANCY) || !restored.found;
+    if let (None, Some(r), true) = (
+        config.robot_radius_m,
+        content.robot_radius_m,
+        radius_follows_map,
+    ) {
         store.set_robot_radius(r);
+    }
+    if restored.found {
+        let map_name = config.map.as_ref().map_or_else(
+            || map_file::BUILTIN_NAME.to_owned(),
+            |p| p.display().to_string(),
+        );
+        store
+            .reload_lost_sources(
+                content.occupancy,
+                content.information,
+                &restored.lost_sources,
+                &map_name,
+            )
+            .map_err(|e| MapServerError::Store(e.to_string()))?;
+        return Ok(store);
     }
     store
         .load_map(content.occupancy, content.information, None)
         .map_err(|e| MapServerError::Store(e.to_string()))?;
     Ok(store)
+}
+
+/// The configured map, or the built-in world when none is configured.
+fn configured_map(config: &MapServerConfig) -> Result<map_file::MapContent, MapServerError> {
+    Ok(match &config.map {
+        Some(path) => map_file::read(path, config.limits.max_layer_cells)?,
+        None => map_file::builtin(config.limits.max_layer_cells)?,
+    })
 }
 
 /// Runs the map server until `cancel` is cancelled.
@@ -182,6 +230,9 @@ pub async fn run(
     let update_q = service
         .declare_queryable(&keys::map_update_any(root))
         .await?;
+    let delete_q = service
+        .declare_queryable(&keys::map_delete_any(root))
+        .await?;
     let index_q = service.declare_queryable(&keys::map_index(root)).await?;
     let load_q = service.declare_queryable(&keys::map_load(root)).await?;
 
@@ -197,6 +248,9 @@ pub async fn run(
     service.serve_within(update_q, Some(budget), state.clone(), |s, q| async move {
         answer_update(s, &q).await
     });
+    service.serve(delete_q, state.clone(), |s, q| async move {
+        answer_delete(s, &q).await
+    });
     service.serve(index_q, state.clone(), |s, q| async move {
         let list = s.store().list();
         reply::send(&q, &list).await;
@@ -210,26 +264,26 @@ pub async fn run(
     Ok(())
 }
 
-/// Answers a layer `get`: every layer whose key matches the query's key expression.
+/// Answers a layer `get`: every layer whose key matches the query's key expression,
+/// all taken from the store at one moment, so a wildcard `get` never mixes a new
+/// `occupancy` with an old `inflated`.
 async fn answer_layer(state: &State, query: &Query) {
-    let names: Vec<String> = state.store().names().map(str::to_owned).collect();
-    let mut answered = 0;
-    for name in &names {
-        let key = keys::map_layer(&state.root, name);
-        let Ok(layer_key) = KeyExpr::try_from(key.as_str()) else {
-            continue;
-        };
-        if !query.key_expr().intersects(&layer_key) {
-            continue;
-        }
-        if let Some(bytes) = state.encoded(name) {
-            if let Err(e) = query.reply(layer_key, bytes).await {
-                tracing::warn!(%key, "reply failed: {e}");
-            }
-            answered += 1;
-        }
-    }
-    if answered == 0 {
+    let (names, matching): (Vec<String>, Vec<_>) = {
+        let store = state.store();
+        let names: Vec<String> = store.names().map(str::to_owned).collect();
+        let matching = names
+            .iter()
+            .filter_map(|name| {
+                let key = KeyExpr::try_from(keys::map_layer(&state.root, name)).ok()?;
+                if !query.key_expr().intersects(&key) {
+                    return None;
+                }
+                Some((key, store.get_shared(name)?))
+            })
+            .collect();
+        (names, matching)
+    };
+    if matching.is_empty() {
         let error = ErrorReply::new(
             ErrorCode::NotFound,
             format!(
@@ -239,6 +293,13 @@ async fn answer_layer(state: &State, query: &Query) {
             ),
         );
         reply::send_error(query, &error).await;
+        return;
+    }
+    for (key, layer) in matching {
+        let bytes = state.encode(&layer);
+        if let Err(e) = query.reply(key.clone(), bytes).await {
+            tracing::warn!(%key, "reply failed: {e}");
+        }
     }
 }
 
@@ -281,6 +342,36 @@ async fn answer_update(state: Arc<State>, query: &Query) {
             reply::send_error(
                 query,
                 &ErrorReply::new(ErrorCode::Internal, format!("the update task failed: {e}")),
+            )
+            .await
+        }
+    }
+}
+
+async fn answer_delete(state: Arc<State>, query: &Query) {
+    let max = state.store().limits().max_request_bytes as usize;
+    let request = layer_name_of(query)
+        .and_then(|name| Ok((name, reply::decode_request::<DeleteLayer>(query, max)?)));
+    let (name, request) = match request {
+        Ok(r) => r,
+        Err(e) => return reply::send_error(query, &e).await,
+    };
+    let worker = state.clone();
+    let outcome = tokio::task::spawn_blocking(move || {
+        let deleted = worker
+            .store()
+            .delete(&name, request.base_version)
+            .map_err(|e| e.to_reply())?;
+        worker.cache().remove(&name);
+        Ok(deleted)
+    })
+    .await;
+    match outcome {
+        Ok(result) => reply::send_result(query, result).await,
+        Err(e) => {
+            reply::send_error(
+                query,
+                &ErrorReply::new(ErrorCode::Internal, format!("the delete task failed: {e}")),
             )
             .await
         }

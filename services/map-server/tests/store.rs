@@ -225,7 +225,7 @@ fn persisted_layers_restore_with_their_versions() {
         let mut store = LayerStore::new(
             DEFAULT_LIMITS,
             DerivedParams::default(),
-            Some(DataDir::open(dir.path()).expect("dir")),
+            Some(DataDir::open(dir.path(), DEFAULT_LIMITS.max_layer_cells).expect("dir")),
         );
         store
             .load_map(Grid::filled(meta(20, 10), occupancy::FREE), None, None)
@@ -237,9 +237,9 @@ fn persisted_layers_restore_with_their_versions() {
     let mut store = LayerStore::new(
         DEFAULT_LIMITS,
         DerivedParams::default(),
-        Some(DataDir::open(dir.path()).expect("dir")),
+        Some(DataDir::open(dir.path(), DEFAULT_LIMITS.max_layer_cells).expect("dir")),
     );
-    assert!(store.restore());
+    assert!(store.restore(false).expect("restore").found);
     assert_eq!(store.version(OCCUPANCY), 2);
     assert_eq!(store.version(INFLATED), 2);
     assert_eq!(store.version(HEURISTIC), 1);

@@ -6,7 +6,9 @@
 use std::time::Duration;
 
 use roam_proto::cells::Cells;
-use roam_proto::map::{Layer, LayerChange, LayerList, LayerUpdate, LoadMap, UpdateAck};
+use roam_proto::map::{
+    DeleteLayer, Layer, LayerChange, LayerDeleted, LayerList, LayerUpdate, LoadMap, UpdateAck,
+};
 use roam_proto::sim::RobotCommand;
 use roam_proto::{encode, keys};
 use roam_runtime::{ClientError, Requester};
@@ -18,6 +20,10 @@ use zenoh::sample::Sample;
 use crate::observe::{drain, put, sim_status, step_and_locate, subscribe, versions};
 use crate::site::{client_config, Secrets};
 use crate::{ROBOT, ROOT};
+
+/// A free layer the operator (a map writer) creates, so that an intruder's deletion of it
+/// is one the map server would accept.
+pub(crate) const SCRATCH: &str = "scratch";
 
 /// How long a query whose reply can never come is waited for (Zenoh in fact ends a
 /// query the router drops at once, with no reply).
@@ -37,7 +43,8 @@ pub(crate) struct Watch {
 
 impl Watch {
     /// The operator (having checked the built-in world has its robot), the `inflated`
-    /// layer a forgery is made from, and the spies.
+    /// layer a forgery is made from, the free layer [`SCRATCH`] (created by the
+    /// operator, a map writer), and the spies.
     pub(crate) async fn start(harness: &Harness) -> Self {
         let operator = harness.client_as("operator").await;
         let status = sim_status(&operator).await;
@@ -51,6 +58,22 @@ impl Watch {
         )
         .await
         .expect("the operator may read a layer");
+        let scratch = LayerUpdate {
+            base_version: 0,
+            change: LayerChange::Replace {
+                meta: inflated.meta,
+                cells: Cells::F32(vec![0.5; inflated.meta.cell_count() as usize]),
+            },
+        };
+        within(
+            "scratch layer",
+            operator.request::<LayerUpdate, UpdateAck>(
+                &keys::map_update(ROOT, SCRATCH),
+                Some(&scratch),
+            ),
+        )
+        .await
+        .expect("the operator may create a layer");
         // The spies have sessions of their own: a session's own puts reach its own
         // subscribers without passing the router.
         let spy_sessions = vec![
@@ -72,8 +95,9 @@ impl Watch {
 /// Everything an intruder (a session without a right to it) tries: command the robot on
 /// its own key, on a robot wildcard and on `roam/**`; publish a forged `inflated` layer
 /// with a huge version; update a layer (the derived `inflated`, which the server would
-/// refuse anyway, and `occupancy`, which it would accept); load a map. Asserts that none
-/// of it had any effect.
+/// refuse anyway, and `occupancy`, which it would accept); delete the free layer
+/// [`SCRATCH`] at its version (which it would accept); load a map. Asserts that none of
+/// it had any effect.
 pub(crate) async fn assert_intrusion_has_no_effect(who: &str, intruder: &Requester, watch: &Watch) {
     let before = versions(&watch.operator).await;
     let at_before = step_and_locate(&watch.operator).await;
@@ -121,6 +145,14 @@ pub(crate) async fn assert_intrusion_has_no_effect(who: &str, intruder: &Request
             cells: forged.cells.clone(),
         },
     };
+    let scratch_version = before.get(SCRATCH).copied();
+    assert!(
+        scratch_version.is_some(),
+        "the layer to delete exists: {before:?}"
+    );
+    let delete_scratch = DeleteLayer {
+        base_version: scratch_version.unwrap_or(0),
+    };
     let load = LoadMap {
         path: repo_path("config/scenarios/es1.yaml").display().to_string(),
         base_version: None,
@@ -129,11 +161,13 @@ pub(crate) async fn assert_intrusion_has_no_effect(who: &str, intruder: &Request
     let update_inflated_key = keys::map_update(ROOT, "inflated");
     let update_occupancy_key = keys::map_update(ROOT, "occupancy");
     let load_key = keys::map_load(ROOT);
-    let (inflated, occupancy, loaded) = within("intruder queries", async {
+    let delete_key = keys::map_delete(ROOT, SCRATCH);
+    let (inflated, occupancy, deleted, loaded) = within("intruder queries", async {
         tokio::join!(
             asker
                 .request::<LayerUpdate, UpdateAck>(&update_inflated_key, Some(&overwrite_inflated)),
             asker.request::<LayerUpdate, UpdateAck>(&update_occupancy_key, Some(&clear_occupancy)),
+            asker.request::<DeleteLayer, LayerDeleted>(&delete_key, Some(&delete_scratch)),
             asker.request::<LoadMap, LayerList>(&load_key, Some(&load)),
         )
     })
@@ -141,6 +175,7 @@ pub(crate) async fn assert_intrusion_has_no_effect(who: &str, intruder: &Request
     for (what, outcome) in [
         ("update inflated", inflated.map(|_| ())),
         ("update occupancy", occupancy.map(|_| ())),
+        ("delete a free layer", deleted.map(|_| ())),
         ("load a map", loaded.map(|_| ())),
     ] {
         assert!(

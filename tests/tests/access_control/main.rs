@@ -10,7 +10,7 @@
 //! role's credentials. Each negative check is one that would fail with the access control
 //! off (`access_control/enabled:false` on the router makes every one of them fail): a
 //! command that would move the robot, a write that a subscriber would receive, a map
-//! update or load the map server would accept.
+//! update, deletion or load the map server would accept.
 
 use std::time::Duration;
 
@@ -19,7 +19,9 @@ use roam_map_server::MapServerConfig;
 use roam_mission::service::MissionConfig;
 use roam_proto::cells::Cells;
 use roam_proto::localization::{PebQuery, PebReply, PebWhere};
-use roam_proto::map::{Layer, LayerChange, LayerList, LayerUpdate, LoadMap, UpdateAck};
+use roam_proto::map::{
+    DeleteLayer, Layer, LayerChange, LayerDeleted, LayerList, LayerUpdate, LoadMap, UpdateAck,
+};
 use roam_proto::mapper::MapperStatus;
 use roam_proto::mission::WindowReport;
 use roam_proto::sim::RobotCommand;
@@ -172,6 +174,23 @@ async fn only_the_controller_drives_and_only_map_writers_change_the_map() {
         ),
         other => panic!("the map server answers the mapper with an error reply, got {other:?}"),
     }
+    // ... and a map writer may delete a layer it may update.
+    let deleted: LayerDeleted = within(
+        "mapper deletes a layer",
+        mapper.request(
+            &keys::map_delete(ROOT, "change_rate"),
+            Some(&DeleteLayer {
+                base_version: ack.version,
+            }),
+        ),
+    )
+    .await
+    .expect("the mapper's deletion is applied");
+    assert_eq!(deleted.version, ack.version);
+    assert!(
+        !versions(&watch.operator).await.contains_key("change_rate"),
+        "the deleted layer is no longer listed"
+    );
 
     stop(sim).await;
     stop(map_server).await;

@@ -89,6 +89,15 @@ pub(crate) fn layer_bases(occupancy_version: u64) -> Vec<Vec<u8>> {
     ]
 }
 
+/// Deletions of the layer the fuzzer's updates create (so some are accepted) or of a
+/// base layer (always refused), at versions it may or may not be at.
+pub(crate) fn delete_bases() -> Vec<Vec<u8>> {
+    [0, 1, 2, u64::MAX]
+        .iter()
+        .map(|&base_version| encode(&DeleteLayer { base_version }))
+        .collect()
+}
+
 pub(crate) fn load_bases() -> Vec<Vec<u8>> {
     // Never a real path: a load that succeeds replaces the map under the other
     // services (devices and FIFOs are refused, tested in the map server's own tests).

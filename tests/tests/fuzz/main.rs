@@ -14,7 +14,8 @@ use rand_chacha::ChaCha8Rng;
 use roam_proto::controller::Mission;
 use roam_proto::localization::{PebQuery, PebReply, PebWhere, PositionEstimate};
 use roam_proto::map::{
-    CellWrite, GridMeta, Layer, LayerChange, LayerList, LayerUpdate, LoadMap, Origin, UpdateAck,
+    CellWrite, DeleteLayer, GridMeta, Layer, LayerChange, LayerDeleted, LayerList, LayerUpdate,
+    LoadMap, Origin, UpdateAck,
 };
 use roam_proto::mapper::MapperStatus;
 use roam_proto::planner::{CancelPlan, GaOverrides, Plan, PlanRequest, PlannerModel};
@@ -47,6 +48,7 @@ const QUERY_TIMEOUT: Duration = Duration::from_secs(20);
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Expects {
     LayerUpdate,
+    DeleteLayer,
     LoadMap,
     PlanRequest,
     SimControl,
@@ -60,6 +62,7 @@ impl Expects {
     fn must_refuse(self, bytes: &[u8]) -> bool {
         match self {
             Expects::LayerUpdate => decode::<LayerUpdate>(bytes).is_err(),
+            Expects::DeleteLayer => decode::<DeleteLayer>(bytes).is_err(),
             Expects::LoadMap => decode::<LoadMap>(bytes).is_err(),
             Expects::PlanRequest => decode::<PlanRequest>(bytes).is_err(),
             Expects::SimControl => decode::<SimControl>(bytes).is_err(),
@@ -72,6 +75,7 @@ impl Expects {
     fn reply_decodes(self, bytes: &[u8]) -> bool {
         match self {
             Expects::LayerUpdate => decode::<UpdateAck>(bytes).is_ok(),
+            Expects::DeleteLayer => decode::<LayerDeleted>(bytes).is_ok(),
             Expects::LoadMap => decode::<LayerList>(bytes).is_ok(),
             Expects::PlanRequest => decode::<Plan>(bytes).is_ok(),
             Expects::SimControl => decode::<SimStatus>(bytes).is_ok(),
@@ -101,6 +105,8 @@ const KINDS: &[&str] = &[
     "layer_list",
     "layer_update",
     "update_ack",
+    "delete_layer",
+    "layer_deleted",
     "load_map",
     "plan_request",
     "plan",
@@ -189,6 +195,18 @@ async fn every_queryable_and_subscriber_survives_random_and_mutated_payloads() {
             Expects::LayerUpdate,
             layer_bases(1),
             1000,
+        ),
+        q(
+            keys::map_delete(&root, "fuzz"),
+            Expects::DeleteLayer,
+            delete_bases(),
+            1000,
+        ),
+        q(
+            keys::map_delete(&root, "occupancy"),
+            Expects::DeleteLayer,
+            delete_bases(),
+            500,
         ),
         q(keys::map_load(&root), Expects::LoadMap, load_bases(), 2000),
         q(keys::map_index(&root), Expects::Nothing, vec![], 1500),
