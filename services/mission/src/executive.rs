@@ -32,8 +32,9 @@ use zenoh::qos::CongestionControl;
 
 use crate::information::gathered;
 use crate::inputs::{listen, lock, wait_for_world, Inputs};
-use crate::path::{clear, eta_slips, off_path_m, thin};
+use crate::path::{clear, thin};
 use crate::tasks::{self, Task, TaskError};
+use crate::watch::{Decision, Reason, Status, Watch, WatchParams};
 
 /// How the executive plans and watches.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -67,6 +68,12 @@ pub struct ExecutiveConfig {
     /// seconds) means the controller lost it (it restarted, or the robot's link was
     /// down when the mission was sent): replan from where the robot is and send again.
     pub controller_silence_s: f64,
+    /// Arriving this much earlier than the task's start is slack: the executive replans
+    /// a curious path from where the robot is with the time left (the mirror of the ETA
+    /// slip rule), seconds. Infinity turns the rule off.
+    pub slack_s: f64,
+    /// Mission seconds between two slack replans at least.
+    pub slack_interval_s: f64,
 }
 
 impl Default for ExecutiveConfig {
@@ -85,6 +92,8 @@ impl Default for ExecutiveConfig {
             max_replans: 5,
             give_up_after_s: 60.0,
             controller_silence_s: 3.0,
+            slack_s: 10.0,
+            slack_interval_s: 10.0,
         }
     }
 }
@@ -167,12 +176,19 @@ fn check(config: &ExecutiveConfig) -> Result<(), ExecutiveError> {
         ("speed_m_per_s", config.speed_m_per_s),
         ("give_up_after_s", config.give_up_after_s),
         ("controller_silence_s", config.controller_silence_s),
+        ("slack_interval_s", config.slack_interval_s),
     ] {
         if !(value.is_finite() && value > 0.0) {
             return Err(ExecutiveError::Config(format!(
                 "{name} is {value}; give a positive number"
             )));
         }
+    }
+    if config.slack_s.is_nan() || config.slack_s <= 0.0 {
+        return Err(ExecutiveError::Config(format!(
+            "slack_s is {}; give a positive number of seconds (.inf turns the slack rule off)",
+            config.slack_s
+        )));
     }
     Ok(())
 }
@@ -197,6 +213,18 @@ struct Run<'a> {
 impl Run<'_> {
     fn now(&self) -> f64 {
         lock(&self.inputs.clock).now_s()
+    }
+
+    fn watch_params(&self) -> WatchParams {
+        WatchParams {
+            off_path_m: self.config.off_path_m,
+            speed_m_per_s: self.config.speed_m_per_s,
+            max_replans: self.config.max_replans,
+            give_up_after_s: self.config.give_up_after_s,
+            controller_silence_s: self.config.controller_silence_s,
+            slack_s: self.config.slack_s,
+            slack_interval_s: self.config.slack_interval_s,
+        }
     }
 
     /// What planning costs on the mission clock.
@@ -409,37 +437,27 @@ impl Run<'_> {
             curious: plan.model != PlannerModel::Shortest,
         });
         let planned_information = plan.distinct_information;
-        let mut path = plan.points.clone();
         let mut plans = vec![plan.points.clone()];
-        let mut mission = {
-            let w = self.waypoints(&plan);
-            self.send(window, w)
-        };
+        let mut waypoints = self.waypoints(&plan);
+        let mut mission = self.send(window, waypoints.clone());
+        let wall = Instant::now();
+        let wall_s = || wall.elapsed().as_secs_f64();
+        let mut watch = Watch::new(
+            self.watch_params(),
+            task.start_s,
+            plan.points.clone(),
+            self.now(),
+            wall_s(),
+        );
         let mut driven = vec![from];
         let mut pebs = Vec::new();
         let mut reasons: Vec<String> = Vec::new();
-        let mut resends = 0usize;
         let mut arrival = None;
-        let mut slipped = false;
         let mut tick = tokio::time::interval(Duration::from_millis(100));
-        let silence = Duration::from_secs_f64(self.config.controller_silence_s);
-        let mut heard_at = Instant::now();
         loop {
-            let mut replan: Option<(&'static str, bool)> = None;
-            let mut resend = false;
-            tokio::select! {
+            let decision = tokio::select! {
                 _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
-                _ = tick.tick() => {
-                    if self.now() > task.start_s + self.config.give_up_after_s {
-                        progress(Progress::GaveUp { window, task: task.name.clone() });
-                        break;
-                    }
-                    if heard_at.elapsed() >= silence {
-                        heard_at = Instant::now();
-                        resend = true;
-                        replan = Some(("the controller went silent on the mission", !slipped));
-                    }
-                }
+                _ = tick.tick() => watch.on_tick(self.now(), wall_s()),
                 sample = self.inputs.estimates.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
                     let Some(e) = self.inputs.estimate(&sample) else { continue };
@@ -451,9 +469,7 @@ impl Run<'_> {
                     if let Some(p) = e.peb_m {
                         pebs.push(p);
                     }
-                    if off_path_m(e.position, &path) > self.config.off_path_m {
-                        replan = Some(("pushed off the path", !slipped));
-                    }
+                    watch.on_estimate(e.position)
                 }
                 sample = self.inputs.statuses.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
@@ -461,68 +477,82 @@ impl Run<'_> {
                     if s.mission.as_deref() != Some(mission.as_str()) {
                         continue;
                     }
-                    heard_at = Instant::now();
-                    match s.state {
-                        MissionState::Completed => {
-                            let at_s = self.now();
-                            arrival = Some(at_s);
-                            progress(Progress::Arrived { window, task: task.name.clone(), at_s, start_s: task.start_s });
-                            break;
-                        }
-                        MissionState::Stuck | MissionState::StepLimit => {
-                            replan = Some(("stuck: the path is blocked", false));
-                        }
-                        MissionState::Active if !slipped => {
-                            let left = s.distance_left_m.unwrap_or(0.0);
-                            if eta_slips(self.now(), left, self.config.speed_m_per_s, task.start_s) {
-                                slipped = true;
-                                replan = Some(("the ETA slipped past the task's start", false));
-                            }
-                        }
-                        _ => {}
-                    }
+                    let status = match s.state {
+                        MissionState::Completed => Status::Completed,
+                        MissionState::Stuck | MissionState::StepLimit => Status::Stuck,
+                        MissionState::Active => Status::Active {
+                            distance_left_m: s.distance_left_m.unwrap_or(0.0),
+                        },
+                        _ => Status::Other,
+                    };
+                    watch.on_status(status, self.now(), wall_s(), self.planning_cost_s())
                 }
+            };
+            let (reason, curious, resend) = match decision {
+                Decision::Keep => continue,
+                Decision::Arrived { at_s } => {
+                    arrival = Some(at_s);
+                    progress(Progress::Arrived {
+                        window,
+                        task: task.name.clone(),
+                        at_s,
+                        start_s: task.start_s,
+                    });
+                    break;
+                }
+                Decision::GiveUp => {
+                    progress(Progress::GaveUp {
+                        window,
+                        task: task.name.clone(),
+                    });
+                    break;
+                }
+                Decision::Replan {
+                    reason,
+                    curious,
+                    resend,
+                } => (reason, curious, resend),
+            };
+            if reason == Reason::Slack {
+                // Slack pays for the robot waiting while it plans, so the new path
+                // starts where the robot is rather than where it was.
+                mission = self.send(window, Vec::new());
             }
-            if let Some((reason, curious)) = replan {
-                // A lost mission is always sent again (at most once per silence period);
-                // the replan limit is for the robot's own trouble.
-                let replans = reasons.len().saturating_sub(resends);
-                if !resend && replans as u32 >= self.config.max_replans {
+            let here = self.position.unwrap_or(from);
+            let shortest_here = match self
+                .plan(here, task.at, PlannerModel::Shortest, 86_400.0)
+                .await
+            {
+                Ok(p) => p,
+                Err(e) => {
+                    tracing::warn!("replanning failed: {e}");
+                    if reason == Reason::Slack {
+                        // Held for nothing: back on the path it had.
+                        mission = self.send(window, waypoints.clone());
+                    }
                     continue;
                 }
-                let here = self.position.unwrap_or(from);
-                let shortest_here = match self
-                    .plan(here, task.at, PlannerModel::Shortest, 86_400.0)
-                    .await
-                {
-                    Ok(p) => p,
-                    Err(e) => {
-                        tracing::warn!("replanning failed: {e}");
-                        continue;
-                    }
-                };
-                // A curious plan that fails (busy, an outage) leaves the shortest way.
-                let plan = match self.plan_window(here, task, &shortest_here, curious).await {
-                    Ok((plan, _)) => plan,
-                    Err(e) => {
-                        tracing::warn!("the curious replan failed, taking the shortest path: {e}");
-                        shortest_here
-                    }
-                };
-                resends += usize::from(resend);
-                reasons.push(reason.to_owned());
-                progress(Progress::Replanned {
-                    window,
-                    reason: reason.to_owned(),
-                });
-                path = std::iter::once(here)
-                    .chain(plan.points.iter().copied())
-                    .collect();
-                plans.push(plan.points.clone());
-                let w = self.waypoints(&plan);
-                mission = self.send(window, w);
-                heard_at = Instant::now();
-            }
+            };
+            // A curious plan that fails (busy, an outage) leaves the shortest way.
+            let plan = match self.plan_window(here, task, &shortest_here, curious).await {
+                Ok((plan, _)) => plan,
+                Err(e) => {
+                    tracing::warn!("the curious replan failed, taking the shortest path: {e}");
+                    shortest_here
+                }
+            };
+            reasons.push(reason.as_str().to_owned());
+            progress(Progress::Replanned {
+                window,
+                reason: reason.as_str().to_owned(),
+            });
+            let path = std::iter::once(here)
+                .chain(plan.points.iter().copied())
+                .collect();
+            watch.replanned(path, resend, self.now(), wall_s());
+            plans.push(plan.points.clone());
+            waypoints = self.waypoints(&plan);
+            mission = self.send(window, waypoints.clone());
         }
         // The task keeps the robot at its place until it ends.
         while arrival.is_some() && self.now() < task.start_s + task.duration_s {

@@ -11,6 +11,8 @@
 //!
 //! - [`tasks`]: the task sequence and its checks; the built-in world's day.
 //! - [`path`]: thinning a planned path into waypoints; off-path distance; ETA slip.
+//! - [`watch`]: the replan policy of a window (arrived, given up, lost mission, blocked,
+//!   late, pushed off the path, slack), a plain state machine.
 //! - [`information`]: the information a path gathers, on the planner's own scale.
 //! - [`experiment`]: `roam reproduce mission`, the couplings compared in batch.
 //! - [`executive`]: the executive on Zenoh (a client of the planner, the controller,
@@ -25,3 +27,4 @@ mod inputs;
 pub mod path;
 pub mod service;
 pub mod tasks;
+pub mod watch;

@@ -1,0 +1,381 @@
+//! The executive's replan policy for one downtime window, as a plain state machine: what
+//! the robot's estimates, the controller's statuses and the passing of time mean for the
+//! plan. No Zenoh, no clock of its own: the executive feeds it events with the mission
+//! time and does what it decides, and the tests feed it events directly.
+//!
+//! The rules, in the order they are checked:
+//! - **arrived**: the controller reports the mission completed;
+//! - **given up**: `give_up_after_s` past the task's start without arriving;
+//! - **lost mission**: no status on the current mission for `controller_silence_s` (wall
+//!   time): the mission is sent again (a fresh plan from where the robot is), however
+//!   many replans the window already had;
+//! - **blocked**: the controller reports the robot stuck: replan the shortest way;
+//! - **late**: the ETA (distance left at the robot's speed) slips past the task's start:
+//!   replan the shortest way, once, and never curious again in this window;
+//! - **pushed off the path**: an estimate farther than `off_path_m` from the path;
+//! - **slack**: the robot will arrive more than `slack_s` early, beyond what a replan
+//!   costs on the mission clock (the time model overestimated the drive, or a replan
+//!   was cheap): replan a curious path from where it is with the time left, the mirror
+//!   of the late rule. At most once per `slack_interval_s`, and never after the window
+//!   slipped. The executive holds the robot while it plans (the slack pays for it), so
+//!   the new path starts where the robot is.
+//!
+//! Replans other than resending a lost mission count toward `max_replans`.
+
+use crate::path::{eta_slips, off_path_m};
+
+/// The policy's parameters (the executive's config, in the units it uses).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WatchParams {
+    pub off_path_m: f64,
+    pub speed_m_per_s: f64,
+    pub max_replans: u32,
+    pub give_up_after_s: f64,
+    pub controller_silence_s: f64,
+    /// Arriving this much earlier than the task's start is slack to spend, seconds.
+    pub slack_s: f64,
+    /// Mission seconds between two slack replans at least.
+    pub slack_interval_s: f64,
+}
+
+/// Why the window's plan changes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reason {
+    ControllerSilent,
+    Stuck,
+    EtaSlipped,
+    PushedOffPath,
+    Slack,
+}
+
+impl Reason {
+    /// The sentence the window's report gives for the replan.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Reason::ControllerSilent => "the controller went silent on the mission",
+            Reason::Stuck => "stuck: the path is blocked",
+            Reason::EtaSlipped => "the ETA slipped past the task's start",
+            Reason::PushedOffPath => "pushed off the path",
+            Reason::Slack => "slack: arriving early, a curious path with the time left",
+        }
+    }
+}
+
+/// What the executive should do after an event.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Decision {
+    /// Nothing changes.
+    Keep,
+    /// Plan again from where the robot is; `curious` asks for a curious path when it
+    /// fits, the shortest otherwise; `resend` marks a lost mission (not counted).
+    Replan {
+        reason: Reason,
+        curious: bool,
+        resend: bool,
+    },
+    /// The robot reached the task's place at this mission time.
+    Arrived { at_s: f64 },
+    /// The window is given up.
+    GiveUp,
+}
+
+/// What the controller said about the current mission.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Status {
+    Active { distance_left_m: f64 },
+    Completed,
+    Stuck,
+    Other,
+}
+
+/// One window's watch.
+#[derive(Debug, Clone)]
+pub struct Watch {
+    params: WatchParams,
+    task_start_s: f64,
+    /// The path the robot should be on (world metres).
+    path: Vec<[f64; 2]>,
+    slipped: bool,
+    replans: u32,
+    resends: u32,
+    /// Wall seconds (executive's clock) when the controller was last heard on the
+    /// current mission.
+    heard_at_wall_s: f64,
+    /// Mission time of the last plan (first or replan).
+    planned_at_s: f64,
+}
+
+impl Watch {
+    /// The watch of a window whose first plan was made at mission time `now_s` (wall
+    /// time `wall_s`) for a task starting at `task_start_s`.
+    pub fn new(
+        params: WatchParams,
+        task_start_s: f64,
+        path: Vec<[f64; 2]>,
+        now_s: f64,
+        wall_s: f64,
+    ) -> Watch {
+        Watch {
+            params,
+            task_start_s,
+            path,
+            slipped: false,
+            replans: 0,
+            resends: 0,
+            heard_at_wall_s: wall_s,
+            planned_at_s: now_s,
+        }
+    }
+
+    /// Replans so far (lost missions resent not counted).
+    pub fn replans(&self) -> u32 {
+        self.replans
+    }
+
+    /// Lost missions resent so far.
+    pub fn resends(&self) -> u32 {
+        self.resends
+    }
+
+    /// The time passes: give up, or resend a lost mission.
+    pub fn on_tick(&mut self, now_s: f64, wall_s: f64) -> Decision {
+        if now_s > self.task_start_s + self.params.give_up_after_s {
+            return Decision::GiveUp;
+        }
+        if wall_s - self.heard_at_wall_s >= self.params.controller_silence_s {
+            self.heard_at_wall_s = wall_s;
+            return Decision::Replan {
+                reason: Reason::ControllerSilent,
+                curious: !self.slipped,
+                resend: true,
+            };
+        }
+        Decision::Keep
+    }
+
+    /// An estimate of the robot (not degraded).
+    pub fn on_estimate(&mut self, position: [f64; 2]) -> Decision {
+        if off_path_m(position, &self.path) > self.params.off_path_m {
+            return self.replan(Reason::PushedOffPath, !self.slipped);
+        }
+        Decision::Keep
+    }
+
+    /// A status of the controller on the current mission; a replan now would cost
+    /// `planning_cost_s` of mission time.
+    pub fn on_status(
+        &mut self,
+        status: Status,
+        now_s: f64,
+        wall_s: f64,
+        planning_cost_s: f64,
+    ) -> Decision {
+        self.heard_at_wall_s = wall_s;
+        match status {
+            Status::Completed => Decision::Arrived { at_s: now_s },
+            Status::Stuck => self.replan(Reason::Stuck, false),
+            Status::Active { distance_left_m } if !self.slipped => {
+                let speed = self.params.speed_m_per_s;
+                if eta_slips(now_s, distance_left_m, speed, self.task_start_s) {
+                    self.slipped = true;
+                    return self.replan(Reason::EtaSlipped, false);
+                }
+                let arrival_s = now_s + distance_left_m / speed;
+                let early = self.task_start_s - arrival_s;
+                if early > self.params.slack_s + planning_cost_s
+                    && now_s - self.planned_at_s >= self.params.slack_interval_s
+                {
+                    return self.replan(Reason::Slack, true);
+                }
+                Decision::Keep
+            }
+            Status::Active { .. } | Status::Other => Decision::Keep,
+        }
+    }
+
+    /// The executive made a new plan at mission time `now_s` (wall `wall_s`): the robot
+    /// should now be on `path`.
+    pub fn replanned(&mut self, path: Vec<[f64; 2]>, resend: bool, now_s: f64, wall_s: f64) {
+        self.path = path;
+        self.planned_at_s = now_s;
+        self.heard_at_wall_s = wall_s;
+        if resend {
+            self.resends += 1;
+        } else {
+            self.replans += 1;
+        }
+    }
+
+    fn replan(&self, reason: Reason, curious: bool) -> Decision {
+        if self.replans >= self.params.max_replans {
+            return Decision::Keep;
+        }
+        Decision::Replan {
+            reason,
+            curious,
+            resend: false,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn params() -> WatchParams {
+        WatchParams {
+            off_path_m: 1.5,
+            speed_m_per_s: 0.5,
+            max_replans: 3,
+            give_up_after_s: 60.0,
+            controller_silence_s: 3.0,
+            slack_s: 10.0,
+            slack_interval_s: 5.0,
+        }
+    }
+
+    fn watch() -> Watch {
+        // A task at 100 s, the path straight along x from 0 to 20 m, planned at 0 s.
+        Watch::new(params(), 100.0, vec![[0.0, 0.0], [20.0, 0.0]], 0.0, 0.0)
+    }
+
+    #[test]
+    fn completed_is_an_arrival() {
+        let mut w = watch();
+        assert_eq!(
+            w.on_status(Status::Completed, 42.0, 1.0, 1.0),
+            Decision::Arrived { at_s: 42.0 }
+        );
+    }
+
+    #[test]
+    fn slack_fires_when_early_and_not_too_often() {
+        let mut w = watch();
+        // 10 m left at 0.5 m/s = 20 s: at 6 s the robot would arrive at 26 s, 74 s early.
+        let d = w.on_status(
+            Status::Active {
+                distance_left_m: 10.0,
+            },
+            6.0,
+            1.0,
+            1.0,
+        );
+        assert_eq!(
+            d,
+            Decision::Replan {
+                reason: Reason::Slack,
+                curious: true,
+                resend: false
+            }
+        );
+        w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], false, 6.0, 1.0);
+        // Right after the replan: not again before slack_interval_s.
+        assert_eq!(
+            w.on_status(
+                Status::Active {
+                    distance_left_m: 10.0
+                },
+                8.0,
+                1.5,
+                1.0
+            ),
+            Decision::Keep
+        );
+        // Early by less than slack_s plus the planning cost: nothing.
+        assert_eq!(
+            w.on_status(
+                Status::Active {
+                    distance_left_m: 10.0
+                },
+                60.0,
+                1.8,
+                25.0
+            ),
+            Decision::Keep
+        );
+        // On time (arriving 5 s early, under slack_s): nothing.
+        assert_eq!(
+            w.on_status(
+                Status::Active {
+                    distance_left_m: 10.0
+                },
+                75.0,
+                2.0,
+                1.0
+            ),
+            Decision::Keep
+        );
+    }
+
+    #[test]
+    fn late_replans_the_shortest_way_once_and_never_curious_again() {
+        let mut w = watch();
+        let d = w.on_status(
+            Status::Active {
+                distance_left_m: 20.0,
+            },
+            70.0,
+            1.0,
+            1.0,
+        );
+        assert_eq!(
+            d,
+            Decision::Replan {
+                reason: Reason::EtaSlipped,
+                curious: false,
+                resend: false
+            }
+        );
+        w.replanned(vec![[10.0, 0.0], [20.0, 0.0]], false, 70.0, 1.0);
+        // After slipping, slack never fires, and a push replans the shortest way.
+        assert_eq!(
+            w.on_status(
+                Status::Active {
+                    distance_left_m: 1.0
+                },
+                80.0,
+                2.0,
+                1.0
+            ),
+            Decision::Keep
+        );
+        assert_eq!(
+            w.on_estimate([10.0, 5.0]),
+            Decision::Replan {
+                reason: Reason::PushedOffPath,
+                curious: false,
+                resend: false
+            }
+        );
+    }
+
+    #[test]
+    fn a_silent_controller_gets_the_mission_again_beyond_the_replan_limit() {
+        let mut w = watch();
+        for _ in 0..params().max_replans {
+            w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], false, 1.0, 0.0);
+        }
+        assert_eq!(
+            w.on_estimate([0.0, 9.0]),
+            Decision::Keep,
+            "replans are used up"
+        );
+        assert_eq!(
+            w.on_tick(2.0, 3.5),
+            Decision::Replan {
+                reason: Reason::ControllerSilent,
+                curious: true,
+                resend: true
+            }
+        );
+        w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], true, 2.0, 3.5);
+        assert_eq!((w.replans(), w.resends()), (3, 1));
+    }
+
+    #[test]
+    fn a_window_is_given_up_after_its_grace() {
+        let mut w = watch();
+        assert_eq!(w.on_tick(159.0, 1.0), Decision::Keep);
+        assert_eq!(w.on_tick(161.0, 1.0), Decision::GiveUp);
+    }
+}
