@@ -73,6 +73,26 @@ pub struct LayerList {
     pub layers: Vec<LayerInfo>,
     #[serde(default)]
     pub warnings: Vec<String>,
+    /// The world the map server holds: the map it loaded (absent from an old server, or
+    /// one restored from a data dir that never recorded it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub world: Option<WorldId>,
+}
+
+/// Which world (map) a service works on: `hash` identifies it (a hash of the occupancy
+/// grid's placement and cells as loaded), `name` is for people (the scenario's name or
+/// the map file's stem). Two services are on the same world when their hashes agree.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorldId {
+    pub name: String,
+    pub hash: String,
+}
+
+impl std::fmt::Display for WorldId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "'{}' ({})", self.name, self.hash)
+    }
 }
 
 impl Message for LayerList {
@@ -87,6 +107,11 @@ impl Message for LayerList {
 pub struct LayerUpdate {
     pub base_version: u64,
     pub change: LayerChange,
+    /// The world the writer computed the change on; the map server refuses a change made
+    /// for another world than its own (a PEB layer of another map, say). Absent: not
+    /// checked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub world: Option<WorldId>,
 }
 
 impl Message for LayerUpdate {

@@ -161,12 +161,12 @@ proptest! {
 
     #[test]
     fn layer_list_round_trips(layers in prop::collection::vec(info(), 0..5), warnings in prop::collection::vec(".{0,30}", 0..3)) {
-        round_trips(&LayerList { layers, warnings });
+        round_trips(&LayerList { layers, warnings, world: None });
     }
 
     #[test]
     fn layer_update_round_trips(base_version in any::<u64>(), change in change()) {
-        round_trips(&LayerUpdate { base_version, change });
+        round_trips(&LayerUpdate { base_version, change, world: None });
     }
 
     #[test]
@@ -197,7 +197,7 @@ proptest! {
     #[test]
     fn other_versions_are_refused(m in layer(), u in change(), v in other_version()) {
         refuses_version(&m, v);
-        refuses_version(&LayerUpdate { base_version: 1, change: u }, v);
+        refuses_version(&LayerUpdate { base_version: 1, change: u, world: None }, v);
     }
 
     #[test]

@@ -7,7 +7,7 @@ use roam_proto::map::{GridMeta, Layer, Origin};
 use roam_proto::sim::{GroundTruth, SimControl, SimStatus};
 use roam_proto::{decode, keys, ErrorCode};
 use roam_runtime::ClientError;
-use roam_tests::{within, Harness};
+use roam_tests::{repo_path, within, Harness};
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn ranges_in_estimates_out_at_the_sim_rate() {
@@ -85,7 +85,13 @@ async fn ranges_in_estimates_out_at_the_sim_rate() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_peb_field_on_es1_shows_the_well_covered_area() {
     let harness = Harness::start().await;
-    let map_server = harness.start_map_server(harness.map_server_config()).await;
+    // The map server on the same world as localization: a stack runs one world.
+    let map_server = harness
+        .start_map_server(roam_map_server::MapServerConfig {
+            map: Some(repo_path("config/scenarios/es1.yaml")),
+            ..harness.map_server_config()
+        })
+        .await;
     let localization = harness
         .start_localization(Some("config/scenarios/es1.yaml"))
         .await;

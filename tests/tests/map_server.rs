@@ -13,7 +13,7 @@ use roam_proto::map::{
 };
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::{ClientError, Requester};
-use roam_tests::{within, Harness};
+use roam_tests::{repo_path, within, Harness};
 
 async fn get_layer(client: &Requester, root: &str, name: &str) -> Layer {
     within(
@@ -30,6 +30,7 @@ fn set(base_version: u64, x: u32, y: u32, value: f64) -> LayerUpdate {
         change: LayerChange::SetCells {
             cells: vec![CellWrite { x, y, value }],
         },
+        world: None,
     }
 }
 
@@ -313,6 +314,7 @@ async fn oversize_updates_are_refused_naming_the_limit() {
                 })
                 .collect(),
         },
+        world: None,
     };
     let reply = refusal(client.request::<LayerUpdate, UpdateAck>(&key, Some(&many))).await;
     assert_eq!(reply.code, ErrorCode::LimitExceeded);
@@ -333,6 +335,7 @@ async fn oversize_updates_are_refused_naming_the_limit() {
             },
             cells: Cells::F32(vec![0.0; 10_000]),
         },
+        world: None,
     };
     let reply =
         refusal(client.request::<LayerUpdate, UpdateAck>(
@@ -457,6 +460,7 @@ async fn a_corrupt_persisted_layer_is_reported_and_the_last_good_copy_served() {
     let data = tempfile::tempdir().expect("tmp");
     let config = roam_map_server::MapServerConfig {
         data_dir: Some(data.path().to_owned()),
+        load_dirs: vec![repo_path("config/maps")],
         ..harness.map_server_config()
     };
     let server = harness.start_map_server(config.clone()).await;
@@ -469,7 +473,7 @@ async fn a_corrupt_persisted_layer_is_reported_and_the_last_good_copy_served() {
     .await
     .expect("v2, in the change log");
     let before_load = get_layer(&client, &harness.root, "occupancy").await;
-    let depot = concat!(env!("CARGO_MANIFEST_DIR"), "/../config/maps/depot.yaml");
+    let depot = "depot.yaml";
     within(
         "load",
         client.request::<LoadMap, LayerList>(
@@ -650,6 +654,7 @@ async fn a_free_layer_is_deleted_and_base_layers_are_refused() {
             },
             cells: Cells::F32(vec![0.5; 16]),
         },
+        world: None,
     };
     let ack: UpdateAck = within(
         "create",

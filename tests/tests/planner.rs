@@ -320,6 +320,7 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
     let update = roam_proto::map::LayerUpdate {
         base_version: 1,
         change: roam_proto::map::LayerChange::SetCells { cells },
+        world: None,
     };
     let _: roam_proto::map::UpdateAck = within(
         "wall",

@@ -32,6 +32,7 @@ use std::time::{Duration, Instant};
 
 use roam_localization::fim::FimOptions;
 use roam_localization::model::RangingModel;
+use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::controller::{
     ControllerStatus, Mission, MissionState, MAX_MISSION_BYTES, MAX_MISSION_ID_BYTES, MAX_WAYPOINTS,
 };
@@ -116,6 +117,8 @@ pub enum ControllerServiceError {
     Scenario(#[from] roam_map_server::scenario::ScenarioError),
     #[error("invalid config: {0}")]
     Config(String),
+    #[error(transparent)]
+    World(#[from] WorldMismatch),
 }
 
 /// One robot under control.
@@ -490,6 +493,7 @@ pub async fn run(
         cancel,
     )
     .await?;
+    let world_guard = world_check::guard(&service, roam_map_server::world::of_scenario(&scenario));
     let state = Arc::new(State {
         root: config.root.clone(),
         session: service.session().clone(),
@@ -556,6 +560,7 @@ pub async fn run(
     service.spawn(async move { watchdog(watched, token).await });
     service.announce().await?;
     service.run_until_stopped().await?;
+    world_guard.outcome()?;
     Ok(())
 }
 

@@ -17,6 +17,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use roam_map_server::scenario::SensingSpec;
+use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::cells::Cells;
 use roam_proto::localization::{CrbCells, PebAt, PebQuery, PebReply, PebWhere};
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
@@ -89,6 +90,8 @@ pub enum LocalizationServiceError {
     Scenario(#[from] roam_map_server::scenario::ScenarioError),
     #[error("the scenario's sensing model is unusable: {0}")]
     Model(#[from] LocalizationError),
+    #[error(transparent)]
+    World(#[from] WorldMismatch),
 }
 
 struct State {
@@ -103,6 +106,8 @@ struct State {
     tracker: Mutex<Tracker>,
     /// Refused scans, logged a few per key and window.
     warnings: WarnLimiter,
+    /// The world this service works on, sent with its layer updates.
+    world: roam_proto::map::WorldId,
 }
 
 fn model_of(
@@ -155,11 +160,14 @@ pub async fn run(
         cancel,
     )
     .await?;
+    let world = roam_map_server::world::of_scenario(&scenario);
+    let world_guard = world_check::guard(&service, world.clone());
     let fim = FimOptions {
         variance_derivative: config.variance_derivative,
         ..FimOptions::default()
     };
     let state = Arc::new(State {
+        world: world.clone(),
         root: config.root.clone(),
         session: service.session().clone(),
         sensing,
@@ -191,6 +199,7 @@ pub async fn run(
     }
     service.announce().await?;
     service.run_until_stopped().await?;
+    world_guard.outcome()?;
     Ok(())
 }
 
@@ -370,6 +379,7 @@ async fn publish_peb_layer(state: Arc<State>, cancel: CancellationToken) {
                     meta,
                     cells: Cells::F32(field.peb.clone()),
                 },
+                world: Some(state.world.clone()),
             };
             requester
                 .request::<LayerUpdate, UpdateAck>(

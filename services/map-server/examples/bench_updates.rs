@@ -49,6 +49,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             meta,
             cells: Cells::F32(vec![0.0; (SIDE * SIDE) as usize]),
         },
+        world: None,
     };
     store.apply("peb", &create)?;
 
@@ -82,6 +83,7 @@ fn measure(
                     value,
                 }],
             },
+            world: None,
         };
         let started = Instant::now();
         store.apply(layer, &update)?;

@@ -23,6 +23,8 @@ pub mod ros_map;
 pub mod scenario;
 pub mod service;
 pub mod store;
+pub mod world;
+pub mod world_check;
 
 pub use config::MapServerConfig;
 pub use service::{run, MapServerError, SERVICE_NAME};

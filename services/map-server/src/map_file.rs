@@ -5,10 +5,13 @@ use std::path::{Path, PathBuf};
 
 use roam_proto::{ErrorCode, ErrorReply};
 
+use roam_proto::map::WorldId;
+
 use crate::grid::Grid;
 use crate::load_dirs::{Access, LoadDirs, LoadRefused};
 use crate::ros_map::{self, RosMapError};
 use crate::scenario::{self, ScenarioError};
+use crate::world::world_id;
 
 /// The embedded default world: a paper-000-like 20 × 20 m downtime world (see
 /// `config/scenarios/downtime.yaml`), used when no map is configured.
@@ -20,6 +23,8 @@ pub const BUILTIN_NAME: &str = "<built-in downtime world>";
 /// What a map file gives the map server.
 #[derive(Debug, Clone)]
 pub struct MapContent {
+    /// Which world this map is ([`crate::world`]).
+    pub world: WorldId,
     pub occupancy: Grid<i8>,
     pub information: Option<Grid<u8>>,
     pub robot_radius_m: Option<f64>,
@@ -94,7 +99,12 @@ fn read_with(path: &Path, max_cells: u64, access: Access<'_>) -> Result<MapConte
         .is_some_and(|v| v.get("image").is_some());
     if is_ros {
         let map = ros_map::load_with(path, max_cells, access)?;
+        let stem = path.file_stem().map_or_else(
+            || path.display().to_string(),
+            |s| s.to_string_lossy().into_owned(),
+        );
         return Ok(MapContent {
+            world: world_id(&stem, &map.grid),
             occupancy: map.grid,
             information: None,
             robot_radius_m: None,
@@ -112,6 +122,7 @@ pub fn builtin(max_cells: u64) -> Result<MapContent, MapFileError> {
 
 fn from_scenario(scenario: scenario::Scenario) -> MapContent {
     MapContent {
+        world: world_id(&scenario.file.name, &scenario.occupancy),
         occupancy: scenario.occupancy,
         information: Some(scenario.information),
         robot_radius_m: scenario.file.robot_radius_m,

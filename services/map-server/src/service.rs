@@ -181,10 +181,18 @@ pub fn open_store(config: &MapServerConfig) -> Result<LayerStore, MapServerError
                 &map_name,
             )
             .map_err(|e| MapServerError::Store(e.to_string()))?;
+        if restored.lost_sources.contains(&OCCUPANCY) || store.world().is_none() {
+            store
+                .set_world(content.world)
+                .map_err(|e| MapServerError::Store(e.to_string()))?;
+        }
         return Ok(store);
     }
     store
         .load_map(content.occupancy, content.information, None)
+        .map_err(|e| MapServerError::Store(e.to_string()))?;
+    store
+        .set_world(content.world)
         .map_err(|e| MapServerError::Store(e.to_string()))?;
     Ok(store)
 }
@@ -415,5 +423,6 @@ fn load(state: &State, request: &LoadMap) -> Result<(LayerList, Vec<String>), Er
     let changed = store
         .load_map(content.occupancy, content.information, request.base_version)
         .map_err(|e| e.to_reply())?;
+    store.set_world(content.world).map_err(|e| e.to_reply())?;
     Ok((store.list(), changed))
 }

@@ -58,6 +58,7 @@ fn set(base_version: u64, cells: &[(u32, u32, f64)]) -> LayerUpdate {
                 .map(|&(x, y, value)| CellWrite { x, y, value })
                 .collect(),
         },
+        world: None,
     }
 }
 
@@ -340,6 +341,7 @@ fn a_one_cell_update_to_a_maximum_size_layer_appends_under_1_kib() {
             meta: meta(side, side),
             cells: Cells::F32(vec![0.0; (side * side) as usize]),
         },
+        world: None,
     };
     store.apply("peb", &create).expect("create");
     let size = |dir: &Path| -> u64 {
@@ -377,6 +379,7 @@ fn create_free(store: &mut LayerStore, name: &str, base: u64) -> u64 {
             meta: meta(4, 4),
             cells: Cells::F32(vec![0.25; 16]),
         },
+        world: None,
     };
     store.apply(name, &update).expect("create").0.version
 }
@@ -444,6 +447,7 @@ fn deleting_a_layer_frees_its_slot() {
             meta: meta(4, 4),
             cells: Cells::F32(vec![0.0; 16]),
         },
+        world: None,
     };
     let refused = store.apply("b", &full).expect_err("full");
     assert_eq!(

@@ -36,6 +36,7 @@ fn set(base_version: u64, cells: &[(u32, u32, f64)]) -> LayerUpdate {
                 .map(|&(x, y, value)| CellWrite { x, y, value })
                 .collect(),
         },
+        world: None,
     }
 }
 
@@ -161,6 +162,7 @@ fn limits_are_named_in_the_error() {
             meta: meta(20, 20),
             cells: Cells::F32(vec![0.0; 400]),
         },
+        world: None,
     };
     let reply = store
         .apply("peb", &big)
@@ -181,6 +183,7 @@ fn free_layers_are_created_at_version_0_and_owned_by_their_writer() {
             meta: meta(4, 2),
             cells: Cells::F32(vec![0.5; 8]),
         },
+        world: None,
     };
     let (ack, _) = store.apply("change_rate", &create).expect("create");
     assert_eq!(ack.version, 1);
@@ -194,6 +197,7 @@ fn free_layers_are_created_at_version_0_and_owned_by_their_writer() {
             meta: meta(4, 2),
             cells: Cells::F32(vec![0.5; 7]),
         },
+        world: None,
     };
     assert!(store
         .apply("other", &wrong_size)
@@ -211,6 +215,7 @@ fn the_information_map_must_match_the_occupancy_grid() {
             meta: meta(5, 5),
             cells: Cells::U8(vec![10; 25]),
         },
+        world: None,
     };
     let err = store
         .apply(INFORMATION, &replace)

@@ -25,6 +25,7 @@ use roam_proto::cells::Cells;
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
 
 type MapMeta = GridMeta;
+use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::mapper::{
     ExplorationGoal, ExplorerStatus, MapperStatus, CHANGE_INFORMATION_LAYER,
     CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER, RECENCY_LAYER,
@@ -100,6 +101,8 @@ pub enum MapperServiceError {
     Scenario(#[from] roam_map_server::scenario::ScenarioError),
     #[error("invalid config: {0}")]
     Config(String),
+    #[error(transparent)]
+    World(#[from] WorldMismatch),
 }
 
 /// What observations change.
@@ -126,6 +129,8 @@ struct State {
     mapping: Mutex<Mapping>,
     /// Refused observations, logged a few per key and window.
     warnings: WarnLimiter,
+    /// The world this service works on, sent with its layer updates.
+    world: roam_proto::map::WorldId,
 }
 
 impl State {
@@ -376,6 +381,7 @@ async fn publish_layers(state: Arc<State>, period: Duration, cancel: Cancellatio
             let update = LayerUpdate {
                 base_version,
                 change: LayerChange::Replace { meta, cells },
+                world: Some(state.world.clone()),
             };
             let sent = requester
                 .request::<LayerUpdate, UpdateAck>(
@@ -447,7 +453,10 @@ pub async fn run(
         cancel,
     )
     .await?;
+    let world = roam_map_server::world::of_scenario(&scenario);
+    let world_guard = world_check::guard(&service, world.clone());
     let state = Arc::new(State {
+        world: world.clone(),
         root: config.root.clone(),
         session: service.session().clone(),
         meta,
@@ -459,7 +468,9 @@ pub async fn run(
             map_changes: 0,
             features: (0.0, 0.0),
             now_s: 0.0,
-            dirty: false,
+            // Sent once at start too: the layers exist at the map's size before the
+            // first observation, so a planner on the change coupling has one to plan on.
+            dirty: true,
             layers_sent: 0,
             epochs: Epochs::default(),
         }),
@@ -494,5 +505,6 @@ pub async fn run(
     service.spawn(async move { publish_layers(published, period, token).await });
     service.announce().await?;
     service.run_until_stopped().await?;
+    world_guard.outcome()?;
     Ok(())
 }

@@ -3,6 +3,11 @@
 //! across machines: the map server, the planner, the sim world (free-running at 1x on the
 //! built-in world), localization, the APF controller (drives a robot once it is given a
 //! mission) and the change-rate mapper (maps; drives no robot unless configured to).
+//!
+//! One stack runs one world: the map or scenario it is given goes to every service. A
+//! ROS map has no sim world (no robots, no anchors), so on one the stack runs what makes
+//! sense on a map alone (the map server, the planners and the mapper, at the map's size)
+//! and says which services it left out ([`Stack::left_out`]).
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -24,7 +29,7 @@ use crate::router::Router;
 #[derive(Debug, Clone, Default)]
 pub struct StackOptions {
     pub root: Option<String>,
-    /// A ROS map or scenario for the map server; the built-in world when absent.
+    /// A ROS map or scenario for every service; the built-in world when absent.
     pub map: Option<PathBuf>,
     /// Where the map server persists its layers; in memory when absent.
     pub data_dir: Option<PathBuf>,
@@ -40,7 +45,7 @@ pub struct StackOptions {
     pub apf: Option<roam_controller::params::ApfParams>,
 }
 
-/// The services `Stack::start` runs, in start order.
+/// The services `Stack::start` runs on a world with a sim world, in start order.
 pub const SERVICES: [&str; 6] = [
     roam_map_server::SERVICE_NAME,
     roam_planner::SERVICE_NAME,
@@ -66,6 +71,8 @@ pub enum StackError {
     },
     #[error("watching liveliness failed: {0}")]
     Liveliness(String),
+    #[error("the stack's world cannot be read: {0}")]
+    World(#[from] roam_map_server::scenario::ScenarioError),
 }
 
 type ServiceTasks = JoinSet<(&'static str, Result<(), String>)>;
@@ -87,6 +94,8 @@ pub struct Stack {
     cancel: CancellationToken,
     /// Each service task returns its own name with its outcome.
     services: ServiceTasks,
+    /// The services not run on this world, each with why.
+    pub left_out: Vec<(&'static str, String)>,
 }
 
 impl Stack {
@@ -107,6 +116,7 @@ impl Stack {
         let client = SessionArgs::client_of(&router.endpoint);
         let mut services = JoinSet::new();
 
+        let (_, world) = roam_sim::service::load_scenario(options.map.as_deref())?;
         let map_config = MapServerConfig {
             root: root.clone(),
             map: options.map.clone(),
@@ -135,47 +145,75 @@ impl Stack {
                 ),
             );
         }
-        let sim_config = SimConfig {
-            root: root.clone(),
-            rate: Some(options.sim_rate.unwrap_or(1.0)),
-            load_dirs: options.load_dirs.clone(),
-            ..SimConfig::default()
-        };
-        spawn(
-            &mut services,
-            roam_sim::service::SERVICE_NAME,
-            roam_sim::service::run(sim_config, client.zenoh_config(None)?, cancel.child_token()),
-        );
-        let localization_config = LocalizationConfig {
-            root: root.clone(),
-            ..LocalizationConfig::default()
-        };
-        spawn(
-            &mut services,
-            roam_localization::service::SERVICE_NAME,
-            roam_localization::service::run(
-                localization_config,
-                client.zenoh_config(None)?,
-                cancel.child_token(),
-            ),
-        );
-
-        let controller_config = ControllerConfig {
-            root: root.clone(),
-            apf: options.apf.clone().unwrap_or_default(),
-            ..ControllerConfig::default()
-        };
-        spawn(
-            &mut services,
-            roam_controller::service::SERVICE_NAME,
-            roam_controller::service::run(
-                controller_config,
-                client.zenoh_config(None)?,
-                cancel.child_token(),
-            ),
-        );
+        let mut running = vec![roam_map_server::SERVICE_NAME, roam_planner::SERVICE_NAME];
+        let mut left_out = Vec::new();
+        if world.has_sim_world() {
+            let sim_config = SimConfig {
+                root: root.clone(),
+                scenario: options.map.clone(),
+                rate: Some(options.sim_rate.unwrap_or(1.0)),
+                load_dirs: options.load_dirs.clone(),
+                ..SimConfig::default()
+            };
+            spawn(
+                &mut services,
+                roam_sim::service::SERVICE_NAME,
+                roam_sim::service::run(
+                    sim_config,
+                    client.zenoh_config(None)?,
+                    cancel.child_token(),
+                ),
+            );
+            let localization_config = LocalizationConfig {
+                root: root.clone(),
+                scenario: options.map.clone(),
+                ..LocalizationConfig::default()
+            };
+            spawn(
+                &mut services,
+                roam_localization::service::SERVICE_NAME,
+                roam_localization::service::run(
+                    localization_config,
+                    client.zenoh_config(None)?,
+                    cancel.child_token(),
+                ),
+            );
+            let controller_config = ControllerConfig {
+                root: root.clone(),
+                scenario: options.map.clone(),
+                apf: options.apf.clone().unwrap_or_default(),
+                ..ControllerConfig::default()
+            };
+            spawn(
+                &mut services,
+                roam_controller::service::SERVICE_NAME,
+                roam_controller::service::run(
+                    controller_config,
+                    client.zenoh_config(None)?,
+                    cancel.child_token(),
+                ),
+            );
+            running.extend([
+                roam_sim::service::SERVICE_NAME,
+                roam_localization::service::SERVICE_NAME,
+                roam_controller::service::SERVICE_NAME,
+            ]);
+        } else {
+            let why = format!(
+                "world '{}' is a map alone: no robots and no anchors to simulate, localize or drive",
+                world.file.name
+            );
+            for service in [
+                roam_sim::service::SERVICE_NAME,
+                roam_localization::service::SERVICE_NAME,
+                roam_controller::service::SERVICE_NAME,
+            ] {
+                left_out.push((service, why.clone()));
+            }
+        }
         let mapper_config = MapperConfig {
             root: root.clone(),
+            scenario: options.map.clone(),
             ..MapperConfig::default()
         };
         spawn(
@@ -187,14 +225,16 @@ impl Stack {
                 cancel.child_token(),
             ),
         );
+        running.push(roam_mapper::service::SERVICE_NAME);
 
         let mut stack = Stack {
             router,
             root,
             cancel,
             services,
+            left_out,
         };
-        for service in SERVICES {
+        for service in running {
             let (session, root) = (stack.router.session.clone(), stack.root.clone());
             let live = wait_until_live(&session, &root, service, timeout);
             tokio::select! {

@@ -22,6 +22,7 @@ use roam_map_server::load_dirs::{Access, LoadDirs};
 use roam_map_server::map_file::{BUILTIN_NAME, BUILTIN_SCENARIO};
 use roam_map_server::scenario::{self, Scenario, ScenarioError};
 use roam_map_server::store::DEFAULT_LIMITS;
+use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::sim::{RobotCommand, SimClock, SimControl, SimStatus};
 use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply, Message};
 use roam_runtime::warn_limit::WarnLimiter;
@@ -108,6 +109,8 @@ pub enum SimServiceError {
     Config(String),
     #[error(transparent)]
     Snapshot(#[from] SnapshotError),
+    #[error(transparent)]
+    World(#[from] WorldMismatch),
 }
 
 /// What control requests change.
@@ -161,11 +164,12 @@ impl State {
     }
 }
 
-/// Reads a scenario file, or the built-in world.
+/// Reads a scenario file (or a ROS map as a scenario of the map alone), or the built-in
+/// world.
 pub fn load_scenario(path: Option<&Path>) -> Result<(String, Scenario), ScenarioError> {
     let max = DEFAULT_LIMITS.max_layer_cells;
     match path {
-        Some(p) => Ok((p.display().to_string(), scenario::load(p, max)?)),
+        Some(p) => Ok((p.display().to_string(), scenario::load_any(p, max)?)),
         None => Ok((
             BUILTIN_NAME.to_owned(),
             scenario::parse(Path::new(BUILTIN_NAME), BUILTIN_SCENARIO, max)?,
@@ -219,6 +223,7 @@ pub async fn run(
         cancel,
     )
     .await?;
+    let world_guard = world_check::guard(&service, roam_map_server::world::of_scenario(&scenario));
     let state = Arc::new(State {
         root: config.root.clone(),
         session: service.session().clone(),
@@ -279,6 +284,7 @@ pub async fn run(
     service
         .shutdown(roam_runtime::service::DEFAULT_GRACE)
         .await?;
+    world_guard.outcome()?;
     Ok(())
 }
 

@@ -109,6 +109,7 @@ async fn a_foxglove_client_sees_the_channels_and_receives_the_map() {
                 change: LayerChange::SetCells {
                     cells: vec![CellWrite { x, y, value: 100.0 }],
                 },
+                world: None,
             }),
         ),
     )

@@ -64,6 +64,7 @@ impl Watch {
                 meta: inflated.meta,
                 cells: Cells::F32(vec![0.5; inflated.meta.cell_count() as usize]),
             },
+            world: None,
         };
         within(
             "scratch layer",
@@ -137,6 +138,7 @@ pub(crate) async fn assert_intrusion_has_no_effect(who: &str, intruder: &Request
                 value: 0.0,
             }],
         },
+        world: None,
     };
     let overwrite_inflated = LayerUpdate {
         base_version: before.get("inflated").copied().unwrap_or(0),
@@ -144,6 +146,7 @@ pub(crate) async fn assert_intrusion_has_no_effect(who: &str, intruder: &Request
             meta: forged.meta,
             cells: forged.cells.clone(),
         },
+        world: None,
     };
     let scratch_version = before.get(SCRATCH).copied();
     assert!(

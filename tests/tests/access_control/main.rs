@@ -131,6 +131,7 @@ async fn only_the_controller_drives_and_only_map_writers_change_the_map() {
             meta,
             cells: Cells::F32(vec![0.25; meta.cell_count() as usize]),
         },
+        world: None,
     };
     let ack: UpdateAck = within(
         "mapper update",
@@ -162,6 +163,7 @@ async fn only_the_controller_drives_and_only_map_writers_change_the_map() {
                     meta,
                     cells: Cells::I8(vec![0; meta.cell_count() as usize]),
                 },
+                world: None,
             }),
         ),
     )

@@ -40,6 +40,7 @@ pub(crate) fn layer_bases(occupancy_version: u64) -> Vec<Vec<u8>> {
         change: LayerChange::SetCells {
             cells: vec![CellWrite { x, y, value }],
         },
+        world: None,
     };
     vec![
         encode(&set(1, 1, 0.0)),
@@ -57,6 +58,7 @@ pub(crate) fn layer_bases(occupancy_version: u64) -> Vec<Vec<u8>> {
                     })
                     .collect(),
             },
+            world: None,
         }),
         encode(&LayerUpdate {
             base_version: 0,
@@ -64,6 +66,7 @@ pub(crate) fn layer_bases(occupancy_version: u64) -> Vec<Vec<u8>> {
                 meta: meta(4, 4, 0.5),
                 cells: Cells::U8(vec![50; 16]),
             },
+            world: None,
         }),
         encode(&LayerUpdate {
             base_version: 0,
@@ -71,6 +74,7 @@ pub(crate) fn layer_bases(occupancy_version: u64) -> Vec<Vec<u8>> {
                 meta: meta(u32::MAX, u32::MAX, 1e-300),
                 cells: Cells::F32(vec![f32::MAX; 4]),
             },
+            world: None,
         }),
         encode(&LayerUpdate {
             base_version: 0,
@@ -78,6 +82,7 @@ pub(crate) fn layer_bases(occupancy_version: u64) -> Vec<Vec<u8>> {
                 meta: meta(2, 2, -1.0),
                 cells: Cells::I8(vec![-1, 0, 100, 127]),
             },
+            world: None,
         }),
         encode(&LayerUpdate {
             base_version: 0,
@@ -85,6 +90,7 @@ pub(crate) fn layer_bases(occupancy_version: u64) -> Vec<Vec<u8>> {
                 meta: meta(0, 0, 0.0),
                 cells: Cells::I8(vec![]),
             },
+            world: None,
         }),
     ]
 }

@@ -18,8 +18,10 @@
 
 pub mod log;
 mod recovery;
+mod small_file;
 pub mod snapshot;
 pub mod tombstones;
+pub mod world;
 
 use std::collections::BTreeMap;
 use std::fs::{self, File};
@@ -159,6 +161,20 @@ impl DataDir {
 
     fn path_with(&self, name: &str, suffix: &str) -> PathBuf {
         self.layers.join(format!("{name}{suffix}"))
+    }
+
+    fn world_path(&self) -> PathBuf {
+        self.root.join("world.json")
+    }
+
+    /// Records which world the layers are of.
+    pub fn save_world(&self, world: &roam_proto::map::WorldId) -> Result<(), PersistError> {
+        world::write(&self.world_path(), world)
+    }
+
+    /// The recorded world, if any.
+    pub fn load_world(&self) -> Result<Option<roam_proto::map::WorldId>, PersistError> {
+        world::read(&self.world_path())
     }
 
     fn tombstones_path(&self) -> PathBuf {

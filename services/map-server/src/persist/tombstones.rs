@@ -7,14 +7,12 @@
 //! oldest first, at most [`MAX_TOMBSTONES`] entries: a name deleted longer ago than the
 //! last 256 deletions starts again at version 1.
 
-use std::fs::{self, File};
-use std::io::{Read, Write};
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
 use super::snapshot::describe_json_error;
-use super::PersistError;
+use super::{small_file, PersistError};
 
 const FORMAT: &str = "roam-deleted-layers";
 const FORMAT_VERSION: u32 = 1;
@@ -46,32 +44,9 @@ pub fn read(path: &Path) -> Result<Vec<Tombstone>, PersistError> {
         path: path.to_owned(),
         reason,
     };
-    let file = match File::open(path) {
-        Ok(f) => f,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => {
-            return Err(PersistError::Read {
-                path: path.to_owned(),
-                reason: e.to_string(),
-            })
-        }
+    let Some(bytes) = small_file::read(path, MAX_FILE_BYTES)? else {
+        return Ok(Vec::new());
     };
-    let meta = file.metadata().map_err(|e| PersistError::Read {
-        path: path.to_owned(),
-        reason: e.to_string(),
-    })?;
-    if !meta.is_file() || meta.len() > MAX_FILE_BYTES {
-        return Err(corrupt(format!(
-            "not a regular file of at most {MAX_FILE_BYTES} bytes"
-        )));
-    }
-    let mut bytes = Vec::new();
-    file.take(MAX_FILE_BYTES)
-        .read_to_end(&mut bytes)
-        .map_err(|e| PersistError::Read {
-            path: path.to_owned(),
-            reason: e.to_string(),
-        })?;
     let parsed: TombstoneFile =
         serde_json::from_slice(&bytes).map_err(|e| corrupt(describe_json_error(&e)))?;
     if parsed.format != FORMAT || parsed.v != FORMAT_VERSION {
@@ -87,15 +62,9 @@ pub fn read(path: &Path) -> Result<Vec<Tombstone>, PersistError> {
     Ok(parsed.layers)
 }
 
-/// Writes the tombstones atomically (temp file, fsync, rename, fsync the folder),
-/// keeping the newest [`MAX_TOMBSTONES`].
+/// Writes the tombstones atomically, keeping the newest [`MAX_TOMBSTONES`].
 pub fn write(path: &Path, tombstones: &[Tombstone]) -> Result<(), PersistError> {
     let keep = &tombstones[tombstones.len().saturating_sub(MAX_TOMBSTONES)..];
-    let tmp = path.with_extension("json.tmp");
-    let write_err = |p: &Path, e: std::io::Error| PersistError::Write {
-        path: p.to_owned(),
-        reason: e.to_string(),
-    };
     let body = serde_json::to_vec(&TombstoneFile {
         format: FORMAT.into(),
         v: FORMAT_VERSION,
@@ -105,12 +74,5 @@ pub fn write(path: &Path, tombstones: &[Tombstone]) -> Result<(), PersistError> 
         path: path.to_owned(),
         reason: e.to_string(),
     })?;
-    let mut file = File::create(&tmp).map_err(|e| write_err(&tmp, e))?;
-    file.write_all(&body).map_err(|e| write_err(&tmp, e))?;
-    file.sync_all().map_err(|e| write_err(&tmp, e))?;
-    fs::rename(&tmp, path).map_err(|e| write_err(path, e))?;
-    if let Some(dir) = path.parent() {
-        super::sync_dir(dir)?;
-    }
-    Ok(())
+    small_file::write(path, &body)
 }

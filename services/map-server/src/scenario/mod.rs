@@ -232,6 +232,49 @@ pub fn load(path: &Path, max_cells: u64) -> Result<Scenario, ScenarioError> {
     load_with(path, max_cells, Access::Anywhere)
 }
 
+/// Reads a scenario, or a ROS `map.yaml` (it has an `image:` key) as a scenario of that
+/// map alone, named after the file: no places, anchors, robots or other sim sections.
+/// So every service can be given the same file, whichever kind it is.
+pub fn load_any(path: &Path, max_cells: u64) -> Result<Scenario, ScenarioError> {
+    let is_ros = crate::ros_map::read_bounded_text(path)
+        .ok()
+        .and_then(|text| serde_yaml_ng::from_str::<serde_yaml_ng::Value>(&text).ok())
+        .is_some_and(|v| v.get("image").is_some());
+    if !is_ros {
+        return load(path, max_cells);
+    }
+    let stem = path
+        .file_stem()
+        .map_or_else(|| "map".to_owned(), |s| s.to_string_lossy().into_owned());
+    let file = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    let text = serde_yaml_ng::to_string(&serde_yaml_ng::Value::Mapping(
+        [
+            ("name".into(), stem.into()),
+            (
+                "map".into(),
+                serde_yaml_ng::Value::Mapping([("ros".into(), file.into())].into_iter().collect()),
+            ),
+        ]
+        .into_iter()
+        .collect(),
+    ))
+    .map_err(|e| ScenarioError::Invalid {
+        path: path.to_owned(),
+        reason: e.to_string(),
+    })?;
+    parse(path, &text, max_cells)
+}
+
+impl Scenario {
+    /// Whether the scenario has a sim world (robots or anchors), or is a map alone.
+    pub fn has_sim_world(&self) -> bool {
+        !self.file.robots.is_empty() || !self.file.anchors.is_empty()
+    }
+}
+
 /// [`load`], following the files the scenario names only where `access` allows (a load
 /// from the wire: inside the load directories).
 pub fn load_with(

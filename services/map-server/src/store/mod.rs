@@ -28,6 +28,7 @@ use std::sync::Arc;
 use roam_proto::keys;
 use roam_proto::map::{
     GridMeta, Layer, LayerChange, LayerDeleted, LayerInfo, LayerList, LayerUpdate, UpdateAck,
+    WorldId,
 };
 
 pub use error::StoreError;
@@ -66,6 +67,8 @@ pub struct LayerStore {
     derived: DerivedParams,
     data: Option<DataDir>,
     warnings: VecDeque<String>,
+    /// The world (map) the layers are of, as last loaded.
+    world: Option<WorldId>,
 }
 
 impl LayerStore {
@@ -78,6 +81,7 @@ impl LayerStore {
             derived,
             data,
             warnings: VecDeque::new(),
+            world: None,
         }
     }
 
@@ -129,12 +133,29 @@ impl LayerStore {
         self.version(name).max(floor) + 1
     }
 
-    /// Every layer's info, and the warnings found while restoring and running.
+    /// Every layer's info, the warnings found while restoring and running, and the
+    /// world.
     pub fn list(&self) -> LayerList {
         LayerList {
             layers: self.layers.values().map(|l| info(l)).collect(),
             warnings: self.warnings.iter().cloned().collect(),
+            world: self.world.clone(),
         }
+    }
+
+    /// The world (map) the layers are of.
+    pub fn world(&self) -> Option<&WorldId> {
+        self.world.as_ref()
+    }
+
+    /// Records which world the layers are of (after loading its map), in the data dir
+    /// too.
+    pub fn set_world(&mut self, world: WorldId) -> Result<(), StoreError> {
+        if let Some(data) = &self.data {
+            data.save_world(&world)?;
+        }
+        self.world = Some(world);
+        Ok(())
     }
 
     /// Logs a warning and keeps it for `map/layers`.
@@ -177,6 +198,13 @@ impl LayerStore {
         update: &LayerUpdate,
     ) -> Result<(UpdateAck, Vec<String>), StoreError> {
         keys::check_name("layer name", name).map_err(|e| StoreError::Invalid(e.to_string()))?;
+        if let (Some(theirs), Some(mine)) = (&update.world, &self.world) {
+            if theirs.hash != mine.hash {
+                return Err(StoreError::Invalid(format!(
+                    "the update of '{name}' was made for world {theirs}, but this map server holds world {mine}: give the writer the same map or scenario"
+                )));
+            }
+        }
         if let Some(source_layer) = derived_source(name) {
             return Err(StoreError::Derived {
                 layer: name.to_owned(),

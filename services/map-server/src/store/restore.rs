@@ -51,8 +51,13 @@ impl LayerStore {
             return Ok(Restored::default());
         };
         let loaded = data.load_all();
+        let world = data.load_world();
         for warning in loaded.warnings {
             self.warn(warning);
+        }
+        match world {
+            Ok(world) => self.world = world,
+            Err(e) => self.warn(format!("{e}; the world the layers are of is unknown")),
         }
         self.tombstones = loaded.tombstones;
         let mut highest: BTreeMap<String, u64> = BTreeMap::new();

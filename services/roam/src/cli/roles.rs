@@ -50,8 +50,9 @@ pub(crate) struct StackArgs {
     /// Key root.
     #[arg(long, env = "ROAM_ROOT")]
     root: Option<String>,
-    /// A ROS map.yaml or roam scenario for the map server (default: the built-in world).
-    #[arg(long, value_name = "PATH")]
+    /// A ROS map.yaml or roam scenario for every service (default: the built-in world);
+    /// on a ROS map, the services that need a sim world are left out.
+    #[arg(long, visible_alias = "scenario", value_name = "PATH")]
     map: Option<PathBuf>,
     /// Persist the map server's layers here.
     #[arg(long, value_name = "DIR")]
@@ -163,6 +164,9 @@ pub(crate) async fn stack(args: StackArgs) -> anyhow::Result<()> {
         ..StackOptions::default()
     };
     let mut stack = Stack::start(options, Duration::from_secs(30)).await?;
+    for (service, why) in &stack.left_out {
+        eprintln!("roam stack: {service} left out: {why}");
+    }
     eprintln!(
         "roam stack up: router {} (root '{}'); connect with --connect {}",
         stack.router.endpoint, stack.root, stack.router.endpoint

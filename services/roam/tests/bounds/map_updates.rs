@@ -29,6 +29,7 @@ fn set_cells_payload(bytes: usize) -> Vec<u8> {
         change: LayerChange::SetCells {
             cells: vec![one; bytes / 28],
         },
+        world: None,
     })
 }
 
@@ -47,6 +48,7 @@ fn replace_payload() -> Vec<u8> {
             meta,
             cells: Cells::F32(vec![0.5; 4096 * 4096]),
         },
+        world: None,
     })
 }
 
