@@ -52,8 +52,8 @@ async fn refusal(client: &Requester, root: &str, request: &PlanRequest) -> Error
     }
 }
 
-/// Starts a plan that runs until it is cancelled (100,000 generations), with a
-/// subscriber to its progress.
+/// Starts a plan that runs until it is cancelled (50,000 generations: a cost of 2e9,
+/// inside `max_plan_cost`), with a subscriber to its progress.
 async fn start_endless_plan(
     client: &Requester,
     root: &str,
@@ -73,7 +73,7 @@ async fn start_endless_plan(
     let endless = PlanRequest {
         request_id: Some(id.into()),
         params: GaOverrides {
-            max_generations: Some(100_000),
+            max_generations: Some(50_000),
             ..GaOverrides::default()
         },
         ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
@@ -162,6 +162,7 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         params: GaParams::with_overrides(&req.params).expect("params"),
         seed: req.seed,
         threads: roam_planner::ga::default_threads(),
+        limits: roam_planner::limits::PlanLimits::default(),
     };
     let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local plan");
     let local_cells = world.grid_cells(&local.path);
@@ -387,7 +388,7 @@ async fn progress_is_published_and_a_plan_can_be_cancelled() {
         .expect("join")
         .expect("plan");
     assert_eq!(plan.stop_reason, StopReason::Cancelled);
-    assert!(plan.generations < 100_000);
+    assert!(plan.generations < 50_000);
     assert!(plan.reaches_goal, "the best path so far is returned");
     // The last progress message says done.
     let done = loop {

@@ -10,6 +10,7 @@
 //! - [`metrics`]: U_ges, D (Eqs. 11–12) and the information of distinct cells;
 //! - [`ga`]: initialisation, layered selection, crossover, mutation (§II.A);
 //! - [`search`]: the shortest-path baseline (A*, octile) and the distance field;
+//! - [`limits`]: what one plan may cost (path length from Eq. 2, memory, work);
 //! - [`plan`]: one request end to end, with the checks that refuse bad requests.
 //!
 //! [`service`] is the thin Zenoh adapter.
@@ -19,6 +20,7 @@ pub mod config;
 pub mod curiosity;
 pub mod eta;
 pub mod ga;
+pub mod limits;
 pub mod maps;
 pub mod metrics;
 pub mod params;

@@ -22,6 +22,7 @@ use zenoh::query::Query;
 use zenoh::Wait;
 
 use crate::config::PlannerConfig;
+use crate::limits::PlanLimits;
 use crate::maps::MapCache;
 use crate::params::GaParams;
 use crate::plan::{plan, PlanOutcome, PlanSpec};
@@ -52,6 +53,7 @@ struct State {
     max_in_flight: usize,
     cancels: Mutex<HashMap<String, Arc<AtomicBool>>>,
     next_id: AtomicU64,
+    limits: PlanLimits,
 }
 
 impl State {
@@ -90,6 +92,14 @@ pub async fn run(
             "max_concurrent_plans must be at least 1".into(),
         ));
     }
+    for (name, value) in [
+        ("max_plan_cost", config.max_plan_cost),
+        ("max_population_cells", config.max_population_cells),
+    ] {
+        if value == 0 {
+            return Err(PlannerError::Config(format!("{name} must be at least 1")));
+        }
+    }
     keys::check_name("information_layer", &config.information_layer)
         .map_err(|e| PlannerError::Config(e.to_string()))?;
     let mut service = Service::start(
@@ -112,6 +122,7 @@ pub async fn run(
         max_in_flight: config.max_concurrent_plans,
         cancels: Mutex::new(HashMap::new()),
         next_id: AtomicU64::new(1),
+        limits: config.limits(),
     });
     let root = config.root.as_str();
 
@@ -304,6 +315,7 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
         params,
         seed: request.seed,
         threads: crate::ga::default_threads(),
+        limits: state.limits,
     };
     let progress_key = keys::planner_progress(&state.root, &request_id);
     let mut batch = Vec::new();
