@@ -124,6 +124,10 @@ pub enum StopReason {
     MaxGenerations,
     Deadline,
     Cancelled,
+    /// The planner's CPU budget granted less wall time than `deadline_s` (its
+    /// `max_plan_seconds`, or what its plan-seconds bucket held) and the plan used it
+    /// all: the path is the best found in [`Plan::budget_s`] seconds.
+    Budget,
     /// Baselines that are not iterative.
     Complete,
 }
@@ -153,6 +157,9 @@ pub struct Plan {
     pub generations: u32,
     pub planning_ms: f64,
     pub stop_reason: StopReason,
+    /// With `stop_reason: budget`: the wall seconds the CPU budget granted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budget_s: Option<f64>,
     pub seed: u64,
     pub map_version: MapVersion,
     /// The planner instance that answered.

@@ -313,9 +313,10 @@ mod planner_messages {
                 Just(StopReason::MaxGenerations),
                 Just(StopReason::Deadline),
                 Just(StopReason::Cancelled),
+                Just(StopReason::Budget),
                 Just(StopReason::Complete)
             ],
-            (any::<u64>(), version(), name()),
+            (any::<u64>(), version(), name(), prop::option::of(finite())),
         )
             .prop_map(
                 |(
@@ -326,7 +327,7 @@ mod planner_messages {
                     f,
                     (u_ges, density, distinct_information, generations, planning_ms),
                     stop_reason,
-                    (seed, map_version, instance),
+                    (seed, map_version, instance, budget_s),
                 )| {
                     let points = cells
                         .iter()
@@ -355,6 +356,7 @@ mod planner_messages {
                         generations,
                         planning_ms,
                         stop_reason,
+                        budget_s,
                         seed,
                         map_version,
                         instance,
@@ -384,8 +386,8 @@ mod planner_messages {
         }
     }
 
-    /// Requests and cancels written before cancel tokens still decode: the new fields
-    /// default to absent.
+    /// Requests, cancels and plans written before cancel tokens and the CPU budget
+    /// still decode: the new fields default to absent.
     #[test]
     fn messages_from_before_cancel_tokens_still_decode() {
         let cancel: CancelPlan =

@@ -1,6 +1,7 @@
 //! The planner through Zenoh: plans, determinism against the in-process planner, every
-//! refusal, progress, cancel (only with the requester's token), busy, made-up request
-//! ids, and two instances sharing load and surviving one's death. Real map server and planners in process, used only as a Zenoh client.
+//! refusal, progress, cancel (only with the requester's token), busy, the limits and the
+//! CPU budget, made-up request ids, and two instances sharing load and surviving one's
+//! death. Real map server and planners in process, used only as a Zenoh client.
 
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
@@ -87,7 +88,7 @@ async fn start_plan(
 }
 
 /// A plan that runs until it is cancelled (50,000 generations: a cost of 2e9, inside
-/// `max_plan_cost`), cancellable with `token`.
+/// `max_plan_cost`; 30 s of the CPU budget), cancellable with `token`.
 fn endless(id: &str, token: Option<&str>) -> PlanRequest {
     PlanRequest {
         request_id: Some(id.into()),
@@ -149,14 +150,22 @@ struct Running {
 }
 
 async fn boot(planners: &[(&str, usize)]) -> Running {
+    boot_with(planners, |config| config).await
+}
+
+/// [`boot`] with each planner's config changed by `adjust`.
+async fn boot_with(
+    planners: &[(&str, usize)],
+    adjust: impl Fn(roam_planner::PlannerConfig) -> roam_planner::PlannerConfig,
+) -> Running {
     let harness = Harness::start().await;
     let map_server = harness.start_map_server(harness.map_server_config()).await;
     let mut started = Vec::new();
     for (name, concurrent) in planners {
-        let config = roam_planner::PlannerConfig {
+        let config = adjust(roam_planner::PlannerConfig {
             max_concurrent_plans: *concurrent,
             ..harness.planner_config(name)
-        };
+        });
         started.push(harness.start_planner(config).await);
     }
     Running {
@@ -581,7 +590,11 @@ async fn two_instances_share_the_load_and_survive_one_death() {
 /// cancel.
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_strangers_cancel_does_nothing_and_the_requesters_cancel_ends_the_plan() {
-    let running = boot(&[("solo", 3)]).await;
+    let running = boot_with(&[("solo", 3)], |config| roam_planner::PlannerConfig {
+        plan_seconds_burst: 300.0,
+        ..config
+    })
+    .await;
     let root = running.harness.root.clone();
     let requester = running.harness.client().await;
     let stranger = running.harness.client().await;
@@ -628,6 +641,97 @@ async fn a_strangers_cancel_does_nothing_and_the_requesters_cancel_ends_the_plan
         .expect("plan");
     assert_eq!(a.stop_reason, StopReason::MaxGenerations);
     assert_eq!(a.generations, generations);
+    running.stop().await;
+}
+
+/// Issue 20: the planner's work has limits named in the error, and its wall time a
+/// budget. The attack's request (population 2000, 100,000 generations) is refused at
+/// once by its cost; the largest requests the cost cap admits are cut at the CPU budget
+/// (here `max_plan_seconds` 2 and a bucket of 3 plan-seconds: one gets 2 s, the next
+/// what is left, about 1 s) and the third is refused `busy` with the bucket's name.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn maximal_requests_are_cut_at_the_cpu_budget_or_refused() {
+    const MAX_PLAN_SECONDS: f64 = 2.0;
+    let running = boot_with(&[("solo", 3)], |config| roam_planner::PlannerConfig {
+        max_plan_seconds: MAX_PLAN_SECONDS,
+        plan_seconds_burst: 3.0,
+        ..config
+    })
+    .await;
+    let root = running.harness.root.clone();
+    let client = running.harness.client().await;
+    let maximal = |id: &str, generations: u32| PlanRequest {
+        request_id: Some(id.into()),
+        deadline_s: 600.0,
+        params: GaOverrides {
+            population: Some(2000),
+            max_generations: Some(generations),
+            ..GaOverrides::default()
+        },
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
+    };
+
+    let started = std::time::Instant::now();
+    let attack = refusal(&client, &root, &maximal("attack", 100_000)).await;
+    assert_eq!(attack.code, ErrorCode::LimitExceeded);
+    let limit = attack.limit.expect("the limit is named");
+    assert_eq!(limit.name, "max_plan_cost");
+    // 80 s at 0.4 s per cell: paths of at most 201 cells.
+    assert_eq!(limit.actual, 2000 * 100_000 * 201);
+    assert!(limit.actual > limit.max);
+    assert!(
+        started.elapsed() < Duration::from_secs(2),
+        "refused before any work"
+    );
+
+    // 2000 × 9000 × 201 = 3.6e9: inside the cost cap, far beyond any budget.
+    let started = std::time::Instant::now();
+    let asks: Vec<_> = ["big-1", "big-2", "big-3"]
+        .into_iter()
+        .map(|id| {
+            let (client, root, request) = (client.clone(), root.clone(), maximal(id, 9000));
+            tokio::spawn(async move {
+                client
+                    .request::<PlanRequest, Plan>(&keys::planner_plan(&root), Some(&request))
+                    .await
+            })
+        })
+        .collect();
+    let mut cut = Vec::new();
+    let mut busy = Vec::new();
+    for ask in asks {
+        match within("a maximal plan", ask).await.expect("join") {
+            Ok(plan) => cut.push(plan),
+            Err(ClientError::Refused(reply)) => busy.push(reply),
+            Err(e) => panic!("{e}"),
+        }
+    }
+    let wall = started.elapsed();
+    // A correct planner ends them at 2 s plus the generation in progress; 10 s of
+    // margin for a debug build on a loaded machine, against the 600 s they asked for.
+    assert!(
+        wall < Duration::from_secs_f64(MAX_PLAN_SECONDS + 10.0),
+        "{wall:?}"
+    );
+    assert_eq!((cut.len(), busy.len()), (2, 1), "{cut:?} {busy:?}");
+    let mut granted: Vec<f64> = cut
+        .iter()
+        .map(|plan| {
+            assert_eq!(plan.stop_reason, StopReason::Budget, "{plan:?}");
+            assert!(plan.reaches_goal, "the best path so far");
+            assert!(plan.generations < 9000);
+            plan.budget_s.expect("the grant is in the reply")
+        })
+        .collect();
+    granted.sort_by(f64::total_cmp);
+    assert!((0.9..1.6).contains(&granted[0]), "{granted:?}");
+    assert_eq!(granted[1], MAX_PLAN_SECONDS);
+    assert_eq!(busy[0].code, ErrorCode::Busy);
+    assert_eq!(
+        busy[0].limit.as_ref().map(|l| l.name.as_str()),
+        Some("plan_seconds_burst")
+    );
+    assert!(busy[0].message.contains("retry in"), "{}", busy[0].message);
     running.stop().await;
 }
 

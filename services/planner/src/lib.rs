@@ -14,9 +14,11 @@
 //! - [`plan`]: one request end to end, with the checks that refuse bad requests.
 //!
 //! [`service`] is the thin Zenoh adapter, with what it needs against other clients:
-//! [`token`] and [`inflight`] (request ids, cancel tokens, who may cancel),
-//! [`log_limit`] and [`excerpt`] (bounded logs and echoes of untrusted input).
+//! [`budget`] (the CPU budget across clients), [`token`] and [`inflight`] (request
+//! ids, cancel tokens, who may cancel), [`log_limit`] and [`excerpt`] (bounded logs and
+//! echoes of untrusted input).
 
+pub mod budget;
 pub mod client;
 pub mod config;
 pub mod curiosity;

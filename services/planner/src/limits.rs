@@ -16,7 +16,8 @@
 //! The defaults admit Table I's population (200) and generations (2000) with paths of up
 //! to 10,000 cells (a budget just under 1000 s on a 5 cm warehouse map at Table I's
 //! 2 s/m; the paper's longest budget, 192 s at 0.2 m, allows 481 cells: 20× less), and
-//! population 2000 with paths of 2000 cells.
+//! population 2000 with paths of 2000 cells. Wall time has its own limit, the CPU budget
+//! ([`crate::budget`]).
 
 use crate::params::GaParams;
 

@@ -9,21 +9,23 @@
 //! | `<root>/map/layer/{inflated,information}` | subscription + get | `layer` |
 //!
 //! Every plan is checked against this instance's limits before any work: its slot
-//! (`max_concurrent_plans`) and its size ([`crate::limits`]). Request ids and tokens are
-//! [`crate::token`]'s; who may cancel is [`crate::inflight`]'s.
+//! (`max_concurrent_plans`), its size ([`crate::limits`]) and its wall time from the CPU
+//! budget ([`crate::budget`]). Request ids and tokens are [`crate::token`]'s; who may
+//! cancel is [`crate::inflight`]'s.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use roam_proto::map::Layer;
-use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest};
+use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, StopReason};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::{reply, Requester, Service, ServiceError};
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
 use zenoh::Wait;
 
+use crate::budget::{CpuBudget, Exhausted};
 use crate::config::PlannerConfig;
 use crate::excerpt::{bound_message, excerpt};
 use crate::inflight::{CancelVerdict, InFlight};
@@ -31,7 +33,7 @@ use crate::limits::PlanLimits;
 use crate::log_limit::LogLimit;
 use crate::maps::MapCache;
 use crate::params::GaParams;
-use crate::plan::{plan, PlanOutcome, PlanSpec};
+use crate::plan::{check_spec, plan, PlanOutcome, PlanSpec};
 use crate::token;
 use crate::world::World;
 
@@ -64,6 +66,7 @@ struct State {
     max_in_flight: usize,
     plans: InFlight,
     limits: PlanLimits,
+    budget: CpuBudget,
     refused_cancels: LogLimit,
     unknown_cancels: LogLimit,
 }
@@ -105,6 +108,7 @@ fn check_config(config: &PlannerConfig) -> Result<(), PlannerError> {
             return Err(PlannerError::Config(format!("{name} must be at least 1")));
         }
     }
+    config.budget().validate().map_err(PlannerError::Config)?;
     keys::check_name("information_layer", &config.information_layer)
         .map_err(|e| PlannerError::Config(e.to_string()))
 }
@@ -136,6 +140,7 @@ pub async fn run(
         max_in_flight: config.max_concurrent_plans,
         plans: InFlight::default(),
         limits: config.limits(),
+        budget: CpuBudget::new(config.budget(), Instant::now()),
         refused_cancels: LogLimit::new(CANCEL_LOG_BURST, CANCEL_LOG_PERIOD),
         unknown_cancels: LogLimit::new(CANCEL_LOG_BURST, CANCEL_LOG_PERIOD),
     });
@@ -307,6 +312,26 @@ fn request_id(request: &PlanRequest) -> Result<String, ErrorReply> {
     }
 }
 
+/// The refusal of a plan the CPU budget has no time for.
+fn exhausted(state: &State, e: Exhausted) -> ErrorReply {
+    let config = state.budget.config();
+    let burst = config.plan_seconds_burst;
+    ErrorReply::limit(
+        "plan_seconds_burst",
+        burst.ceil() as u64,
+        (burst - e.available_s + e.needed_s).ceil().max(0.0) as u64,
+        format!(
+            "planner {} has spent its CPU budget: {:.1} of its {burst} plan-seconds are left (refilled at {} per second) and a plan needs {:.1}; retry in {:.1} s or ask another instance",
+            state.instance,
+            e.available_s.max(0.0),
+            config.plan_seconds_per_second,
+            e.needed_s,
+            e.retry_in_s
+        ),
+    )
+    .with_code(ErrorCode::Busy)
+}
+
 /// Checks a request against this instance's state, plans, and builds the reply.
 fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply> {
     // A bounded number of plans at once; the next is refused now, never queued.
@@ -364,7 +389,7 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
     };
     let params = GaParams::with_overrides(&request.params)
         .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
-    let spec = PlanSpec {
+    let mut spec = PlanSpec {
         start: request.start,
         goal: request.goal,
         t_exec_s: request.t_exec_s,
@@ -375,6 +400,14 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
         threads: crate::ga::default_threads(),
         limits: state.limits,
     };
+    // The deadline is checked before the budget takes it as the grant it asks for.
+    check_spec(&spec).map_err(|e| e.to_reply())?;
+    let grant = state
+        .budget
+        .grant(spec.deadline_s, Instant::now())
+        .map_err(|e| exhausted(state, e))?;
+    spec.deadline_s = grant.seconds;
+
     let progress_key = keys::planner_progress(&state.root, &request_id);
     let mut batch = Vec::new();
     let mut last_sent = Instant::now();
@@ -388,7 +421,7 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
             tracing::debug!("progress publication failed: {e}");
         }
     };
-    let outcome = plan(&world, &spec, &stop, |generation, best| {
+    let mut outcome = plan(&world, &spec, &stop, |generation, best| {
         batch.push((generation, best));
         if last_sent.elapsed() >= PROGRESS_PERIOD {
             publish(&mut batch, false);
@@ -396,15 +429,24 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
         }
     })
     .map_err(|e| e.to_reply())?;
+    let (granted_s, cut) = (grant.seconds, grant.cut);
+    grant.finish(Instant::now());
     publish(&mut batch, true);
-    Ok(to_message(
+    // The grant ended the plan only if it was shorter than the request's deadline.
+    let budget_s = (cut && outcome.stop_reason == StopReason::Deadline).then(|| {
+        outcome.stop_reason = StopReason::Budget;
+        granted_s
+    });
+    let mut plan = to_message(
         &world,
         &request,
         request_id,
         map_version,
         &state.instance,
         outcome,
-    ))
+    );
+    plan.budget_s = budget_s;
+    Ok(plan)
 }
 
 /// The reply message of an outcome.
@@ -433,6 +475,7 @@ pub fn to_message(
         generations: outcome.generations,
         planning_ms: outcome.planning.as_secs_f64() * 1000.0,
         stop_reason: outcome.stop_reason,
+        budget_s: None,
         seed: request.seed,
         map_version,
         instance: instance.to_owned(),
