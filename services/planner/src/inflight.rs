@@ -32,16 +32,6 @@ pub enum CancelVerdict {
     Unknown,
 }
 
-impl CancelVerdict {
-    /// Whether the cancel was refused for want of proof: worth a (rate-limited) warning.
-    pub fn is_refusal(self) -> bool {
-        matches!(
-            self,
-            CancelVerdict::WrongToken | CancelVerdict::MissingToken | CancelVerdict::NotCancellable
-        )
-    }
-}
-
 /// The request id is already being planned on this instance.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("the request id is already being planned")]
