@@ -146,13 +146,15 @@ pub fn planner_plan_at(root: &str, instance: &str) -> String {
 }
 
 /// `<root>/planner/progress/<request_id>`: the planner working on a request publishes
-/// [`PlanProgress`](crate::planner::PlanProgress) here, at most every 50 ms.
+/// [`PlanProgress`](crate::planner::PlanProgress) here, at most every 50 ms. Public:
+/// a request id is a name, not a secret (cancelling takes the request's token).
 pub fn planner_progress(root: &str, request_id: &str) -> String {
     format!("{root}/planner/progress/{request_id}")
 }
 
 /// `<root>/planner/cancel/<request_id>`: put a [`CancelPlan`](crate::planner::CancelPlan)
-/// here to stop a plan in flight; every planner instance listens.
+/// here to stop a plan in flight; every planner instance listens, and honours it only
+/// with the request's `cancel_token`.
 pub fn planner_cancel(root: &str, request_id: &str) -> String {
     format!("{root}/planner/cancel/{request_id}")
 }

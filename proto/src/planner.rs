@@ -68,10 +68,19 @@ pub struct GaOverrides {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlanRequest {
-    /// Names the plan's progress key and lets a client cancel it; the planner makes one
-    /// up when absent. Characters a-z, A-Z, 0-9, '_' and '-'.
+    /// Names the plan's progress key (`<root>/planner/progress/<request_id>`) and its
+    /// cancel key; 1 to 64 characters a-z, A-Z, 0-9, '_' and '-'. Not a secret: anyone
+    /// subscribed to the progress keys sees it. When absent the planner makes up an
+    /// unguessable one (32 hex characters, 128 random bits) and returns it in the plan.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub request_id: Option<String>,
+    /// The secret that proves a [`CancelPlan`] comes from the requester: 16 to 128
+    /// characters from a-z, A-Z, 0-9, '-' and '_' (e.g. 32 hex characters of 16 random
+    /// bytes, fresh for each request). The planner never logs it or sends it back. A
+    /// request without one cannot be cancelled: it ends at its generations or its
+    /// deadline.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cancel_token: Option<String>,
     pub start: [f64; 2],
     pub goal: [f64; 2],
     /// Seconds the robot has to drive (paper 000: t_exec).
@@ -115,6 +124,10 @@ pub enum StopReason {
     MaxGenerations,
     Deadline,
     Cancelled,
+    /// The planner's CPU budget granted less wall time than `deadline_s` (its
+    /// `max_plan_seconds`, or what its plan-seconds bucket held) and the plan used it
+    /// all: the path is the best found in [`Plan::budget_s`] seconds.
+    Budget,
     /// Baselines that are not iterative.
     Complete,
 }
@@ -144,6 +157,9 @@ pub struct Plan {
     pub generations: u32,
     pub planning_ms: f64,
     pub stop_reason: StopReason,
+    /// With `stop_reason: budget`: the wall seconds the CPU budget granted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budget_s: Option<f64>,
     pub seed: u64,
     pub map_version: MapVersion,
     /// The planner instance that answered.
@@ -169,12 +185,18 @@ impl Message for PlanProgress {
     const KIND: &'static str = "plan_progress";
 }
 
-/// Cancel a plan in flight: put on `<root>/planner/cancel/<request_id>`. The planner
-/// stops and replies with the best path found so far (`stop_reason: cancelled`).
+/// Cancel a plan in flight: put on `<root>/planner/cancel/<request_id>`. Honoured only
+/// when `token` is the request's `cancel_token` (compared in constant time): the planner
+/// then stops and replies with the best path found so far (`stop_reason: cancelled`). A
+/// cancel with another token or none (as every cancel before tokens) is ignored and
+/// logged, rate-limited.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CancelPlan {
     pub request_id: String,
+    /// The plan request's `cancel_token`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub token: Option<String>,
 }
 
 impl Message for CancelPlan {

@@ -273,7 +273,7 @@ mod planner_messages {
 
     fn request() -> impl Strategy<Value = PlanRequest> {
         (
-            prop::option::of(name()),
+            (prop::option::of(name()), prop::option::of(name())),
             [finite(), finite()],
             [finite(), finite()],
             (finite(), finite()),
@@ -284,7 +284,7 @@ mod planner_messages {
         )
             .prop_map(
                 |(
-                    request_id,
+                    (request_id, cancel_token),
                     start,
                     goal,
                     (t_exec_s, deadline_s),
@@ -294,6 +294,7 @@ mod planner_messages {
                     map_version,
                 )| PlanRequest {
                     request_id,
+                    cancel_token,
                     start,
                     goal,
                     t_exec_s,
@@ -318,9 +319,10 @@ mod planner_messages {
                 Just(StopReason::MaxGenerations),
                 Just(StopReason::Deadline),
                 Just(StopReason::Cancelled),
+                Just(StopReason::Budget),
                 Just(StopReason::Complete)
             ],
-            (any::<u64>(), version(), name()),
+            (any::<u64>(), version(), name(), prop::option::of(finite())),
         )
             .prop_map(
                 |(
@@ -331,7 +333,7 @@ mod planner_messages {
                     f,
                     (u_ges, density, distinct_information, generations, planning_ms),
                     stop_reason,
-                    (seed, map_version, instance),
+                    (seed, map_version, instance, budget_s),
                 )| {
                     let points = cells
                         .iter()
@@ -360,6 +362,7 @@ mod planner_messages {
                         generations,
                         planning_ms,
                         stop_reason,
+                        budget_s,
                         seed,
                         map_version,
                         instance,
@@ -378,7 +381,8 @@ mod planner_messages {
         #[test]
         fn progress_and_cancel_round_trip(id in name(), best in prop::collection::vec((any::<u32>(), finite()), 0..20), done in any::<bool>()) {
             round_trips(&PlanProgress { request_id: id.clone(), best_fitness: best, done });
-            round_trips(&CancelPlan { request_id: id });
+            round_trips(&CancelPlan { request_id: id.clone(), token: None });
+            round_trips(&CancelPlan { request_id: id.clone(), token: Some(id) });
         }
 
         #[test]
@@ -386,6 +390,34 @@ mod planner_messages {
             refuses_trailing(&m, &g);
             refuses_version(&m, v);
         }
+    }
+
+    /// Requests, cancels and plans written before cancel tokens and the CPU budget
+    /// still decode: the new fields default to absent.
+    #[test]
+    fn messages_from_before_cancel_tokens_still_decode() {
+        let cancel: CancelPlan =
+            decode(br#"{"v":1,"kind":"cancel_plan","body":{"request_id":"trip-42"}}"#)
+                .expect("an old cancel");
+        assert_eq!(
+            cancel,
+            CancelPlan {
+                request_id: "trip-42".into(),
+                token: None
+            }
+        );
+        let request: PlanRequest = decode(
+            br#"{"v":1,"kind":"plan_request","body":{"start":[0,0],"goal":[1,1],"t_exec_s":10,"deadline_s":1,"model":"model1"}}"#,
+        )
+        .expect("an old request");
+        assert_eq!((request.request_id, request.cancel_token), (None, None));
+        // And a request without a token is written without the field.
+        let text = String::from_utf8(encode(&CancelPlan {
+            request_id: "x".into(),
+            token: None,
+        }))
+        .expect("utf-8");
+        assert!(!text.contains("token"), "{text}");
     }
 }
 

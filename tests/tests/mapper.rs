@@ -177,6 +177,7 @@ async fn sim_to_mapper_to_map_server_shows_where_the_blocks_move() {
             &keys::planner_plan_at(&root, "curious-about-change"),
             Some(&PlanRequest {
                 request_id: None,
+                cancel_token: None,
                 start: [0.5, 0.5],
                 goal: [0.5, -6.5],
                 t_exec_s: 60.0,

@@ -1,5 +1,6 @@
 //! The planner through Zenoh: plans, determinism against the in-process planner, every
-//! refusal, progress, cancel, busy, and two instances sharing load and surviving one's
+//! refusal, progress, cancel (only with the requester's token), busy, the limits and the
+//! CPU budget, made-up request ids, and two instances sharing load and surviving one's
 //! death. Real map server and planners in process, used only as a Zenoh client.
 
 use std::sync::atomic::AtomicBool;
@@ -22,6 +23,7 @@ use roam_tests::{within, Harness, RunningService};
 fn request(start: [f64; 2], goal: [f64; 2], t_exec_s: f64, generations: u32) -> PlanRequest {
     PlanRequest {
         request_id: None,
+        cancel_token: None,
         start,
         goal,
         t_exec_s,
@@ -52,40 +54,94 @@ async fn refusal(client: &Requester, root: &str, request: &PlanRequest) -> Error
     }
 }
 
-/// Starts a plan that runs until it is cancelled (100,000 generations), with a
-/// subscriber to its progress.
-async fn start_endless_plan(
+type ProgressSubscriber =
+    zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>;
+
+/// Sends `request` (which names its id) in the background, with a subscriber to its
+/// progress declared first.
+async fn start_plan(
     client: &Requester,
     root: &str,
-    id: &str,
+    request: PlanRequest,
 ) -> (
-    zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
+    ProgressSubscriber,
     tokio::task::JoinHandle<Result<Plan, ClientError>>,
 ) {
+    let id = request.request_id.clone().expect("a named request");
     let subscriber = within(
         "subscribe",
         client
             .session()
-            .declare_subscriber(keys::planner_progress(root, id)),
+            .declare_subscriber(keys::planner_progress(root, &id)),
     )
     .await
     .expect("progress subscriber");
-    let endless = PlanRequest {
-        request_id: Some(id.into()),
-        params: GaOverrides {
-            max_generations: Some(100_000),
-            ..GaOverrides::default()
-        },
-        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
-    };
-    let (client, root) = (client.clone(), root.to_owned());
+    // The plans started here take longer than a harness client's 5 s.
+    let client = Requester::new(client.session().clone(), Duration::from_secs(60));
+    let root = root.to_owned();
     let pending = tokio::spawn(async move {
         client
-            .request::<PlanRequest, Plan>(&keys::planner_plan(&root), Some(&endless))
+            .request::<PlanRequest, Plan>(&keys::planner_plan(&root), Some(&request))
             .await
     });
     (subscriber, pending)
 }
+
+/// A plan that runs until it is cancelled (50,000 generations: a cost of 2e9, inside
+/// `max_plan_cost`; 30 s of the CPU budget), cancellable with `token`.
+fn endless(id: &str, token: Option<&str>) -> PlanRequest {
+    PlanRequest {
+        request_id: Some(id.into()),
+        cancel_token: token.map(str::to_owned),
+        params: GaOverrides {
+            max_generations: Some(50_000),
+            ..GaOverrides::default()
+        },
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
+    }
+}
+
+/// Starts [`endless`], with a subscriber to its progress.
+async fn start_endless_plan(
+    client: &Requester,
+    root: &str,
+    id: &str,
+    token: Option<&str>,
+) -> (
+    ProgressSubscriber,
+    tokio::task::JoinHandle<Result<Plan, ClientError>>,
+) {
+    start_plan(client, root, endless(id, token)).await
+}
+
+/// Waits for the first progress message of a plan: it is planning.
+async fn planning(subscriber: &ProgressSubscriber) {
+    within("progress", subscriber.recv_async())
+        .await
+        .expect("the plan is planning");
+}
+
+/// Puts a cancel for `id` with `token` from `client`'s session.
+async fn cancel(client: &Requester, root: &str, id: &str, token: Option<&str>) {
+    within(
+        "cancel",
+        client.session().put(
+            keys::planner_cancel(root, id),
+            encode(&CancelPlan {
+                request_id: id.into(),
+                token: token.map(str::to_owned),
+            }),
+        ),
+    )
+    .await
+    .expect("put");
+}
+
+const TOKEN_A: &str = "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa";
+const TOKEN_B: &str = "bbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbb";
+const TOKEN_C: &str = "cccccccccccccccccccccccccccccccc";
+/// Right length, right alphabet, wrong secret.
+const GUESS: &str = "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaab";
 
 struct Running {
     harness: Harness,
@@ -94,14 +150,22 @@ struct Running {
 }
 
 async fn boot(planners: &[(&str, usize)]) -> Running {
+    boot_with(planners, |config| config).await
+}
+
+/// [`boot`] with each planner's config changed by `adjust`.
+async fn boot_with(
+    planners: &[(&str, usize)],
+    adjust: impl Fn(roam_planner::PlannerConfig) -> roam_planner::PlannerConfig,
+) -> Running {
     let harness = Harness::start().await;
     let map_server = harness.start_map_server(harness.map_server_config()).await;
     let mut started = Vec::new();
     for (name, concurrent) in planners {
-        let config = roam_planner::PlannerConfig {
+        let config = adjust(roam_planner::PlannerConfig {
             max_concurrent_plans: *concurrent,
             ..harness.planner_config(name)
-        };
+        });
         started.push(harness.start_planner(config).await);
     }
     Running {
@@ -162,6 +226,7 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         params: GaParams::with_overrides(&req.params).expect("params"),
         seed: req.seed,
         threads: roam_planner::ga::default_threads(),
+        limits: roam_planner::limits::PlanLimits::default(),
     };
     let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local plan");
     let local_cells = world.grid_cells(&local.path);
@@ -265,6 +330,62 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
         params.message
     );
 
+    // A cancel token outside the rules is refused without being repeated.
+    let token = refusal(
+        &client,
+        &root,
+        &PlanRequest {
+            cancel_token: Some("short-secret".into()),
+            ..ok.clone()
+        },
+    )
+    .await;
+    assert_eq!(token.code, ErrorCode::InvalidRequest);
+    assert!(token.message.contains("cancel_token"), "{}", token.message);
+    assert!(!token.message.contains("short-secret"), "{}", token.message);
+
+    // A huge request id comes back as a short excerpt and its length.
+    let long_id = "x".repeat(60_000);
+    let id = refusal(
+        &client,
+        &root,
+        &PlanRequest {
+            request_id: Some(long_id),
+            ..ok.clone()
+        },
+    )
+    .await;
+    assert_eq!(id.code, ErrorCode::InvalidRequest);
+    assert!(id.message.contains("(60000 bytes)"), "{}", id.message);
+    assert!(id.message.len() < 400, "{} bytes", id.message.len());
+
+    // A decoder's error quoting a huge string is bounded too.
+    let quoted = match within(
+        "raw",
+        client.request_raw::<Plan>(
+            &keys::planner_plan(&root),
+            Some(
+                format!(
+                    r#"{{"v":1,"kind":"plan_request","body":{{"start":[0,0],"goal":[1,1],"t_exec_s":1,"deadline_s":1,"model":"{}"}}}}"#,
+                    "m".repeat(50_000)
+                )
+                .into_bytes(),
+            ),
+        ),
+    )
+    .await
+    {
+        Err(ClientError::Refused(r)) => r,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(quoted.code, ErrorCode::Malformed);
+    assert!(
+        quoted.message.len() < 1000,
+        "{} bytes",
+        quoted.message.len()
+    );
+    assert!(quoted.message.contains("bytes cut"), "{}", quoted.message);
+
     let version = refusal(
         &client,
         &root,
@@ -355,7 +476,7 @@ async fn progress_is_published_and_a_plan_can_be_cancelled() {
     let client = running.harness.client().await;
     let root = running.harness.root.clone();
     let id = "long-plan";
-    let (subscriber, pending) = start_endless_plan(&client, &root, id).await;
+    let (subscriber, pending) = start_endless_plan(&client, &root, id, Some(TOKEN_A)).await;
     // Progress arrives while it plans: generations in order, best fitness never worse.
     let mut seen: Vec<(u32, f64)> = Vec::new();
     while seen.len() < 5 {
@@ -372,23 +493,13 @@ async fn progress_is_published_and_a_plan_can_be_cancelled() {
         "{seen:?}"
     );
 
-    within(
-        "cancel",
-        client.session().put(
-            keys::planner_cancel(&root, id),
-            encode(&CancelPlan {
-                request_id: id.into(),
-            }),
-        ),
-    )
-    .await
-    .expect("put");
+    cancel(&client, &root, id, Some(TOKEN_A)).await;
     let plan = within("cancelled plan", pending)
         .await
         .expect("join")
         .expect("plan");
     assert_eq!(plan.stop_reason, StopReason::Cancelled);
-    assert!(plan.generations < 100_000);
+    assert!(plan.generations < 50_000);
     assert!(plan.reaches_goal, "the best path so far is returned");
     // The last progress message says done.
     let done = loop {
@@ -410,10 +521,8 @@ async fn a_full_planner_refuses_at_once_with_busy() {
     let client = running.harness.client().await;
     let root = running.harness.root.clone();
     let id = "hog";
-    let (subscriber, pending) = start_endless_plan(&client, &root, id).await;
-    within("hog progress", subscriber.recv_async())
-        .await
-        .expect("the hog is planning");
+    let (subscriber, pending) = start_endless_plan(&client, &root, id, Some(TOKEN_A)).await;
+    planning(&subscriber).await;
     let started = std::time::Instant::now();
     let busy = refusal(&client, &root, &request([-8.0, -8.0], [6.0, -7.0], 80.0, 5)).await;
     assert_eq!(busy.code, ErrorCode::Busy);
@@ -425,17 +534,7 @@ async fn a_full_planner_refuses_at_once_with_busy() {
         busy.limit.map(|l| l.name),
         Some("max_concurrent_plans".to_owned())
     );
-    within(
-        "cancel",
-        client.session().put(
-            keys::planner_cancel(&root, id),
-            encode(&CancelPlan {
-                request_id: id.into(),
-            }),
-        ),
-    )
-    .await
-    .expect("put");
+    cancel(&client, &root, id, Some(TOKEN_A)).await;
     within("hog", pending).await.expect("join").expect("plan");
     running.stop().await;
 }
@@ -478,5 +577,192 @@ async fn two_instances_share_the_load_and_survive_one_death() {
         .expect("plan after a death");
         assert_eq!(plan.instance, "beta");
     }
+    running.stop().await;
+}
+
+/// Issue 19: anyone sees request ids (progress keys are public), so an id is not enough
+/// to cancel. A stranger's cancels, with a guessed token or none, do nothing; the
+/// requester's token ends the plan.
+///
+/// Ordering makes it certain the stranger's cancels were handled while both plans ran:
+/// the stranger cancels its own plan C last, from the same session, and the planner
+/// handles one session's cancels in order. When C's cancelled reply arrives, A and B are
+/// still planning; then A runs to its last generation and B ends at its requester's
+/// cancel.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_strangers_cancel_does_nothing_and_the_requesters_cancel_ends_the_plan() {
+    let running = boot_with(&[("solo", 3)], |config| roam_planner::PlannerConfig {
+        plan_seconds_burst: 300.0,
+        ..config
+    })
+    .await;
+    let root = running.harness.root.clone();
+    let requester = running.harness.client().await;
+    let stranger = running.harness.client().await;
+    let generations = 2500;
+    let finite = PlanRequest {
+        request_id: Some("plan-a".into()),
+        cancel_token: Some(TOKEN_A.into()),
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, generations)
+    };
+    let (a_progress, a) = start_plan(&requester, &root, finite).await;
+    let (b_progress, b) = start_endless_plan(&requester, &root, "plan-b", Some(TOKEN_B)).await;
+    let (c_progress, c) = start_endless_plan(&stranger, &root, "plan-c", Some(TOKEN_C)).await;
+    for progress in [&a_progress, &b_progress, &c_progress] {
+        planning(progress).await;
+    }
+    for id in ["plan-a", "plan-b"] {
+        cancel(&stranger, &root, id, Some(GUESS)).await;
+        cancel(&stranger, &root, id, None).await;
+        cancel(&stranger, &root, id, Some(TOKEN_C)).await;
+    }
+    cancel(&stranger, &root, "plan-c", Some(TOKEN_C)).await;
+    let c = within("the stranger's own plan", c)
+        .await
+        .expect("join")
+        .expect("plan");
+    assert_eq!(c.stop_reason, StopReason::Cancelled);
+    assert!(
+        !a.is_finished() && !b.is_finished(),
+        "A and B must still be planning when the stranger's cancels have been handled"
+    );
+
+    cancel(&requester, &root, "plan-b", Some(TOKEN_B)).await;
+    let b = within("the requester's cancel", b)
+        .await
+        .expect("join")
+        .expect("plan");
+    assert_eq!(b.stop_reason, StopReason::Cancelled);
+    assert!(b.generations < 50_000);
+
+    let a = tokio::time::timeout(Duration::from_secs(60), a)
+        .await
+        .expect("plan A completes")
+        .expect("join")
+        .expect("plan");
+    assert_eq!(a.stop_reason, StopReason::MaxGenerations);
+    assert_eq!(a.generations, generations);
+    running.stop().await;
+}
+
+/// Issue 20: the planner's work has limits named in the error, and its wall time a
+/// budget. The attack's request (population 2000, 100,000 generations) is refused at
+/// once by its cost; the largest requests the cost cap admits are cut at the CPU budget
+/// (here `max_plan_seconds` 2 and a bucket of 3 plan-seconds: one gets 2 s, the next
+/// what is left, about 1 s) and the third is refused `busy` with the bucket's name.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn maximal_requests_are_cut_at_the_cpu_budget_or_refused() {
+    const MAX_PLAN_SECONDS: f64 = 2.0;
+    let running = boot_with(&[("solo", 3)], |config| roam_planner::PlannerConfig {
+        max_plan_seconds: MAX_PLAN_SECONDS,
+        plan_seconds_burst: 3.0,
+        ..config
+    })
+    .await;
+    let root = running.harness.root.clone();
+    let client = running.harness.client().await;
+    let maximal = |id: &str, generations: u32| PlanRequest {
+        request_id: Some(id.into()),
+        deadline_s: 600.0,
+        params: GaOverrides {
+            population: Some(2000),
+            max_generations: Some(generations),
+            ..GaOverrides::default()
+        },
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
+    };
+
+    let started = std::time::Instant::now();
+    let attack = refusal(&client, &root, &maximal("attack", 100_000)).await;
+    assert_eq!(attack.code, ErrorCode::LimitExceeded);
+    let limit = attack.limit.expect("the limit is named");
+    assert_eq!(limit.name, "max_plan_cost");
+    // 80 s at 0.4 s per cell: paths of at most 201 cells.
+    assert_eq!(limit.actual, 2000 * 100_000 * 201);
+    assert!(limit.actual > limit.max);
+    assert!(
+        started.elapsed() < Duration::from_secs(2),
+        "refused before any work"
+    );
+
+    // 2000 × 9000 × 201 = 3.6e9: inside the cost cap, far beyond any budget.
+    let started = std::time::Instant::now();
+    let asks: Vec<_> = ["big-1", "big-2", "big-3"]
+        .into_iter()
+        .map(|id| {
+            let (client, root, request) = (client.clone(), root.clone(), maximal(id, 9000));
+            tokio::spawn(async move {
+                client
+                    .request::<PlanRequest, Plan>(&keys::planner_plan(&root), Some(&request))
+                    .await
+            })
+        })
+        .collect();
+    let mut cut = Vec::new();
+    let mut busy = Vec::new();
+    for ask in asks {
+        match within("a maximal plan", ask).await.expect("join") {
+            Ok(plan) => cut.push(plan),
+            Err(ClientError::Refused(reply)) => busy.push(reply),
+            Err(e) => panic!("{e}"),
+        }
+    }
+    let wall = started.elapsed();
+    // A correct planner ends them at 2 s plus the generation in progress; 10 s of
+    // margin for a debug build on a loaded machine, against the 600 s they asked for.
+    assert!(
+        wall < Duration::from_secs_f64(MAX_PLAN_SECONDS + 10.0),
+        "{wall:?}"
+    );
+    assert_eq!((cut.len(), busy.len()), (2, 1), "{cut:?} {busy:?}");
+    let mut granted: Vec<f64> = cut
+        .iter()
+        .map(|plan| {
+            assert_eq!(plan.stop_reason, StopReason::Budget, "{plan:?}");
+            assert!(plan.reaches_goal, "the best path so far");
+            assert!(plan.generations < 9000);
+            plan.budget_s.expect("the grant is in the reply")
+        })
+        .collect();
+    granted.sort_by(f64::total_cmp);
+    assert!((0.9..1.6).contains(&granted[0]), "{granted:?}");
+    assert_eq!(granted[1], MAX_PLAN_SECONDS);
+    assert_eq!(busy[0].code, ErrorCode::Busy);
+    assert_eq!(
+        busy[0].limit.as_ref().map(|l| l.name.as_str()),
+        Some("plan_seconds_burst")
+    );
+    assert!(busy[0].message.contains("retry in"), "{}", busy[0].message);
+    running.stop().await;
+}
+
+/// Ids the planner makes up are 128 random bits in hex, distinct from each other.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn made_up_request_ids_are_distinct_and_32_hex_characters() {
+    let running = boot(&[("solo", 2)]).await;
+    let client = running.harness.client().await;
+    let mut ids = std::collections::BTreeSet::new();
+    for _ in 0..3 {
+        let plan = ask(
+            &client,
+            &running.harness.root,
+            &PlanRequest {
+                model: PlannerModel::Shortest,
+                ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
+            },
+        )
+        .await
+        .expect("plan");
+        assert_eq!(plan.request_id.len(), 32, "{}", plan.request_id);
+        assert!(
+            plan.request_id
+                .bytes()
+                .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)),
+            "{}",
+            plan.request_id
+        );
+        ids.insert(plan.request_id);
+    }
+    assert_eq!(ids.len(), 3);
     running.stop().await;
 }

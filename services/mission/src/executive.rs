@@ -241,6 +241,7 @@ impl Run<'_> {
     ) -> Result<Plan, ClientError> {
         let request = PlanRequest {
             request_id: None,
+            cancel_token: None,
             start: from,
             goal: to,
             t_exec_s,

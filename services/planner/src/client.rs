@@ -7,13 +7,21 @@
 //! instances in turn (round robin), and moves on to the next one when an instance is
 //! busy, stopping or gone. Any language can do the same: a liveliness `get` on
 //! `<root>/@live/planner/*`, then a `get` on the chosen instance's key.
+//!
+//! Every request this client sends carries a request id and a secret `cancel_token`,
+//! fresh and random for each request unless the caller set them ([`PlanTicket`]): only
+//! the holder of the token can cancel the plan ([`PlannerClient::cancel`]). A plan whose
+//! future is dropped before its reply (the caller gave up) is cancelled with its token,
+//! so the planner does not keep computing a path nobody waits for.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 
-use roam_proto::planner::{Plan, PlanRequest};
-use roam_proto::{keys, ErrorCode};
+use roam_proto::planner::{CancelPlan, Plan, PlanRequest};
+use roam_proto::{encode, keys, ErrorCode};
 use roam_runtime::{ClientError, Requester};
+
+use crate::token::random_hex128;
 
 /// Extra time a client waits beyond the plan's own deadline for the reply.
 pub const REPLY_MARGIN: Duration = Duration::from_secs(10);
@@ -23,6 +31,77 @@ pub struct PlannerClient {
     session: zenoh::Session,
     root: String,
     next: AtomicUsize,
+}
+
+/// What cancels one plan: its request id and its secret token. Keep it to yourself:
+/// whoever holds it can cancel the plan.
+#[derive(Clone)]
+pub struct PlanTicket {
+    pub request_id: String,
+    token: String,
+}
+
+impl std::fmt::Debug for PlanTicket {
+    // The token is a secret: never in a debug print.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PlanTicket")
+            .field("request_id", &self.request_id)
+            .finish_non_exhaustive()
+    }
+}
+
+impl PlanTicket {
+    /// Gives `request` a fresh random request id and cancel token where it has none
+    /// ([`random_hex128`]: 128 bits each), and returns what cancels it.
+    pub fn issue(request: &mut PlanRequest) -> PlanTicket {
+        let request_id = request.request_id.get_or_insert_with(random_hex128).clone();
+        let token = request
+            .cancel_token
+            .get_or_insert_with(random_hex128)
+            .clone();
+        PlanTicket { request_id, token }
+    }
+
+    /// The cancel message for this plan.
+    pub fn cancel_message(&self) -> CancelPlan {
+        CancelPlan {
+            request_id: self.request_id.clone(),
+            token: Some(self.token.clone()),
+        }
+    }
+}
+
+/// Cancels a plan when dropped before [`CancelOnDrop::disarm`]: the caller stopped
+/// waiting. The put is spawned on the current runtime (a drop cannot await); best
+/// effort, like any cancel.
+struct CancelOnDrop<'a> {
+    client: &'a PlannerClient,
+    ticket: Option<PlanTicket>,
+}
+
+impl CancelOnDrop<'_> {
+    fn disarm(mut self) {
+        self.ticket = None;
+    }
+}
+
+impl Drop for CancelOnDrop<'_> {
+    fn drop(&mut self) {
+        let Some(ticket) = self.ticket.take() else {
+            return;
+        };
+        let Ok(runtime) = tokio::runtime::Handle::try_current() else {
+            return;
+        };
+        let session = self.client.session.clone();
+        let key = keys::planner_cancel(&self.client.root, &ticket.request_id);
+        let message = encode(&ticket.cancel_message());
+        runtime.spawn(async move {
+            if let Err(e) = session.put(&key, message).await {
+                tracing::debug!("cancelling an abandoned plan failed: {e}");
+            }
+        });
+    }
 }
 
 impl PlannerClient {
@@ -60,10 +139,38 @@ impl PlannerClient {
         Ok(instances)
     }
 
+    /// Cancels the plan of `ticket` on every instance: the one planning it stops and
+    /// replies with its best path so far (`stop_reason: cancelled`).
+    pub async fn cancel(&self, ticket: &PlanTicket) -> Result<(), ClientError> {
+        let key = keys::planner_cancel(&self.root, &ticket.request_id);
+        self.session
+            .put(&key, encode(&ticket.cancel_message()))
+            .await
+            .map_err(|e| ClientError::Zenoh {
+                key,
+                reason: e.to_string(),
+            })
+    }
+
     /// Asks one live instance after another (round robin) until one plans; an instance
     /// that is busy, stopping or silent is skipped. Refusals about the request itself
-    /// (a blocked goal, a short budget) come back at once.
+    /// (a blocked goal, a short budget) come back at once. The request gets a fresh id
+    /// and cancel token where it has none ([`PlanTicket::issue`]; to cancel it
+    /// yourself, issue the ticket first), and is cancelled if this future is dropped
+    /// before the reply.
     pub async fn plan(&self, request: &PlanRequest) -> Result<Plan, ClientError> {
+        let mut request = request.clone();
+        let ticket = PlanTicket::issue(&mut request);
+        let guard = CancelOnDrop {
+            client: self,
+            ticket: Some(ticket),
+        };
+        let result = self.plan_on_any(&request).await;
+        guard.disarm();
+        result
+    }
+
+    async fn plan_on_any(&self, request: &PlanRequest) -> Result<Plan, ClientError> {
         let instances = self.live_instances().await?;
         let timeout = Duration::from_secs_f64(request.deadline_s.clamp(0.0, 600.0)) + REPLY_MARGIN;
         let requester = Requester::new(self.session.clone(), timeout);
@@ -97,5 +204,52 @@ impl PlannerClient {
             key: keys::planner_plan(&self.root),
             timeout,
         }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roam_proto::planner::{GaOverrides, PlannerModel};
+
+    fn request() -> PlanRequest {
+        PlanRequest {
+            request_id: None,
+            cancel_token: None,
+            start: [0.0, 0.0],
+            goal: [1.0, 1.0],
+            t_exec_s: 10.0,
+            deadline_s: 1.0,
+            model: PlannerModel::Model1,
+            params: GaOverrides::default(),
+            seed: 0,
+            map_version: None,
+        }
+    }
+
+    #[test]
+    fn every_request_gets_a_fresh_id_and_token_unless_it_has_them() {
+        let (mut a, mut b) = (request(), request());
+        let (ta, tb) = (PlanTicket::issue(&mut a), PlanTicket::issue(&mut b));
+        assert_ne!(ta.request_id, tb.request_id);
+        assert_ne!(a.cancel_token, b.cancel_token);
+        let token = a.cancel_token.clone().expect("token");
+        assert!(crate::token::check_token(&token).is_ok());
+        assert_eq!(ta.cancel_message().token.as_deref(), Some(token.as_str()));
+        assert_eq!(a.request_id.as_deref(), Some(ta.request_id.as_str()));
+        // The caller's own id and token are kept.
+        let mut own = PlanRequest {
+            request_id: Some("trip-42".into()),
+            cancel_token: Some("my-own-secret-token".into()),
+            ..request()
+        };
+        let ticket = PlanTicket::issue(&mut own);
+        assert_eq!(ticket.request_id, "trip-42");
+        assert_eq!(
+            ticket.cancel_message().token.as_deref(),
+            Some("my-own-secret-token")
+        );
+        // A debug print never shows the token.
+        assert!(!format!("{ticket:?}").contains("secret"));
     }
 }

@@ -6,10 +6,20 @@
 //! max_concurrent_plans: 2      # more are refused at once with `busy`
 //! map_history: 4               # map versions kept for requests that name one
 //! information_layer: information  # or change_information: plan on the mapper's P(E>0)
+//! # What one plan may cost, checked before any work (crate::limits):
+//! max_population_cells: 4000000   # population × longest path the budget allows
+//! max_plan_cost: 4000000000       # population × generations × that path length
+//! # The CPU budget across clients, in plan-seconds (crate::budget):
+//! max_plan_seconds: 30         # one plan's wall time at most (its deadline is cut)
+//! plan_seconds_per_second: 0.5 # the bucket's refill
+//! plan_seconds_burst: 60       # the bucket's size
 //! zenoh: { mode: client, connect: { endpoints: ["tcp/router:7447"] } }
 //! ```
 
 use serde::Deserialize;
+
+use crate::budget::BudgetConfig;
+use crate::limits::PlanLimits;
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -24,20 +34,77 @@ pub struct PlannerConfig {
     /// The u8 layer the planner takes as paper 000's information map I_xy: the map
     /// server's static `information` (default), or the mapper's `change_information`
     /// (100 · P(E > 0), paper 004), so curiosity goes where the world has likely
-    /// changed since a robot last looked.
+    /// changed since a robot last looked. Scores above 100 count as 100
+    /// ([`crate::world::MAX_INFORMATION_SCORE`]).
     pub information_layer: String,
+    /// Most genes a plan's population may hold: population × the longest path its
+    /// budget allows (Eq. 2, [`crate::limits`]). Refused `limit_exceeded` above it.
+    pub max_population_cells: u64,
+    /// Most work a plan may ask for: population × max_generations × that path length.
+    /// Refused `limit_exceeded` above it.
+    pub max_plan_cost: u64,
+    /// One plan's wall time at most, seconds: a longer `deadline_s` is cut to it and a
+    /// plan that runs into it replies `stop_reason: budget` ([`crate::budget`]).
+    pub max_plan_seconds: f64,
+    /// Plan-seconds the instance's CPU budget refills per wall second.
+    pub plan_seconds_per_second: f64,
+    /// Plan-seconds the CPU budget holds at most.
+    pub plan_seconds_burst: f64,
     pub zenoh: Option<serde_json::Value>,
 }
 
 impl Default for PlannerConfig {
     fn default() -> Self {
+        let limits = PlanLimits::default();
+        let budget = BudgetConfig::default();
         PlannerConfig {
             root: roam_proto::keys::DEFAULT_ROOT.to_owned(),
             instance: None,
             max_concurrent_plans: 2,
             map_history: 4,
             information_layer: crate::maps::INFORMATION.to_owned(),
+            max_population_cells: limits.max_population_cells,
+            max_plan_cost: limits.max_plan_cost,
+            max_plan_seconds: budget.max_plan_seconds,
+            plan_seconds_per_second: budget.plan_seconds_per_second,
+            plan_seconds_burst: budget.plan_seconds_burst,
             zenoh: None,
         }
+    }
+}
+
+impl PlannerConfig {
+    /// The size limits of one plan.
+    pub fn limits(&self) -> PlanLimits {
+        PlanLimits {
+            max_population_cells: self.max_population_cells,
+            max_plan_cost: self.max_plan_cost,
+        }
+    }
+
+    /// The CPU budget's numbers.
+    pub fn budget(&self) -> BudgetConfig {
+        BudgetConfig {
+            max_plan_seconds: self.max_plan_seconds,
+            plan_seconds_per_second: self.plan_seconds_per_second,
+            plan_seconds_burst: self.plan_seconds_burst,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_documented_example_parses_to_the_defaults() {
+        // The config file is YAML; its JSON subset parses the same way.
+        let text = r#"{"max_population_cells": 4000000, "max_plan_cost": 4000000000,
+            "max_plan_seconds": 30, "plan_seconds_per_second": 0.5, "plan_seconds_burst": 60}"#;
+        let parsed: PlannerConfig = serde_json::from_str(text).expect("parses");
+        assert_eq!(parsed, PlannerConfig::default());
+        assert!(parsed.budget().validate().is_ok());
+        // Well under the 600 s a request may ask for.
+        assert!(parsed.max_plan_seconds <= 60.0);
     }
 }

@@ -16,7 +16,10 @@
 //!   at least one cell of score I (not one per cell), n_I being the number of such
 //!   genes so far including this one, and t_s the path time (Eq. 2) since the previous
 //!   gene that experienced I (t_s = ∞ for the first, so the time term vanishes).
-//!   Score 0 carries no stimulus.
+//!   Score 0 carries no stimulus. Stimuli are counted per score value in tables of
+//!   `MAX_INFORMATION_SCORE + 1` entries; a [`World`] clamps its scores to that range
+//!   (see [`crate::world::MAX_INFORMATION_SCORE`]) and the lookup clamps again, so no
+//!   score can index past the tables.
 //! - Model II (Eq. 10): `M = |H − I|` with H the mean of the cell's heuristic block.
 //!   Both maps are updated along the path (§II.B.3): a perceived cell's I becomes 0 and
 //!   its block's mean drops accordingly. The paper recomputed block averages, which
@@ -27,7 +30,10 @@ use roam_proto::planner::{FitnessTerms, PlannerModel};
 
 use crate::eta::step_time;
 use crate::params::GaParams;
-use crate::world::{Cell, World, MOVES};
+use crate::world::{Cell, World, MAX_INFORMATION_SCORE, MOVES};
+
+/// Entries of Model I's per-score tables: one per score 0..=MAX_INFORMATION_SCORE.
+const SCORES: usize = MAX_INFORMATION_SCORE as usize + 1;
 
 /// The curiosity model that scores information (the GA's F_1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,10 +94,10 @@ pub struct Evaluator<'a> {
     stamp: Vec<u32>,
     current: u32,
     // Model I: per score value, experiences so far, time of the last, gene of the last.
-    experiences: [u32; 101],
-    last_time: [f64; 101],
-    last_gene: [u32; 101],
-    factor: [f64; 101],
+    experiences: [u32; SCORES],
+    last_time: [f64; SCORES],
+    last_gene: [u32; SCORES],
+    factor: [f64; SCORES],
     // Model II: block sums as this path has changed them.
     block_sums: Vec<f64>,
 }
@@ -117,10 +123,10 @@ impl<'a> Evaluator<'a> {
             }),
             stamp: vec![0; world.cell_count()],
             current: 0,
-            experiences: [0; 101],
-            last_time: [f64::NEG_INFINITY; 101],
-            last_gene: [u32::MAX; 101],
-            factor: [0.0; 101],
+            experiences: [0; SCORES],
+            last_time: [f64::NEG_INFINITY; SCORES],
+            last_gene: [u32::MAX; SCORES],
+            factor: [0.0; SCORES],
             block_sums: Vec::new(),
         }
     }
@@ -138,9 +144,9 @@ impl<'a> Evaluator<'a> {
         self.next_stamp();
         match self.model {
             Model::Novelty => {
-                self.experiences = [0; 101];
-                self.last_time = [f64::NEG_INFINITY; 101];
-                self.last_gene = [u32::MAX; 101];
+                self.experiences = [0; SCORES];
+                self.last_time = [f64::NEG_INFINITY; SCORES];
+                self.last_gene = [u32::MAX; SCORES];
             }
             Model::Heterogeneity => {
                 self.block_sums.clear();
@@ -223,7 +229,8 @@ impl<'a> Evaluator<'a> {
         match self.model {
             Model::Coverage => self.params.coverage_gain,
             Model::Novelty => {
-                let score = self.world.information[idx] as usize;
+                // `information` is public: clamp again rather than trust every writer.
+                let score = usize::from(self.world.information[idx].min(MAX_INFORMATION_SCORE));
                 if score == 0 {
                     return 0.0;
                 }
@@ -258,6 +265,61 @@ impl<'a> Evaluator<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use roam_map_server::grid::Grid;
+    use roam_proto::map::{GridMeta, Origin};
+
+    fn world_with_scores(scores: &[u8], width: u32) -> World {
+        let meta = GridMeta {
+            width,
+            height: scores.len() as u32 / width,
+            resolution: 0.2,
+            origin: Origin::default(),
+        };
+        let information = Grid {
+            meta,
+            cells: scores.to_vec(),
+        };
+        World::new(&Grid::filled(meta, 0i8), &information, 0.25).expect("world")
+    }
+
+    /// Issue 18: any u8 layer can be the information map, and a score above 100 indexed
+    /// past Model I's tables. A world clamps it to 100, so a 255 cell counts as a 100
+    /// cell, and the clamping is reported.
+    #[test]
+    fn a_score_of_255_is_clamped_to_100_and_model_one_does_not_panic() {
+        let mut scores = vec![0u8; 64];
+        scores[8 * 3 + 4] = 255;
+        scores[8 * 5 + 2] = 101;
+        let loud = world_with_scores(&scores, 8);
+        assert_eq!(
+            loud.clamped,
+            Some(crate::world::Clamped {
+                cells: 2,
+                first: (4, 3, 255)
+            })
+        );
+        assert_eq!(loud.information[8 * 3 + 4], 100);
+        scores[8 * 3 + 4] = 100;
+        scores[8 * 5 + 2] = 100;
+        let capped = world_with_scores(&scores, 8);
+        assert_eq!(capped.clamped, None);
+        let params = GaParams::default();
+        let path: Vec<Cell> = (0..8).map(|x| 8 * 4 + x).collect();
+        let goal = *path.last().expect("cells");
+        for model in [Model::Coverage, Model::Novelty, Model::Heterogeneity] {
+            let a = Evaluator::new(&loud, &params, model, goal, 60.0).evaluate(&path);
+            let b = Evaluator::new(&capped, &params, model, goal, 60.0).evaluate(&path);
+            assert_eq!(a, b, "{model:?}");
+        }
+        // A score written into the public field after the world was built is clamped
+        // at the lookup too.
+        let mut written = capped.clone();
+        written.information[8 * 3 + 4] = 255;
+        let c = Evaluator::new(&written, &params, Model::Novelty, goal, 60.0).evaluate(&path);
+        let d = Evaluator::new(&capped, &params, Model::Novelty, goal, 60.0).evaluate(&path);
+        assert_eq!(c, d);
+        assert!(c.model_information > 0.0);
+    }
 
     #[test]
     fn a_straight_move_brings_4_new_cells_and_a_diagonal_7_for_d3() {

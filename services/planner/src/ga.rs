@@ -8,6 +8,8 @@
 //!   longer walks can never fit the budget; and a walk that has not reached G is
 //!   finished along the shortest route to G, so that the first population already
 //!   reaches the goal and the GA spends its generations on information and time.
+//!   A walk also stops early where finishing it at the goal would make it longer than
+//!   the longest chromosome ([`GaOptions::max_path_cells`]).
 //!   One more choice: the shortest path (which the request was checked against, so it
 //!   fits the budget) joins the first population. The GA therefore always holds a path
 //!   that reaches the goal in time, and a tight budget cannot end in an over-budget
@@ -39,7 +41,7 @@ use roam_proto::planner::StopReason;
 
 use crate::curiosity::{Evaluation, Evaluator, Model};
 use crate::params::GaParams;
-use crate::search::descend_to_goal;
+use crate::search::{descend_to_goal, descent_steps};
 use crate::world::{Cell, World, MOVES};
 
 /// How a GA run starts and when it stops, beyond the paper's parameters.
@@ -53,8 +55,10 @@ pub struct GaOptions {
     pub cap_walks_by_budget: bool,
     /// Finish initial walks at the goal along the shortest route.
     pub complete_walks_to_goal: bool,
-    /// Longest chromosome, in cells: crossovers and mutations that would exceed it are
-    /// dropped, so memory stays bounded.
+    /// Longest chromosome, in cells: no initial walk, crossover or mutation makes a
+    /// longer one, so a population holds at most population × this many genes. The
+    /// planner sets it to the longest path the budget allows ([`crate::limits`], from
+    /// Eq. 2), so a chromosome that could never be on time is never built.
     pub max_path_cells: usize,
     /// Threads that evaluate a generation's new chromosomes. Evaluation is a pure
     /// function of the path and the best is picked in population order afterwards, so
@@ -271,13 +275,25 @@ fn initial_walk(problem: &Problem<'_>, options: &GaOptions, rng: &mut ChaCha8Rng
     } else {
         map_cap
     };
-    let cap = cap.min(options.max_path_cells.saturating_sub(1).max(manhattan));
+    let max_cells = options.max_path_cells.max(1);
+    let cap = cap.min(max_cells.saturating_sub(1).max(manhattan));
     let length = rng.random_range(manhattan..=cap);
-    let mut walk = Vec::with_capacity(length + 1);
+    let mut walk = Vec::with_capacity((length + 1).min(max_cells));
     walk.push(problem.start);
     let mut cell = problem.start;
     let mut moves = [0 as Cell; 8];
-    while walk.len() < length && cell != problem.goal {
+    // Room for one more step: with it the walk, and the descent to the goal that
+    // finishes it (a neighbour's descent is at most two steps longer), stays within
+    // `max_cells`.
+    let room = |walk: &Vec<Cell>, cell: Cell| {
+        let descent = if options.complete_walks_to_goal {
+            descent_steps(problem.goal_field, cell).saturating_add(2)
+        } else {
+            0
+        };
+        walk.len().saturating_add(1).saturating_add(descent) <= max_cells
+    };
+    while walk.len() < length && cell != problem.goal && room(&walk, cell) {
         let mut count = 0;
         for dir in 0..MOVES.len() {
             if let Some(next) = world.step(cell, dir) {
@@ -294,6 +310,9 @@ fn initial_walk(problem: &Problem<'_>, options: &GaOptions, rng: &mut ChaCha8Rng
     if options.complete_walks_to_goal && cell != problem.goal {
         descend_to_goal(world, problem.goal_field, &mut walk);
     }
+    // Only a walk that took no step can get here longer (its descent is the shortest
+    // route, which fits the budget); cut it all the same, the bound is a promise.
+    walk.truncate(max_cells);
     walk
 }
 
@@ -420,7 +439,8 @@ fn mutate(
     let mut changed = false;
     for _ in 0..count {
         let genes = &mut chromosome.genes;
-        if genes.len() >= options.max_path_cells || genes.len() < 2 {
+        // A mutation adds at most two genes (a bridge on each side).
+        if genes.len() + 2 > options.max_path_cells || genes.len() < 2 {
             break;
         }
         // Any gene but S; the last gene only when it is not G.
@@ -486,4 +506,121 @@ fn bridge(world: &World, a: Cell, b: Cell) -> Option<Bridge> {
         .filter_map(|d| world.step(a, d))
         .find(|&c| world.is_legal_move(c, b))
         .map(Bridge::Via)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::search::distance_field;
+    use roam_map_server::grid::Grid;
+    use roam_proto::map::{GridMeta, Origin};
+
+    fn open_world(side: u32) -> World {
+        let meta = GridMeta {
+            width: side,
+            height: side,
+            resolution: 0.2,
+            origin: Origin::default(),
+        };
+        World::new(&Grid::filled(meta, 0i8), &Grid::filled(meta, 50u8), 0.25).expect("world")
+    }
+
+    fn options(max_path_cells: usize) -> GaOptions {
+        GaOptions {
+            seed: 3,
+            deadline: None,
+            cap_walks_by_budget: true,
+            complete_walks_to_goal: true,
+            max_path_cells,
+            threads: 1,
+        }
+    }
+
+    /// No chromosome the GA builds is longer than `max_path_cells`: initial walks (with
+    /// their descent to the goal), mutations and crossovers all keep to it.
+    #[test]
+    fn no_chromosome_outgrows_max_path_cells() {
+        let world = open_world(60);
+        let params = GaParams::default();
+        let (start, goal) = (world.cell(5, 5), world.cell(30, 20));
+        let field = distance_field(&world, goal);
+        // A generous budget (400 s = 1000 cells at 0.4 s per cell) but a tight bound.
+        let problem = Problem {
+            world: &world,
+            params: &params,
+            model: Model::Novelty,
+            start,
+            goal,
+            t_exec: 400.0,
+            goal_field: &field,
+            seed_paths: &[],
+        };
+        let max = 40;
+        let options = options(max);
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let mut population: Vec<Chromosome> = (0..300)
+            .map(|_| Chromosome {
+                genes: initial_walk(&problem, &options, &mut rng),
+                fitness: None,
+            })
+            .collect();
+        assert!(population.iter().all(|c| c.genes.len() <= max));
+        assert!(
+            population.iter().any(|c| c.genes.len() > max - 5),
+            "walks use the room they have"
+        );
+        assert!(
+            population
+                .iter()
+                .filter(|c| c.genes.last() == Some(&goal))
+                .count()
+                > 250,
+            "walks that stop early still reach the goal"
+        );
+        let mut scratch = Scratch::new(world.cell_count());
+        for round in 0..50 {
+            for chromosome in population.iter_mut() {
+                mutate(chromosome, &problem, &options, &mut rng);
+            }
+            for pair in (0..population.len()).collect::<Vec<_>>().chunks_exact(2) {
+                crossover(
+                    &mut population,
+                    pair[0],
+                    pair[1],
+                    &problem,
+                    &options,
+                    &mut scratch,
+                    &mut rng,
+                );
+            }
+            let longest = population.iter().map(|c| c.genes.len()).max();
+            assert!(longest <= Some(max), "round {round}: {longest:?}");
+        }
+    }
+
+    /// Without the bound (the map's cell count), the same walks are far longer: the test
+    /// above would catch a bound that is not applied.
+    #[test]
+    fn without_a_tight_bound_walks_are_longer() {
+        let world = open_world(60);
+        let params = GaParams::default();
+        let (start, goal) = (world.cell(5, 5), world.cell(30, 20));
+        let field = distance_field(&world, goal);
+        let problem = Problem {
+            world: &world,
+            params: &params,
+            model: Model::Novelty,
+            start,
+            goal,
+            t_exec: 400.0,
+            goal_field: &field,
+            seed_paths: &[],
+        };
+        let options = options(world.cell_count());
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let longest = (0..300)
+            .map(|_| initial_walk(&problem, &options, &mut rng).len())
+            .max();
+        assert!(longest > Some(400), "{longest:?}");
+    }
 }

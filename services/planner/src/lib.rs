@@ -10,21 +10,31 @@
 //! - [`metrics`]: U_ges, D (Eqs. 11–12) and the information of distinct cells;
 //! - [`ga`]: initialisation, layered selection, crossover, mutation (§II.A);
 //! - [`search`]: the shortest-path baseline (A*, octile) and the distance field;
+//! - [`limits`]: what one plan may cost (path length from Eq. 2, memory, work);
 //! - [`plan`]: one request end to end, with the checks that refuse bad requests.
 //!
-//! [`service`] is the thin Zenoh adapter.
+//! [`service`] is the thin Zenoh adapter, with what it needs against other clients:
+//! [`budget`] (the CPU budget across clients), [`token`] and [`inflight`] (request
+//! ids, cancel tokens, who may cancel), [`log_limit`] and [`excerpt`] (bounded logs and
+//! echoes of untrusted input).
 
+pub mod budget;
 pub mod client;
 pub mod config;
 pub mod curiosity;
 pub mod eta;
+pub mod excerpt;
 pub mod ga;
+pub mod inflight;
+pub mod limits;
+pub mod log_limit;
 pub mod maps;
 pub mod metrics;
 pub mod params;
 pub mod plan;
 pub mod search;
 pub mod service;
+pub mod token;
 pub mod world;
 
 pub use config::PlannerConfig;

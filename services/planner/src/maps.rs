@@ -95,6 +95,18 @@ impl MapCache {
         };
         match World::new(&occ, &info, DEFAULT_COMPRESSION) {
             Ok(mut world) => {
+                if let Some(c) = world.clamped {
+                    let (x, y, score) = c.first;
+                    tracing::warn!(
+                        layer = %self.information_layer,
+                        version = information.version,
+                        cells = c.cells,
+                        "information layer has {} cells scored above {}, the first at cell ({x}, {y}) with {score}; they count as {} (fix the layer, or plan on a 0..=100 layer)",
+                        c.cells,
+                        crate::world::MAX_INFORMATION_SCORE,
+                        crate::world::MAX_INFORMATION_SCORE,
+                    );
+                }
                 if let Some(Cells::F32(peb)) = self.peb.as_ref().map(|l| &l.cells) {
                     world.set_localizability(peb);
                 }

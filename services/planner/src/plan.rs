@@ -1,5 +1,6 @@
-//! One plan end to end: check the request, find the shortest path (to refuse what
-//! cannot work), run the chosen planner, measure the result.
+//! One plan end to end: check the request and its size against the limits
+//! ([`crate::limits`]), find the shortest path (to refuse what cannot work), run the
+//! chosen planner, measure the result.
 
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
@@ -10,6 +11,7 @@ use roam_proto::{ErrorCode, ErrorReply};
 use crate::curiosity::{Evaluator, Model};
 use crate::eta::path_eta;
 use crate::ga::{self, GaOptions, Problem};
+use crate::limits::{self, LimitError, PlanLimits};
 use crate::metrics::{path_metrics, PathMetrics};
 use crate::params::{GaParams, ParamError};
 use crate::search::{distance_field, shortest_path};
@@ -32,12 +34,14 @@ pub struct PlanSpec {
     pub seed: u64,
     /// Evaluation threads (see [`GaOptions::threads`]); the result does not depend on it.
     pub threads: usize,
+    /// The size limits a GA plan is checked against before any work.
+    pub limits: PlanLimits,
 }
 
 impl PlanSpec {
     /// A batch-experiment spec: Table I's parameters with `max_generations`, a deadline
     /// far enough away that the generation count ends the run (so results repeat bit
-    /// for bit), and the default evaluation threads.
+    /// for bit), the default evaluation threads and the default limits.
     pub fn batch(
         start: [f64; 2],
         goal: [f64; 2],
@@ -58,6 +62,7 @@ impl PlanSpec {
             },
             seed,
             threads: crate::ga::default_threads(),
+            limits: PlanLimits::default(),
         }
     }
 }
@@ -108,6 +113,8 @@ pub enum PlanError {
     },
     #[error(transparent)]
     Param(#[from] ParamError),
+    #[error(transparent)]
+    Limit(#[from] LimitError),
 }
 
 impl PlanError {
@@ -115,6 +122,10 @@ impl PlanError {
         let message = self.to_string();
         match self {
             PlanError::NoPath => ErrorReply::new(ErrorCode::NotFound, message),
+            PlanError::Limit(limit) => {
+                let (max, actual) = limit.max_actual();
+                ErrorReply::limit(limit.name(), max, actual, message)
+            }
             PlanError::OutOfRange { name, value, .. }
                 if *name == "deadline_s" || *name == "t_exec_s" =>
             {
@@ -198,6 +209,17 @@ pub fn plan(
     let start = locate(world, "start", spec.start)?;
     let goal = locate(world, "goal", spec.goal)?;
     let params = &spec.params;
+    // The GA's size, before any search: the baseline has no population to bound.
+    let size = match Model::of(spec.model) {
+        Some(_) => Some(limits::check(
+            params,
+            world.meta.resolution,
+            spec.t_exec_s,
+            world.cell_count(),
+            &spec.limits,
+        )?),
+        None => None,
+    };
     let shortest = shortest_path(world, start, goal).ok_or(PlanError::NoPath)?;
     let needed = path_eta(world, params, &shortest);
     if needed > spec.t_exec_s {
@@ -242,7 +264,11 @@ pub fn plan(
                 deadline: Some(started + Duration::from_secs_f64(spec.deadline_s)),
                 cap_walks_by_budget: true,
                 complete_walks_to_goal: true,
-                max_path_cells: max_path_cells(world, params, spec.t_exec_s),
+                // The shortest path is in the first population; it fits the budget, so
+                // the bound holds it (the max only guards rounding).
+                max_path_cells: size
+                    .map_or(world.cell_count(), |s| s.path_cells)
+                    .max(shortest.len()),
                 threads: spec.threads,
             };
             let result = ga::run(&problem, &options, cancel, progress);
@@ -268,16 +294,4 @@ pub fn plan(
         planning: started.elapsed(),
         stop_reason,
     })
-}
-
-/// The longest chromosome worth keeping: twice what the budget allows in straight
-/// cells, at least 64, at most the map's cell count.
-pub fn max_path_cells(world: &World, params: &GaParams, t_exec_s: f64) -> usize {
-    let per_cell = world.meta.resolution * params.v_lin;
-    let budget = if per_cell > 0.0 {
-        (t_exec_s / per_cell).ceil() as usize
-    } else {
-        world.cell_count()
-    };
-    (2 * budget).clamp(64, world.cell_count().max(64))
 }

@@ -75,6 +75,16 @@ pub fn distance_field(world: &World, goal: Cell) -> Vec<u32> {
     dist
 }
 
+/// At most how many cells [`descend_to_goal`] appends from `cell`: every step costs at
+/// least [`STRAIGHT`] and lowers the field by its cost. `usize::MAX` where the goal is
+/// out of reach.
+pub fn descent_steps(field: &[u32], cell: Cell) -> usize {
+    match field.get(cell as usize) {
+        Some(&d) if d != u32::MAX => (d / STRAIGHT) as usize,
+        _ => usize::MAX,
+    }
+}
+
 /// Appends to `path` the descent along `field` from its last cell to the goal (where
 /// the field is 0). Returns false, leaving `path` as it was, if the last cell cannot
 /// reach the goal.

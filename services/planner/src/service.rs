@@ -5,26 +5,36 @@
 //! | `<root>/planner/plan` | queryable (every instance) | `plan_request` → `plan` |
 //! | `<root>/planner/instance/<instance>/plan` | queryable (this instance) | `plan_request` → `plan` |
 //! | `<root>/planner/progress/<request_id>` | publication | `plan_progress`, at most every 50 ms |
-//! | `<root>/planner/cancel/*` | subscription | `cancel_plan` |
+//! | `<root>/planner/cancel/*` | subscription | `cancel_plan`, honoured only with the request's `cancel_token` |
 //! | `<root>/map/layer/{inflated,information}` | subscription + get | `layer` |
+//!
+//! Every plan is checked against this instance's limits before any work: its slot
+//! (`max_concurrent_plans`), its size ([`crate::limits`]) and its wall time from the CPU
+//! budget ([`crate::budget`]). Request ids and tokens are [`crate::token`]'s; who may
+//! cancel is [`crate::inflight`]'s.
 
-use std::collections::HashMap;
-use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use roam_proto::map::Layer;
-use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest};
+use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, StopReason};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::{reply, Requester, Service, ServiceError};
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
 use zenoh::Wait;
 
+use crate::budget::{CpuBudget, Exhausted};
 use crate::config::PlannerConfig;
+use crate::excerpt::{bound_message, excerpt};
+use crate::inflight::{CancelVerdict, InFlight};
+use crate::limits::PlanLimits;
+use crate::log_limit::LogLimit;
 use crate::maps::MapCache;
 use crate::params::GaParams;
-use crate::plan::{plan, PlanOutcome, PlanSpec};
+use crate::plan::{check_spec, plan, PlanOutcome, PlanSpec};
+use crate::token;
 use crate::world::World;
 
 pub const SERVICE_NAME: &str = "planner";
@@ -34,6 +44,10 @@ pub const MAX_REQUEST_BYTES: usize = 64 * 1024;
 
 /// How often progress is published at most.
 pub const PROGRESS_PERIOD: Duration = Duration::from_millis(50);
+
+/// Refused cancels logged at most, per [`CANCEL_LOG_PERIOD`]; the rest are counted.
+const CANCEL_LOG_BURST: u32 = 5;
+const CANCEL_LOG_PERIOD: Duration = Duration::from_secs(10);
 
 #[derive(Debug, thiserror::Error)]
 pub enum PlannerError {
@@ -50,21 +64,21 @@ struct State {
     maps: Mutex<MapCache>,
     in_flight: AtomicUsize,
     max_in_flight: usize,
-    cancels: Mutex<HashMap<String, Arc<AtomicBool>>>,
-    next_id: AtomicU64,
+    plans: InFlight,
+    limits: PlanLimits,
+    budget: CpuBudget,
+    refused_cancels: LogLimit,
+    unknown_cancels: LogLimit,
 }
 
 impl State {
     fn maps(&self) -> MutexGuard<'_, MapCache> {
         self.maps.lock().unwrap_or_else(|p| p.into_inner())
     }
-
-    fn cancels(&self) -> MutexGuard<'_, HashMap<String, Arc<AtomicBool>>> {
-        self.cancels.lock().unwrap_or_else(|p| p.into_inner())
-    }
 }
 
-/// Frees a plan slot and its cancel entry however the plan ends.
+/// Frees a plan slot and its entry in the table of plans in flight however the plan
+/// ends.
 struct Slot<'a> {
     state: &'a State,
     request_id: Option<String>,
@@ -73,10 +87,30 @@ struct Slot<'a> {
 impl Drop for Slot<'_> {
     fn drop(&mut self) {
         if let Some(id) = &self.request_id {
-            self.state.cancels().remove(id);
+            self.state.plans.remove(id);
         }
         self.state.in_flight.fetch_sub(1, Ordering::AcqRel);
     }
+}
+
+/// Checks the config's numbers; names the first that is wrong.
+fn check_config(config: &PlannerConfig) -> Result<(), PlannerError> {
+    if config.max_concurrent_plans == 0 {
+        return Err(PlannerError::Config(
+            "max_concurrent_plans must be at least 1".into(),
+        ));
+    }
+    for (name, value) in [
+        ("max_plan_cost", config.max_plan_cost),
+        ("max_population_cells", config.max_population_cells),
+    ] {
+        if value == 0 {
+            return Err(PlannerError::Config(format!("{name} must be at least 1")));
+        }
+    }
+    config.budget().validate().map_err(PlannerError::Config)?;
+    keys::check_name("information_layer", &config.information_layer)
+        .map_err(|e| PlannerError::Config(e.to_string()))
 }
 
 /// Runs a planner instance until `cancel` is cancelled.
@@ -85,13 +119,7 @@ pub async fn run(
     zenoh_config: zenoh::Config,
     cancel: CancellationToken,
 ) -> Result<(), PlannerError> {
-    if config.max_concurrent_plans == 0 {
-        return Err(PlannerError::Config(
-            "max_concurrent_plans must be at least 1".into(),
-        ));
-    }
-    keys::check_name("information_layer", &config.information_layer)
-        .map_err(|e| PlannerError::Config(e.to_string()))?;
+    check_config(&config)?;
     let mut service = Service::start(
         SERVICE_NAME,
         &config.root,
@@ -110,8 +138,11 @@ pub async fn run(
         )),
         in_flight: AtomicUsize::new(0),
         max_in_flight: config.max_concurrent_plans,
-        cancels: Mutex::new(HashMap::new()),
-        next_id: AtomicU64::new(1),
+        plans: InFlight::default(),
+        limits: config.limits(),
+        budget: CpuBudget::new(config.budget(), Instant::now()),
+        refused_cancels: LogLimit::new(CANCEL_LOG_BURST, CANCEL_LOG_PERIOD),
+        unknown_cancels: LogLimit::new(CANCEL_LOG_BURST, CANCEL_LOG_PERIOD),
     });
     let root = config.root.as_str();
 
@@ -135,11 +166,7 @@ pub async fn run(
         .subscribe(
             &keys::planner_cancel_any(root),
             state.clone(),
-            |state: &Arc<State>, request: CancelPlan| {
-                if let Some(flag) = state.cancels().get(&request.request_id) {
-                    flag.store(true, Ordering::Relaxed);
-                }
-            },
+            |state: &Arc<State>, request: CancelPlan| take_cancel(state, &request),
         )
         .await?;
 
@@ -171,9 +198,7 @@ pub async fn run(
 
     service.cancelled().await;
     // Stop every plan in flight: each returns its best path so far.
-    for flag in state.cancels().values() {
-        flag.store(true, Ordering::Relaxed);
-    }
+    state.plans.stop_all();
     service
         .shutdown(roam_runtime::service::DEFAULT_GRACE)
         .await?;
@@ -187,6 +212,39 @@ fn take_layer(state: &State, layer: Layer) {
             information = version.information,
             "planning on a new map"
         );
+    }
+}
+
+/// A cancel: honoured only with the plan's own token ([`InFlight::cancel`]); refusals
+/// are logged, rate-limited, with the id cut to an excerpt and never the token.
+fn take_cancel(state: &State, request: &CancelPlan) {
+    let verdict = state
+        .plans
+        .cancel(&request.request_id, request.token.as_deref());
+    let id = || excerpt(&request.request_id);
+    match verdict {
+        CancelVerdict::Cancelled => {
+            tracing::info!(request_id = %id(), "plan cancelled by its requester");
+        }
+        CancelVerdict::Unknown => {
+            if let Some(suppressed) = state.unknown_cancels.admit(Instant::now()) {
+                tracing::debug!(request_id = %id(), suppressed, "cancel for a plan not in flight here; ignored");
+            }
+        }
+        refused => {
+            if let Some(suppressed) = state.refused_cancels.admit(Instant::now()) {
+                let why = match refused {
+                    CancelVerdict::WrongToken => "its token is not the request's",
+                    CancelVerdict::MissingToken => "it has no token",
+                    _ => "the request had no cancel_token, so it cannot be cancelled",
+                };
+                tracing::warn!(
+                    request_id = %id(),
+                    suppressed,
+                    "cancel ignored: {why} (only the requester, with its cancel_token, can cancel a plan)"
+                );
+            }
+        }
     }
 }
 
@@ -216,7 +274,11 @@ async fn fetch_maps(state: Arc<State>, requester: Requester, cancel: Cancellatio
 async fn answer_plan(state: Arc<State>, query: Query) {
     let request = match reply::decode_request::<PlanRequest>(&query, MAX_REQUEST_BYTES) {
         Ok(r) => r,
-        Err(e) => return reply::send_error(&query, &e).await,
+        Err(mut e) => {
+            // A decoder's message may quote the payload (an unknown variant, say).
+            e.message = bound_message(&e.message);
+            return reply::send_error(&query, &e).await;
+        }
     };
     let result = tokio::task::spawn_blocking({
         let state = state.clone();
@@ -230,6 +292,44 @@ async fn answer_plan(state: Arc<State>, query: Query) {
         ))
     });
     reply::send_result(&query, result).await;
+}
+
+/// The request's id, checked, or a fresh unguessable one ([`token::random_hex128`]).
+fn request_id(request: &PlanRequest) -> Result<String, ErrorReply> {
+    match &request.request_id {
+        Some(id) => match keys::check_name("request id", id) {
+            Ok(()) => Ok(id.clone()),
+            Err(_) => Err(ErrorReply::new(
+                ErrorCode::InvalidRequest,
+                format!(
+                    "request id '{}' cannot name a key: use 1 to {} characters from a-z, A-Z, 0-9, '_' and '-', or omit it and the planner makes one up",
+                    excerpt(id),
+                    keys::MAX_SEGMENT_LEN
+                ),
+            )),
+        },
+        None => Ok(token::random_hex128()),
+    }
+}
+
+/// The refusal of a plan the CPU budget has no time for.
+fn exhausted(state: &State, e: Exhausted) -> ErrorReply {
+    let config = state.budget.config();
+    let burst = config.plan_seconds_burst;
+    ErrorReply::limit(
+        "plan_seconds_burst",
+        burst.ceil() as u64,
+        (burst - e.available_s + e.needed_s).ceil().max(0.0) as u64,
+        format!(
+            "planner {} has spent its CPU budget: {:.1} of its {burst} plan-seconds are left (refilled at {} per second) and a plan needs {:.1}; retry in {:.1} s or ask another instance",
+            state.instance,
+            e.available_s.max(0.0),
+            config.plan_seconds_per_second,
+            e.needed_s,
+            e.retry_in_s
+        ),
+    )
+    .with_code(ErrorCode::Busy)
 }
 
 /// Checks a request against this instance's state, plans, and builds the reply.
@@ -252,29 +352,23 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
         )
         .with_code(ErrorCode::Busy));
     }
-    let request_id = match &request.request_id {
-        Some(id) => {
-            keys::check_name("request id", id)
-                .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
-            id.clone()
-        }
-        None => format!(
-            "{}-{}",
-            state.instance,
-            state.next_id.fetch_add(1, Ordering::Relaxed)
-        ),
-    };
-    let flag = Arc::new(AtomicBool::new(false));
-    {
-        let mut cancels = state.cancels();
-        if cancels.contains_key(&request_id) {
-            return Err(ErrorReply::new(
-                ErrorCode::InvalidRequest,
-                format!("request id '{request_id}' is already being planned; use a fresh id"),
-            ));
-        }
-        cancels.insert(request_id.clone(), flag.clone());
+    let request_id = request_id(&request)?;
+    if let Some(token) = &request.cancel_token {
+        token::check_token(token)
+            .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
     }
+    let stop = state
+        .plans
+        .register(&request_id, request.cancel_token.clone())
+        .map_err(|_| {
+            ErrorReply::new(
+                ErrorCode::InvalidRequest,
+                format!(
+                    "request id '{}' is already being planned on this instance; use a fresh id, or omit it",
+                    excerpt(&request_id)
+                ),
+            )
+        })?;
     slot.request_id = Some(request_id.clone());
 
     let (map_version, world) = {
@@ -295,7 +389,7 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
     };
     let params = GaParams::with_overrides(&request.params)
         .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
-    let spec = PlanSpec {
+    let mut spec = PlanSpec {
         start: request.start,
         goal: request.goal,
         t_exec_s: request.t_exec_s,
@@ -304,7 +398,16 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
         params,
         seed: request.seed,
         threads: crate::ga::default_threads(),
+        limits: state.limits,
     };
+    // The deadline is checked before the budget takes it as the grant it asks for.
+    check_spec(&spec).map_err(|e| e.to_reply())?;
+    let grant = state
+        .budget
+        .grant(spec.deadline_s, Instant::now())
+        .map_err(|e| exhausted(state, e))?;
+    spec.deadline_s = grant.seconds;
+
     let progress_key = keys::planner_progress(&state.root, &request_id);
     let mut batch = Vec::new();
     let mut last_sent = Instant::now();
@@ -318,7 +421,7 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
             tracing::debug!("progress publication failed: {e}");
         }
     };
-    let outcome = plan(&world, &spec, &flag, |generation, best| {
+    let mut outcome = plan(&world, &spec, &stop, |generation, best| {
         batch.push((generation, best));
         if last_sent.elapsed() >= PROGRESS_PERIOD {
             publish(&mut batch, false);
@@ -326,15 +429,24 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
         }
     })
     .map_err(|e| e.to_reply())?;
+    let (granted_s, cut) = (grant.seconds, grant.cut);
+    grant.finish(Instant::now());
     publish(&mut batch, true);
-    Ok(to_message(
+    // The grant ended the plan only if it was shorter than the request's deadline.
+    let budget_s = (cut && outcome.stop_reason == StopReason::Deadline).then(|| {
+        outcome.stop_reason = StopReason::Budget;
+        granted_s
+    });
+    let mut plan = to_message(
         &world,
         &request,
-        request_id.clone(),
+        request_id,
         map_version,
         &state.instance,
         outcome,
-    ))
+    );
+    plan.budget_s = budget_s;
+    Ok(plan)
 }
 
 /// The reply message of an outcome.
@@ -363,6 +475,7 @@ pub fn to_message(
         generations: outcome.generations,
         planning_ms: outcome.planning.as_secs_f64() * 1000.0,
         stop_reason: outcome.stop_reason,
+        budget_s: None,
         seed: request.seed,
         map_version,
         instance: instance.to_owned(),

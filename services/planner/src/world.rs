@@ -29,8 +29,11 @@ pub struct World {
     /// A cell is traversable when the inflated occupancy is free (0). Unknown cells
     /// are not: a plan never counts on space nobody has seen.
     traversable: Vec<bool>,
-    /// Information scores I_xy, 0..=100.
+    /// Information scores I_xy, 0..=[`MAX_INFORMATION_SCORE`]: higher scores of the
+    /// layer were clamped (see [`World::clamped`]).
     pub information: Vec<u8>,
+    /// The scores above [`MAX_INFORMATION_SCORE`] the information layer had, if any.
+    pub clamped: Option<Clamped>,
     /// Model II: the heuristic block of each cell and each block's cell count and
     /// initial sum of scores (paper 000 §II.B.3).
     pub block_of: Vec<u32>,
@@ -44,6 +47,26 @@ pub struct World {
     pub localizability: Vec<f32>,
     /// Index difference of each move: `dx + dy · width`.
     move_offsets: [i64; 8],
+}
+
+/// The highest information score I_xy (paper 000's scores, the map server's
+/// `information` layer and the mapper's 100 · P(E > 0) are 0..=100).
+///
+/// The planner may be pointed at any u8 layer (`information_layer`), so a world clamps
+/// higher scores to this one rather than refusing the map: a cell scored 255 is as
+/// interesting as the most interesting cell, the planner keeps planning, and the map
+/// cache logs the layer, how many cells were clamped and the first of them. (Model I
+/// counts stimuli per score value, Eq. 9, in tables of 101 entries: a score above 100
+/// used to panic the plan.)
+pub const MAX_INFORMATION_SCORE: u8 = 100;
+
+/// What clamping the information layer changed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Clamped {
+    /// Cells whose score was above [`MAX_INFORMATION_SCORE`].
+    pub cells: usize,
+    /// The first of them (row-major): column, row and the layer's score.
+    pub first: (usize, usize, u8),
 }
 
 /// The PEB a cell without a position fix counts as in the localizability cost, metres:
@@ -80,12 +103,30 @@ impl World {
             return Err(WorldError::Empty);
         }
         let traversable = inflated.cells.iter().map(|&c| c == 0).collect();
+        let over = information
+            .cells
+            .iter()
+            .filter(|&&s| s > MAX_INFORMATION_SCORE)
+            .count();
+        let clamped = information
+            .cells
+            .iter()
+            .position(|&s| s > MAX_INFORMATION_SCORE)
+            .map(|i| Clamped {
+                cells: over,
+                first: (i % w, i / w, information.cells[i]),
+            });
         let mut world = World {
             meta: inflated.meta,
             width: w,
             height: h,
             traversable,
-            information: information.cells.clone(),
+            information: information
+                .cells
+                .iter()
+                .map(|&s| s.min(MAX_INFORMATION_SCORE))
+                .collect(),
+            clamped,
             block_of: Vec::new(),
             block_cells: Vec::new(),
             block_sums: Vec::new(),

@@ -96,6 +96,7 @@ pub async fn load(requests: usize) -> Result<LoadBench, BenchError> {
         tasks.spawn(async move {
             let request = PlanRequest {
                 request_id: Some(format!("load-{i}")),
+                cancel_token: None,
                 start: [-8.0, -8.0],
                 goal: [-2.0, 4.0],
                 t_exec_s: 60.0,

@@ -142,6 +142,7 @@ async fn zenoh_overhead(world: &World, budget: f64, runs: usize) -> Result<f64, 
         let client = PlannerClient::new(session.clone(), &stack.root);
         let request = PlanRequest {
             request_id: None,
+            cancel_token: None,
             start: START,
             goal: GOAL,
             t_exec_s: budget,

@@ -176,6 +176,7 @@ async fn plan_mission(
 ) -> Result<(MissionReport, Plan, Plan), ReportError> {
     let mut request = PlanRequest {
         request_id: None,
+        cancel_token: None,
         start: mission.start,
         goal: mission.goal,
         t_exec_s: 86_400.0,

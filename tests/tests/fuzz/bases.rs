@@ -19,6 +19,7 @@ pub(crate) fn meta(width: u32, height: u32, resolution: f64) -> GridMeta {
 pub(crate) fn plan_request(start: [f64; 2], goal: [f64; 2]) -> PlanRequest {
     PlanRequest {
         request_id: None,
+        cancel_token: None,
         start,
         goal,
         t_exec_s: 80.0,
@@ -406,9 +407,11 @@ pub(crate) fn cancel_bases() -> Vec<Vec<u8>> {
     vec![
         encode(&CancelPlan {
             request_id: "x".into(),
+            token: None,
         }),
         encode(&CancelPlan {
             request_id: "y".repeat(3000),
+            token: Some("z".repeat(3000)),
         }),
     ]
 }

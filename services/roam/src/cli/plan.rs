@@ -6,7 +6,7 @@ use anyhow::{bail, Context};
 use clap::Args;
 use roam_map_server::grid::Grid;
 use roam_map_server::render;
-use roam_planner::client::PlannerClient;
+use roam_planner::client::{PlanTicket, PlannerClient};
 use roam_proto::cells::Cells;
 use roam_proto::keys;
 use roam_proto::map::Layer;
@@ -72,8 +72,9 @@ pub(crate) fn parse_model(text: &str) -> Result<PlannerModel, String> {
 pub(crate) async fn plan(args: PlanArgs) -> anyhow::Result<()> {
     let (requester, session) = connect(&args.client).await?;
     let planner = PlannerClient::new(session.clone(), &args.client.root);
-    let request = PlanRequest {
+    let mut request = PlanRequest {
         request_id: None,
+        cancel_token: None,
         start: args.start,
         goal: args.goal,
         t_exec_s: args.budget,
@@ -86,7 +87,19 @@ pub(crate) async fn plan(args: PlanArgs) -> anyhow::Result<()> {
         seed: args.seed,
         map_version: None,
     };
-    let outcome = planner.plan(&request).await;
+    // A fresh random id and cancel token for this request: Ctrl-C cancels the plan with
+    // the token, and the planner replies with its best path so far.
+    let ticket = PlanTicket::issue(&mut request);
+    let pending = planner.plan(&request);
+    tokio::pin!(pending);
+    let outcome = tokio::select! {
+        outcome = &mut pending => outcome,
+        _ = tokio::signal::ctrl_c() => {
+            eprintln!("cancelling plan {}; waiting for its best path so far", ticket.request_id);
+            planner.cancel(&ticket).await?;
+            pending.await
+        }
+    };
     let picture = match (&outcome, &args.png) {
         (Ok(plan), Some(path)) => Some(draw_plan(&requester, &args.client.root, plan, path).await),
         _ => None,
