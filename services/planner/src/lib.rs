@@ -15,19 +15,17 @@
 //!
 //! [`service`] is the thin Zenoh adapter, with what it needs against other clients:
 //! [`budget`] (the CPU budget across clients), [`token`] and [`inflight`] (request
-//! ids, cancel tokens, who may cancel), [`log_limit`] and [`excerpt`] (bounded logs and
-//! echoes of untrusted input).
+//! ids, cancel tokens, who may cancel); bounded logs and echoes of untrusted input come
+//! from `roam_runtime::warn_limit` and `roam_proto::excerpt`, shared by every service.
 
 pub mod budget;
 pub mod client;
 pub mod config;
 pub mod curiosity;
 pub mod eta;
-pub mod excerpt;
 pub mod ga;
 pub mod inflight;
 pub mod limits;
-pub mod log_limit;
 pub mod maps;
 pub mod metrics;
 pub mod params;

@@ -17,9 +17,11 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
+use roam_proto::excerpt;
 use roam_proto::map::Layer;
 use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, StopReason};
 use roam_proto::{encode, keys, ErrorCode, ErrorReply};
+use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, Requester, Service, ServiceError};
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
@@ -27,15 +29,16 @@ use zenoh::Wait;
 
 use crate::budget::{CpuBudget, Exhausted};
 use crate::config::PlannerConfig;
-use crate::excerpt::{bound_message, excerpt};
 use crate::inflight::{CancelVerdict, InFlight};
 use crate::limits::PlanLimits;
-use crate::log_limit::LogLimit;
 use crate::maps::MapCache;
 use crate::params::GaParams;
 use crate::plan::{check_spec, plan, PlanOutcome, PlanSpec};
 use crate::token;
 use crate::world::World;
+
+/// Largest cancel decoded, bytes: an id and a token.
+const MAX_CANCEL_BYTES: usize = 4 * 1024;
 
 pub const SERVICE_NAME: &str = "planner";
 
@@ -44,10 +47,6 @@ pub const MAX_REQUEST_BYTES: usize = 64 * 1024;
 
 /// How often progress is published at most.
 pub const PROGRESS_PERIOD: Duration = Duration::from_millis(50);
-
-/// Refused cancels logged at most, per [`CANCEL_LOG_PERIOD`]; the rest are counted.
-const CANCEL_LOG_BURST: u32 = 5;
-const CANCEL_LOG_PERIOD: Duration = Duration::from_secs(10);
 
 #[derive(Debug, thiserror::Error)]
 pub enum PlannerError {
@@ -67,8 +66,8 @@ struct State {
     plans: InFlight,
     limits: PlanLimits,
     budget: CpuBudget,
-    refused_cancels: LogLimit,
-    unknown_cancels: LogLimit,
+    /// Refused and unknown cancels, logged a few per window (`roam_runtime::warn_limit`).
+    cancel_warnings: WarnLimiter,
 }
 
 impl State {
@@ -141,8 +140,7 @@ pub async fn run(
         plans: InFlight::default(),
         limits: config.limits(),
         budget: CpuBudget::new(config.budget(), Instant::now()),
-        refused_cancels: LogLimit::new(CANCEL_LOG_BURST, CANCEL_LOG_PERIOD),
-        unknown_cancels: LogLimit::new(CANCEL_LOG_BURST, CANCEL_LOG_PERIOD),
+        cancel_warnings: WarnLimiter::new(),
     });
     let root = config.root.as_str();
 
@@ -163,10 +161,21 @@ pub async fn run(
         service.spawn(async move { fetch_maps(state, requester, cancel).await });
     }
     service
-        .subscribe(
+        .subscribe_with(
             &keys::planner_cancel_any(root),
+            MAX_CANCEL_BYTES,
             state.clone(),
-            |state: &Arc<State>, request: CancelPlan| take_cancel(state, &request),
+            |state: &Arc<State>, key: &str, request: CancelPlan| {
+                // Keys decide: the request a cancel is for is the one its key names.
+                if key.rsplit('/').next() == Some(request.request_id.as_str()) {
+                    take_cancel(state, &request)
+                } else if let Some(suppressed) = state.cancel_warnings.allow("mismatch") {
+                    tracing::warn!(
+                        key = %excerpt(key), request_id = %excerpt(&request.request_id), suppressed,
+                        "cancel ignored: its body names another request than its key"
+                    );
+                }
+            },
         )
         .await?;
 
@@ -221,18 +230,18 @@ fn take_cancel(state: &State, request: &CancelPlan) {
     let verdict = state
         .plans
         .cancel(&request.request_id, request.token.as_deref());
-    let id = || excerpt(&request.request_id);
+    let id = || excerpt(&request.request_id).to_string();
     match verdict {
         CancelVerdict::Cancelled => {
             tracing::info!(request_id = %id(), "plan cancelled by its requester");
         }
         CancelVerdict::Unknown => {
-            if let Some(suppressed) = state.unknown_cancels.admit(Instant::now()) {
+            if let Some(suppressed) = state.cancel_warnings.allow("unknown") {
                 tracing::debug!(request_id = %id(), suppressed, "cancel for a plan not in flight here; ignored");
             }
         }
         refused => {
-            if let Some(suppressed) = state.refused_cancels.admit(Instant::now()) {
+            if let Some(suppressed) = state.cancel_warnings.allow("refused") {
                 let why = match refused {
                     CancelVerdict::WrongToken => "its token is not the request's",
                     CancelVerdict::MissingToken => "it has no token",
@@ -274,11 +283,8 @@ async fn fetch_maps(state: Arc<State>, requester: Requester, cancel: Cancellatio
 async fn answer_plan(state: Arc<State>, query: Query) {
     let request = match reply::decode_request::<PlanRequest>(&query, MAX_REQUEST_BYTES) {
         Ok(r) => r,
-        Err(mut e) => {
-            // A decoder's message may quote the payload (an unknown variant, say).
-            e.message = bound_message(&e.message);
-            return reply::send_error(&query, &e).await;
-        }
+        // The codec's refusals quote the payload only as a bounded excerpt.
+        Err(e) => return reply::send_error(&query, &e).await,
     };
     let result = tokio::task::spawn_blocking({
         let state = state.clone();
