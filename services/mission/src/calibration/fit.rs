@@ -162,16 +162,15 @@ fn clamp(model: TimeModel, config: &CalibrationConfig) -> TimeModel {
 /// A stretch's robust reference (see the module): its own lower quartiles, `fallback`
 /// where it has too few chunks of a kind.
 fn reference(chunks: &[Chunk], fallback: TimeModel, config: &CalibrationConfig) -> TimeModel {
-    let straight = chunks
-        .iter()
+    let driven = || chunks.iter().filter(|c| !c.leading);
+    let straight = driven()
         .filter(|c| c.turn_rad == 0.0)
         .map(|c| c.duration_s / c.distance_m)
         .collect();
     let v_lin = lower_quartile(straight)
         .unwrap_or(fallback.v_lin)
         .clamp(config.min.v_lin, config.max.v_lin);
-    let corners = chunks
-        .iter()
+    let corners = driven()
         .filter(|c| c.turn_rad >= MIN_REFERENCE_TURN_RAD)
         .map(|c| (c.duration_s - v_lin * c.distance_m) / c.turn_rad)
         .collect();
