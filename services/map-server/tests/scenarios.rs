@@ -316,3 +316,39 @@ fn bad_unicycle_speeds_are_refused_naming_the_field_and_the_limit() {
         );
     }
 }
+
+#[test]
+fn the_unicycle_downtime_world_is_the_downtime_world_with_a_unicycle() {
+    let load = |file: &str| {
+        scenario::load(
+            &config_dir().join("scenarios").join(file),
+            DEFAULT_LIMITS.max_layer_cells,
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let (point, unicycle) = (load("downtime.yaml"), load("downtime-unicycle.yaml"));
+    assert_eq!(point.occupancy.meta, unicycle.occupancy.meta);
+    assert_eq!(point.occupancy.cells, unicycle.occupancy.cells);
+    assert_eq!(point.information.cells, unicycle.information.cells);
+    let (p, u) = (&point.file, &unicycle.file);
+    assert_eq!(p.robot_radius_m, u.robot_radius_m);
+    assert_eq!(p.places, u.places);
+    assert_eq!(p.anchors, u.anchors);
+    assert_eq!(p.robots, u.robots);
+    assert_eq!(p.sensing, u.sensing);
+    assert_eq!(p.time, u.time);
+    assert_eq!(p.blocks, u.blocks);
+    assert_eq!(p.walkers, u.walkers);
+    assert_eq!(p.waypoints, u.waypoints);
+    assert_eq!(p.motion.model, scenario::MotionModel::Point);
+    assert_eq!(
+        u.motion,
+        scenario::MotionSpec {
+            model: scenario::MotionModel::Unicycle(scenario::UnicycleSpec {
+                v_max_m_per_s: 0.5,
+                w_max_rad_per_s: 1.0,
+            }),
+            ..p.motion
+        }
+    );
+}
