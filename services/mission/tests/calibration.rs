@@ -345,3 +345,45 @@ fn with_almost_no_data_the_fit_stays_near_table_i() {
     }
     assert!(last.0.abs() < 0.05 && last.1.abs() < 0.05, "{last:?}");
 }
+
+#[test]
+fn noisy_position_estimates_need_the_scaled_config() {
+    // The drive above, seen through position estimates with white noise of σ per axis
+    // (odometry-like 0.02 m, TOA-estimate-like 0.05 m), measured with the config scaled
+    // for that noise. Position-only measurement degrades with the noise: within 5% at
+    // 0.02 m, within 10% at 0.05 m on this zig-zag (legs of 2.7 to 4.5 m).
+    let stretches = drive(Drive {
+        sigma_tr_m: roam_map_server::scenario::DEFAULT_SIGMA_TR_M,
+        wait_every: Some(53),
+        wait_steps: 20,
+    });
+    for (sigma, within) in [(0.02, 0.05), (0.05, 0.10)] {
+        let mut rng = roam_sim::noise::stream(3, "estimates");
+        let mut n = || sigma * roam_sim::noise::standard_normal(&mut rng);
+        let estimates: Vec<Stretch> = stretches
+            .iter()
+            .map(|s| {
+                Stretch::from_samples(s.samples().iter().map(|x| Sample {
+                    time_s: x.time_s,
+                    at: [x.at[0] + n(), x.at[1] + n()],
+                }))
+                .expect("stretch")
+            })
+            .collect();
+        let config = CalibrationConfig::for_position_noise(sigma);
+        let m = fit(TimeModel::table_i(), &estimates, config).expect("fit");
+        let (e_lin, e_ang) = errors(m);
+        println!(
+            "estimates σ = {sigma} m (spacing {:.2} m, straight {:.2} rad, tolerance {:.2} m): v_lin {:+.2}%, v_ang {:+.2}%",
+            config.spacing_m,
+            config.straight_rad,
+            config.corner_tolerance_m,
+            100.0 * e_lin,
+            100.0 * e_ang
+        );
+        assert!(
+            e_lin.abs() < within && e_ang.abs() < within,
+            "σ {sigma}: {m:?}"
+        );
+    }
+}
