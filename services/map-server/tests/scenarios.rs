@@ -123,6 +123,8 @@ fn sim_sections_parse_with_the_papers_defaults() {
     assert_eq!(file.sensing.range_gate, scenario::RangeGate::TrueDistance);
     assert_eq!(file.motion.step_mu, 0.2);
     assert_eq!(file.motion.sigma_tr_m, 0.01);
+    assert_eq!(file.motion.model, scenario::MotionModel::Point);
+    assert_eq!(file.robots[0].heading_rad, 0.0);
     assert_eq!(file.time.step_s, scenario::DEFAULT_STEP_S);
     assert_eq!(file.blocks[0].size_m, Some([1.0, 0.5]));
     assert_eq!(file.waypoints[1].name, "B");
@@ -174,6 +176,11 @@ fn sim_section_errors_name_the_file_and_field() {
             "positive",
         ),
         ("time: { step_s: -1.0 }\n", "time.step_s", "positive"),
+        (
+            "robots: [ { name: r, at: [2.0, 2.0], heading_rad: .nan } ]\n",
+            "robots[0].heading_rad",
+            "finite number of radians",
+        ),
         (
             "blocks: [ { name: b, size_cells: [2, 2], period_steps: 7, path: [[7.0, 7.0], [7.0, 11.0]] } ]\n",
             "blocks[0].path[1]",
@@ -229,4 +236,119 @@ fn sim_section_errors_name_the_file_and_field() {
     // A typo inside a sim section is refused by name.
     let err = sim_scenario("sensing: { sigma_toa: 0.1 }\n").expect_err("typo");
     assert!(err.to_string().contains("sigma_toa"), "{err}");
+}
+
+#[test]
+fn the_motion_model_is_point_by_default_and_a_unicycle_when_asked() {
+    let point = sim_scenario("motion: { model: point, step_mu: 0.5 }\n").expect("point");
+    assert_eq!(point.file.motion.model, scenario::MotionModel::Point);
+    assert_eq!(point.file.motion.step_mu, 0.5);
+    let unicycle = sim_scenario(
+        "motion:\n  model: { unicycle: { v_max_m_per_s: 0.8, w_max_rad_per_s: 1.5 } }\nrobots: [ { name: r, at: [2.0, 2.0], heading_rad: 1.5 } ]\n",
+    )
+    .expect("unicycle");
+    assert_eq!(
+        unicycle.file.motion.model,
+        scenario::MotionModel::Unicycle(scenario::UnicycleSpec {
+            v_max_m_per_s: 0.8,
+            w_max_rad_per_s: 1.5,
+        })
+    );
+    assert_eq!(unicycle.file.motion.step_mu, scenario::DEFAULT_STEP_MU);
+    assert_eq!(unicycle.file.robots[0].heading_rad, 1.5);
+    // A unicycle has no default speeds: a robot's top speed is said, not guessed.
+    let err = sim_scenario("motion: { model: unicycle }\n").expect_err("no speeds");
+    assert!(matches!(err, ScenarioError::Invalid { .. }), "{err}");
+    // (Parse errors quote nothing of the file, so the missing field is not named; the
+    // section and what it expects are.)
+    let err = sim_scenario("motion: { model: { unicycle: { v_max_m_per_s: 0.5 } } }\n")
+        .expect_err("no turn rate");
+    assert!(
+        err.to_string()
+            .contains("motion.model.unicycle: missing field"),
+        "{err}"
+    );
+    let err = sim_scenario(
+        "motion: { model: { unicycle: { v_max_m_per_s: 0.5, w_max_rad_per_s: 1.0, w: 1 } } }\n",
+    )
+    .expect_err("typo");
+    assert!(
+        err.to_string().contains("unknown field") && err.to_string().contains("v_max_m_per_s"),
+        "{err}"
+    );
+    let err = sim_scenario("motion: { model: bicycle }\n").expect_err("no such model");
+    assert!(
+        err.to_string().contains("expected `point` or `unicycle`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_unicycle_speeds_are_refused_naming_the_field_and_the_limit() {
+    let v = "motion.model.unicycle.v_max_m_per_s";
+    let w = "motion.model.unicycle.w_max_rad_per_s";
+    let cases: &[(&str, &str, &str, &str)] = &[
+        ("0.0", "1.0", v, "got 0"),
+        ("-0.5", "1.0", v, "got -0.5"),
+        (".nan", "1.0", v, "got NaN"),
+        (".inf", "1.0", v, "got inf"),
+        ("25.0", "1.0", v, "got 25"),
+        ("0.5", "0.0", w, "got 0"),
+        ("0.5", "-1.0", w, "got -1"),
+        ("0.5", ".nan", w, "got NaN"),
+        ("0.5", "90.0", w, "got 90"),
+    ];
+    for (v_max, w_max, field, got) in cases {
+        let extra = format!(
+            "motion: {{ model: {{ unicycle: {{ v_max_m_per_s: {v_max}, w_max_rad_per_s: {w_max} }} }} }}\n"
+        );
+        let err = sim_scenario(&extra).expect_err(&extra);
+        let msg = err.to_string();
+        assert!(matches!(err, ScenarioError::Field { .. }), "{extra}: {msg}");
+        let limit = if *field == v {
+            "greater than 0 and at most 20 (limit max_v_m_per_s)"
+        } else {
+            "greater than 0 and at most 20 (limit max_w_rad_per_s)"
+        };
+        assert!(
+            msg.contains(&format!("field {field}:")) && msg.contains(limit) && msg.contains(got),
+            "{extra}: {msg}"
+        );
+    }
+}
+
+#[test]
+fn the_unicycle_downtime_world_is_the_downtime_world_with_a_unicycle() {
+    let load = |file: &str| {
+        scenario::load(
+            &config_dir().join("scenarios").join(file),
+            DEFAULT_LIMITS.max_layer_cells,
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let (point, unicycle) = (load("downtime.yaml"), load("downtime-unicycle.yaml"));
+    assert_eq!(point.occupancy.meta, unicycle.occupancy.meta);
+    assert_eq!(point.occupancy.cells, unicycle.occupancy.cells);
+    assert_eq!(point.information.cells, unicycle.information.cells);
+    let (p, u) = (&point.file, &unicycle.file);
+    assert_eq!(p.robot_radius_m, u.robot_radius_m);
+    assert_eq!(p.places, u.places);
+    assert_eq!(p.anchors, u.anchors);
+    assert_eq!(p.robots, u.robots);
+    assert_eq!(p.sensing, u.sensing);
+    assert_eq!(p.time, u.time);
+    assert_eq!(p.blocks, u.blocks);
+    assert_eq!(p.walkers, u.walkers);
+    assert_eq!(p.waypoints, u.waypoints);
+    assert_eq!(p.motion.model, scenario::MotionModel::Point);
+    assert_eq!(
+        u.motion,
+        scenario::MotionSpec {
+            model: scenario::MotionModel::Unicycle(scenario::UnicycleSpec {
+                v_max_m_per_s: 0.5,
+                w_max_rad_per_s: 1.0,
+            }),
+            ..p.motion
+        }
+    );
 }

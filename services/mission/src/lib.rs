@@ -10,6 +10,8 @@
 //! the PEB along the way.
 //!
 //! - [`tasks`]: the task sequence and its checks; the built-in world's day.
+//! - [`calibration`]: paper 000's time model (Eq. 2's v_lin, v_ang) fitted to what the
+//!   robot drove, with Table I as the prior, kept per robot in a small file.
 //! - [`path`]: thinning a planned path into waypoints; off-path distance; ETA slip.
 //! - [`watch`]: the replan policy of a window (arrived, given up, lost mission, blocked,
 //!   late, pushed off the path, slack), a plain state machine.
@@ -20,6 +22,7 @@
 //!   controller status, the world).
 //! - [`service`]: `roam mission`, the executive as a service that publishes its reports.
 
+pub mod calibration;
 pub mod executive;
 pub mod experiment;
 pub mod information;

@@ -10,7 +10,9 @@
 //! - [`world`]: the static grid, anchors, scripted blocks (paper 004), random walkers,
 //!   the dynamic occupancy.
 //! - [`robot`]: a robot and paper 002's motion model (Eq. 1) with a top speed and
-//!   collisions.
+//!   collisions; [`unicycle`]: roam's robot with a heading, which turns (at most
+//!   w_max·dt per step) before it drives, so turning costs time as paper 000's Eq. 2
+//!   assumes (`motion.model: { unicycle: ... }`).
 //! - [`sensors`]: TOA ranges to the anchors in range; [`los`]: the local grid observation
 //!   with line of sight; [`raster`]: the cells a segment crosses.
 //! - [`sim`]: [`Sim`], its step, reset, robots, reports and errors; [`event`]: what
@@ -35,6 +37,7 @@ pub mod sensors;
 pub mod service;
 pub mod sim;
 pub mod snapshot;
+pub mod unicycle;
 pub mod world;
 
 pub use event::Event;

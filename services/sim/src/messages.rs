@@ -80,6 +80,9 @@ pub fn robot_messages(sim: &Sim, step: u64, time_s: f64, report: &RobotReport) -
             })
             .collect(),
     };
+    // A unicycle's heading (`report.readings.heading_rad`) is not on the wire yet:
+    // `GroundTruth` has no field for it, and adding one (optional, serde default) also
+    // means the live view's own `GroundTruth` literals (services/view) take it.
     let truth = GroundTruth {
         robot: report.name.clone(),
         step,

@@ -1,5 +1,6 @@
-//! A robot: where it is, its own random stream, and paper 002's motion model (Eq. 1)
-//! with a top speed and collisions.
+//! A robot: where it is (and, for roam's unicycle, which way it faces), its own random
+//! stream, and paper 002's motion model (Eq. 1) with a top speed and collisions. The
+//! unicycle's rule is in [`crate::unicycle`]; both end in the same collision walk.
 
 use rand_chacha::ChaCha8Rng;
 use roam_map_server::scenario::MotionSpec;
@@ -14,12 +15,16 @@ use crate::world::World;
 /// enough that rounding never puts the stopping point inside that cell.
 const BACKOFF_CELLS: f64 = 1e-6;
 
-/// A robot in the sim: a point that moves on the plane (paper 002 models no heading).
+/// A robot in the sim: a point that moves on the plane (paper 002 models no heading),
+/// with a heading that only the unicycle model turns and uses.
 #[derive(Debug, Clone)]
 pub struct Robot {
     name: String,
     start: [f64; 2],
     at: [f64; 2],
+    /// Heading at the start and now, radians counter-clockwise from +x, in [-π, π).
+    start_heading: f64,
+    heading: f64,
     /// The robot's own stream: its transition noise and its range noise.
     rng: ChaCha8Rng,
     /// Events that happened between steps (a reset put it on a free cell), reported
@@ -28,29 +33,36 @@ pub struct Robot {
 }
 
 impl Robot {
-    /// A robot at its start, its stream derived from the sim's seed and its name.
-    pub(crate) fn new(name: &str, start: [f64; 2], seed: u64) -> Robot {
+    /// A robot at its start, facing `heading` (radians), its stream derived from the
+    /// sim's seed and its name.
+    pub(crate) fn new(name: &str, start: [f64; 2], heading: f64, seed: u64) -> Robot {
+        let heading = crate::unicycle::wrap(heading);
         Robot {
             name: name.to_owned(),
             start,
             at: start,
+            start_heading: heading,
+            heading,
             rng: stream(seed, name),
             pending: Vec::new(),
         }
     }
 
-    /// Back to its start with its stream restarted from `seed`.
+    /// Back to its start (and its start heading) with its stream restarted from `seed`.
     pub(crate) fn reset(&mut self, seed: u64) {
         self.at = self.start;
+        self.heading = self.start_heading;
         self.rng = stream(seed, &self.name);
         self.pending.clear();
     }
 
     /// Put back where a snapshot saw it at `step`, its stream restarted from
     /// `(seed, name, step)` (see [`crate::snapshot`]).
-    pub(crate) fn resume(&mut self, start: [f64; 2], at: [f64; 2], seed: u64, step: u64) {
-        self.start = start;
-        self.at = at;
+    pub(crate) fn resume(&mut self, pose: Resumed, seed: u64, step: u64) {
+        self.start = pose.start;
+        self.at = pose.at;
+        self.start_heading = crate::unicycle::wrap(pose.start_heading);
+        self.heading = crate::unicycle::wrap(pose.heading);
         self.rng = noise::stream(seed, &format!("robot/{}/resumed/{step}", self.name));
         self.pending.clear();
     }
@@ -73,9 +85,33 @@ impl Robot {
         self.at = at;
     }
 
+    /// Which way it faces: the ground truth, radians counter-clockwise from +x, in
+    /// [-π, π). A point robot keeps its start heading (it has none that matters).
+    pub fn heading_rad(&self) -> f64 {
+        self.heading
+    }
+
+    /// Its heading at the start (and after a reset), radians.
+    pub fn start_heading_rad(&self) -> f64 {
+        self.start_heading
+    }
+
+    pub(crate) fn set_heading(&mut self, heading: f64) {
+        self.heading = heading;
+    }
+
     pub(crate) fn rng(&mut self) -> &mut ChaCha8Rng {
         &mut self.rng
     }
+}
+
+/// Where a snapshot saw a robot: its start and position, and its headings there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Resumed {
+    pub start: [f64; 2],
+    pub at: [f64; 2],
+    pub start_heading: f64,
+    pub heading: f64,
 }
 
 /// The robot's stream: `"robot/<name>"` under the sim's seed.
@@ -127,6 +163,19 @@ pub fn step_motion(
             allowed_m: motion.max_speed_m_per_step,
         });
     }
+    translate(at, step, nu, world, events)
+}
+
+/// Moves a robot at `at` by `step + nu` against the world as it is now, walking the
+/// segment cell by cell and stopping just short of the first cell it may not be in (a
+/// `Collision` event, after `events`). Both motion models end here.
+pub(crate) fn translate(
+    at: [f64; 2],
+    step: [f64; 2],
+    nu: [f64; 2],
+    world: &World,
+    mut events: Vec<Event>,
+) -> Moved {
     let target = [at[0] + step[0] + nu[0], at[1] + step[1] + nu[1]];
     let (from, to) = (world.to_cell_units(at), world.to_cell_units(target));
     let Some((t, cell)) = raster::first_blocked(from, to, |c| world.is_blocked(c)) else {

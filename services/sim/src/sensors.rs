@@ -53,6 +53,10 @@ pub struct Readings {
     /// The ground-truth position, world metres: for evaluation only, never for the
     /// robot's own estimate.
     pub truth: [f64; 2],
+    /// The ground-truth heading, radians counter-clockwise from +x in [-π, π), for a
+    /// unicycle (roam's addition); `None` for paper 002's point robot, which has none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub heading_rad: Option<f64>,
     /// TOA ranges to the anchors within the sensing range, in anchor order.
     pub ranges: Vec<Range>,
     /// The local grid within the observation radius, with line of sight; `None` when

@@ -3,15 +3,18 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use roam_map_server::scenario::{MotionSpec, Scenario, ScenarioFile, SensingSpec, TimeSpec};
+use roam_map_server::scenario::{
+    MotionModel, MotionSpec, Scenario, ScenarioFile, SensingSpec, TimeSpec,
+};
 use serde::Serialize;
 
 use crate::event::Event;
 use crate::los::LosTable;
 use crate::noise;
-use crate::robot::{step_motion, Robot};
+use crate::robot::{step_motion, Resumed, Robot};
 use crate::sensors::{self, Readings};
 use crate::snapshot::{RobotState, SimSnapshot};
+use crate::unicycle::Unicycle;
 use crate::world::{Anchor, Obstacle, World, WorldError};
 
 /// The most robots one sim holds (limit `max_robots`): each costs a stream, a report
@@ -52,8 +55,9 @@ impl SimParams {
     }
 }
 
-/// A motion command for one robot: `u` in paper 002 Eq. 1 (the robot moves μ·u, at most
-/// the top speed).
+/// A motion command for one robot: `u` in paper 002 Eq. 1 (the point robot moves μ·u,
+/// at most the top speed; the unicycle turns toward u and drives, see
+/// [`crate::unicycle`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Command {
     pub robot: String,
@@ -148,7 +152,7 @@ impl Sim {
             seed,
         };
         for robot in &scenario.file.robots {
-            sim.add_robot(&robot.name, robot.at)?;
+            sim.add_robot_facing(&robot.name, robot.at, robot.heading_rad)?;
         }
         Ok(sim)
     }
@@ -168,10 +172,21 @@ impl Sim {
         }
     }
 
-    /// Adds a robot at `at` (world metres), which must be a free cell now. Its stream
-    /// is derived from the seed and its name, so a robot removed and added again under
-    /// the same name draws the same noise again.
+    /// Adds a robot at `at` (world metres), which must be a free cell now, facing +x.
+    /// Its stream is derived from the seed and its name, so a robot removed and added
+    /// again under the same name draws the same noise again.
     pub fn add_robot(&mut self, name: &str, at: [f64; 2]) -> Result<(), SimError> {
+        self.add_robot_facing(name, at, 0.0)
+    }
+
+    /// [`Sim::add_robot`] facing `heading_rad` (radians counter-clockwise from +x; only
+    /// a unicycle turns and uses it).
+    pub fn add_robot_facing(
+        &mut self,
+        name: &str,
+        at: [f64; 2],
+        heading_rad: f64,
+    ) -> Result<(), SimError> {
         if name.is_empty() || name.len() > MAX_ROBOT_NAME_BYTES {
             return Err(SimError::BadName(name.to_owned()));
         }
@@ -190,6 +205,11 @@ impl Sim {
         if !(at[0].is_finite() && at[1].is_finite()) {
             return Err(bad("the position must be two finite numbers".into()));
         }
+        if !heading_rad.is_finite() {
+            return Err(bad(format!(
+                "the heading must be a finite number of radians, got {heading_rad}"
+            )));
+        }
         let Some(cell) = self.world.cell_of(at) else {
             return Err(bad("the position is outside the map".into()));
         };
@@ -199,8 +219,10 @@ impl Sim {
                 describe(&obstacle)
             )));
         }
-        self.robots
-            .insert(name.to_owned(), Robot::new(name, at, self.seed));
+        self.robots.insert(
+            name.to_owned(),
+            Robot::new(name, at, heading_rad, self.seed),
+        );
         Ok(())
     }
 
@@ -239,6 +261,10 @@ impl Sim {
             .collect();
         self.world.advance(&robot_cells);
         let (world, params, los) = (&self.world, &self.params, &self.los);
+        let unicycle = match &params.motion.model {
+            MotionModel::Point => None,
+            MotionModel::Unicycle(spec) => Some(Unicycle::new(&params.motion, spec, &params.time)),
+        };
         let meta = *world.meta();
         let mut reports = Vec::with_capacity(self.robots.len());
         for (name, robot) in &mut self.robots {
@@ -246,7 +272,14 @@ impl Sim {
             events.extend(displace(world, robot));
             let nu = noise::transition(params.motion.sigma_tr_m, robot.rng());
             let u = u_of.get(name.as_str()).copied().unwrap_or([0.0, 0.0]);
-            let moved = step_motion(robot.position(), u, nu, &params.motion, world);
+            let moved = match &unicycle {
+                None => step_motion(robot.position(), u, nu, &params.motion, world),
+                Some(model) => {
+                    let stepped = model.step(robot.position(), robot.heading_rad(), u, nu, world);
+                    robot.set_heading(stepped.heading);
+                    stepped.moved
+                }
+            };
             robot.set_position(moved.at);
             events.extend(moved.events);
             let at = robot.position();
@@ -260,6 +293,7 @@ impl Sim {
                 events,
                 readings: Readings {
                     truth: at,
+                    heading_rad: unicycle.is_some().then(|| robot.heading_rad()),
                     ranges,
                     observation,
                 },
@@ -272,8 +306,15 @@ impl Sim {
         })
     }
 
-    /// What a snapshot keeps of this sim (see [`crate::snapshot`]).
+    /// Whether the robots are unicycles (they have a heading that matters).
+    fn has_heading(&self) -> bool {
+        matches!(self.params.motion.model, MotionModel::Unicycle(_))
+    }
+
+    /// What a snapshot keeps of this sim (see [`crate::snapshot`]): the headings too
+    /// when the robots are unicycles (a point robot's snapshot is what it always was).
     pub fn snapshot(&self, scenario: &str) -> SimSnapshot {
+        let heading = self.has_heading();
         let robots = self
             .robots
             .values()
@@ -281,14 +322,19 @@ impl Sim {
                 name: r.name().to_owned(),
                 start: r.start(),
                 at: r.position(),
+                start_heading_rad: heading.then(|| r.start_heading_rad()),
+                heading_rad: heading.then(|| r.heading_rad()),
             })
             .collect();
         SimSnapshot::new(scenario, self.seed, self.steps(), robots)
     }
 
     /// Back to where `snapshot` was taken: the world replayed to its step, its robots
-    /// (and only those) at their positions, their streams restarted from the step. The
-    /// snapshot's seed becomes the sim's.
+    /// (and only those) at their positions and headings, their streams restarted from
+    /// the step. The snapshot's seed becomes the sim's. A snapshot without headings (a
+    /// point robot's, or one written before headings were kept) starts each robot at the
+    /// scenario's heading for its name (0 for a robot the scenario does not name), and
+    /// facing its start heading.
     pub fn resume(&mut self, snapshot: &SimSnapshot) -> Result<(), SimError> {
         if snapshot.robots.len() > MAX_ROBOTS {
             return Err(SimError::TooManyRobots { max: MAX_ROBOTS });
@@ -297,12 +343,19 @@ impl Sim {
             if r.name.is_empty() || r.name.len() > MAX_ROBOT_NAME_BYTES {
                 return Err(SimError::BadName(r.name.clone()));
             }
-            if !r.at.iter().chain(&r.start).all(|v| v.is_finite()) {
+            let headings = r.start_heading_rad.iter().chain(&r.heading_rad);
+            if !r
+                .at
+                .iter()
+                .chain(&r.start)
+                .chain(headings)
+                .all(|v| v.is_finite())
+            {
                 return Err(SimError::BadStart {
                     robot: r.name.clone(),
                     x: r.at[0],
                     y: r.at[1],
-                    reason: "the snapshot's position is not finite".into(),
+                    reason: "the snapshot's position or heading is not finite".into(),
                 });
             }
         }
@@ -318,8 +371,22 @@ impl Sim {
         }
         self.robots.clear();
         for r in &snapshot.robots {
-            let mut robot = Robot::new(&r.name, r.start, snapshot.seed);
-            robot.resume(r.start, r.at, snapshot.seed, snapshot.step);
+            let start_heading = r.start_heading_rad.unwrap_or_else(|| {
+                self.scenario
+                    .file
+                    .robots
+                    .iter()
+                    .find(|s| s.name == r.name)
+                    .map_or(0.0, |s| s.heading_rad)
+            });
+            let pose = Resumed {
+                start: r.start,
+                at: r.at,
+                start_heading,
+                heading: r.heading_rad.unwrap_or(start_heading),
+            };
+            let mut robot = Robot::new(&r.name, r.start, start_heading, snapshot.seed);
+            robot.resume(pose, snapshot.seed, snapshot.step);
             self.robots.insert(r.name.clone(), robot);
         }
         Ok(())

@@ -3,7 +3,7 @@
 //!
 //! A snapshot holds what the fleet around the sim has already acted on: the scenario
 //! and seed it belongs to, the step (so the clock goes on), and each robot's start and
-//! position. It does not hold the random streams: a resumed sim replays the world to the
+//! position (and a unicycle's headings there). It does not hold the random streams: a resumed sim replays the world to the
 //! step (blocks follow their script; walkers redraw from the world's stream, blocked by
 //! the robots' starts instead of where the robots were) and restarts each robot's stream
 //! from `(seed, name, step)`. So a resumed run is reproducible from its snapshot, bit for
@@ -34,6 +34,12 @@ pub struct RobotState {
     pub name: String,
     pub start: [f64; 2],
     pub at: [f64; 2],
+    /// A unicycle's heading at its start and now, radians (absent for a point robot,
+    /// so its snapshot is what it was before headings existed, and old files load).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start_heading_rad: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heading_rad: Option<f64>,
 }
 
 /// What the sim writes to its `state_file`.
@@ -143,14 +149,35 @@ mod tests {
             "built-in",
             7,
             1234,
-            vec![RobotState {
-                name: "r1".into(),
-                start: [1.0, 2.0],
-                at: [1.5, 2.5],
-            }],
+            vec![
+                RobotState {
+                    name: "r1".into(),
+                    start: [1.0, 2.0],
+                    at: [1.5, 2.5],
+                    start_heading_rad: None,
+                    heading_rad: None,
+                },
+                RobotState {
+                    name: "u1".into(),
+                    start: [1.0, 2.0],
+                    at: [1.5, 2.5],
+                    start_heading_rad: Some(0.5),
+                    heading_rad: Some(-2.25),
+                },
+            ],
         );
         save(&path, &s).expect("save");
         assert_eq!(load(&path).expect("load"), Some(s));
+        // A point robot's entry is written as it always was, and such a file still loads.
+        let text = std::fs::read_to_string(&path).expect("read");
+        assert!(
+            text.contains(r#"{"name":"r1","start":[1.0,2.0],"at":[1.5,2.5]}"#),
+            "{text}"
+        );
+        assert!(
+            text.contains(r#""start_heading_rad":0.5,"heading_rad":-2.25"#),
+            "{text}"
+        );
         let _ = std::fs::remove_dir_all(&d);
     }
 

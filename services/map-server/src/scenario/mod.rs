@@ -31,9 +31,11 @@
 //! anchors:                     # TOA beacons, metres; may stand on walls
 //!   - { name: a1, at: [-9.5, -9.5] }
 //! sensing: { range_m: 30.0, sigma_toa_m: 0.10, d0_m: 15.0, k: 2.0, observation_radius_m: 5.0 }
-//! motion: { step_mu: 0.2, sigma_tr_m: 0.01, max_speed_m_per_step: 0.2 }
+//! motion: { step_mu: 0.2, sigma_tr_m: 0.01, max_speed_m_per_step: 0.2 }   # model: point
+//! # or a robot that pays for turning (roam's unicycle):
+//! # motion: { model: { unicycle: { v_max_m_per_s: 0.5, w_max_rad_per_s: 1.0 } } }
 //! robots:                      # start positions, metres, on free cells
-//!   - { name: r1, at: [-8.0, -8.0] }
+//!   - { name: r1, at: [-8.0, -8.0] }   # heading_rad: 0.0 (the unicycle's, default 0)
 //! blocks:                      # scripted moving obstacles
 //!   - { name: b1, size_cells: [2, 2], period_steps: 7, path: [[1.0, 1.0], [3.0, 1.0]] }
 //! walkers:                     # random walkers
@@ -53,9 +55,11 @@ use crate::load_dirs::{Access, LoadRefused};
 use crate::ros_map::{self, RosMapError};
 
 mod build;
+mod motion;
 mod sim_sections;
 
 use build::{build_grid, build_information};
+pub use motion::*;
 use sim_sections::validate_sim;
 pub use sim_sections::*;
 
@@ -83,12 +87,14 @@ pub struct ScenarioFile {
     /// Sim world: the range sensor and the local grid observation.
     #[serde(default)]
     pub sensing: SensingSpec,
-    /// Sim world: the robots' motion model (paper 002 Eq. 1).
-    #[serde(default)]
+    /// Sim world: the robots' motion model (paper 002 Eq. 1's point, or roam's
+    /// unicycle). Its `model` enum is written as a plain name or a one-key map too.
+    #[serde(default, with = "serde_yaml_ng::with::singleton_map_recursive")]
     pub motion: MotionSpec,
-    /// Sim world: the robots and where each starts (world metres, on a free cell).
+    /// Sim world: the robots, where each starts (world metres, on a free cell) and its
+    /// heading there (radians, default 0; only a unicycle has one).
     #[serde(default)]
-    pub robots: Vec<Place>,
+    pub robots: Vec<RobotStart>,
     /// Sim world: scripted moving obstacles (paper 004 §5's two blocks).
     #[serde(default)]
     pub blocks: Vec<BlockSpec>,

@@ -1,5 +1,6 @@
-//! The sim world's sections of a scenario file (anchors, sensing, motion, time, robots,
-//! blocks, walkers, waypoints): their types, defaults and checks.
+//! The sim world's sections of a scenario file (anchors, sensing, time, blocks,
+//! walkers, waypoints): their types, defaults and checks, and the check of all the sim
+//! sections against the map (`motion` and the robots' starts are in [`super::motion`]).
 
 use roam_proto::map::GridMeta;
 use serde::Deserialize;
@@ -18,13 +19,6 @@ pub const DEFAULT_K: f64 = 2.0;
 /// roam's choice (no paper gives one for a laser-like grid observation): 5 m, about what
 /// covers one of the 6 × 6 m rooms of paper 004's Stage world from inside it.
 pub const DEFAULT_OBSERVATION_RADIUS_M: f64 = 5.0;
-/// Paper 002 §4's step size μ: 0.2.
-pub const DEFAULT_STEP_MU: f64 = 0.2;
-/// Paper 002 §4's σ_tr: 0.01 m.
-pub const DEFAULT_SIGMA_TR_M: f64 = 0.01;
-/// 0.2 m per step, μ times a unit command: paper 002's ES1 robot covers 59.56 m in 296
-/// steps (0.201 m per step), so its commands have unit length at most.
-pub const DEFAULT_MAX_SPEED_M_PER_STEP: f64 = 0.2;
 /// 0.4 s per step: with the default 0.2 m per step a robot drives at 0.5 m/s, the speed
 /// paper 000's Table I implies (v_lin = 2.0 s/m) and the planner's t_ETA assumes. Paper
 /// 002 counts steps, not seconds.
@@ -81,30 +75,6 @@ impl Default for SensingSpec {
             k: DEFAULT_K,
             range_gate: RangeGate::default(),
             observation_radius_m: DEFAULT_OBSERVATION_RADIUS_M,
-        }
-    }
-}
-
-/// The motion model `p ← p + μ·u + ν`, ν ~ N(0, σ_tr²) per axis (paper 002 Eq. 1).
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct MotionSpec {
-    /// Step size μ, metres per unit of command per step (paper 002: 0.2).
-    pub step_mu: f64,
-    /// Transition noise standard deviation σ_tr per axis, metres (paper 002: 0.01); 0
-    /// makes motion deterministic (paper 004's grid world).
-    pub sigma_tr_m: f64,
-    /// The longest commanded move μ·|u| in one step, metres; longer commands are
-    /// clipped to this length.
-    pub max_speed_m_per_step: f64,
-}
-
-impl Default for MotionSpec {
-    fn default() -> Self {
-        MotionSpec {
-            step_mu: DEFAULT_STEP_MU,
-            sigma_tr_m: DEFAULT_SIGMA_TR_M,
-            max_speed_m_per_step: DEFAULT_MAX_SPEED_M_PER_STEP,
         }
     }
 }
@@ -260,6 +230,7 @@ pub(super) fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<
             &format!("robot '{}'", robot.name),
             robot.at,
         )?;
+        robot.check_heading(&format!("robots[{i}]"))?;
     }
     unique(
         "blocks",
@@ -401,37 +372,6 @@ impl SensingSpec {
                      {MAX_OBSERVATION_RADIUS_CELLS} cells ({} m on this map)",
                     self.observation_radius_m,
                     MAX_OBSERVATION_RADIUS_CELLS * resolution
-                ),
-            ));
-        }
-        Ok(())
-    }
-}
-
-impl MotionSpec {
-    /// Checks every field.
-    pub fn check(&self) -> Result<(), FieldIssue> {
-        if !(self.step_mu.is_finite() && self.step_mu > 0.0) {
-            return Err(FieldIssue::new(
-                "motion.step_mu",
-                format!("must be a positive number, got {}", self.step_mu),
-            ));
-        }
-        if !(self.sigma_tr_m.is_finite() && self.sigma_tr_m >= 0.0) {
-            return Err(FieldIssue::new(
-                "motion.sigma_tr_m",
-                format!(
-                    "must be a non-negative number of metres, got {}",
-                    self.sigma_tr_m
-                ),
-            ));
-        }
-        if !(self.max_speed_m_per_step.is_finite() && self.max_speed_m_per_step > 0.0) {
-            return Err(FieldIssue::new(
-                "motion.max_speed_m_per_step",
-                format!(
-                    "must be a positive number of metres per step, got {}",
-                    self.max_speed_m_per_step
                 ),
             ));
         }
