@@ -35,6 +35,26 @@ pub struct WindowReport {
     pub replans: u32,
     /// Why each replan happened, in order.
     pub replan_reasons: Vec<String>,
+    /// The time model (paper 000 Eq. 2) the window was planned with, and how well it
+    /// predicted what the robot drove.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_model: Option<TimeModelReport>,
+}
+
+/// A window's time model and its prediction error.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeModelReport {
+    /// Seconds per metre and per radian the window's plans were made with.
+    pub v_lin: f64,
+    pub v_ang: f64,
+    /// What the model predicted for the distance and turning the robot drove, and how
+    /// long that driving took (stops left out), seconds.
+    pub predicted_s: f64,
+    pub driving_s: f64,
+    /// `driving_s` over the window (the task's start minus the window's beginning): the
+    /// share of the downtime the robot spent driving.
+    pub driven_share: f64,
 }
 
 impl Message for WindowReport {

@@ -573,7 +573,7 @@ mod mission_messages {
     proptest! {
         #[test]
         fn window_reports_round_trip(robot in name(), x in finite(), arrival in prop::option::of(finite()), on_time in any::<bool>()) {
-            round_trips(&WindowReport { robot: robot.clone(), task: robot, window: 1, began_s: x, task_start_s: x, arrival_s: arrival, on_time, budget_s: x, planned_information: x, driven_information: x, shortest_information: x, peb_mean_m: arrival, replans: 2, replan_reasons: vec!["off_path".into()] });
+            round_trips(&WindowReport { robot: robot.clone(), task: robot, window: 1, began_s: x, task_start_s: x, arrival_s: arrival, on_time, budget_s: x, planned_information: x, driven_information: x, shortest_information: x, peb_mean_m: arrival, replans: 2, replan_reasons: vec!["off_path".into()], time_model: None });
         }
     }
 }

@@ -16,13 +16,14 @@
 //! 20× charges a 0.5 s plan 10 s of downtime); the driving budget t_exec is the time to
 //! the task's start minus that.
 
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use roam_planner::client::PlannerClient;
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
 use roam_proto::controller::{Mission, MissionState};
-use roam_proto::mission::WindowReport;
+use roam_proto::mission::{TimeModelReport, WindowReport};
 use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
 use roam_proto::{encode, keys};
 use roam_runtime::{ClientError, Requester};
@@ -30,6 +31,7 @@ use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
 use zenoh::qos::CongestionControl;
 
+use crate::calibration::{store, Calibration, CalibrationConfig, Sample, Stretch, TimeModel};
 use crate::information::gathered;
 use crate::inputs::{listen, lock, wait_for_world, Inputs};
 use crate::path::{clear, thin};
@@ -74,6 +76,11 @@ pub struct ExecutiveConfig {
     pub slack_s: f64,
     /// Mission seconds between two slack replans at least.
     pub slack_interval_s: f64,
+    /// Plan with paper 000 Eq. 2's v_lin and v_ang fitted to what this robot drove
+    /// (Table I as the prior; see [`crate::calibration`]); `false`: Table I throughout.
+    pub calibrate: bool,
+    /// Where the robot's fit is kept across restarts; absent: in memory only.
+    pub calibration_file: Option<PathBuf>,
 }
 
 impl Default for ExecutiveConfig {
@@ -94,6 +101,8 @@ impl Default for ExecutiveConfig {
             controller_silence_s: 3.0,
             slack_s: 10.0,
             slack_interval_s: 10.0,
+            calibrate: true,
+            calibration_file: None,
         }
     }
 }
@@ -204,6 +213,8 @@ struct Run<'a> {
     inputs: Inputs,
     position: Option<[f64; 2]>,
     missions_sent: u64,
+    /// The robot's time model, fitted as it drives.
+    calibration: Calibration,
     /// This executive's own tag in its mission ids (from its Zenoh session id), so a
     /// restarted executive never reuses an id its predecessor sent: the controller's
     /// statuses on an old mission are not taken for a new one's.
@@ -215,10 +226,21 @@ impl Run<'_> {
         lock(&self.inputs.clock).now_s()
     }
 
+    /// The model plans are made with: the fit, or Table I when not calibrating.
+    fn time_model(&self) -> TimeModel {
+        if self.config.calibrate {
+            self.calibration.model()
+        } else {
+            TimeModel::table_i()
+        }
+    }
+
     fn watch_params(&self) -> WatchParams {
+        let expected = 1.0 / self.time_model().v_lin;
         WatchParams {
             off_path_m: self.config.off_path_m,
-            speed_m_per_s: self.config.speed_m_per_s,
+            speed_m_per_s: self.config.speed_m_per_s.min(expected),
+            expected_speed_m_per_s: expected,
             max_replans: self.config.max_replans,
             give_up_after_s: self.config.give_up_after_s,
             controller_silence_s: self.config.controller_silence_s,
@@ -250,7 +272,7 @@ impl Run<'_> {
             params: GaOverrides {
                 max_generations: self.config.max_generations,
                 w_loc: self.config.w_loc,
-                ..GaOverrides::default()
+                ..self.time_model().overrides()
             },
             seed: self.config.seed,
             map_version: None,
@@ -383,6 +405,56 @@ impl Run<'_> {
         }
     }
 
+    /// What the window's driving says about the time model: how well `model` (the one
+    /// the window was planned with) predicted it, for the report; and, when calibrating,
+    /// the fit updated with it and kept in the calibration file.
+    fn learn(
+        &mut self,
+        window: usize,
+        model: &TimeModel,
+        stretches: &[Stretch],
+        window_s: f64,
+    ) -> Option<TimeModelReport> {
+        let config = self.calibration.config().clone();
+        let error = match model.window_error(stretches, &config) {
+            Ok(e) => e,
+            Err(e) => {
+                tracing::warn!(window, "no time model error for the window: {e}");
+                return None;
+            }
+        };
+        if self.config.calibrate {
+            for s in stretches {
+                self.calibration.add(s);
+            }
+            if let Some(path) = &self.config.calibration_file {
+                if let Err(e) = store::save(path, &self.config.robot, &self.calibration) {
+                    tracing::warn!("{e}");
+                }
+            }
+            let fitted = self.calibration.model();
+            tracing::info!(
+                window,
+                v_lin = fitted.v_lin,
+                v_ang = fitted.v_ang,
+                predicted_s = error.predicted_s,
+                driving_s = error.measured_s,
+                "time model updated from the window's driving"
+            );
+        }
+        Some(TimeModelReport {
+            v_lin: model.v_lin,
+            v_ang: model.v_ang,
+            predicted_s: error.predicted_s,
+            driving_s: error.measured_s,
+            driven_share: if window_s > 0.0 {
+                error.measured_s / window_s
+            } else {
+                0.0
+            },
+        })
+    }
+
     async fn window(
         &mut self,
         window: usize,
@@ -422,6 +494,7 @@ impl Run<'_> {
                 peb_mean_m: None,
                 replans: 0,
                 replan_reasons: vec!["no planner answered before the window was given up".into()],
+                time_model: None,
             };
             return Ok(Some(WindowOutcome {
                 report,
@@ -438,6 +511,9 @@ impl Run<'_> {
             curious: plan.model != PlannerModel::Shortest,
         });
         let planned_information = plan.distinct_information;
+        let model = self.time_model();
+        let mut stretches: Vec<Stretch> = Vec::new();
+        let mut stretch = Stretch::new();
         let mut plans = vec![plan.points.clone()];
         let mut waypoints = self.waypoints(&plan);
         let mut mission = self.send(window, waypoints.clone());
@@ -469,6 +545,11 @@ impl Run<'_> {
                     driven.push(e.position);
                     if let Some(p) = e.peb_m {
                         pebs.push(p);
+                    }
+                    let sample = Sample { time_s: self.now(), at: e.position };
+                    if stretch.push(sample).is_err() {
+                        // A stretch is full (hours of one mission): go on in a new one.
+                        stretches.push(std::mem::take(&mut stretch));
                     }
                     watch.on_estimate(e.position)
                 }
@@ -551,6 +632,7 @@ impl Run<'_> {
                 .chain(plan.points.iter().copied())
                 .collect();
             watch.replanned(path, resend, self.now(), wall_s());
+            stretches.push(std::mem::take(&mut stretch));
             plans.push(plan.points.clone());
             waypoints = self.waypoints(&plan);
             mission = self.send(window, waypoints.clone());
@@ -563,6 +645,8 @@ impl Run<'_> {
             }
         }
         while self.inputs.estimates.try_recv().ok().flatten().is_some() {}
+        stretches.push(stretch);
+        let time_model = self.learn(window, &model, &stretches, task.start_s - began);
         let driven_information = gathered(&self.world, &self.params, &driven);
         let report = WindowReport {
             robot: self.config.robot.clone(),
@@ -579,6 +663,7 @@ impl Run<'_> {
             peb_mean_m: (!pebs.is_empty()).then(|| pebs.iter().sum::<f64>() / pebs.len() as f64),
             replans: reasons.len() as u32,
             replan_reasons: reasons,
+            time_model,
         };
         Ok(Some(WindowOutcome {
             report,
@@ -587,6 +672,25 @@ impl Run<'_> {
             driven,
         }))
     }
+}
+
+/// The robot's time calibration: from its file when one is configured and usable, else
+/// Table I's prior.
+fn load_calibration(config: &ExecutiveConfig) -> Result<Calibration, ExecutiveError> {
+    let prior = TimeModel::table_i();
+    let settings = CalibrationConfig::default();
+    let calibration = match &config.calibration_file {
+        Some(path) => {
+            let (calibration, loaded) = store::load(path, &config.robot, prior, settings)
+                .map_err(|e| ExecutiveError::Config(e.to_string()))?;
+            tracing::info!(path = %path.display(), ?loaded, model = ?calibration.model(), "time calibration");
+            calibration
+        }
+        None => {
+            Calibration::new(prior, settings).map_err(|e| ExecutiveError::Config(e.to_string()))?
+        }
+    };
+    Ok(calibration)
 }
 
 /// Drives `config.robot` through its tasks and returns each window's outcome, calling
@@ -613,6 +717,7 @@ pub async fn run(
         inputs,
         position: None,
         missions_sent: 0,
+        calibration: load_calibration(config)?,
         tag: session.zid().to_string().chars().take(8).collect(),
     };
     run.hear_the_clock(cancel).await?;

@@ -28,7 +28,11 @@ use crate::path::{eta_slips, off_path_m};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WatchParams {
     pub off_path_m: f64,
+    /// The speed the late rule assumes (the slower of the configured speed and the time
+    /// model's), m/s.
     pub speed_m_per_s: f64,
+    /// The speed the slack rule expects (the time model's, 1 / v_lin), m/s.
+    pub expected_speed_m_per_s: f64,
     pub max_replans: u32,
     pub give_up_after_s: f64,
     pub controller_silence_s: f64,
@@ -180,7 +184,7 @@ impl Watch {
                     self.slipped = true;
                     return self.replan(Reason::EtaSlipped, false);
                 }
-                let arrival_s = now_s + distance_left_m / speed;
+                let arrival_s = now_s + distance_left_m / self.params.expected_speed_m_per_s;
                 let early = self.task_start_s - arrival_s;
                 if early > self.params.slack_s + planning_cost_s
                     && now_s - self.planned_at_s >= self.params.slack_interval_s
@@ -226,6 +230,7 @@ mod tests {
         WatchParams {
             off_path_m: 1.5,
             speed_m_per_s: 0.5,
+            expected_speed_m_per_s: 0.5,
             max_replans: 3,
             give_up_after_s: 60.0,
             controller_silence_s: 3.0,
