@@ -17,6 +17,7 @@
 //! | module | what it holds |
 //! |---|---|
 //! | [`params`] | [`ApfParams`]: paper 002 §4's values as defaults, roam's safety parameters, checks |
+//! | [`carrot`] | pure pursuit on the mission's path: the forward-only projection and the carrot f_a pulls toward under `follow: path` |
 //! | [`weights`] | [`Scheme`] and z_isa(ω) (Eq. 2) |
 //! | [`forces`] | f_a, f_Tr, f_is's combination, ω, the command u (Eq. 3) |
 //! | [`obstacle_field`] | η and the direction away from the nearest obstacle, from the exact EDT, built once per map |
@@ -57,6 +58,7 @@
 //!   their comments say which. ES3's random missions are sampled as
 //!   [`experiments::es3`] documents.
 
+pub mod carrot;
 pub mod controller;
 pub mod episode;
 pub mod experiments;
