@@ -32,7 +32,7 @@ use zenoh::qos::CongestionControl;
 
 use crate::information::gathered;
 use crate::inputs::{listen, lock, wait_for_world, Inputs};
-use crate::path::{clear, eta_slips, off_path_m, thin};
+use crate::path::{eta_slips, mission_waypoints, off_path_m};
 use crate::tasks::{self, Task, TaskError};
 
 /// How the executive plans and watches.
@@ -272,9 +272,7 @@ impl Run<'_> {
     }
 
     fn waypoints(&self, plan: &Plan) -> Vec<[f64; 2]> {
-        thin(&plan.points, self.config.waypoint_spacing_m, |a, b| {
-            clear(&self.world, a, b)
-        })
+        mission_waypoints(&plan.points, self.config.waypoint_spacing_m)
     }
 
     /// The window's shortest and curious plans, asked again every [`PLAN_RETRY`] while

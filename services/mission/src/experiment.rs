@@ -1,7 +1,8 @@
 //! `roam reproduce mission`: the papers joined, in batch (no network), over many seeded
 //! missions in the built-in world. Each mission is a downtime trip between two random
 //! free places with a budget of twice the shortest path's ETA; it is planned by the
-//! curious GA (paper 000, Model I), thinned into waypoints, and driven by the APF
+//! curious GA (paper 000, Model I), made into waypoints as the executive makes them
+//! (every turn of the cell path kept), and driven by the APF
 //! controller on the localization's estimates in the sim (paper 002), exactly the code
 //! the services run. What is compared is what the planner is given:
 //!
@@ -41,7 +42,7 @@ use roam_proto::planner::PlannerModel;
 use serde::Serialize;
 
 use crate::information::gathered;
-use crate::path::{clear, distance, thin};
+use crate::path::{distance, mission_waypoints};
 
 /// How much to run.
 #[derive(Debug, Clone)]
@@ -247,7 +248,7 @@ pub fn run(
                 _ => shortest.clone(),
             };
             let points = world.centers(&outcome.path);
-            let waypoints = thin(&points, 1.0, |a, b| clear(&world, a, b));
+            let waypoints = mission_waypoints(&points, 1.0);
             let robot = driving
                 .file
                 .robots

@@ -10,7 +10,7 @@
 //! the PEB along the way.
 //!
 //! - [`tasks`]: the task sequence and its checks; the built-in world's day.
-//! - [`path`]: thinning a planned path into waypoints; off-path distance; ETA slip.
+//! - [`path`]: a planned path's waypoints (every turn kept); off-path distance; ETA slip.
 //! - [`information`]: the information a path gathers, on the planner's own scale.
 //! - [`experiment`]: `roam reproduce mission`, the couplings compared in batch.
 //! - [`executive`]: the executive on Zenoh (a client of the planner, the controller,
