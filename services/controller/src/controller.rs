@@ -626,6 +626,7 @@ mod tests {
     fn path_params() -> ApfParams {
         ApfParams {
             follow: Follow::Path,
+            lookahead_m: 0.4,
             ..plain()
         }
     }
