@@ -102,6 +102,7 @@ impl PathTracker {
         })
     }
 
+    /// The polyline's points, in the order they are followed.
     pub fn points(&self) -> &[[f64; 2]] {
         &self.points
     }

@@ -85,6 +85,7 @@ pub struct ApfParams {
     /// passed, metres; `None` means g_thres (paper 002 §4 uses g_thres for every
     /// waypoint). A mission executive that hands over a planned path as many waypoints
     /// wants a looser value: only the last one is a place the robot must reach exactly.
+    /// Unused under `follow: path`, which passes no waypoint but follows the path.
     pub via_thres_m: Option<f64>,
     /// Updates a mission may take before it ends as `step_limit` (paper 002 §4).
     pub max_steps: u64,
