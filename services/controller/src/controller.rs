@@ -14,15 +14,23 @@
 //! Completed, Stuck and StepLimit are final: the robot gets zero commands until a new
 //! mission arrives. HaltedPeb is not: the robot is held while its PEB is above
 //! `max_peb_m` (or unbounded) and resumes when it is good again.
+//!
+//! What f_a pulls toward is the parameter `follow` ([`Follow`]): the current waypoint
+//! (paper 002), or the carrot of pure pursuit on the mission's path ([`crate::carrot`]),
+//! the polyline from where the robot was at the mission's first driven update through
+//! every waypoint. Either way f_Tr and f_is act and z_isa(ω) adapts (Eqs. 2–3), and
+//! progress for the stuck rule is the distance left: to the current waypoint (the
+//! record restarts at each waypoint), or along the path.
 
 use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
+use crate::carrot::PathTracker;
 use crate::forces::{command, Forces};
 use crate::information::InformationField;
 use crate::obstacle_field::ObstacleField;
-use crate::params::ApfParams;
+use crate::params::{ApfParams, Follow};
 
 /// Where a mission stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -59,9 +67,11 @@ pub struct Decision {
     /// The command u of paper 002 Eq. 3; zero unless `status` is Active.
     pub u: [f64; 2],
     pub status: MissionStatus,
-    /// Index of the current waypoint; `None` when idle or completed.
+    /// Index of the current waypoint (under `follow: path`, the first one ahead of the
+    /// robot's projection onto the path); `None` when idle or completed.
     pub waypoint: Option<usize>,
-    /// From the position to the current waypoint plus the remaining legs, metres; 0 when
+    /// From the position to the current waypoint plus the remaining legs (under
+    /// `follow: path`, to the projection plus the rest of the path), metres; 0 when
     /// completed or idle.
     pub distance_left_m: f64,
     /// Updates since the mission began (this one included).
@@ -93,6 +103,12 @@ pub struct Controller {
     checkpoint: Option<(f64, u64)>,
     /// Metres of the legs after the current waypoint.
     legs_after: Vec<f64>,
+    /// Under `follow: path`: the path being followed, from the mission's first driven
+    /// update on (`None` before it).
+    path: Option<PathTracker>,
+    /// Under `follow: path`: the mission's index of each path point after the first
+    /// (the robot's start), for [`Decision::waypoint`].
+    path_waypoints: Vec<usize>,
 }
 
 impl Controller {
@@ -114,10 +130,13 @@ impl Controller {
             halted_updates: 0,
             checkpoint: None,
             legs_after: Vec::new(),
+            path: None,
+            path_waypoints: Vec::new(),
         }
     }
 
-    /// Replaces the mission, at any time: the robot heads for the first waypoint, with
+    /// Replaces the mission, at any time: the robot heads for the first waypoint (under
+    /// `follow: path`, along the path from where it is at the next driven update), with
     /// the step count and the progress record reset. An empty mission makes it idle.
     pub fn set_mission(&mut self, waypoints: Vec<[f64; 2]>) {
         // legs_after[i]: the length of the route from waypoint i to the last one.
@@ -138,6 +157,8 @@ impl Controller {
         self.active_steps = 0;
         self.halted_updates = 0;
         self.checkpoint = None;
+        self.path = None;
+        self.path_waypoints.clear();
     }
 
     /// Ends the mission as if emptied: zero commands, status Idle.
@@ -173,9 +194,10 @@ impl Controller {
     }
 
     fn distance_left(&self, p: [f64; 2]) -> f64 {
-        match self.waypoints.get(self.current) {
-            Some(w) => (w[0] - p[0]).hypot(w[1] - p[1]) + self.legs_after[self.current],
-            None => 0.0,
+        match (self.waypoints.get(self.current), &self.path) {
+            (None, _) => 0.0,
+            (Some(_), Some(path)) => path.distance_left_m(p),
+            (Some(w), None) => (w[0] - p[0]).hypot(w[1] - p[1]) + self.legs_after[self.current],
         }
     }
 
@@ -203,11 +225,13 @@ impl Controller {
     ///
     /// In order: a final or idle mission gives a zero command and changes nothing; the
     /// step count rises; after `max_steps` updates the mission ends (StepLimit); a PEB
-    /// above `max_peb_m` or unbounded holds the robot (HaltedPeb); waypoints within
-    /// g_thres of `position` are passed (the next one becomes current in this same
-    /// update; after the last, Completed); no progress over the stuck window ends it
-    /// (Stuck); otherwise the command is Eq. 3 toward the current waypoint, with the IS
-    /// force evaluated at `position`.
+    /// above `max_peb_m` or unbounded holds the robot (HaltedPeb); then, by `follow`,
+    /// waypoints within g_thres of `position` are passed (the next one becomes current
+    /// in this same update; after the last, Completed) or the robot is projected onto
+    /// the path (the carrot at its end and the robot within g_thres of it: Completed);
+    /// no progress over the stuck window ends it (Stuck); otherwise the command is Eq. 3
+    /// toward the current waypoint or the carrot, with the IS force evaluated at
+    /// `position`.
     pub fn update(&mut self, position: [f64; 2], peb_m: Option<f64>) -> Decision {
         if self.status.is_final() || self.status == MissionStatus::Idle {
             return self.decision(position, None);
@@ -228,6 +252,17 @@ impl Controller {
         self.status = MissionStatus::Active;
         self.halted_updates = 0;
         self.active_steps += 1;
+        match self.params.follow {
+            Follow::Waypoints => self.toward_waypoint(position),
+            Follow::Path => self.along_path(position),
+        }
+    }
+
+    /// `follow: waypoints` (paper 002): waypoints within g_thres of `position` (or
+    /// `via_thres_m`, but the last) are passed, the next one becoming current in this
+    /// same update (after the last, Completed); no progress toward the current one over
+    /// the stuck window ends the mission (Stuck); otherwise Eq. 3 toward it.
+    fn toward_waypoint(&mut self, position: [f64; 2]) -> Decision {
         while let Some(&w) = self.waypoints.get(self.current) {
             let last = self.current + 1 == self.waypoints.len();
             let reach = match self.params.via_thres_m {
@@ -245,16 +280,9 @@ impl Controller {
             return self.decision(position, None);
         };
         let distance = (waypoint[0] - position[0]).hypot(waypoint[1] - position[1]);
-        match self.checkpoint {
-            None => self.checkpoint = Some((distance, self.active_steps)),
-            Some((best, _)) if distance <= best - self.params.stuck_min_progress_m => {
-                self.checkpoint = Some((distance, self.active_steps));
-            }
-            Some((_, since)) if self.active_steps - since >= self.params.stuck_window_steps => {
-                self.status = MissionStatus::Stuck;
-                return self.decision(position, None);
-            }
-            Some(_) => {}
+        if self.no_progress(distance) {
+            self.status = MissionStatus::Stuck;
+            return self.decision(position, None);
         }
         let forces = command(
             &self.params,
@@ -264,6 +292,91 @@ impl Controller {
             waypoint,
         );
         self.decision(position, Some(&forces))
+    }
+
+    /// `follow: path` ([`crate::carrot`]): the path is the polyline from `position` at
+    /// the mission's first driven update through the waypoints (one that is not a
+    /// finite point is left out, as `waypoints` passes it at once). The robot is
+    /// projected onto it, forward only; with the carrot at the last point and the robot
+    /// within g_thres of it, Completed; no progress along the path over the stuck
+    /// window, Stuck; otherwise Eq. 3 with f_a toward the carrot.
+    fn along_path(&mut self, position: [f64; 2]) -> Decision {
+        if self.path.is_none() {
+            let (indices, points): (Vec<usize>, Vec<[f64; 2]>) = self
+                .waypoints
+                .iter()
+                .enumerate()
+                .filter(|(_, w)| w[0].is_finite() && w[1].is_finite())
+                .map(|(i, &w)| (i, w))
+                .unzip();
+            if points.is_empty() {
+                // Nothing to drive to: as `waypoints` passes every such waypoint.
+                self.current = self.waypoints.len();
+                self.status = MissionStatus::Completed;
+                return self.decision(position, None);
+            }
+            // `position` is finite here (`update` holds a robot that is not), and so is
+            // every point: the tracker cannot refuse the path.
+            match PathTracker::new(std::iter::once(position).chain(points).collect()) {
+                Ok(path) => self.path = Some(path),
+                Err(e) => {
+                    tracing::warn!("the mission's path cannot be followed: {e}");
+                    self.clear();
+                    return self.decision(position, None);
+                }
+            }
+            self.path_waypoints = indices;
+        }
+        let (lookahead, window) = (self.params.lookahead_m, self.params.window_m());
+        let Some(path) = self.path.as_mut() else {
+            return self.decision(position, None);
+        };
+        let pursuit = path.pursue(position, lookahead, window);
+        let Some(&end) = path.points().last() else {
+            return self.decision(position, None);
+        };
+        // Path point k ≥ 1 is mission waypoint path_waypoints[k − 1].
+        self.current = pursuit
+            .next_point
+            .checked_sub(1)
+            .and_then(|k| self.path_waypoints.get(k))
+            .copied()
+            .unwrap_or(0);
+        if pursuit.at_end
+            && (end[0] - position[0]).hypot(end[1] - position[1]) <= self.params.g_thres_m
+        {
+            self.current = self.waypoints.len();
+            self.status = MissionStatus::Completed;
+            return self.decision(position, None);
+        }
+        if self.no_progress(pursuit.distance_left_m) {
+            self.status = MissionStatus::Stuck;
+            return self.decision(position, None);
+        }
+        let forces = command(
+            &self.params,
+            &self.obstacles,
+            &self.information,
+            position,
+            pursuit.carrot,
+        );
+        self.decision(position, Some(&forces))
+    }
+
+    /// The stuck rule: whether `distance` (what is left to drive) has not improved by
+    /// `stuck_min_progress_m` on its best over `stuck_window_steps` unhalted updates.
+    fn no_progress(&mut self, distance: f64) -> bool {
+        match self.checkpoint {
+            None => self.checkpoint = Some((distance, self.active_steps)),
+            Some((best, _)) if distance <= best - self.params.stuck_min_progress_m => {
+                self.checkpoint = Some((distance, self.active_steps));
+            }
+            Some((_, since)) if self.active_steps - since >= self.params.stuck_window_steps => {
+                return true;
+            }
+            Some(_) => {}
+        }
+        false
     }
 }
 
@@ -508,5 +621,160 @@ mod tests {
         assert!((d.u[1] - 0.8 * f_is[1]).abs() < 1e-12);
         assert!((d.omega_deg - crate::forces::omega_deg([1.0, 0.0], f_is)).abs() < 1e-12);
         assert_eq!(d.z_isa, 0.8);
+    }
+
+    fn path_params() -> ApfParams {
+        ApfParams {
+            follow: Follow::Path,
+            lookahead_m: 0.4,
+            ..plain()
+        }
+    }
+
+    #[test]
+    fn under_follow_path_f_a_pulls_toward_the_carrot_along_the_path() {
+        let mut c = controller(path_params());
+        // An L from where the robot is: east 4 m, then north 4 m.
+        c.set_mission(vec![[22.0, 20.0], [24.0, 20.0], [24.0, 24.0]]);
+        let d = c.update([20.0, 20.0], GOOD);
+        assert_eq!((d.status, d.waypoint), (MissionStatus::Active, Some(0)));
+        // On the path: the carrot is 0.4 m ahead, straight east.
+        assert!(
+            (d.u[0] - 1.0).abs() < 1e-12 && d.u[1].abs() < 1e-12,
+            "{:?}",
+            d.u
+        );
+        assert!((d.distance_left_m - 8.0).abs() < 1e-12);
+        // A step at a time (the projection moves at most 2 L = 0.8 m per update), then
+        // 0.3 m north of the first leg at x = 21: the carrot (21.4, 20) pulls back
+        // toward the path, where f_a toward the waypoint (22, 20) would cut across.
+        c.update([20.4, 20.0], GOOD);
+        c.update([20.8, 20.0], GOOD);
+        let d = c.update([21.0, 20.3], GOOD);
+        let expect = crate::forces::attractive([21.0, 20.3], [21.4, 20.0]);
+        assert!((d.u[0] - expect[0]).abs() < 1e-12 && (d.u[1] - expect[1]).abs() < 1e-12);
+        assert!((d.distance_left_m - (0.3 + 7.0)).abs() < 1e-12);
+        // Next to the corner: the carrot is round it and the reported waypoint is the one
+        // ahead of the projection.
+        for x in [21.6, 22.4, 23.2] {
+            c.update([x, 20.0], GOOD);
+        }
+        let d = c.update([23.9, 20.0], GOOD);
+        assert_eq!(d.waypoint, Some(1));
+        let expect = crate::forces::attractive([23.9, 20.0], [24.0, 20.3]);
+        assert!((d.u[0] - expect[0]).abs() < 1e-12 && (d.u[1] - expect[1]).abs() < 1e-12);
+        c.update([24.0, 20.4], GOOD);
+        let d = c.update([24.0, 21.0], GOOD);
+        assert_eq!(d.waypoint, Some(2));
+        assert!((d.u[1] - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn under_follow_path_the_mission_completes_at_the_last_point_only() {
+        let mut c = controller(path_params());
+        // Out 3 m and back to 0.05 m from the start: the start is within g_thres of the
+        // last point, but the carrot is not at the end yet.
+        c.set_mission(vec![
+            [23.0, 20.0],
+            [23.0, 20.5],
+            [20.05, 20.5],
+            [20.05, 20.05],
+        ]);
+        let d = c.update([20.0, 20.0], GOOD);
+        assert_eq!(d.status, MissionStatus::Active);
+        // Along the way, then within g_thres of the end with the carrot there.
+        for x in [20.4, 20.8, 21.2, 21.6, 22.0, 22.4, 22.8] {
+            assert_eq!(c.update([x, 20.0], GOOD).status, MissionStatus::Active);
+        }
+        for p in [
+            [23.0, 20.2],
+            [22.6, 20.5],
+            [22.2, 20.5],
+            [21.8, 20.5],
+            [21.4, 20.5],
+        ] {
+            assert_eq!(c.update(p, GOOD).status, MissionStatus::Active);
+        }
+        for x in [21.0, 20.6, 20.2] {
+            assert_eq!(c.update([x, 20.5], GOOD).status, MissionStatus::Active);
+        }
+        // 0.11 m short is not reached; 0.09 m is.
+        assert_eq!(c.update([20.05, 20.16], GOOD).status, MissionStatus::Active);
+        let d = c.update([20.05, 20.14], GOOD);
+        assert_eq!(d.status, MissionStatus::Completed);
+        assert_eq!(
+            (d.u, d.waypoint, d.distance_left_m),
+            ([0.0, 0.0], None, 0.0)
+        );
+        // A one-waypoint mission where the robot stands is complete at once.
+        c.set_mission(vec![[20.05, 20.0]]);
+        assert_eq!(
+            c.update([20.0, 20.0], GOOD).status,
+            MissionStatus::Completed
+        );
+    }
+
+    #[test]
+    fn under_follow_path_progress_along_the_path_is_what_the_stuck_rule_counts() {
+        let mut c = controller(ApfParams {
+            stuck_window_steps: 10,
+            stuck_min_progress_m: 0.25,
+            ..path_params()
+        });
+        c.set_mission(vec![[30.0, 20.0]]);
+        // Sideways on the spot (no progress along the path): stuck after the window.
+        for k in 0..10 {
+            let y = if k % 2 == 0 { 20.1 } else { 19.9 };
+            assert_eq!(
+                c.update([20.0, y], GOOD).status,
+                MissionStatus::Active,
+                "{k}"
+            );
+        }
+        assert_eq!(c.update([20.0, 20.1], GOOD).status, MissionStatus::Stuck);
+        // 0.3 m along the path per 9 updates: never stuck.
+        c.set_mission(vec![[40.0, 20.0]]);
+        for k in 0..150 {
+            let x = 10.0 + 0.3 * (k / 9) as f64;
+            assert_eq!(
+                c.update([x, 20.0], GOOD).status,
+                MissionStatus::Active,
+                "{k}"
+            );
+        }
+    }
+
+    #[test]
+    fn under_follow_path_a_waypoint_that_is_not_finite_is_left_out() {
+        let mut c = controller(path_params());
+        c.set_mission(vec![[f64::NAN, 0.0], [22.0, 20.0]]);
+        let d = c.update([20.0, 20.0], GOOD);
+        assert_eq!((d.status, d.waypoint), (MissionStatus::Active, Some(1)));
+        assert!((d.u[0] - 1.0).abs() < 1e-12);
+        c.set_mission(vec![[f64::INFINITY, 0.0]]);
+        assert_eq!(
+            c.update([20.0, 20.0], GOOD).status,
+            MissionStatus::Completed
+        );
+    }
+
+    #[test]
+    fn under_follow_path_the_path_starts_where_the_first_driven_update_is() {
+        let mut c = controller(path_params());
+        c.set_mission(vec![[24.0, 20.0]]);
+        // Held for the PEB at first: the path starts at the first update that drives.
+        assert_eq!(
+            c.update([10.0, 10.0], None).status,
+            MissionStatus::HaltedPeb
+        );
+        let d = c.update([20.0, 24.0], GOOD);
+        // The carrot is 0.4 m along the segment (20, 24) → (24, 20): diagonal.
+        let s = std::f64::consts::FRAC_1_SQRT_2;
+        assert!(
+            (d.u[0] - s).abs() < 1e-12 && (d.u[1] + s).abs() < 1e-12,
+            "{:?}",
+            d.u
+        );
+        assert!((d.distance_left_m - 32f64.sqrt()).abs() < 1e-12);
     }
 }

@@ -8,7 +8,8 @@
 //! u = z_a · f_a + z_r · f_Tr + z_isa(ω) · f_is
 //! ```
 //!
-//! with f_a the unit vector to the current waypoint, f_Tr Khatib's repulsion of the
+//! with f_a the unit vector to the current waypoint (or, under `follow: path`, to the
+//! carrot of pure pursuit on the mission's path: [`carrot`]), f_Tr Khatib's repulsion of the
 //! nearest obstacle, f_is the unit vector down the PEB's slope, and z_isa(ω) the
 //! information-seeking weight that adapts to the angle ω between f_a and f_is (Eq. 2).
 //! The Zenoh service ([`service`], a thin adapter) and the batch [`episode`] run the
@@ -16,7 +17,8 @@
 //!
 //! | module | what it holds |
 //! |---|---|
-//! | [`params`] | [`ApfParams`]: paper 002 §4's values as defaults, roam's safety parameters, checks |
+//! | [`params`] | [`ApfParams`]: paper 002 §4's values as defaults, roam's safety and path-following parameters, checks |
+//! | [`carrot`] | pure pursuit on the mission's path: the forward-only projection and the carrot f_a pulls toward under `follow: path` |
 //! | [`weights`] | [`Scheme`] and z_isa(ω) (Eq. 2) |
 //! | [`forces`] | f_a, f_Tr, f_is's combination, ω, the command u (Eq. 3) |
 //! | [`obstacle_field`] | η and the direction away from the nearest obstacle, from the exact EDT, built once per map |
@@ -57,6 +59,7 @@
 //!   their comments say which. ES3's random missions are sampled as
 //!   [`experiments::es3`] documents.
 
+pub mod carrot;
 pub mod controller;
 pub mod episode;
 pub mod experiments;
@@ -72,5 +75,5 @@ pub use controller::{Controller, Decision, MissionStatus};
 pub use episode::{run_episode, Episode, PositionSource, RobotMission, RobotTrack, Setup};
 pub use information::InformationField;
 pub use obstacle_field::ObstacleField;
-pub use params::{ApfParams, ParamError};
+pub use params::{ApfParams, Follow, ParamError};
 pub use weights::{is_weight, Scheme};

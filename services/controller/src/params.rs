@@ -2,7 +2,7 @@
 //! parameters (not in the paper) say when a mission is given up. Every value is checked
 //! by [`ApfParams::check`], which names the parameter and its allowed range.
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::weights::Scheme;
 
@@ -30,6 +30,39 @@ pub const DEFAULT_MAX_PEB_M: f64 = 2.0;
 pub const DEFAULT_STUCK_WINDOW_STEPS: u64 = 300;
 /// roam's least progress over the stuck window, metres (not in paper 002).
 pub const DEFAULT_STUCK_MIN_PROGRESS_M: f64 = 0.25;
+/// Paper 002 §4's step size μ = 0.2 m (Eq. 1), also the built-in world's (roam-sim's
+/// default `step_mu`, with a top speed of 0.2 m per step).
+pub const PAPER_STEP_MU_M: f64 = 0.2;
+/// The carrot's lookahead L under `follow: path`, metres: one and a half steps μ (0.3 m,
+/// one and a half cells of the built-in world's 0.2 m grid). More than a step, so the
+/// robot does not reach its carrot in one step on a straight stretch and the estimate's
+/// noise (σ about 0.1 m) does not steer every step; short enough that the GA's one-cell
+/// detours are driven and not smoothed away, and that the IS force (z_is 0.3 indoors,
+/// at right angles to the path) holds the robot at most about L·z_is/√(1 − z_is²) ≈
+/// 0.09 m off it. Measured in the built-in world (`roam reproduce mission`, the median
+/// of driven / planned information): 0.2 m gathers slightly more but wiggles (7% more
+/// steps on a straight line), 0.4 m cuts the small detours (0.945 against 0.987).
+pub const DEFAULT_LOOKAHEAD_M: f64 = 0.3;
+/// The projection's search window under `follow: path`, in lookaheads: each update
+/// searches at most 2 L of the path ahead of the last projection.
+pub const WINDOW_LOOKAHEADS: f64 = 2.0;
+
+/// What the attractive force pulls toward (roam's choice; paper 002 §3 has the first).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Follow {
+    /// Paper 002 §3: f_a toward the current waypoint; a waypoint within g_thres (or
+    /// `via_thres_m`) is passed and the next becomes current. Straight between
+    /// waypoints: the paper's experiments (ES1–ES3) and missions whose waypoints are
+    /// places.
+    Waypoints,
+    /// Pure pursuit on the path ([`crate::carrot`]): f_a toward the carrot `lookahead_m`
+    /// ahead, along the polyline from the robot's position at the mission's start
+    /// through its waypoints, of the robot's projection onto it (searched forward
+    /// only). Complete within g_thres of the last point. For missions that are a planned
+    /// path, which should be driven as planned (the mission executive's).
+    Path,
+}
 
 /// The largest step limit a mission may have.
 pub const MAX_MAX_STEPS: u64 = 10_000_000;
@@ -52,6 +85,7 @@ pub struct ApfParams {
     /// passed, metres; `None` means g_thres (paper 002 §4 uses g_thres for every
     /// waypoint). A mission executive that hands over a planned path as many waypoints
     /// wants a looser value: only the last one is a place the robot must reach exactly.
+    /// Unused under `follow: path`, which passes no waypoint but follows the path.
     pub via_thres_m: Option<f64>,
     /// Updates a mission may take before it ends as `step_limit` (paper 002 §4).
     pub max_steps: u64,
@@ -73,8 +107,17 @@ pub struct ApfParams {
     /// improved by `stuck_min_progress_m` over this many (unhalted) updates, the mission
     /// ends as `stuck` (a local minimum or an oscillation).
     pub stuck_window_steps: u64,
-    /// See `stuck_window_steps`, metres.
+    /// See `stuck_window_steps`, metres. Under `follow: path` the distance is the one
+    /// left along the path (from the robot to its projection, then the rest).
     pub stuck_min_progress_m: f64,
+    /// How the mission is followed: `waypoints` (paper 002, the default) or `path`
+    /// (pure pursuit on the polyline; roam's mission executive).
+    pub follow: Follow,
+    /// L, the carrot's lookahead along the path under `follow: path`, metres
+    /// ([`DEFAULT_LOOKAHEAD_M`]: 1.5 steps μ, 0.3 m). It should be more than the
+    /// robot's longest step (the sim's top speed per step), which the projection's
+    /// window (2 L per update) then also exceeds. Unused under `waypoints`.
+    pub lookahead_m: f64,
 }
 
 impl Default for ApfParams {
@@ -93,6 +136,8 @@ impl Default for ApfParams {
             max_peb_m: DEFAULT_MAX_PEB_M,
             stuck_window_steps: DEFAULT_STUCK_WINDOW_STEPS,
             stuck_min_progress_m: DEFAULT_STUCK_MIN_PROGRESS_M,
+            follow: Follow::Waypoints,
+            lookahead_m: DEFAULT_LOOKAHEAD_M,
         }
     }
 }
@@ -121,14 +166,18 @@ impl ApfParams {
     /// the attraction). Here the repulsion reaches 0.6 m, the robot's radius plus a
     /// margin (a planned path already keeps the inflation radius from walls), and IS is
     /// gentle (z_is 0.3): the building's anchors cover it well. A mission executive
-    /// hands a planned path over as many waypoints, and only the last is a place to
-    /// reach exactly (`via_thres_m` 0.5 m).
+    /// hands a planned path over as many waypoints, to be driven as planned: the path is
+    /// followed as a path (`follow: path`, L = [`DEFAULT_LOOKAHEAD_M`]), and only the
+    /// last point is a place to reach exactly. Under `follow: waypoints` the other
+    /// waypoints are passed within `via_thres_m` 0.5 m.
     pub fn indoor() -> ApfParams {
         ApfParams {
             eta_thres_m: 0.6,
             z_r: 0.05,
             z_is: 0.3,
             via_thres_m: Some(0.5),
+            follow: Follow::Path,
+            lookahead_m: DEFAULT_LOOKAHEAD_M,
             ..ApfParams::default()
         }
     }
@@ -196,7 +245,19 @@ impl ApfParams {
             self.stuck_min_progress_m,
             self.stuck_min_progress_m >= 0.0 && self.stuck_min_progress_m <= 1e4,
             "0 to 1e4 metres",
+        )?;
+        check(
+            "lookahead_m",
+            self.lookahead_m,
+            self.lookahead_m > 0.0 && self.lookahead_m <= 1e4,
+            "more than 0 up to 1e4 metres",
         )
+    }
+
+    /// The projection's search window under `follow: path`, metres
+    /// ([`WINDOW_LOOKAHEADS`] · L).
+    pub fn window_m(&self) -> f64 {
+        WINDOW_LOOKAHEADS * self.lookahead_m
     }
 }
 
@@ -210,7 +271,12 @@ mod tests {
         assert_eq!((p.z_a, p.z_r, p.eta_thres_m), (1.0, 20.0, 3.0));
         assert_eq!((p.g_thres_m, p.max_steps, p.z_is), (0.10, 10_000, 0.8));
         assert_eq!((p.omega_t_deg, p.cutoff_keep), (90.0, 0.0));
+        assert_eq!((p.follow, p.lookahead_m), (Follow::Waypoints, 0.3));
+        assert!((DEFAULT_LOOKAHEAD_M - 1.5 * PAPER_STEP_MU_M).abs() < 1e-12);
         assert_eq!(p.check(), Ok(()));
+        let indoor = ApfParams::indoor();
+        assert_eq!((indoor.follow, indoor.lookahead_m), (Follow::Path, 0.3));
+        assert_eq!(indoor.check(), Ok(()));
     }
 
     #[test]
@@ -288,6 +354,9 @@ mod tests {
             }),
             Some("stuck_window_steps")
         );
+        for lookahead_m in [0.0, -0.4, f64::INFINITY, f64::NAN] {
+            assert_eq!(bad(ApfParams { lookahead_m, ..d() }), Some("lookahead_m"));
+        }
         let e = ApfParams {
             cutoff_keep: 2.0,
             ..d()
@@ -310,5 +379,9 @@ mod tests {
         assert_eq!(p.z_r, 20.0);
         assert!(serde_json::from_str::<ApfParams>(r#"{"zis": 0.9}"#).is_err());
         assert!(serde_json::from_str::<ApfParams>(r#"{"scheme": "spline"}"#).is_err());
+        let p: ApfParams =
+            serde_json::from_str(r#"{"follow": "path", "lookahead_m": 0.6}"#).expect("parse");
+        assert_eq!((p.follow, p.lookahead_m), (Follow::Path, 0.6));
+        assert!(serde_json::from_str::<ApfParams>(r#"{"follow": "carrot"}"#).is_err());
     }
 }

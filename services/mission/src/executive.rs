@@ -34,7 +34,7 @@ use zenoh::qos::CongestionControl;
 use crate::calibration::{store, Calibration, CalibrationConfig, Sample, Stretch, TimeModel};
 use crate::information::gathered;
 use crate::inputs::{listen, lock, wait_for_world, Inputs};
-use crate::path::{clear, thin};
+use crate::path::mission_waypoints;
 use crate::tasks::{self, Task, TaskError};
 use crate::watch::{Decision, Reason, Status, Watch, WatchParams};
 
@@ -323,9 +323,7 @@ impl Run<'_> {
     }
 
     fn waypoints(&self, plan: &Plan) -> Vec<[f64; 2]> {
-        thin(&plan.points, self.config.waypoint_spacing_m, |a, b| {
-            clear(&self.world, a, b)
-        })
+        mission_waypoints(&plan.points, self.config.waypoint_spacing_m)
     }
 
     /// The window's shortest and curious plans, asked again every [`PLAN_RETRY`] while

@@ -1,7 +1,8 @@
 //! `roam reproduce mission`: the papers joined, in batch (no network), over many seeded
 //! missions in the built-in world. Each mission is a downtime trip between two random
 //! free places with a budget of twice the shortest path's ETA; it is planned by the
-//! curious GA (paper 000, Model I), thinned into waypoints, and driven by the APF
+//! curious GA (paper 000, Model I), made into waypoints as the executive makes them
+//! (every turn of the cell path kept), and driven by the APF
 //! controller on the localization's estimates in the sim (paper 002), exactly the code
 //! the services run. What is compared is what the planner is given:
 //!
@@ -16,7 +17,9 @@
 //!
 //! Measured per mission: the information of the distinct cells seen along the path the
 //! robot really drove (paper 000's measure on the static map, for every variant), whether
-//! it arrived within the budget, and the mean PEB at its true positions.
+//! it arrived within the budget, and the mean PEB at its true positions; and, against
+//! what the plan promised on the same measure, driven / planned information per mission
+//! and its median (how closely the plan was driven as planned).
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
@@ -39,7 +42,7 @@ use roam_proto::planner::PlannerModel;
 use serde::Serialize;
 
 use crate::information::gathered;
-use crate::path::{clear, distance, thin};
+use crate::path::{distance, mission_waypoints};
 
 /// How much to run.
 #[derive(Debug, Clone)]
@@ -75,6 +78,32 @@ pub struct VariantResult {
     pub peb_mean_m: f64,
     /// Mean information of the planned paths (what the planner promised).
     pub planned_information: f64,
+    /// Each mission's information, driven and planned, in the missions' order.
+    pub per_mission: Vec<MissionInformation>,
+    /// The median over the missions of driven / planned information (the missions whose
+    /// plan promised any); `None` when none did.
+    pub driven_over_planned_median: Option<f64>,
+}
+
+/// One mission's information: what the robot drove against what the plan promised.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct MissionInformation {
+    pub driven: f64,
+    pub planned: f64,
+    /// driven / planned; `None` when the plan promised nothing.
+    pub driven_over_planned: Option<f64>,
+}
+
+/// The median of `values` (the mean of the middle two for an even count); `None` when
+/// empty.
+fn median(mut values: Vec<f64>) -> Option<f64> {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    match n {
+        0 => None,
+        _ if n % 2 == 1 => Some(values[n / 2]),
+        _ => Some((values[n / 2 - 1] + values[n / 2]) / 2.0),
+    }
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -175,6 +204,7 @@ pub fn run(
         .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let mut sums = [[0.0f64; 4]; VARIANTS.len()];
+    let mut per_mission: [Vec<MissionInformation>; VARIANTS.len()] = Default::default();
     for mission in 0..options.missions {
         let pick = |rng: &mut ChaCha8Rng| {
             let c = free[rng.random_range(0..free.len())];
@@ -218,7 +248,7 @@ pub fn run(
                 _ => shortest.clone(),
             };
             let points = world.centers(&outcome.path);
-            let waypoints = thin(&points, 1.0, |a, b| clear(&world, a, b));
+            let waypoints = mission_waypoints(&points, 1.0);
             let robot = driving
                 .file
                 .robots
@@ -250,10 +280,17 @@ pub fn run(
             } else {
                 pebs.iter().sum::<f64>() / pebs.len() as f64
             };
-            sums[v][0] += gathered(&world, &params, &track.truth);
+            let driven = gathered(&world, &params, &track.truth);
+            let planned = outcome.metrics.distinct_information;
+            sums[v][0] += driven;
             sums[v][1] += f64::from(u8::from(on_time));
             sums[v][2] += peb;
-            sums[v][3] += outcome.metrics.distinct_information;
+            sums[v][3] += planned;
+            per_mission[v].push(MissionInformation {
+                driven,
+                planned,
+                driven_over_planned: (planned > 0.0).then(|| driven / planned),
+            });
         }
         progress(mission + 1, options.missions);
     }
@@ -264,12 +301,20 @@ pub fn run(
         variants: VARIANTS
             .iter()
             .zip(sums)
-            .map(|(variant, s)| VariantResult {
+            .zip(per_mission)
+            .map(|((variant, s), per_mission)| VariantResult {
                 variant,
                 information: s[0] / n,
                 on_time_share: s[1] / n,
                 peb_mean_m: s[2] / n,
                 planned_information: s[3] / n,
+                driven_over_planned_median: median(
+                    per_mission
+                        .iter()
+                        .filter_map(|m| m.driven_over_planned)
+                        .collect(),
+                ),
+                per_mission,
             })
             .collect(),
     })
@@ -282,18 +327,34 @@ pub fn table(r: &MissionReproduction) -> String {
         r.missions
     );
     out.push_str(&format!(
-        "{:<10} {:>12} {:>12} {:>14} {:>12}\n",
-        "variant", "information", "on time", "mean PEB m", "planned I"
+        "{:<10} {:>12} {:>12} {:>14} {:>12} {:>16}\n",
+        "variant", "information", "on time", "mean PEB m", "planned I", "driven/planned"
     ));
     for v in &r.variants {
+        let ratio = v
+            .driven_over_planned_median
+            .map_or_else(|| "-".to_owned(), |m| format!("{m:.3}"));
         out.push_str(&format!(
-            "{:<10} {:>12.0} {:>11.0}% {:>14.3} {:>12.0}\n",
+            "{:<10} {:>12.0} {:>11.0}% {:>14.3} {:>12.0} {:>16}\n",
             v.variant,
             v.information,
             v.on_time_share * 100.0,
             v.peb_mean_m,
-            v.planned_information
+            v.planned_information,
+            ratio
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::median;
+
+    #[test]
+    fn the_median_of_odd_even_and_no_values() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), Some(2.5));
+        assert_eq!(median(Vec::new()), None);
+    }
 }

@@ -12,7 +12,7 @@
 //! - [`tasks`]: the task sequence and its checks; the built-in world's day.
 //! - [`calibration`]: paper 000's time model (Eq. 2's v_lin, v_ang) fitted to what the
 //!   robot drove, with Table I as the prior, kept per robot in a small file.
-//! - [`path`]: thinning a planned path into waypoints; off-path distance; ETA slip.
+//! - [`path`]: a planned path's waypoints (every turn kept); off-path distance; ETA slip.
 //! - [`watch`]: the replan policy of a window (arrived, given up, lost mission, blocked,
 //!   late, pushed off the path, slack), a plain state machine.
 //! - [`information`]: the information a path gathers, on the planner's own scale.

@@ -6,7 +6,7 @@ use std::fmt::Write;
 use serde::Serialize;
 
 use super::{Es2Row, Reproduction};
-use crate::params::{ApfParams, DEFAULT_MAX_STEPS};
+use crate::params::{ApfParams, Follow, DEFAULT_MAX_STEPS};
 use crate::weights::Scheme;
 
 /// ES1 as paper 002 §4 reports it (`None`: not reported).
@@ -112,10 +112,14 @@ pub const PAPER_ES2: [&str; 4] = [
 /// stuck rule off (`stuck_window_steps = max_steps`), since the paper runs every mission
 /// until it completes or reaches max_steps. The PEB guard stays on: it is how a robot
 /// that lost its fix "cannot complete its mission" (ES1); a robot held for it is given up
-/// after the same window, i.e. at max_steps.
+/// after the same window, i.e. at max_steps. The robot moves toward each waypoint in
+/// turn, as paper 002 §3 has it (`follow: waypoints`, explicitly: its experiments are
+/// about where the IS force takes the robot between waypoints, which following a path
+/// between them would undo).
 pub fn paper_params() -> ApfParams {
     ApfParams {
         stuck_window_steps: DEFAULT_MAX_STEPS,
+        follow: Follow::Waypoints,
         ..ApfParams::default()
     }
 }
@@ -323,6 +327,7 @@ mod tests {
     fn the_reproduction_runs_without_the_stuck_rule() {
         let p = paper_params();
         assert_eq!(p.stuck_window_steps, p.max_steps);
+        assert_eq!(p.follow, Follow::Waypoints);
         assert_eq!(p.check(), Ok(()));
     }
 }
