@@ -413,7 +413,7 @@ impl Run<'_> {
         stretches: &[Stretch],
         window_s: f64,
     ) -> Option<TimeModelReport> {
-        let config = self.calibration.config().clone();
+        let config = *self.calibration.config();
         let error = match model.window_error(stretches, &config) {
             Ok(e) => e,
             Err(e) => {
