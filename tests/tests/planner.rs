@@ -384,7 +384,11 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
         "{} bytes",
         quoted.message.len()
     );
-    assert!(quoted.message.contains("bytes cut"), "{}", quoted.message);
+    assert!(
+        quoted.message.contains("(50076 bytes)"),
+        "{}",
+        quoted.message
+    );
 
     let version = refusal(
         &client,

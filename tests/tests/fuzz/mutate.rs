@@ -89,6 +89,11 @@ pub(crate) fn json_edit(rng: &mut ChaCha8Rng, base: &[u8]) -> Vec<u8> {
     let Ok(mut value) = serde_json::from_slice::<serde_json::Value>(base) else {
         return base.to_vec();
     };
+    // Indexing a JSON value that is not an object panics (serde_json's `IndexMut`):
+    // a base that is a bare number or string (a mutation of a mutation) is left alone.
+    if !value.is_object() {
+        return base.to_vec();
+    }
     match rng.random_range(0..8) {
         0 => {
             value["v"] = match rng.random_range(0..6) {

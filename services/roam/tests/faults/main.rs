@@ -62,7 +62,11 @@ async fn every_service_killed_in_turn_comes_back_and_the_mission_completes() {
     let mission = std::fs::read_to_string(repo("config/mission.yaml"))
         .expect("config/mission.yaml")
         .replace("root: roam", &format!("root: {}", fleet.root))
-        .replace("executive:\n", "executive:\n  slack_s: .inf\n");
+        .replace("slack_s: 10.0", "slack_s: .inf");
+    assert!(
+        mission.contains("slack_s: .inf"),
+        "config/mission.yaml sets slack_s"
+    );
     let mission = write(&dir, "mission.yaml", &mission);
     let roles = vec![
         role(
