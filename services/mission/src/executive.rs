@@ -31,7 +31,7 @@ use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
 use zenoh::qos::CongestionControl;
 
-use crate::calibration::{store, Calibration, CalibrationConfig, Sample, Stretch, TimeModel};
+use crate::calibration::{path_measure, store, Calibration, CalibrationConfig, TimeModel};
 use crate::information::gathered;
 use crate::inputs::{listen, lock, wait_for_world, Inputs};
 use crate::path::mission_waypoints;
@@ -172,6 +172,11 @@ pub enum Progress {
 /// How often the executive asks again for a window's first plans when none came.
 const PLAN_RETRY: Duration = Duration::from_secs(1);
 
+/// A curious plan is expected to take this times the slowest recent one, plus
+/// [`PLAN_WALL_SLACK_S`].
+const PLAN_WALL_MARGIN: f64 = 1.5;
+const PLAN_WALL_SLACK_S: f64 = 0.05;
+
 /// How long the executive waits for the sim's clock at its start.
 const CLOCK_WAIT: Duration = Duration::from_secs(2);
 
@@ -215,6 +220,8 @@ struct Run<'a> {
     missions_sent: u64,
     /// The robot's time model, fitted as it drives.
     calibration: Calibration,
+    /// Wall seconds the recent curious plans took (request to reply), the slowest.
+    plan_wall_s: std::sync::Mutex<Option<f64>>,
     /// This executive's own tag in its mission ids (from its Zenoh session id), so a
     /// restarted executive never reuses an id its predecessor sent: the controller's
     /// statuses on an old mission are not taken for a new one's.
@@ -249,9 +256,16 @@ impl Run<'_> {
         }
     }
 
-    /// What planning costs on the mission clock.
+    /// What a curious plan costs on the mission clock: the wall time the last ones
+    /// took (with a margin; the deadline until one was measured) at the clock's rate.
+    /// Charging the whole deadline would waste it whenever the GA ends sooner (its
+    /// generations, on a small map): at a sim running 20x, a 1 s deadline is 20 s of
+    /// downtime the robot would wait through.
     fn planning_cost_s(&self) -> f64 {
-        self.config.plan_deadline_s * lock(&self.inputs.clock).rate()
+        let wall = lock(&self.plan_wall_s).map_or(self.config.plan_deadline_s, |w| {
+            (w * PLAN_WALL_MARGIN + PLAN_WALL_SLACK_S).min(self.config.plan_deadline_s)
+        });
+        wall * lock(&self.inputs.clock).rate()
     }
 
     async fn plan(
@@ -277,7 +291,15 @@ impl Run<'_> {
             seed: self.config.seed,
             map_version: None,
         };
-        self.planner.plan(&request).await
+        let asked = Instant::now();
+        let plan = self.planner.plan(&request).await?;
+        if model != PlannerModel::Shortest {
+            let took = asked.elapsed().as_secs_f64();
+            let mut slowest = lock(&self.plan_wall_s);
+            // The slowest of the recent plans, forgetting slowly.
+            *slowest = Some(slowest.map_or(took, |w| took.max(0.8 * w)));
+        }
+        Ok(plan)
     }
 
     /// The curious plan for the budget, or the shortest when curiosity does not fit.
@@ -403,54 +425,52 @@ impl Run<'_> {
         }
     }
 
-    /// What the window's driving says about the time model: how well `model` (the one
-    /// the window was planned with) predicted it, for the report; and, when calibrating,
-    /// the fit updated with it and kept in the calibration file.
+    /// What the window's last mission says about the time model: the plan it drove
+    /// (its Σd and Σθ as Eq. 2 counts them on the cells) and how long driving it took.
+    /// Reported against what `model` (the one the window was planned with) predicted;
+    /// when calibrating, the fit learns from it and is kept in the calibration file.
     fn learn(
         &mut self,
         window: usize,
         model: &TimeModel,
-        stretches: &[Stretch],
+        drive: Option<(&[[f64; 2]], f64)>,
+        driving_s: f64,
         window_s: f64,
-    ) -> Option<TimeModelReport> {
-        let config = *self.calibration.config();
-        let error = match model.window_error(stretches, &config) {
-            Ok(e) => e,
-            Err(e) => {
-                tracing::warn!(window, "no time model error for the window: {e}");
-                return None;
-            }
-        };
-        if self.config.calibrate {
-            for s in stretches {
-                self.calibration.add(s);
-            }
-            if let Some(path) = &self.config.calibration_file {
-                if let Err(e) = store::save(path, &self.config.robot, &self.calibration) {
-                    tracing::warn!("{e}");
+    ) -> TimeModelReport {
+        let predicted_s = drive.map_or(0.0, |(points, _)| {
+            let (d, theta) = path_measure(points);
+            model.eta(d, theta)
+        });
+        if let (true, Some((points, took_s))) = (self.config.calibrate, drive) {
+            let (d, theta) = path_measure(points);
+            if self.calibration.add_planned(d, theta, took_s) {
+                if let Some(path) = &self.config.calibration_file {
+                    if let Err(e) = store::save(path, &self.config.robot, &self.calibration) {
+                        tracing::warn!("{e}");
+                    }
                 }
+                let fitted = self.calibration.model();
+                tracing::info!(
+                    window,
+                    v_lin = fitted.v_lin,
+                    v_ang = fitted.v_ang,
+                    predicted_s,
+                    took_s,
+                    "time model updated from the window's driving"
+                );
             }
-            let fitted = self.calibration.model();
-            tracing::info!(
-                window,
-                v_lin = fitted.v_lin,
-                v_ang = fitted.v_ang,
-                predicted_s = error.predicted_s,
-                driving_s = error.measured_s,
-                "time model updated from the window's driving"
-            );
         }
-        Some(TimeModelReport {
+        TimeModelReport {
             v_lin: model.v_lin,
             v_ang: model.v_ang,
-            predicted_s: error.predicted_s,
-            driving_s: error.measured_s,
+            predicted_s,
+            driving_s: drive.map_or(0.0, |(_, t)| t),
             driven_share: if window_s > 0.0 {
-                error.measured_s / window_s
+                driving_s / window_s
             } else {
                 0.0
             },
-        })
+        }
     }
 
     async fn window(
@@ -510,11 +530,14 @@ impl Run<'_> {
         });
         let planned_information = plan.distinct_information;
         let model = self.time_model();
-        let mut stretches: Vec<Stretch> = Vec::new();
-        let mut stretch = Stretch::new();
         let mut plans = vec![plan.points.clone()];
         let mut waypoints = self.waypoints(&plan);
         let mut mission = self.send(window, waypoints.clone());
+        let first_sent_at = self.now();
+        let mut sent_at = first_sent_at;
+        let mut current_path: Vec<[f64; 2]> = std::iter::once(from)
+            .chain(plan.points.iter().copied())
+            .collect();
         let wall = Instant::now();
         let wall_s = || wall.elapsed().as_secs_f64();
         let mut watch = Watch::new(
@@ -543,11 +566,6 @@ impl Run<'_> {
                     driven.push(e.position);
                     if let Some(p) = e.peb_m {
                         pebs.push(p);
-                    }
-                    let sample = Sample { time_s: self.now(), at: e.position };
-                    if stretch.push(sample).is_err() {
-                        // A stretch is full (hours of one mission): go on in a new one.
-                        stretches.push(std::mem::take(&mut stretch));
                     }
                     watch.on_estimate(e.position)
                 }
@@ -630,10 +648,13 @@ impl Run<'_> {
                 .chain(plan.points.iter().copied())
                 .collect();
             watch.replanned(path, resend, self.now(), wall_s());
-            stretches.push(std::mem::take(&mut stretch));
             plans.push(plan.points.clone());
             waypoints = self.waypoints(&plan);
             mission = self.send(window, waypoints.clone());
+            sent_at = self.now();
+            current_path = std::iter::once(here)
+                .chain(plan.points.iter().copied())
+                .collect();
         }
         // The task keeps the robot at its place until it ends.
         while arrival.is_some() && self.now() < task.start_s + task.duration_s {
@@ -643,8 +664,11 @@ impl Run<'_> {
             }
         }
         while self.inputs.estimates.try_recv().ok().flatten().is_some() {}
-        stretches.push(stretch);
-        let time_model = self.learn(window, &model, &stretches, task.start_s - began);
+        // The time model learns from the mission that arrived, driven as planned from
+        // where it was sent (the path following keeps the robot on it).
+        let drive = arrival.map(|at| (current_path.as_slice(), at - sent_at));
+        let driving_s = arrival.map_or(0.0, |at| at - first_sent_at);
+        let time_model = Some(self.learn(window, &model, drive, driving_s, task.start_s - began));
         let driven_information = gathered(&self.world, &self.params, &driven);
         let report = WindowReport {
             robot: self.config.robot.clone(),
@@ -716,6 +740,7 @@ pub async fn run(
         position: None,
         missions_sent: 0,
         calibration: load_calibration(config)?,
+        plan_wall_s: std::sync::Mutex::new(None),
         tag: session.zid().to_string().chars().take(8).collect(),
     };
     run.hear_the_clock(cancel).await?;

@@ -13,8 +13,9 @@
 //! - **late**: the ETA (distance left at the robot's speed) slips past the task's start:
 //!   replan the shortest way, once, and never curious again in this window;
 //! - **pushed off the path**: an estimate farther than `off_path_m` from the path;
-//! - **slack**: the robot will arrive more than `slack_s` early, beyond what a replan
-//!   costs on the mission clock (the time model overestimated the drive, or a replan
+//! - **slack**: the robot will arrive more than `slack_s` early (predicted from its own
+//!   progress along the path once it has driven a few seconds, from the time model
+//!   before), beyond what a replan costs on the mission clock (the time model overestimated the drive, or a replan
 //!   was cheap): replan a curious path from where it is with the time left, the mirror
 //!   of the late rule. At most once per `slack_interval_s`, and never after the window
 //!   slipped. The executive holds the robot while it plans (the slack pays for it), so
@@ -107,7 +108,13 @@ pub struct Watch {
     heard_at_wall_s: f64,
     /// Mission time of the last plan (first or replan).
     planned_at_s: f64,
+    /// The first status on the current mission: when, and how far the robot had to go.
+    progress_from: Option<(f64, f64)>,
 }
+
+/// Mission seconds of driving after which the robot's own progress, rather than the time
+/// model, predicts its arrival for the slack rule.
+const PROGRESS_AFTER_S: f64 = 3.0;
 
 impl Watch {
     /// The watch of a window whose first plan was made at mission time `now_s` (wall
@@ -128,6 +135,7 @@ impl Watch {
             resends: 0,
             heard_at_wall_s: wall_s,
             planned_at_s: now_s,
+            progress_from: None,
         }
     }
 
@@ -184,7 +192,14 @@ impl Watch {
                     self.slipped = true;
                     return self.replan(Reason::EtaSlipped, false);
                 }
-                let arrival_s = now_s + distance_left_m / self.params.expected_speed_m_per_s;
+                let (t0, d0) = *self.progress_from.get_or_insert((now_s, distance_left_m));
+                let progress_speed = (d0 - distance_left_m) / (now_s - t0);
+                let speed = if now_s - t0 >= PROGRESS_AFTER_S && progress_speed > 0.0 {
+                    progress_speed
+                } else {
+                    self.params.expected_speed_m_per_s
+                };
+                let arrival_s = now_s + distance_left_m / speed;
                 let early = self.task_start_s - arrival_s;
                 if early > self.params.slack_s + planning_cost_s
                     && now_s - self.planned_at_s >= self.params.slack_interval_s
@@ -202,6 +217,7 @@ impl Watch {
     pub fn replanned(&mut self, path: Vec<[f64; 2]>, resend: bool, now_s: f64, wall_s: f64) {
         self.path = path;
         self.planned_at_s = now_s;
+        self.progress_from = None;
         self.heard_at_wall_s = wall_s;
         if resend {
             self.resends += 1;
@@ -310,6 +326,38 @@ mod tests {
             ),
             Decision::Keep
         );
+    }
+
+    #[test]
+    fn slack_is_predicted_from_the_robots_own_progress() {
+        // The model expects 0.1 m/s (arrival far too late to be early), but the robot
+        // covers 1 m/s along the path: the slack rule sees it once it has driven a bit.
+        let mut w = Watch::new(
+            WatchParams {
+                expected_speed_m_per_s: 0.1,
+                ..params()
+            },
+            100.0,
+            vec![[0.0, 0.0], [40.0, 0.0]],
+            0.0,
+            0.0,
+        );
+        let active = |left| Status::Active {
+            distance_left_m: left,
+        };
+        assert_eq!(w.on_status(active(40.0), 11.0, 0.1, 1.0), Decision::Keep);
+        assert_eq!(
+            w.on_status(active(38.0), 13.0, 0.2, 1.0),
+            Decision::Keep,
+            "too soon to tell"
+        );
+        assert!(matches!(
+            w.on_status(active(35.0), 16.0, 0.3, 1.0),
+            Decision::Replan {
+                reason: Reason::Slack,
+                ..
+            }
+        ));
     }
 
     #[test]
