@@ -34,7 +34,7 @@ use zenoh::qos::CongestionControl;
 use crate::calibration::{path_measure, store, Calibration, CalibrationConfig, TimeModel};
 use crate::information::gathered;
 use crate::inputs::{listen, lock, wait_for_world, Inputs};
-use crate::path::mission_waypoints;
+use crate::path::{distance, mission_waypoints};
 use crate::tasks::{self, Task, TaskError};
 use crate::watch::{Decision, Reason, Status, Watch, WatchParams};
 
@@ -172,6 +172,19 @@ pub enum Progress {
 /// How often the executive asks again for a window's first plans when none came.
 const PLAN_RETRY: Duration = Duration::from_secs(1);
 
+/// A window's plans made ahead, while the robot did the previous task.
+struct Preplanned {
+    window: usize,
+    from: [f64; 2],
+    shortest: Plan,
+    plan: Plan,
+    budget: f64,
+}
+
+/// A preplanned window is used when the robot sets off at most this far from where the
+/// plans start, metres.
+const PREPLAN_FROM_M: f64 = 0.5;
+
 /// A curious plan is expected to take this times the slowest recent one, plus
 /// [`PLAN_WALL_SLACK_S`].
 const PLAN_WALL_MARGIN: f64 = 1.5;
@@ -222,6 +235,8 @@ struct Run<'a> {
     calibration: Calibration,
     /// Wall seconds the recent curious plans took (request to reply), the slowest.
     plan_wall_s: std::sync::Mutex<Option<f64>>,
+    /// The next window's plans, made while the robot did its task.
+    preplanned: Option<Preplanned>,
     /// This executive's own tag in its mission ids (from its Zenoh session id), so a
     /// restarted executive never reuses an id its predecessor sent: the controller's
     /// statuses on an old mission are not taken for a new one's.
@@ -303,14 +318,18 @@ impl Run<'_> {
     }
 
     /// The curious plan for the budget, or the shortest when curiosity does not fit.
+    /// `leave_at_s`: when the robot can set off at the earliest (a window planned while
+    /// the robot is still at its task), on the mission clock.
     async fn plan_window(
         &self,
         from: [f64; 2],
         task: &Task,
         shortest: &Plan,
         curious: bool,
+        leave_at_s: Option<f64>,
     ) -> Result<(Plan, f64), ClientError> {
-        let budget = task.start_s - self.now() - self.planning_cost_s();
+        let earliest = self.now() + self.planning_cost_s();
+        let budget = task.start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
         if !curious || budget <= shortest.t_eta_s {
             return Ok((shortest.clone(), budget));
         }
@@ -355,6 +374,7 @@ impl Run<'_> {
         &self,
         from: [f64; 2],
         task: &Task,
+        leave_at_s: Option<f64>,
         cancel: &CancellationToken,
     ) -> Result<Option<(Plan, Plan, f64)>, ExecutiveError> {
         loop {
@@ -363,7 +383,7 @@ impl Run<'_> {
                 .await
             {
                 Ok(shortest) => self
-                    .plan_window(from, task, &shortest, true)
+                    .plan_window(from, task, &shortest, true, leave_at_s)
                     .await
                     .map(|(plan, budget)| (shortest, plan, budget)),
                 Err(e) => Err(e),
@@ -477,6 +497,7 @@ impl Run<'_> {
         &mut self,
         window: usize,
         task: &Task,
+        next: Option<&Task>,
         cancel: &CancellationToken,
         progress: &(dyn Fn(Progress) + Sync),
     ) -> Result<Option<WindowOutcome>, ExecutiveError> {
@@ -491,7 +512,15 @@ impl Run<'_> {
             });
             return Ok(None);
         }
-        let Some((shortest, plan, budget)) = self.first_plans(from, task, cancel).await? else {
+        let preplanned = self
+            .preplanned
+            .take()
+            .filter(|p| p.window == window && distance(p.from, from) <= PREPLAN_FROM_M);
+        let planned = match preplanned {
+            Some(p) => Some((p.shortest, p.plan, p.budget)),
+            None => self.first_plans(from, task, None, cancel).await?,
+        };
+        let Some((shortest, plan, budget)) = planned else {
             // Given up before a plan came: reported like any window that was given up.
             progress(Progress::GaveUp {
                 window,
@@ -632,7 +661,10 @@ impl Run<'_> {
                 }
             };
             // A curious plan that fails (busy, an outage) leaves the shortest way.
-            let plan = match self.plan_window(here, task, &shortest_here, curious).await {
+            let plan = match self
+                .plan_window(here, task, &shortest_here, curious, None)
+                .await
+            {
                 Ok((plan, _)) => plan,
                 Err(e) => {
                     tracing::warn!("the curious replan failed, taking the shortest path: {e}");
@@ -656,6 +688,30 @@ impl Run<'_> {
                 .chain(plan.points.iter().copied())
                 .collect();
         }
+        // The time model learns from the mission that arrived, driven as planned from
+        // where it was sent (the path following keeps the robot on it).
+        let drive = arrival.map(|at| (current_path.as_slice(), at - sent_at));
+        let driving_s = arrival.map_or(0.0, |at| at - first_sent_at);
+        let time_model = Some(self.learn(window, &model, drive, driving_s, task.start_s - began));
+        // The next window is planned while the robot does this task, from its place,
+        // so that planning costs the next window nothing.
+        if let (Some(_), Some(next)) = (arrival, next) {
+            let leave_at = task.start_s + task.duration_s;
+            if let Ok(Some((shortest, plan, budget))) = self
+                .first_plans(task.at, next, Some(leave_at), cancel)
+                .await
+            {
+                if self.now() <= leave_at {
+                    self.preplanned = Some(Preplanned {
+                        window: window + 1,
+                        from: task.at,
+                        shortest,
+                        plan,
+                        budget,
+                    });
+                }
+            }
+        }
         // The task keeps the robot at its place until it ends.
         while arrival.is_some() && self.now() < task.start_s + task.duration_s {
             tokio::select! {
@@ -664,11 +720,6 @@ impl Run<'_> {
             }
         }
         while self.inputs.estimates.try_recv().ok().flatten().is_some() {}
-        // The time model learns from the mission that arrived, driven as planned from
-        // where it was sent (the path following keeps the robot on it).
-        let drive = arrival.map(|at| (current_path.as_slice(), at - sent_at));
-        let driving_s = arrival.map_or(0.0, |at| at - first_sent_at);
-        let time_model = Some(self.learn(window, &model, drive, driving_s, task.start_s - began));
         let driven_information = gathered(&self.world, &self.params, &driven);
         let report = WindowReport {
             robot: self.config.robot.clone(),
@@ -741,12 +792,14 @@ pub async fn run(
         missions_sent: 0,
         calibration: load_calibration(config)?,
         plan_wall_s: std::sync::Mutex::new(None),
+        preplanned: None,
         tag: session.zid().to_string().chars().take(8).collect(),
     };
     run.hear_the_clock(cancel).await?;
     let mut outcomes = Vec::with_capacity(config.tasks.len());
     for (window, task) in config.tasks.iter().enumerate() {
-        if let Some(outcome) = run.window(window, task, cancel, progress).await? {
+        let next = config.tasks.get(window + 1);
+        if let Some(outcome) = run.window(window, task, next, cancel, progress).await? {
             on_window(&outcome);
             outcomes.push(outcome);
         }

@@ -93,9 +93,39 @@ pub fn builtin() -> Vec<Task> {
     ]
 }
 
+/// The demo's day world (`config/scenarios/day.yaml`), embedded so `roam demo` needs no
+/// file.
+pub const DAY_SCENARIO: &str = include_str!("../../../config/scenarios/day.yaml");
+
+/// The day in [`DAY_SCENARIO`]: four windows. From `start` to `goal1` by 75 s, to
+/// `goal2` by 165 s, a round trip back to `goal2` by 245 s (the next task is where the
+/// robot is: the whole window is downtime), and home to `start` by 335 s.
+pub fn day() -> Vec<Task> {
+    let task = |name: &str, at: [f64; 2], start_s: f64| Task {
+        name: name.into(),
+        at,
+        start_s,
+        duration_s: 5.0,
+    };
+    vec![
+        task("goal1", [-2.0, 4.0], 75.0),
+        task("goal2", [6.0, -7.0], 165.0),
+        task("goal2-again", [6.0, -7.0], 245.0),
+        task("home", [-8.0, -8.0], 335.0),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_demo_day_is_valid_with_a_round_trip() {
+        let day = day();
+        assert_eq!(check(&day), Ok(()));
+        assert!(day.len() >= 4);
+        assert!(day.windows(2).any(|w| w[0].at == w[1].at), "a round trip");
+    }
 
     #[test]
     fn the_builtin_day_is_valid_and_overlaps_are_refused() {

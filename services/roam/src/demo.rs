@@ -1,8 +1,10 @@
 //! `roam demo`: roam's main job on its embedded default. The whole stack boots in one
-//! process on the built-in world, the sim runs faster than real time, and one robot
-//! spends the downtime before each of its two tasks on a curious path: the mission
-//! executive plans it (paper 000), the controller drives it on the localization's
-//! estimates (paper 002), and the run ends with a report directory.
+//! process on the demo's day world (`config/scenarios/day.yaml`, embedded: a moving
+//! cart, 3 m observations, a poorly covered north-east room), the sim runs faster than
+//! real time, and one robot spends the downtime before each of its four tasks (one a
+//! round trip) on a curious path: the mission executive plans it (paper 000) with the
+//! robot's own time model and the PEB cost, the controller drives it on the
+//! localization's estimates (paper 002), and the run ends with a report directory.
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -61,6 +63,10 @@ impl Default for DemoOptions {
     }
 }
 
+/// The PEB cost the demo's executive plans with (the planner's W_loc, as in `roam
+/// reproduce mission`): paths through the poorly covered room cost information.
+pub const DEMO_W_LOC: f64 = 2000.0;
+
 /// The controller's parameters for the built-in world: [`ApfParams::indoor`].
 pub fn indoor_apf() -> ApfParams {
     ApfParams::indoor()
@@ -118,10 +124,17 @@ pub async fn run(
     progress: &(dyn Fn(&str) + Sync),
 ) -> Result<DemoReport, DemoError> {
     let started = Instant::now();
+    std::fs::create_dir_all(&options.out_dir).map_err(|e| write_error(&options.out_dir, e))?;
+    // The day's world goes to every service as a file in the report directory, so the
+    // report holds the world it was made on.
+    let world = options.out_dir.join("world.yaml");
+    std::fs::write(&world, roam_mission::tasks::DAY_SCENARIO)
+        .map_err(|e| write_error(&world, e))?;
     progress("booting the stack (map server, planner, sim, localization, controller, mapper)");
     let stack = Stack::start(
         StackOptions {
             root: options.root.clone(),
+            map: Some(world.clone()),
             planners: 1,
             sim_rate: Some(options.rate),
             apf: Some(indoor_apf()),
@@ -138,7 +151,7 @@ pub async fn run(
             return Err(e);
         }
     };
-    let result = drive(&stack, options, progress, started).await;
+    let result = drive(&stack, options, &world, progress, started).await;
     view_cancel.cancel();
     let viewed = match view {
         Some(view) => view.join().await.map(|_| ()),
@@ -182,6 +195,7 @@ async fn start_view(
 async fn drive(
     stack: &Stack,
     options: &DemoOptions,
+    world: &Path,
     progress: &(dyn Fn(&str) + Sync),
     started: Instant,
 ) -> Result<DemoReport, DemoError> {
@@ -215,6 +229,8 @@ async fn drive(
         .map_err(|e| DemoError::Zenoh(e.to_string()))?;
     let config = ExecutiveConfig {
         seed: options.seed,
+        tasks: roam_mission::tasks::day(),
+        w_loc: Some(DEMO_W_LOC),
         ..ExecutiveConfig::default()
     };
     let say = |p: Progress| match p {
@@ -254,9 +270,8 @@ async fn drive(
     let outcomes = executive::run(&session, &root, &config, &cancel, &say, &|_| {}).await?;
     let driven = truth.lock().unwrap_or_else(|p| p.into_inner()).clone();
 
-    std::fs::create_dir_all(&options.out_dir).map_err(|e| write_error(&options.out_dir, e))?;
     let picture = options.out_dir.join("world.png");
-    let anchors: Vec<[f64; 2]> = roam_sim::service::load_scenario(None)
+    let anchors: Vec<[f64; 2]> = roam_sim::service::load_scenario(Some(world))
         .map(|(_, s)| s.file.anchors.iter().map(|a| a.at).collect())
         .unwrap_or_default();
     let image = draw_world(
