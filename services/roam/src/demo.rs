@@ -389,22 +389,34 @@ fn draw_world(
 fn markdown(r: &DemoReport) -> String {
     let mut out = String::from("# roam demo\n\n");
     out.push_str(&format!(
-        "One robot, two tasks in the built-in world, the sim at {}x (seed {}), {:.1} s of wall time.\n\n",
-        r.sim_rate, r.seed, r.wall_s
+        "One robot, a day of {} tasks in the demo's day world (`world.yaml`), the sim at {}x (seed {}), {:.1} s of wall time.\n\n",
+        r.windows.len(),
+        r.sim_rate,
+        r.seed,
+        r.wall_s
     ));
-    out.push_str("| window | task | task starts s | arrived s | on time | budget s | information driven | planned | shortest path | mean PEB m | replans |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| window | task | task starts s | arrived s | on time | budget s | share driven | information driven | planned | driven / planned | shortest path | v_lin s/m | v_ang s/rad | mean PEB m | replans |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for w in &r.windows {
+        let ratio = if w.planned_information > 0.0 {
+            format!("{:.2}", w.driven_information / w.planned_information)
+        } else {
+            "-".to_owned()
+        };
+        let model = w.time_model;
         out.push_str(&format!(
-            "| {} | {} | {:.1} | {} | {} | {:.1} | {:.0} | {:.0} | {:.0} | {} | {} |\n",
+            "| {} | {} | {:.1} | {} | {} | {:.1} | {} | {:.0} | {:.0} | {ratio} | {:.0} | {} | {} | {} | {} |\n",
             w.window + 1,
             w.task,
             w.task_start_s,
             w.arrival_s.map_or("-".to_owned(), |a| format!("{a:.1}")),
             if w.on_time { "yes" } else { "no" },
             w.budget_s,
+            model.map_or("-".to_owned(), |m| format!("{:.0}%", m.driven_share * 100.0)),
             w.driven_information,
             w.planned_information,
             w.shortest_information,
+            model.map_or("-".to_owned(), |m| format!("{:.2}", m.v_lin)),
+            model.map_or("-".to_owned(), |m| format!("{:.2}", m.v_ang)),
             w.peb_mean_m.map_or("-".to_owned(), |p| format!("{p:.3}")),
             w.replans,
         ));

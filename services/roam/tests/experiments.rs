@@ -181,7 +181,20 @@ fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
     ] {
         assert!(!report[field].is_null(), "{field} missing: {report}");
     }
-    assert_eq!(report["windows"].as_array().expect("windows").len(), 2);
+    // The day: four windows, one a round trip, each with the time model it planned with
+    // and the share of the window the robot drove.
+    let windows = report["windows"].as_array().expect("windows");
+    assert_eq!(windows.len(), 4, "{report}");
+    for w in windows {
+        let share = w["time_model"]["driven_share"]
+            .as_f64()
+            .expect("driven share");
+        assert!((0.0..=1.0).contains(&share), "{w}");
+        assert!(
+            w["time_model"]["v_lin"].as_f64().is_some_and(|v| v > 0.0),
+            "{w}"
+        );
+    }
     let markdown = std::fs::read_to_string(out.path().join("report.md")).expect("md");
     assert!(markdown.contains("| 1 | goal1 |") && markdown.contains("world.png"));
 
