@@ -8,7 +8,9 @@
 //! - [`eta`]: the travel-time estimate t_ETA (Eq. 2);
 //! - [`curiosity`]: the fitness (Eqs. 1, 3–7) with Models 0 / I / II (Eqs. 8–10);
 //! - [`metrics`]: U_ges, D (Eqs. 11–12) and the information of distinct cells;
-//! - [`ga`]: initialisation, layered selection, crossover, mutation (§II.A);
+//! - [`ga`]: initialisation, layered selection, crossover, mutation (§II.A), with roam's
+//!   round-trip rule for random walks;
+//! - [`seeds`]: via-point seeds, paths through informative cells within the budget;
 //! - [`search`]: the shortest-path baseline (A*, octile) and the distance field;
 //! - [`limits`]: what one plan may cost (path length from Eq. 2, memory, work);
 //! - [`plan`]: one request end to end, with the checks that refuse bad requests.
@@ -31,6 +33,7 @@ pub mod metrics;
 pub mod params;
 pub mod plan;
 pub mod search;
+pub mod seeds;
 pub mod service;
 pub mod token;
 pub mod world;
