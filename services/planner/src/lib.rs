@@ -11,6 +11,7 @@
 //! - [`ga`]: initialisation, layered selection, crossover, mutation (§II.A), with roam's
 //!   round-trip rule for random walks;
 //! - [`seeds`]: via-point seeds, paths through informative cells within the budget;
+//! - [`best`]: the plan is never below the shortest path or a seed;
 //! - [`search`]: the shortest-path baseline (A*, octile) and the distance field;
 //! - [`limits`]: what one plan may cost (path length from Eq. 2, memory, work);
 //! - [`plan`]: one request end to end, with the checks that refuse bad requests.
@@ -20,6 +21,7 @@
 //! ids, cancel tokens, who may cancel); bounded logs and echoes of untrusted input come
 //! from `roam_runtime::warn_limit` and `roam_proto::excerpt`, shared by every service.
 
+pub mod best;
 pub mod budget;
 pub mod client;
 pub mod config;
