@@ -384,7 +384,8 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
         "{} bytes",
         quoted.message.len()
     );
-    assert!(quoted.message.contains("bytes cut"), "{}", quoted.message);
+    // The shared excerpt (roam_proto::excerpt) marks the cut with the quoted length.
+    assert!(quoted.message.contains("bytes)"), "{}", quoted.message);
 
     let version = refusal(
         &client,
