@@ -29,6 +29,11 @@ use crate::stack::{Stack, StackOptions};
 pub struct ModelBench {
     pub plan_s_median: f64,
     pub evals_per_s: f64,
+    /// Genes evaluated per second: the GA's speed per unit of work, which (unlike
+    /// `evals_per_s`) does not fall when the paths it works on are longer.
+    pub genes_per_s: f64,
+    /// Cells of the returned path.
+    pub path_cells_median: f64,
     pub generations: u32,
     pub distinct_information_median: f64,
 }
@@ -87,6 +92,8 @@ pub async fn planner(runs: usize) -> Result<PlannerBench, BenchError> {
     ] {
         let mut seconds = Vec::new();
         let mut rates = Vec::new();
+        let mut gene_rates = Vec::new();
+        let mut cells = Vec::new();
         let mut info = Vec::new();
         let mut generations = 0;
         for run in 0..runs {
@@ -97,6 +104,8 @@ pub async fn planner(runs: usize) -> Result<PlannerBench, BenchError> {
             let elapsed = started.elapsed().as_secs_f64();
             seconds.push(elapsed);
             rates.push(outcome.evaluations as f64 / elapsed);
+            gene_rates.push(outcome.evaluated_genes as f64 / elapsed);
+            cells.push(outcome.path.len() as f64);
             info.push(outcome.metrics.distinct_information);
             generations = outcome.generations;
         }
@@ -105,6 +114,8 @@ pub async fn planner(runs: usize) -> Result<PlannerBench, BenchError> {
             ModelBench {
                 plan_s_median: median(&mut seconds),
                 evals_per_s: median(&mut rates),
+                genes_per_s: median(&mut gene_rates),
+                path_cells_median: median(&mut cells),
                 generations,
                 distinct_information_median: median(&mut info),
             },

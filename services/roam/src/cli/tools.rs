@@ -144,6 +144,10 @@ pub(crate) enum ReproduceCommand {
         /// Where the per-model pictures go.
         #[arg(long, default_value = "roam-reproduce/planner")]
         out: PathBuf,
+        /// Plan with paper 000's own initialization (random walks that stop at the goal,
+        /// no via-point seeds): the figures as they were before issue 14.
+        #[arg(long)]
+        paper_init: bool,
     },
 }
 
@@ -347,6 +351,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             total,
             generations_per_t,
             out,
+            paper_init,
         } => {
             if runs == 0
                 || !(total.is_finite() && total > 0.0)
@@ -359,6 +364,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 total_s: total,
                 generations_per_t,
                 out_dir: out,
+                paper_initialization: paper_init,
             };
             let result =
                 tokio::task::spawn_blocking(move || roam::reproduce_planner::run(&options))
