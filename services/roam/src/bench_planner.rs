@@ -44,6 +44,8 @@ pub struct PlannerBench {
     pub model2_over_model1: f64,
     pub zenoh_overhead_ms_median: f64,
     pub runs: usize,
+    /// `paper` (paper 000's initialization, `--paper-init`) or `roam` (the default).
+    pub initialization: String,
 }
 
 pub const START: [f64; 2] = [-8.0, -8.0];
@@ -73,7 +75,9 @@ fn spec(model: PlannerModel, t_exec_s: f64, seed: u64, generations: u32) -> Plan
     PlanSpec::batch(START, GOAL, t_exec_s, model, generations, seed)
 }
 
-pub async fn planner(runs: usize) -> Result<PlannerBench, BenchError> {
+/// Runs the benchmark; `paper_initialization` plans the in-process runs with paper
+/// 000's initialization (no via-point seeds, walks that stop at the goal) to compare.
+pub async fn planner(runs: usize, paper_initialization: bool) -> Result<PlannerBench, BenchError> {
     let world = builtin_world()?;
     let never = AtomicBool::new(false);
     let shortest = plan(
@@ -97,7 +101,10 @@ pub async fn planner(runs: usize) -> Result<PlannerBench, BenchError> {
         let mut info = Vec::new();
         let mut generations = 0;
         for run in 0..runs {
-            let s = spec(model, budget, run as u64, 2000);
+            let mut s = spec(model, budget, run as u64, 2000);
+            if paper_initialization {
+                s.params = s.params.with_paper_initialization();
+            }
             let started = Instant::now();
             let outcome = plan(&world, &s, &never, |_, _| {})
                 .map_err(|e| BenchError::Setup(e.to_string()))?;
@@ -128,6 +135,12 @@ pub async fn planner(runs: usize) -> Result<PlannerBench, BenchError> {
         model2_over_model1: ratio,
         zenoh_overhead_ms_median: overhead,
         runs,
+        initialization: if paper_initialization {
+            "paper"
+        } else {
+            "roam"
+        }
+        .to_owned(),
     })
 }
 

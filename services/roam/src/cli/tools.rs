@@ -64,6 +64,10 @@ pub(crate) enum BenchCommand {
         /// Plans per model.
         #[arg(long, default_value_t = 5)]
         runs: usize,
+        /// Plan with paper 000's own initialization (random walks that stop at the goal,
+        /// no via-point seeds), to compare with roam's default.
+        #[arg(long)]
+        paper_init: bool,
     },
 }
 
@@ -218,11 +222,15 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
                 tokio::task::spawn_blocking(move || roam_mapper::bench::bench(&options)).await??;
             print_json(&result, json)
         }
-        BenchCommand::Planner { json, runs } => {
+        BenchCommand::Planner {
+            json,
+            runs,
+            paper_init,
+        } => {
             if runs == 0 {
                 bail!("--runs must be at least 1");
             }
-            let result = roam::bench_planner::planner(runs).await?;
+            let result = roam::bench_planner::planner(runs, paper_init).await?;
             print_json(&result, json)
         }
     }
