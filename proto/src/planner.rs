@@ -29,12 +29,16 @@ impl PlannerModel {
     }
 }
 
-/// The map a plan was made on: the versions of the two layers the planner reads.
+/// The map a plan was made on: the versions of the layers the planner reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MapVersion {
     pub inflated: u64,
     pub information: u64,
+    /// The change layer's version, on a planner that couples one (its `change_layer`)
+    /// and once it has one; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub change: Option<u64>,
 }
 
 /// Overrides of the GA parameters (paper 000 Table I); every field is optional.

@@ -243,10 +243,13 @@ mod planner_messages {
     }
 
     fn version() -> impl Strategy<Value = MapVersion> {
-        (any::<u64>(), any::<u64>()).prop_map(|(inflated, information)| MapVersion {
-            inflated,
-            information,
-        })
+        (any::<u64>(), any::<u64>(), any::<Option<u64>>()).prop_map(
+            |(inflated, information, change)| MapVersion {
+                inflated,
+                information,
+                change,
+            },
+        )
     }
 
     fn overrides() -> impl Strategy<Value = GaOverrides> {

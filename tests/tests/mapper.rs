@@ -171,30 +171,51 @@ async fn sim_to_mapper_to_map_server_shows_where_the_blocks_move() {
     let mut planner_config = harness.planner_config("curious-about-change");
     planner_config.information_layer = CHANGE_INFORMATION_LAYER.into();
     let _planner = harness.start_planner(planner_config).await;
-    let plan: Plan = within(
-        "plan",
-        client.request::<PlanRequest, Plan>(
-            &keys::planner_plan_at(&root, "curious-about-change"),
-            Some(&PlanRequest {
-                request_id: None,
-                cancel_token: None,
-                start: [0.5, 0.5],
-                goal: [0.5, -6.5],
-                t_exec_s: 60.0,
-                deadline_s: 2.0,
-                model: PlannerModel::Model1,
-                params: GaOverrides {
-                    max_generations: Some(200),
-                    ..GaOverrides::default()
-                },
-                seed: 1,
-                map_version: None,
-            }),
-        ),
-    )
-    .await
-    .expect("plan");
+    // The change coupling: a planner on max(information, change_information).
+    let mut coupled_config = harness.planner_config("coupled");
+    coupled_config.change_layer = Some(CHANGE_INFORMATION_LAYER.into());
+    let _coupled = harness.start_planner(coupled_config).await;
+    let plan_request = PlanRequest {
+        request_id: None,
+        cancel_token: None,
+        start: [0.5, 0.5],
+        goal: [0.5, -6.5],
+        t_exec_s: 60.0,
+        deadline_s: 2.0,
+        model: PlannerModel::Model1,
+        params: GaOverrides {
+            max_generations: Some(200),
+            ..GaOverrides::default()
+        },
+        seed: 1,
+        map_version: None,
+    };
+    let request = |instance: &'static str| {
+        let (client, key, body) = (
+            client.clone(),
+            keys::planner_plan_at(&root, instance),
+            plan_request.clone(),
+        );
+        async move { client.request::<PlanRequest, Plan>(&key, Some(&body)).await }
+    };
+    let plan: Plan = within("plan", request("curious-about-change"))
+        .await
+        .expect("plan");
     assert!(plan.reaches_goal);
+    let coupled: Plan = within("coupled plan", request("coupled"))
+        .await
+        .expect("coupled plan");
+    assert!(coupled.reaches_goal);
+    assert!(
+        coupled
+            .map_version
+            .change
+            .is_some_and(|v| v >= scores.version),
+        "the coupled plan names change version {:?} (change_information is at {})",
+        coupled.map_version.change,
+        scores.version
+    );
+    assert_eq!(coupled.map_version.information, 1, "the static map stays");
     assert!(
         plan.map_version.information >= scores.version,
         "planned on information version {} (change_information is at {})",

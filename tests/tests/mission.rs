@@ -6,6 +6,8 @@
 use std::time::Duration;
 
 use roam_controller::service::ControllerConfig;
+use roam_mission::calibration::TimeModel;
+use roam_mission::executive::ExecutiveConfig;
 use roam_mission::service::MissionConfig;
 use roam_proto::mission::WindowReport;
 use roam_proto::{decode, keys};
@@ -44,6 +46,16 @@ async fn the_demo_mission_is_on_time_and_more_curious_than_the_shortest_path() {
             roam_mission::service::run(
                 MissionConfig {
                     root,
+                    executive: ExecutiveConfig {
+                        // A pessimistic prior (a stale datasheet: the robot drives a
+                        // metre in 2 s, the executive believes 3 s), so the first
+                        // window's plan would arrive early: the slack rule must fire.
+                        time_model_prior: TimeModel {
+                            v_lin: 3.0,
+                            v_ang: 1.0,
+                        },
+                        ..ExecutiveConfig::default()
+                    },
                     ..MissionConfig::default()
                 },
                 zenoh,
@@ -66,9 +78,9 @@ async fn the_demo_mission_is_on_time_and_more_curious_than_the_shortest_path() {
         windows.iter().map(|w| w.task.as_str()).collect::<Vec<_>>(),
         ["goal1", "goal2"]
     );
-    // The first window is planned with Table I's time model, which overestimates this
-    // robot's drive: it would arrive early, so the slack rule replans a curious path
-    // with the time left, and the robot is still on time.
+    // The first window is planned with the pessimistic prior: the robot would arrive
+    // early, so the slack rule replans a curious path with the time left, and the robot
+    // is still on time.
     assert!(
         windows
             .iter()

@@ -204,7 +204,8 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         remote.map_version,
         MapVersion {
             inflated: 1,
-            information: 1
+            information: 1,
+            change: None,
         }
     );
     assert_eq!(remote.points.len(), remote.cells.len());
@@ -330,6 +331,27 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
         params.message
     );
 
+    // An impossible time model (a robot that drives in no time) names the parameter
+    // and its range.
+    let time_model = refusal(
+        &client,
+        &root,
+        &PlanRequest {
+            params: GaOverrides {
+                v_lin: Some(0.0),
+                ..GaOverrides::default()
+            },
+            ..ok.clone()
+        },
+    )
+    .await;
+    assert_eq!(time_model.code, ErrorCode::InvalidRequest, "{time_model:?}");
+    assert!(
+        time_model.message.contains("v_lin") && time_model.message.contains("(0, 1000]"),
+        "{}",
+        time_model.message
+    );
+
     // A cancel token outside the rules is refused without being repeated.
     let token = refusal(
         &client,
@@ -397,6 +419,7 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
             map_version: Some(MapVersion {
                 inflated: 99,
                 information: 1,
+                change: None,
             }),
             ..ok.clone()
         },
@@ -466,6 +489,7 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
         map_version: Some(MapVersion {
             inflated: 2,
             information: 1,
+            change: None,
         }),
         ..ok.clone()
     };

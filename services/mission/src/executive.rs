@@ -76,11 +76,22 @@ pub struct ExecutiveConfig {
     pub slack_s: f64,
     /// Mission seconds between two slack replans at least.
     pub slack_interval_s: f64,
+    /// What a plan leaves unspent of the time to the task: this share of it, and at
+    /// least `arrival_margin_min_s`. A curious plan fills its budget (round trips and
+    /// via-points make sure of it), so any error of the time model or a slow stretch
+    /// would make the robot late; the margin absorbs them, and the slack rule gives
+    /// back what the robot did not need.
+    pub arrival_margin_share: f64,
+    pub arrival_margin_min_s: f64,
     /// Plan with paper 000 Eq. 2's v_lin and v_ang fitted to what this robot drove
     /// (Table I as the prior; see [`crate::calibration`]); `false`: Table I throughout.
     pub calibrate: bool,
     /// Where the robot's fit is kept across restarts; absent: in memory only.
     pub calibration_file: Option<PathBuf>,
+    /// The time model before anything was driven (the calibration's prior): Table I's
+    /// v_lin 2.0 s/m and v_ang 1.0 s/rad by default; a robot's datasheet figures where
+    /// they are known. Bounded as the calibration's fits are.
+    pub time_model_prior: TimeModel,
 }
 
 impl Default for ExecutiveConfig {
@@ -101,8 +112,11 @@ impl Default for ExecutiveConfig {
             controller_silence_s: 3.0,
             slack_s: 10.0,
             slack_interval_s: 10.0,
+            arrival_margin_share: 0.05,
+            arrival_margin_min_s: 2.0,
             calibrate: true,
             calibration_file: None,
+            time_model_prior: TimeModel::table_i(),
         }
     }
 }
@@ -210,6 +224,18 @@ fn check(config: &ExecutiveConfig) -> Result<(), ExecutiveError> {
                 "{name} is {value}; give a positive number"
             )));
         }
+    }
+    if !(0.0..0.5).contains(&config.arrival_margin_share) {
+        return Err(ExecutiveError::Config(format!(
+            "arrival_margin_share is {}; give a share in 0..0.5 of the time to the task",
+            config.arrival_margin_share
+        )));
+    }
+    if !(config.arrival_margin_min_s.is_finite() && config.arrival_margin_min_s >= 0.0) {
+        return Err(ExecutiveError::Config(format!(
+            "arrival_margin_min_s is {}; give 0 or more seconds",
+            config.arrival_margin_min_s
+        )));
     }
     if config.slack_s.is_nan() || config.slack_s <= 0.0 {
         return Err(ExecutiveError::Config(format!(
@@ -329,7 +355,10 @@ impl Run<'_> {
         leave_at_s: Option<f64>,
     ) -> Result<(Plan, f64), ClientError> {
         let earliest = self.now() + self.planning_cost_s();
-        let budget = task.start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
+        let time_left = task.start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
+        let margin =
+            (time_left * self.config.arrival_margin_share).max(self.config.arrival_margin_min_s);
+        let budget = time_left - margin;
         if !curious || budget <= shortest.t_eta_s {
             return Ok((shortest.clone(), budget));
         }
@@ -557,7 +586,9 @@ impl Run<'_> {
             eta_s: plan.t_eta_s,
             curious: plan.model != PlannerModel::Shortest,
         });
-        let planned_information = plan.distinct_information;
+        // On the static map, as the driven path's: a planner on the change coupling
+        // reports its own figure on the coupled map, which changes with the mapper.
+        let planned_information = gathered(&self.world, &self.params, &plan.points);
         let model = self.time_model();
         let mut plans = vec![plan.points.clone()];
         let mut waypoints = self.waypoints(&plan);
@@ -732,7 +763,7 @@ impl Run<'_> {
             budget_s: budget,
             planned_information,
             driven_information,
-            shortest_information: shortest.distinct_information,
+            shortest_information: gathered(&self.world, &self.params, &shortest.points),
             peb_mean_m: (!pebs.is_empty()).then(|| pebs.iter().sum::<f64>() / pebs.len() as f64),
             replans: reasons.len() as u32,
             replan_reasons: reasons,
@@ -750,7 +781,7 @@ impl Run<'_> {
 /// The robot's time calibration: from its file when one is configured and usable, else
 /// Table I's prior.
 fn load_calibration(config: &ExecutiveConfig) -> Result<Calibration, ExecutiveError> {
-    let prior = TimeModel::table_i();
+    let prior = config.time_model_prior;
     let settings = CalibrationConfig::default();
     let calibration = match &config.calibration_file {
         Some(path) => {

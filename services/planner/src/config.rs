@@ -6,6 +6,7 @@
 //! max_concurrent_plans: 2      # more are refused at once with `busy`
 //! map_history: 4               # map versions kept for requests that name one
 //! information_layer: information  # or change_information: plan on the mapper's P(E>0)
+//! change_layer: change_information # optional: plan on max(information, change) (crate::coupling)
 //! # What one plan may cost, checked before any work (crate::limits):
 //! max_population_cells: 4000000   # population × longest path the budget allows
 //! max_plan_cost: 4000000000       # population × generations × that path length
@@ -37,6 +38,10 @@ pub struct PlannerConfig {
     /// changed since a robot last looked. Scores above 100 count as 100
     /// ([`crate::world::MAX_INFORMATION_SCORE`]).
     pub information_layer: String,
+    /// A u8 change layer (the mapper's `change_information`) coupled into the
+    /// information map: the planner plans on max(I_xy, C_xy) cell by cell
+    /// ([`crate::coupling`]). Off by default.
+    pub change_layer: Option<String>,
     /// Most genes a plan's population may hold: population × the longest path its
     /// budget allows (Eq. 2, [`crate::limits`]). Refused `limit_exceeded` above it.
     pub max_population_cells: u64,
@@ -63,6 +68,7 @@ impl Default for PlannerConfig {
             max_concurrent_plans: 2,
             map_history: 4,
             information_layer: crate::maps::INFORMATION.to_owned(),
+            change_layer: None,
             max_population_cells: limits.max_population_cells,
             max_plan_cost: limits.max_plan_cost,
             max_plan_seconds: budget.max_plan_seconds,

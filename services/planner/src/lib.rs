@@ -25,6 +25,7 @@ pub mod best;
 pub mod budget;
 pub mod client;
 pub mod config;
+pub mod coupling;
 pub mod curiosity;
 pub mod eta;
 pub mod ga;

@@ -1,5 +1,6 @@
 //! The maps the planner plans on: the latest `inflated` and `information` layers from
-//! the map server, and a few earlier versions for requests that name one.
+//! the map server (and, on a planner that couples one, the mapper's change layer; see
+//! [`crate::coupling`]), and a few earlier versions for requests that name one.
 
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -9,6 +10,7 @@ use roam_proto::cells::Cells;
 use roam_proto::map::Layer;
 use roam_proto::planner::MapVersion;
 
+use crate::coupling;
 use crate::world::World;
 
 /// The layer names the planner reads.
@@ -31,6 +33,9 @@ pub struct MapCache {
     history: usize,
     /// The layer taken as the information map.
     information_layer: String,
+    /// The change layer coupled into the information map, if any, and its latest.
+    change_layer: Option<String>,
+    change: Option<Layer>,
 }
 
 impl MapCache {
@@ -47,9 +52,18 @@ impl MapCache {
         }
     }
 
+    /// This cache with `change_layer` (a u8 layer of scores 0–100, the mapper's
+    /// `change_information`) coupled into the information map ([`crate::coupling`]).
+    pub fn coupling_change(mut self, change_layer: Option<&str>) -> Self {
+        self.change_layer = change_layer.map(str::to_owned);
+        self
+    }
+
     /// The layer names this cache follows.
-    pub fn layers(&self) -> [&str; 3] {
-        [INFLATED, self.information_layer.as_str(), PEB]
+    pub fn layers(&self) -> Vec<&str> {
+        let mut names = vec![INFLATED, self.information_layer.as_str(), PEB];
+        names.extend(self.change_layer.as_deref());
+        names
     }
 
     /// Takes a new layer; rebuilds the world when both layers are present and agree in
@@ -62,6 +76,7 @@ impl MapCache {
         let slot = match layer.name.as_str() {
             INFLATED => &mut self.inflated,
             name if name == self.information_layer => &mut self.information,
+            name if Some(name) == self.change_layer.as_deref() => &mut self.change,
             _ => return None,
         };
         if slot
@@ -74,9 +89,24 @@ impl MapCache {
         let (Some(inflated), Some(information)) = (&self.inflated, &self.information) else {
             return None;
         };
+        if let Some(change) = &self.change {
+            if coupling::usable(change, information).is_none() {
+                tracing::warn!(
+                    layer = %change.name,
+                    version = change.version,
+                    "the change layer is not u8 scores on the information layer's grid; planning on {} alone",
+                    self.information_layer
+                );
+            }
+        }
+        let change = self
+            .change
+            .as_ref()
+            .and_then(|c| coupling::usable(c, information));
         let version = MapVersion {
             inflated: inflated.version,
             information: information.version,
+            change: change.map(|c| c.version),
         };
         if self.worlds.iter().any(|(v, _)| *v == version) {
             return None;
@@ -91,7 +121,10 @@ impl MapCache {
         };
         let info = Grid {
             meta: information.meta,
-            cells: info.clone(),
+            cells: match change.map(|c| &c.cells) {
+                Some(Cells::U8(scores)) => coupling::couple(info, scores),
+                _ => info.clone(),
+            },
         };
         match World::new(&occ, &info, DEFAULT_COMPRESSION) {
             Ok(mut world) => {
@@ -154,5 +187,71 @@ impl MapCache {
 
     pub fn versions(&self) -> Vec<MapVersion> {
         self.worlds.iter().map(|(v, _)| *v).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roam_proto::map::{GridMeta, Origin};
+
+    fn layer(name: &str, version: u64, cells: Cells) -> Layer {
+        Layer {
+            name: name.to_owned(),
+            version,
+            derived_from: None,
+            meta: GridMeta {
+                width: 4,
+                height: 1,
+                resolution: 0.2,
+                origin: Origin {
+                    x: 0.0,
+                    y: 0.0,
+                    yaw: 0.0,
+                },
+            },
+            cells,
+        }
+    }
+
+    #[test]
+    fn a_coupled_cache_plans_on_the_static_map_until_change_arrives_then_on_the_maximum() {
+        let mut cache = MapCache::new(4).coupling_change(Some("change_information"));
+        assert_eq!(
+            cache.layers(),
+            vec![INFLATED, INFORMATION, PEB, "change_information"]
+        );
+        cache.update(layer(INFLATED, 1, Cells::I8(vec![0; 4])));
+        let first = cache
+            .update(layer(INFORMATION, 1, Cells::U8(vec![10, 20, 30, 40])))
+            .expect("a world once both layers are in");
+        assert_eq!(first.change, None);
+        let (_, world) = cache.world(None).expect("world");
+        assert_eq!(world.information, vec![10, 20, 30, 40]);
+
+        let coupled = cache
+            .update(layer(
+                "change_information",
+                3,
+                Cells::U8(vec![90, 0, 35, 0]),
+            ))
+            .expect("a new world for the change layer");
+        assert_eq!(coupled.change, Some(3));
+        let (_, world) = cache.world(None).expect("world");
+        assert_eq!(world.information, vec![90, 20, 35, 40]);
+        // The static world stays for requests that name it.
+        assert_eq!(cache.world(Some(first)).map(|(v, _)| v), Some(first));
+    }
+
+    #[test]
+    fn an_uncoupled_cache_ignores_the_change_layer() {
+        let mut cache = MapCache::new(4);
+        assert_eq!(cache.layers(), vec![INFLATED, INFORMATION, PEB]);
+        cache.update(layer(INFLATED, 1, Cells::I8(vec![0; 4])));
+        cache.update(layer(INFORMATION, 1, Cells::U8(vec![1; 4])));
+        assert_eq!(
+            cache.update(layer("change_information", 1, Cells::U8(vec![99; 4]))),
+            None
+        );
     }
 }

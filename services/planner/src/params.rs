@@ -188,14 +188,21 @@ impl GaParams {
         ] {
             check(name, v, (0.0..=1.0).contains(&v), "0..=1")?;
         }
-        for (name, v) in [("v_lin", self.v_lin), ("v_ang", self.v_ang)] {
-            check(
-                name,
-                v,
-                (0.0..=1000.0).contains(&v),
-                "0..=1000 seconds per metre / radian",
-            )?;
-        }
+        // v_lin 0 would be a robot that drives any distance in no time: every path
+        // fits every budget and the budget's cell bound (limits.rs) is the whole map.
+        // Turning may be free (a point robot), driving may not.
+        check(
+            "v_lin",
+            self.v_lin,
+            self.v_lin > 0.0 && self.v_lin <= 1000.0,
+            "(0, 1000] seconds per metre",
+        )?;
+        check(
+            "v_ang",
+            self.v_ang,
+            (0.0..=1000.0).contains(&self.v_ang),
+            "0..=1000 seconds per radian",
+        )?;
         for (name, v) in [
             ("w1", self.w1),
             ("w2", self.w2),
@@ -311,6 +318,33 @@ mod tests {
             let err = GaParams::with_overrides(&overrides).expect_err("must be refused");
             assert_eq!(err.name, name);
         }
+    }
+
+    #[test]
+    fn an_impossible_time_model_is_refused_and_free_turning_is_not() {
+        for v_lin in [0.0, -1.0, f64::NAN, f64::INFINITY, 1001.0] {
+            let err = GaParams::with_overrides(&GaOverrides {
+                v_lin: Some(v_lin),
+                ..GaOverrides::default()
+            })
+            .expect_err("a robot that drives in no time (or backwards) is no time model");
+            assert_eq!(err.name, "v_lin");
+            assert!(err.to_string().contains("(0, 1000]"), "{err}");
+        }
+        let err = GaParams::with_overrides(&GaOverrides {
+            v_ang: Some(-0.5),
+            ..GaOverrides::default()
+        })
+        .expect_err("negative turning time");
+        assert_eq!(err.name, "v_ang");
+        // A point robot turns for free.
+        let p = GaParams::with_overrides(&GaOverrides {
+            v_ang: Some(0.0),
+            v_lin: Some(0.9),
+            ..GaOverrides::default()
+        })
+        .expect("v_ang 0 is a point robot");
+        assert_eq!((p.v_lin, p.v_ang), (0.9, 0.0));
     }
 
     #[test]

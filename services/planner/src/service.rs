@@ -109,7 +109,17 @@ fn check_config(config: &PlannerConfig) -> Result<(), PlannerError> {
     }
     config.budget().validate().map_err(PlannerError::Config)?;
     keys::check_name("information_layer", &config.information_layer)
-        .map_err(|e| PlannerError::Config(e.to_string()))
+        .map_err(|e| PlannerError::Config(e.to_string()))?;
+    if let Some(change) = &config.change_layer {
+        keys::check_name("change_layer", change)
+            .map_err(|e| PlannerError::Config(e.to_string()))?;
+        if *change == config.information_layer {
+            return Err(PlannerError::Config(format!(
+                "change_layer {change:?} is the information layer itself; name the mapper's change layer (change_information) or leave it out"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Runs a planner instance until `cancel` is cancelled.
@@ -131,10 +141,10 @@ pub async fn run(
         root: config.root.clone(),
         instance: service.instance().to_owned(),
         session: service.session().clone(),
-        maps: Mutex::new(MapCache::with_information(
-            config.map_history,
-            &config.information_layer,
-        )),
+        maps: Mutex::new(
+            MapCache::with_information(config.map_history, &config.information_layer)
+                .coupling_change(config.change_layer.as_deref()),
+        ),
         in_flight: AtomicUsize::new(0),
         max_in_flight: config.max_concurrent_plans,
         plans: InFlight::default(),
@@ -145,7 +155,12 @@ pub async fn run(
     let root = config.root.as_str();
 
     // Maps: follow publications, and fetch the current layers until we have them.
-    let layers = state.maps().layers().map(str::to_owned);
+    let layers: Vec<String> = state
+        .maps()
+        .layers()
+        .into_iter()
+        .map(str::to_owned)
+        .collect();
     for layer in &layers {
         service
             .subscribe(
@@ -260,7 +275,12 @@ fn take_cancel(state: &State, request: &CancelPlan) {
 /// Gets the two layers from the map server, retrying until both arrive.
 async fn fetch_maps(state: Arc<State>, requester: Requester, cancel: CancellationToken) {
     loop {
-        let layers = state.maps().layers().map(str::to_owned);
+        let layers: Vec<String> = state
+            .maps()
+            .layers()
+            .into_iter()
+            .map(str::to_owned)
+            .collect();
         for name in &layers {
             match requester
                 .request::<Layer, Layer>(&keys::map_layer(&state.root, name), None)

@@ -14,7 +14,7 @@ use image::{Rgb, RgbImage};
 use roam_controller::params::ApfParams;
 use roam_map_server::grid::Grid;
 use roam_map_server::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, PATH};
-use roam_map_server::store::{INFORMATION, OCCUPANCY};
+use roam_map_server::store::{INFLATED, INFORMATION, OCCUPANCY};
 use roam_mission::executive::{self, ExecutiveConfig, Progress, WindowOutcome};
 use roam_proto::cells::Cells;
 use roam_proto::map::{GridMeta, Layer};
@@ -25,6 +25,7 @@ use roam_runtime::Requester;
 use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
+use crate::demo_today::{todays_plans, TodaysPlan};
 use crate::stack::{Stack, StackOptions};
 
 /// The colour of the path the robot drove (its true positions).
@@ -84,6 +85,11 @@ pub struct DemoReport {
     pub information_shortest_path: f64,
     /// The same along the planned curious paths.
     pub information_planned: f64,
+    /// What today's executive (static map, Table I, one plan per window, paper 000's
+    /// initialization) would have planned per window ([`crate::demo_today`]), and the
+    /// information those plans promised, summed.
+    pub todays_plans: Vec<Option<TodaysPlan>>,
+    pub information_todays_plans: f64,
     /// The mean PEB of the estimates along the way, metres.
     pub peb_mean_m: Option<f64>,
     pub windows: Vec<WindowReport>,
@@ -212,6 +218,11 @@ async fn drive(
             .request::<Layer, Layer>(&keys::map_layer(&root, INFORMATION), None)
             .await?,
     );
+    let inflated = grid_i8(
+        requester
+            .request::<Layer, Layer>(&keys::map_layer(&root, INFLATED), None)
+            .await?,
+    );
     let truth: Arc<Mutex<Vec<[f64; 2]>>> = Arc::default();
     let recorded = truth.clone();
     let _truth = session
@@ -284,6 +295,17 @@ async fn drive(
     );
     image.save(&picture).map_err(|e| write_error(&picture, e))?;
 
+    progress("replaying today's executive's plans for comparison");
+    let today = {
+        let (outcomes, generations) = (outcomes.clone(), config.max_generations.unwrap_or(1000));
+        let seed = config.seed;
+        let information = information.clone();
+        tokio::task::spawn_blocking(move || {
+            todays_plans(&inflated, &information, &outcomes, generations, seed)
+        })
+        .await
+        .map_err(|e| DemoError::Zenoh(format!("today's plans: {e}")))?
+    };
     let windows: Vec<WindowReport> = outcomes.iter().map(|o| o.report.clone()).collect();
     let pebs: Vec<f64> = windows.iter().filter_map(|w| w.peb_mean_m).collect();
     let report = DemoReport {
@@ -291,6 +313,8 @@ async fn drive(
         information: windows.iter().map(|w| w.driven_information).sum(),
         information_shortest_path: windows.iter().map(|w| w.shortest_information).sum(),
         information_planned: windows.iter().map(|w| w.planned_information).sum(),
+        information_todays_plans: today.iter().flatten().map(|t| t.planned_information).sum(),
+        todays_plans: today,
         peb_mean_m: (!pebs.is_empty()).then(|| pebs.iter().sum::<f64>() / pebs.len() as f64),
         windows,
         sim_rate: options.rate,
@@ -395,8 +419,14 @@ fn markdown(r: &DemoReport) -> String {
         r.seed,
         r.wall_s
     ));
-    out.push_str("| window | task | task starts s | arrived s | on time | budget s | share driven | information driven | planned | driven / planned | shortest path | v_lin s/m | v_ang s/rad | mean PEB m | replans |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| window | task | task starts s | arrived s | on time | budget s | share driven | information driven | planned | driven / planned | shortest path | today's plan | v_lin s/m | v_ang s/rad | mean PEB m | replans |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for w in &r.windows {
+        let today = r
+            .todays_plans
+            .iter()
+            .flatten()
+            .find(|t| t.window == w.window)
+            .map_or("-".to_owned(), |t| format!("{:.0}", t.planned_information));
         let ratio = if w.planned_information > 0.0 {
             format!("{:.2}", w.driven_information / w.planned_information)
         } else {
@@ -404,7 +434,7 @@ fn markdown(r: &DemoReport) -> String {
         };
         let model = w.time_model;
         out.push_str(&format!(
-            "| {} | {} | {:.1} | {} | {} | {:.1} | {} | {:.0} | {:.0} | {ratio} | {:.0} | {} | {} | {} | {} |\n",
+            "| {} | {} | {:.1} | {} | {} | {:.1} | {} | {:.0} | {:.0} | {ratio} | {:.0} | {today} | {} | {} | {} | {} |\n",
             w.window + 1,
             w.task,
             w.task_start_s,
@@ -429,11 +459,20 @@ fn markdown(r: &DemoReport) -> String {
     } else {
         "-".to_owned()
     };
+    let against_today = if r.information_todays_plans > 0.0 {
+        format!(
+            "{:+.0}%",
+            (r.information / r.information_todays_plans - 1.0) * 100.0
+        )
+    } else {
+        "-".to_owned()
+    };
     out.push_str(&format!(
-        "\nOn time at every task: **{}**. Information gathered: **{:.0}** against {:.0} on the shortest paths ({gain}). Mean PEB {}.\n\n",
+        "\nOn time at every task: **{}**. Information gathered: **{:.0}** against {:.0} on the shortest paths ({gain}) and {:.0} that today's executive would have planned ({against_today}; static map, Table I's time model, one plan per window; what it planned, of which it drove 84-89%). Mean PEB {}.\n\n",
         if r.on_time { "yes" } else { "no" },
         r.information,
         r.information_shortest_path,
+        r.information_todays_plans,
         r.peb_mean_m.map_or("-".to_owned(), |p| format!("{p:.3} m")),
     ));
     out.push_str("![the world, the planned (blue), shortest (magenta) and driven (red) paths, anchors (purple), start and tasks (green)](world.png)\n");

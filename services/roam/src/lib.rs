@@ -8,6 +8,7 @@ pub mod bench_localization;
 pub mod bench_planner;
 pub mod bench_sim;
 pub mod demo;
+pub mod demo_today;
 pub mod peb_picture;
 pub mod report;
 pub mod reproduce_apf;

@@ -133,6 +133,8 @@ impl Stack {
             let planner_config = PlannerConfig {
                 root: root.clone(),
                 instance: Some(format!("planner-{index}")),
+                // The stack runs the mapper: plan on the change coupling.
+                change_layer: Some(roam_proto::mapper::CHANGE_INFORMATION_LAYER.to_owned()),
                 ..PlannerConfig::default()
             };
             spawn(

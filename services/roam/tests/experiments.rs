@@ -207,9 +207,27 @@ fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
         "on_time",
         "information",
         "information_shortest_path",
+        "information_todays_plans",
         "peb_mean_m",
     ] {
         assert!(!report[field].is_null(), "{field} missing: {report}");
+    }
+    // Today's executive's plan replayed for each window, within its window.
+    let today = report["todays_plans"].as_array().expect("today's plans");
+    assert_eq!(today.len(), 4, "{report}");
+    for (w, t) in report["windows"]
+        .as_array()
+        .expect("windows")
+        .iter()
+        .zip(today)
+    {
+        let window =
+            w["task_start_s"].as_f64().expect("start") - w["began_s"].as_f64().expect("began");
+        let eta = t["t_eta_s"].as_f64().expect("today's plan");
+        assert!(
+            eta <= window + 1e-6,
+            "today's plan {t} does not fit window {w}"
+        );
     }
     // The day: four windows, one a round trip, each with the time model it planned with
     // and the share of the window the robot drove.
@@ -227,6 +245,7 @@ fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
     }
     let markdown = std::fs::read_to_string(out.path().join("report.md")).expect("md");
     assert!(markdown.contains("| 1 | goal1 |") && markdown.contains("world.png"));
+    assert!(markdown.contains("today's plan"), "{markdown}");
 
     // The built-in world: 100 x 100 cells of 0.2 m from (-10, -10), 8 px per cell.
     let picture = image::open(out.path().join("world.png"))

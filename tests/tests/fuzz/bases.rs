@@ -182,6 +182,7 @@ pub(crate) fn plan_bases() -> Vec<Vec<u8>> {
         map_version: Some(roam_proto::planner::MapVersion {
             inflated: u64::MAX,
             information: 0,
+            change: None,
         }),
         ..ok
     }));
