@@ -202,6 +202,10 @@ const PREPLAN_FROM_M: f64 = 0.5;
 /// A curious plan is expected to take this times the slowest recent one, plus
 /// [`PLAN_WALL_SLACK_S`].
 const PLAN_WALL_MARGIN: f64 = 1.5;
+/// The arrival margin's largest share of the time to a task, whatever the model's error.
+const MAX_ARRIVAL_MARGIN_SHARE: f64 = 0.25;
+/// How much of the last underestimate the next window still remembers.
+const UNDERESTIMATE_MEMORY: f64 = 0.5;
 const PLAN_WALL_SLACK_S: f64 = 0.05;
 
 /// How long the executive waits for the sim's clock at its start.
@@ -261,6 +265,10 @@ struct Run<'a> {
     calibration: Calibration,
     /// Wall seconds the recent curious plans took (request to reply), the slowest.
     plan_wall_s: std::sync::Mutex<Option<f64>>,
+    /// How much longer than its time model predicted the robot's recent drives took, as
+    /// a share (0 when the model was right or pessimistic), forgetting slowly: the
+    /// arrival margin is at least this.
+    underestimate: f64,
     /// The next window's plans, made while the robot did its task.
     preplanned: Option<Preplanned>,
     /// This executive's own tag in its mission ids (from its Zenoh session id), so a
@@ -356,8 +364,12 @@ impl Run<'_> {
     ) -> Result<(Plan, f64), ClientError> {
         let earliest = self.now() + self.planning_cost_s();
         let time_left = task.start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
-        let margin =
-            (time_left * self.config.arrival_margin_share).max(self.config.arrival_margin_min_s);
+        let share = self
+            .config
+            .arrival_margin_share
+            .max(self.underestimate)
+            .min(MAX_ARRIVAL_MARGIN_SHARE);
+        let margin = (time_left * share).max(self.config.arrival_margin_min_s);
         let budget = time_left - margin;
         if !curious || budget <= shortest.t_eta_s {
             return Ok((shortest.clone(), budget));
@@ -490,6 +502,12 @@ impl Run<'_> {
             let (d, theta) = path_measure(points);
             model.eta(d, theta)
         });
+        if let Some((_, took_s)) = drive {
+            if predicted_s > 0.0 && took_s.is_finite() {
+                let error = (took_s / predicted_s - 1.0).max(0.0);
+                self.underestimate = error.max(UNDERESTIMATE_MEMORY * self.underestimate);
+            }
+        }
         if let (true, Some((points, took_s))) = (self.config.calibrate, drive) {
             let (d, theta) = path_measure(points);
             if self.calibration.add_planned(d, theta, took_s) {
@@ -823,6 +841,7 @@ pub async fn run(
         missions_sent: 0,
         calibration: load_calibration(config)?,
         plan_wall_s: std::sync::Mutex::new(None),
+        underestimate: 0.0,
         preplanned: None,
         tag: session.zid().to_string().chars().take(8).collect(),
     };

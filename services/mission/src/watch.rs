@@ -12,6 +12,13 @@
 //! - **blocked**: the controller reports the robot stuck: replan the shortest way;
 //! - **late**: the ETA (distance left at the robot's speed) slips past the task's start:
 //!   replan the shortest way, once, and never curious again in this window;
+//! - **behind**: at the robot's own progress along the path (once it has driven a few
+//!   seconds) it would arrive after the task's start, though at its top speed it would
+//!   not: the time model underestimated this path (a slow stretch, turns the model
+//!   does not charge). Replan a curious path from where it is with the time left (the
+//!   executive's arrival margin included), at most once per `slack_interval_s`: cheaper
+//!   than giving the rest of the window to the shortest path, and if the robot still
+//!   falls behind, the late rule takes over;
 //! - **pushed off the path**: an estimate farther than `off_path_m` from the path;
 //! - **slack**: the robot will arrive more than `slack_s` early (predicted from its own
 //!   progress along the path once it has driven a few seconds, from the time model
@@ -51,6 +58,7 @@ pub enum Reason {
     EtaSlipped,
     PushedOffPath,
     Slack,
+    Behind,
 }
 
 impl Reason {
@@ -62,6 +70,7 @@ impl Reason {
             Reason::EtaSlipped => "the ETA slipped past the task's start",
             Reason::PushedOffPath => "pushed off the path",
             Reason::Slack => "slack: arriving early, a curious path with the time left",
+            Reason::Behind => "behind the plan: a curious path with the time left",
         }
     }
 }
@@ -187,23 +196,32 @@ impl Watch {
             Status::Completed => Decision::Arrived { at_s: now_s },
             Status::Stuck => self.replan(Reason::Stuck, false),
             Status::Active { distance_left_m } if !self.slipped => {
-                let speed = self.params.speed_m_per_s;
-                if eta_slips(now_s, distance_left_m, speed, self.task_start_s) {
+                let (t0, d0) = *self.progress_from.get_or_insert((now_s, distance_left_m));
+                let progress_speed = (d0 - distance_left_m) / (now_s - t0);
+                // The robot's own progress along the path, once it has driven a few
+                // seconds: it counts the turns and slow stretches that the distance
+                // at top speed leaves out.
+                let progress = (now_s - t0 >= PROGRESS_AFTER_S && progress_speed > 0.0)
+                    .then_some(progress_speed);
+                if eta_slips(
+                    now_s,
+                    distance_left_m,
+                    self.params.speed_m_per_s,
+                    self.task_start_s,
+                ) {
                     self.slipped = true;
                     return self.replan(Reason::EtaSlipped, false);
                 }
-                let (t0, d0) = *self.progress_from.get_or_insert((now_s, distance_left_m));
-                let progress_speed = (d0 - distance_left_m) / (now_s - t0);
-                let speed = if now_s - t0 >= PROGRESS_AFTER_S && progress_speed > 0.0 {
-                    progress_speed
-                } else {
-                    self.params.expected_speed_m_per_s
-                };
+                let spaced = now_s - self.planned_at_s >= self.params.slack_interval_s;
+                if let Some(pace) = progress {
+                    if spaced && eta_slips(now_s, distance_left_m, pace, self.task_start_s) {
+                        return self.replan(Reason::Behind, true);
+                    }
+                }
+                let speed = progress.unwrap_or(self.params.expected_speed_m_per_s);
                 let arrival_s = now_s + distance_left_m / speed;
                 let early = self.task_start_s - arrival_s;
-                if early > self.params.slack_s + planning_cost_s
-                    && now_s - self.planned_at_s >= self.params.slack_interval_s
-                {
+                if early > self.params.slack_s + planning_cost_s && spaced {
                     return self.replan(Reason::Slack, true);
                 }
                 Decision::Keep
@@ -358,6 +376,37 @@ mod tests {
                 ..
             }
         ));
+    }
+
+    #[test]
+    fn behind_the_plan_replans_curious_with_the_time_left() {
+        // 20 m left at the configured 0.5 m/s would arrive at 70 s for a task at 100 s,
+        // but the robot makes 0.25 m/s along the path (turns, a crowd): at that pace it
+        // arrives at 110 s. Not late, behind: a curious plan that fits the time left.
+        // (The time model expects 0.3 m/s: no slack before the robot's pace is known.)
+        let params = WatchParams {
+            expected_speed_m_per_s: 0.3,
+            ..params()
+        };
+        let mut w = Watch::new(params, 100.0, vec![[0.0, 0.0], [40.0, 0.0]], 0.0, 0.0);
+        let active = |left| Status::Active {
+            distance_left_m: left,
+        };
+        assert_eq!(w.on_status(active(21.0), 26.0, 0.1, 1.0), Decision::Keep);
+        let behind = Decision::Replan {
+            reason: Reason::Behind,
+            curious: true,
+            resend: false,
+        };
+        assert_eq!(w.on_status(active(20.0), 30.0, 0.2, 1.0), behind);
+        w.replanned(vec![[20.0, 0.0], [40.0, 0.0]], false, 30.0, 0.2);
+        // Not again before slack_interval_s, and not on a pace that arrives in time.
+        assert_eq!(w.on_status(active(19.0), 31.0, 0.3, 1.0), Decision::Keep);
+        assert_eq!(w.on_status(active(18.0), 34.0, 0.4, 1.0), Decision::Keep);
+        // 0.3 m/s since the replan arrives at 94 s: in time, and not early enough to be slack.
+        assert_eq!(w.on_status(active(17.5), 36.0, 0.5, 1.0), Decision::Keep);
+        // Behind again later (0.23 m/s: 114 s): replanned again.
+        assert_eq!(w.on_status(active(17.4), 38.0, 0.6, 1.0), behind);
     }
 
     #[test]
