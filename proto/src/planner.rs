@@ -61,6 +61,15 @@ pub struct GaOverrides {
     /// W_loc: weight of the localizability cost (roam, not paper 000).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub w_loc: Option<f64>,
+    /// Share of the first population built through via-points drawn from the
+    /// information layer (roam, not paper 000); 0..=1, default 0.25.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub via_share: Option<f64>,
+    /// Share of t_exec a random walk of the first population uses before it may end at
+    /// the goal (roam's round-trip rule); 0..=1, default 0.5. Both 0: paper 000's own
+    /// initialization.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub walk_end_share: Option<f64>,
 }
 
 /// Ask for a plan: from `start` to `goal` (world metres) within `t_exec_s` seconds of

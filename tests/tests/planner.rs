@@ -442,6 +442,13 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
             value: 100.0,
         });
     }
+    // And a ring around cell (42, 42) at two cells: with the robot's inflation that
+    // cell is left free with no legal move out of it.
+    for k in 40..=44u32 {
+        for (x, y) in [(k, 40), (k, 44), (40, k), (44, k)] {
+            cells.push(roam_proto::map::CellWrite { x, y, value: 100.0 });
+        }
+    }
     let update = roam_proto::map::LayerUpdate {
         base_version: 1,
         change: roam_proto::map::LayerChange::SetCells { cells },
@@ -471,6 +478,67 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
     };
     assert_eq!(no_path.code, ErrorCode::NotFound);
     assert!(no_path.message.contains("no path"), "{}", no_path.message);
+
+    // A round trip from the enclosed cell (42, 42), the world point (-1.5, -1.5): no
+    // loop fits, and the refusal names the start and t_exec_s.
+    let enclosed = refusal(
+        &client,
+        &root,
+        &PlanRequest {
+            start: [-1.5, -1.5],
+            goal: [-1.5, -1.5],
+            ..walled.clone()
+        },
+    )
+    .await;
+    assert_eq!(enclosed.code, ErrorCode::InvalidRequest);
+    for named in ["start (-1.5, -1.5)", "no legal move", "t_exec_s"] {
+        assert!(enclosed.message.contains(named), "{}", enclosed.message);
+    }
+    running.stop().await;
+}
+
+/// Issue 14: a robot whose next task is where it stands (start = goal), or a cell away,
+/// gets a loop through Zenoh that uses at least 80% of its budget and ends on time at
+/// the goal, the same loop bit for bit as the in-process planner's.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_round_trip_through_zenoh_uses_the_budget() {
+    let running = boot(&[("solo", 2)]).await;
+    let client = running.harness.client().await;
+    let content = map_file::builtin(DEFAULT_LIMITS.max_layer_cells).expect("builtin");
+    let inflated = inflate(
+        &content.occupancy,
+        content.robot_radius_m.unwrap_or(0.2),
+        65,
+    );
+    let world = World::new(&inflated, &content.information.expect("info"), 0.25).expect("world");
+    for goal in [[-8.0, -8.0], [-7.8, -8.0]] {
+        let req = request([-8.0, -8.0], goal, 40.0, 200);
+        let remote = ask(&client, &running.harness.root, &req)
+            .await
+            .expect("plan");
+        assert!(remote.reaches_goal && remote.within_budget, "{remote:?}");
+        assert!(
+            remote.t_eta_s >= 0.8 * req.t_exec_s && remote.t_eta_s <= req.t_exec_s,
+            "{goal:?}: {} s of {} s",
+            remote.t_eta_s,
+            req.t_exec_s
+        );
+        assert!(remote.cells.len() > 20, "{} cells", remote.cells.len());
+        let spec = PlanSpec {
+            start: req.start,
+            goal: req.goal,
+            t_exec_s: req.t_exec_s,
+            deadline_s: req.deadline_s,
+            model: req.model,
+            params: GaParams::with_overrides(&req.params).expect("params"),
+            seed: req.seed,
+            threads: roam_planner::ga::default_threads(),
+            limits: roam_planner::limits::PlanLimits::default(),
+        };
+        let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local");
+        assert_eq!(remote.cells, world.grid_cells(&local.path));
+    }
     running.stop().await;
 }
 

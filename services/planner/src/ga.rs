@@ -14,6 +14,25 @@
 //!   fits the budget) joins the first population. The GA therefore always holds a path
 //!   that reaches the goal in time, and a tight budget cannot end in an over-budget
 //!   plan just because no random walk happened to fit.
+//! - Round trips (roam, issue 14; [`GaParams::walk_end_share`], default 0.5): a walk
+//!   ends only once its t_ETA (Eq. 2, summed as it walks) has reached
+//!   `walk_end_share · t_exec`. Before that, arriving at G does not end it (it walks on
+//!   through G) and neither does its drawn length; after that, the first of the two
+//!   does, and the walk is finished at G as above. With S = G the paper's rule ends every
+//!   walk at once, at S: the first population is the one cell S, no operator can grow
+//!   it, and the plan tells a robot whose next task is where it stands to stand still.
+//!   With the rule every walk is a loop that used at least half the budget before
+//!   heading back. Far goals change little: a walk that reaches G late, or is drawn
+//!   long (random walks turn at almost every step, so they cost several times the
+//!   budget's cells), has used the share anyway. `walk_end_share = 0` is the paper's rule.
+//! - Via-point seeds (roam, issue 14; [`GaParams::via_share`], default 0.25): that share
+//!   of the first population is built by [`crate::seeds`] (paths through cells drawn ∝
+//!   information, joined by shortest paths, within the budget) and handed in with the
+//!   shortest path as [`Problem::seed_paths`]; the rest are random walks.
+//! - Loops stay loops: a chromosome starts at S and ends at G, and no operator moves its
+//!   first gene or a last gene that is G (crossover joins a head of one parent to a tail
+//!   of the other, mutation moves inner genes only). A loop through S or G in its middle
+//!   may be cut or nudged there like any other inner gene.
 //! - Selection (§II.A.3): "layered selection" after Li et al. is not spelled out in the
 //!   paper. roam sorts by fitness and splits the population into three layers: the top
 //!   third enters the next generation twice, the middle third once, the bottom third
@@ -40,6 +59,7 @@ use rand_chacha::ChaCha8Rng;
 use roam_proto::planner::StopReason;
 
 use crate::curiosity::{Evaluation, Evaluator, Model};
+use crate::eta::step_time;
 use crate::params::GaParams;
 use crate::search::{descend_to_goal, descent_steps};
 use crate::world::{Cell, World, MOVES};
@@ -120,6 +140,8 @@ pub struct GaResult {
     pub evaluation: Evaluation,
     pub generations: u32,
     pub evaluations: u64,
+    /// Genes of all evaluated chromosomes: the GA's work, which grows with path length.
+    pub evaluated_genes: u64,
     pub stop_reason: StopReason,
 }
 
@@ -181,6 +203,7 @@ pub fn run(
     let mut scratch = Scratch::new(problem.world.cell_count());
     let mut best: Option<(Chromosome, Evaluation)> = None;
     let mut evaluations = 0u64;
+    let mut evaluated_genes = 0u64;
     let mut generation = 0u32;
     let stop_reason = loop {
         // Evaluate what changed, then take the best in population order.
@@ -189,6 +212,10 @@ pub fn run(
             .collect();
         let results = evaluate_dirty(&mut evaluators, &population, &dirty);
         evaluations += results.len() as u64;
+        evaluated_genes += dirty
+            .iter()
+            .map(|&i| population[i].genes.len() as u64)
+            .sum::<u64>();
         for (&i, evaluation) in dirty.iter().zip(results) {
             let chromosome = &mut population[i];
             chromosome.fitness = Some(evaluation.fitness.total);
@@ -255,6 +282,7 @@ pub fn run(
         evaluation,
         generations: generation,
         evaluations,
+        evaluated_genes,
         stop_reason,
     }
 }
@@ -293,18 +321,33 @@ fn initial_walk(problem: &Problem<'_>, options: &GaOptions, rng: &mut ChaCha8Rng
         };
         walk.len().saturating_add(1).saturating_add(descent) <= max_cells
     };
-    while walk.len() < length && cell != problem.goal && room(&walk, cell) {
+    // The round-trip rule (`walk_end_share`, see the module doc): neither the drawn
+    // length nor G ends a walk before it has used this much of t_exec. 0 is the paper's
+    // rule: 0 s are always used, so the walk stops at its length or at G.
+    let floor = problem.params.walk_end_share * problem.t_exec;
+    let mut t = 0.0;
+    let mut prev_dir = None;
+    let mut dirs = [0usize; 8];
+    loop {
+        let done = walk.len() >= length || cell == problem.goal;
+        if (done && t >= floor) || !room(&walk, cell) {
+            break;
+        }
         let mut count = 0;
         for dir in 0..MOVES.len() {
             if let Some(next) = world.step(cell, dir) {
                 moves[count] = next;
+                dirs[count] = dir;
                 count += 1;
             }
         }
         if count == 0 {
             break;
         }
-        cell = moves[rng.random_range(0..count)];
+        let pick = rng.random_range(0..count);
+        cell = moves[pick];
+        t += step_time(world, problem.params, prev_dir, dirs[pick]);
+        prev_dir = Some(dirs[pick]);
         walk.push(cell);
     }
     if options.complete_walks_to_goal && cell != problem.goal {
@@ -596,6 +639,78 @@ mod tests {
             let longest = population.iter().map(|c| c.genes.len()).max();
             assert!(longest <= Some(max), "round {round}: {longest:?}");
         }
+    }
+
+    /// Issue 14: with S = G the round-trip rule makes every walk a loop that used at
+    /// least `walk_end_share` of the budget before heading back (the paper's rule makes
+    /// every walk the one cell S), and crossover and mutation keep every chromosome a
+    /// legal path from S back to S.
+    #[test]
+    fn round_trip_walks_are_loops_and_the_operators_keep_them_loops() {
+        let world = open_world(60);
+        let start = world.cell(30, 30);
+        let field = distance_field(&world, start);
+        let paper = GaParams::default().with_paper_initialization();
+        let params = GaParams::default();
+        let problem = |params| Problem {
+            world: &world,
+            params,
+            model: Model::Novelty,
+            start,
+            goal: start,
+            t_exec: 60.0,
+            goal_field: &field,
+            seed_paths: &[],
+        };
+        // 60 s at 0.4 s per cell: at most 151 cells.
+        let options = options(151);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let paper_problem = problem(&paper);
+        for _ in 0..50 {
+            assert_eq!(
+                initial_walk(&paper_problem, &options, &mut rng),
+                vec![start]
+            );
+        }
+        let problem = problem(&params);
+        let mut population: Vec<Chromosome> = (0..300)
+            .map(|_| Chromosome {
+                genes: initial_walk(&problem, &options, &mut rng),
+                fitness: None,
+            })
+            .collect();
+        for c in &population {
+            assert!(c.genes.len() >= 3, "{:?}", c.genes);
+            let eta = crate::eta::path_eta(&world, &params, &c.genes);
+            assert!(eta >= 0.5 * 60.0, "a walk of {eta} s");
+        }
+        let is_loop = |genes: &[Cell]| {
+            genes.first() == Some(&start)
+                && genes.last() == Some(&start)
+                && genes.windows(2).all(|w| world.is_legal_move(w[0], w[1]))
+        };
+        let mut scratch = Scratch::new(world.cell_count());
+        let mut changed = 0;
+        for _ in 0..50 {
+            for chromosome in population.iter_mut() {
+                let before = chromosome.genes.clone();
+                mutate(chromosome, &problem, &options, &mut rng);
+                changed += usize::from(chromosome.genes != before);
+            }
+            for pair in (0..population.len()).collect::<Vec<_>>().chunks_exact(2) {
+                crossover(
+                    &mut population,
+                    pair[0],
+                    pair[1],
+                    &problem,
+                    &options,
+                    &mut scratch,
+                    &mut rng,
+                );
+            }
+            assert!(population.iter().all(|c| is_loop(&c.genes)));
+        }
+        assert!(changed > 1000, "the operators did work: {changed}");
     }
 
     /// Without the bound (the map's cell count), the same walks are far longer: the test

@@ -8,7 +8,10 @@
 //! - [`eta`]: the travel-time estimate t_ETA (Eq. 2);
 //! - [`curiosity`]: the fitness (Eqs. 1, 3–7) with Models 0 / I / II (Eqs. 8–10);
 //! - [`metrics`]: U_ges, D (Eqs. 11–12) and the information of distinct cells;
-//! - [`ga`]: initialisation, layered selection, crossover, mutation (§II.A);
+//! - [`ga`]: initialisation, layered selection, crossover, mutation (§II.A), with roam's
+//!   round-trip rule for random walks;
+//! - [`seeds`]: via-point seeds, paths through informative cells within the budget;
+//! - [`best`]: the plan is never below the shortest path or a seed;
 //! - [`search`]: the shortest-path baseline (A*, octile) and the distance field;
 //! - [`limits`]: what one plan may cost (path length from Eq. 2, memory, work);
 //! - [`plan`]: one request end to end, with the checks that refuse bad requests.
@@ -18,6 +21,7 @@
 //! ids, cancel tokens, who may cancel); bounded logs and echoes of untrusted input come
 //! from `roam_runtime::warn_limit` and `roam_proto::excerpt`, shared by every service.
 
+pub mod best;
 pub mod budget;
 pub mod client;
 pub mod config;
@@ -31,6 +35,7 @@ pub mod metrics;
 pub mod params;
 pub mod plan;
 pub mod search;
+pub mod seeds;
 pub mod service;
 pub mod token;
 pub mod world;

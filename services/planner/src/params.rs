@@ -52,6 +52,20 @@ pub struct GaParams {
     /// have to fight for its position costs more. 0 (off) by default: Table I has no
     /// such term.
     pub w_loc: f64,
+    /// Share of the first population built through via-points ([`crate::seeds`]): paths
+    /// S → v₁ → … → G through cells drawn from the information layer, joined by shortest
+    /// paths and kept only within the budget (Eq. 2). roam's, not paper 000's, whose
+    /// first population is random walks only (§II.A.1): random walks from S seldom find
+    /// information off the straight route. 0 (with `walk_end_share` 0) is the paper's
+    /// initialization ([`GaParams::with_paper_initialization`]). Default 0.25.
+    pub via_share: f64,
+    /// The share of t_exec a random walk must have used (Eq. 2) before it may end: a
+    /// walk that arrives at G earlier passes through it, one that reaches its drawn
+    /// length earlier walks on; then it is finished at G. roam's round-trip rule
+    /// ([`crate::ga`]): the paper's walks stop at G at once, so with start = goal every
+    /// walk was the one cell S and the robot was told to stand still. 0 is the paper's
+    /// rule. Default 0.5.
+    pub walk_end_share: f64,
 }
 
 impl Default for GaParams {
@@ -75,9 +89,16 @@ impl Default for GaParams {
             perception_diameter: 3,
             coverage_gain: 1.0,
             w_loc: 0.0,
+            via_share: DEFAULT_VIA_SHARE,
+            walk_end_share: DEFAULT_WALK_END_SHARE,
         }
     }
 }
+
+/// Default [`GaParams::via_share`].
+pub const DEFAULT_VIA_SHARE: f64 = 0.25;
+/// Default [`GaParams::walk_end_share`].
+pub const DEFAULT_WALK_END_SHARE: f64 = 0.5;
 
 /// The largest population a request may ask for.
 pub const MAX_POPULATION: usize = 2000;
@@ -132,7 +153,9 @@ impl GaParams {
             w_n,
             heuristic_compression,
             coverage_gain,
-            w_loc
+            w_loc,
+            via_share,
+            walk_end_share
         );
         if let Some(v) = o.perception_diameter {
             p.perception_diameter = v;
@@ -160,6 +183,8 @@ impl GaParams {
             ("crossover_ratio", self.crossover_ratio),
             ("mutation_ratio", self.mutation_ratio),
             ("mutation_percentage", self.mutation_percentage),
+            ("via_share", self.via_share),
+            ("walk_end_share", self.walk_end_share),
         ] {
             check(name, v, (0.0..=1.0).contains(&v), "0..=1")?;
         }
@@ -202,6 +227,25 @@ impl GaParams {
             "1..=15 cells",
         )?;
         Ok(())
+    }
+
+    /// These parameters with paper 000's own initialization (§II.A.1): no via-point
+    /// seeds and walks that stop at G at once. What roam added before this issue stays
+    /// (walks capped by the budget and finished at G, the shortest path in the first
+    /// population), so plans made this way are the plans roam made before via-points
+    /// and round trips, bit for bit.
+    pub fn with_paper_initialization(self) -> GaParams {
+        GaParams {
+            via_share: 0.0,
+            walk_end_share: 0.0,
+            ..self
+        }
+    }
+
+    /// Whether the first population is paper 000's (see
+    /// [`GaParams::with_paper_initialization`]).
+    pub fn is_paper_initialization(&self) -> bool {
+        self.via_share == 0.0 && self.walk_end_share == 0.0
     }
 
     /// The perception window's offsets, Eq. 3 with floor brackets (see
@@ -248,5 +292,42 @@ mod tests {
         .expect_err("must be refused");
         assert_eq!(err.name, "crossover_ratio");
         assert!(err.to_string().contains("0..=1"));
+        for (name, overrides) in [
+            (
+                "via_share",
+                GaOverrides {
+                    via_share: Some(-0.1),
+                    ..GaOverrides::default()
+                },
+            ),
+            (
+                "walk_end_share",
+                GaOverrides {
+                    walk_end_share: Some(1.5),
+                    ..GaOverrides::default()
+                },
+            ),
+        ] {
+            let err = GaParams::with_overrides(&overrides).expect_err("must be refused");
+            assert_eq!(err.name, name);
+        }
+    }
+
+    #[test]
+    fn the_papers_initialization_is_one_call_away() {
+        let roam = GaParams::default();
+        assert!(!roam.is_paper_initialization());
+        let paper = roam.clone().with_paper_initialization();
+        assert!(paper.is_paper_initialization());
+        assert_eq!((paper.via_share, paper.walk_end_share), (0.0, 0.0));
+        // Nothing else changes.
+        assert_eq!(
+            GaParams {
+                via_share: roam.via_share,
+                walk_end_share: roam.walk_end_share,
+                ..paper
+            },
+            roam
+        );
     }
 }

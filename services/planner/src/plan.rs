@@ -1,21 +1,40 @@
 //! One plan end to end: check the request and its size against the limits
-//! ([`crate::limits`]), find the shortest path (to refuse what cannot work), run the
-//! chosen planner, measure the result.
+//! ([`crate::limits`]), find the shortest path (to refuse what cannot work), seed the
+//! first population through informative via-points ([`crate::seeds`]), run the chosen
+//! planner, return the fittest of its result and the plans it was seeded with
+//! ([`crate::best`]), measure the result.
+//!
+//! **Round trips** (start = goal: a robot whose next task is where it stands, the
+//! commonest downtime of all). Nothing special is planned for them: the shortest path is
+//! the one cell S, the via-point seeds are loops S → v → … → S, and random walks use
+//! `walk_end_share` of the budget before they may end ([`crate::ga`]). The fitness then
+//! prefers a loop within the budget to standing still, for every model: both earn F2
+//! (on time, Eq. 4) and F3 (at G, Eq. 5); the loop's F1 (Eq. 3) is at least the
+//! one cell's, since its first gene perceives the same window and every later gain is
+//! ≥ 0 (Eqs. 8–10); and its F5 (Eq. 7) is higher by W_5 · t_ETA(loop), 10 per second
+//! driven at Table I's weights. So a loop that drives t seconds wins by at least
+//! W_5 · t, and by W_1 times whatever new information it sees. Standing still is the plan
+//! only when no loop fits: a budget below the smallest loop's t_ETA (one cell out and
+//! back, 2 · v_lin · resolution + π · v_ang: 3.9 s at Table I on 0.2 m cells), when the
+//! one-cell path is the only plan on time. A start with no legal move at all is refused
+//! ([`PlanError::Enclosed`]).
 
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use roam_proto::planner::{FitnessTerms, PlannerModel, StopReason};
 use roam_proto::{ErrorCode, ErrorReply};
 
+use crate::best::{best_of, PlanSource, Scored};
 use crate::curiosity::{Evaluator, Model};
 use crate::eta::path_eta;
 use crate::ga::{self, GaOptions, Problem};
-use crate::limits::{self, LimitError, PlanLimits};
+use crate::limits::{self, LimitError, PlanLimits, PlanSize};
 use crate::metrics::{path_metrics, PathMetrics};
 use crate::params::{GaParams, ParamError};
 use crate::search::{distance_field, shortest_path};
-use crate::world::{Cell, World};
+use crate::seeds::{self, SeedProblem, ViaSeeds};
+use crate::world::{Cell, World, MOVES};
 
 /// The longest planning deadline a request may set.
 pub const MAX_DEADLINE_S: f64 = 600.0;
@@ -78,8 +97,15 @@ pub struct PlanOutcome {
     pub metrics: PathMetrics,
     pub generations: u32,
     pub evaluations: u64,
+    /// Genes of all evaluated paths ([`crate::ga::GaResult::evaluated_genes`]).
+    pub evaluated_genes: u64,
     pub planning: Duration,
     pub stop_reason: StopReason,
+    /// Where the path comes from: the GA, or unchanged the shortest path or a seed when
+    /// one of them was fitter ([`crate::best`]).
+    pub source: PlanSource,
+    /// The via-point seeds the first population held ([`crate::seeds`]).
+    pub via_seeds: usize,
 }
 
 /// Why a plan was refused. Each says what to change.
@@ -99,6 +125,8 @@ pub enum PlanError {
     Blocked { which: &'static str, x: f64, y: f64 },
     #[error("there is no path from the start to the goal on this map")]
     NoPath,
+    #[error("the start ({x}, {y}) is also the goal, so the plan is a round trip, but no legal move leaves the start's cell (its 8 neighbours are obstacles, their inflation, or corners that cannot be cut): no loop fits any t_exec_s; move the start to open floor, or ask model shortest to stay")]
+    Enclosed { x: f64, y: f64 },
     #[error("the budget t_exec = {given_s:.1} s is {short_by_s:.1} s shorter than the shortest path's ETA of {needed_s:.1} s; give at least {needed_s:.1} s")]
     BudgetTooShort {
         given_s: f64,
@@ -196,15 +224,27 @@ pub fn check_spec(spec: &PlanSpec) -> Result<(), PlanError> {
     Ok(())
 }
 
-/// Plans on `world`. `progress` gets each generation's best fitness; `cancel` stops
-/// the GA early (the best path so far is returned).
-pub fn plan(
-    world: &World,
-    spec: &PlanSpec,
-    cancel: &AtomicBool,
-    progress: impl FnMut(u32, f64),
-) -> Result<PlanOutcome, PlanError> {
-    let started = Instant::now();
+/// A request that passed every check before planning.
+struct Checked {
+    start: Cell,
+    goal: Cell,
+    shortest: Vec<Cell>,
+    /// The GA's size; `None` for the baseline.
+    size: Option<PlanSize>,
+}
+
+impl Checked {
+    /// The longest chromosome. The shortest path is in the first population and fits
+    /// the budget, so the bound holds it (the max only guards rounding).
+    fn max_path_cells(&self, world: &World) -> usize {
+        self.size
+            .map_or(world.cell_count(), |s| s.path_cells)
+            .max(self.shortest.len())
+    }
+}
+
+/// Everything [`plan`] refuses before any work, and the shortest path.
+fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
     check_spec(spec)?;
     let start = locate(world, "start", spec.start)?;
     let goal = locate(world, "goal", spec.goal)?;
@@ -220,6 +260,12 @@ pub fn plan(
         )?),
         None => None,
     };
+    if start == goal && size.is_some() && (0..MOVES.len()).all(|d| world.step(start, d).is_none()) {
+        return Err(PlanError::Enclosed {
+            x: spec.start[0],
+            y: spec.start[1],
+        });
+    }
     let shortest = shortest_path(world, start, goal).ok_or(PlanError::NoPath)?;
     let needed = path_eta(world, params, &shortest);
     if needed > spec.t_exec_s {
@@ -229,69 +275,143 @@ pub fn plan(
             short_by_s: needed - spec.t_exec_s,
         });
     }
-    let (path, evaluation, generations, evaluations, stop_reason) = match Model::of(spec.model) {
-        None => {
-            // The baseline's fitness terms are scored with Model I, the paper's best,
-            // so that they compare with the curious plans.
-            let mut evaluator = Evaluator::new(world, params, Model::Novelty, goal, spec.t_exec_s);
-            let evaluation = evaluator.evaluate(&shortest);
-            (shortest, evaluation, 0, 1, StopReason::Complete)
-        }
-        Some(model) => {
-            let mut world_for_model;
-            let world = if model == Model::Heterogeneity
-                && params.heuristic_compression != world.heuristic_compression
-            {
-                world_for_model = world.clone();
-                world_for_model.set_heuristic_compression(params.heuristic_compression);
-                &world_for_model
-            } else {
-                world
-            };
-            let field = distance_field(world, goal);
-            let problem = Problem {
-                world,
-                params,
-                model,
-                start,
-                goal,
-                t_exec: spec.t_exec_s,
-                goal_field: &field,
-                seed_paths: std::slice::from_ref(&shortest),
-            };
-            let options = GaOptions {
-                seed: spec.seed,
-                deadline: Some(started + Duration::from_secs_f64(spec.deadline_s)),
-                cap_walks_by_budget: true,
-                complete_walks_to_goal: true,
-                // The shortest path is in the first population; it fits the budget, so
-                // the bound holds it (the max only guards rounding).
-                max_path_cells: size
-                    .map_or(world.cell_count(), |s| s.path_cells)
-                    .max(shortest.len()),
-                threads: spec.threads,
-            };
-            let result = ga::run(&problem, &options, cancel, progress);
-            (
-                result.best,
-                result.evaluation,
-                result.generations,
-                result.evaluations,
-                result.stop_reason,
-            )
-        }
+    Ok(Checked {
+        start,
+        goal,
+        shortest,
+        size,
+    })
+}
+
+/// The via-point seeds [`plan`] puts in a GA's first population for `spec`
+/// ([`crate::seeds`]; none for the baseline), built the same way: for tests and for
+/// anyone who wants to see them.
+pub fn via_seeds(world: &World, spec: &PlanSpec) -> Result<ViaSeeds, PlanError> {
+    let checked = check(world, spec)?;
+    if checked.size.is_none() {
+        return Ok(ViaSeeds::default());
+    }
+    let field = distance_field(world, checked.goal);
+    Ok(seeds_for(world, spec, &checked, &field, &|| false))
+}
+
+fn seeds_for(
+    world: &World,
+    spec: &PlanSpec,
+    checked: &Checked,
+    goal_field: &[u32],
+    stop: &dyn Fn() -> bool,
+) -> ViaSeeds {
+    let problem = SeedProblem {
+        world,
+        params: &spec.params,
+        start: checked.start,
+        goal: checked.goal,
+        t_exec: spec.t_exec_s,
+        goal_field,
+        max_path_cells: checked.max_path_cells(world),
     };
-    let metrics = path_metrics(world, params, &path);
+    seeds::via_paths(&problem, seeds::seed_count(&spec.params), spec.seed, stop)
+}
+
+/// Plans on `world`. `progress` gets each generation's best fitness; `cancel` stops
+/// the GA early (the best path so far is returned).
+pub fn plan(
+    world: &World,
+    spec: &PlanSpec,
+    cancel: &AtomicBool,
+    progress: impl FnMut(u32, f64),
+) -> Result<PlanOutcome, PlanError> {
+    let started = Instant::now();
+    let checked = check(world, spec)?;
+    let params = &spec.params;
+    let (start, goal) = (checked.start, checked.goal);
+    let deadline = started + Duration::from_secs_f64(spec.deadline_s);
+    let (chosen, generations, (evaluations, evaluated_genes), stop_reason, via_seeds) =
+        match Model::of(spec.model) {
+            None => {
+                // The baseline's fitness terms are scored with Model I, the paper's best,
+                // so that they compare with the curious plans.
+                let mut evaluator =
+                    Evaluator::new(world, params, Model::Novelty, goal, spec.t_exec_s);
+                let evaluation = evaluator.evaluate(&checked.shortest);
+                let genes = checked.shortest.len() as u64;
+                let chosen = Scored {
+                    path: checked.shortest,
+                    evaluation,
+                    source: PlanSource::Shortest,
+                };
+                (chosen, 0, (1, genes), StopReason::Complete, 0)
+            }
+            Some(model) => {
+                let mut world_for_model;
+                let world = if model == Model::Heterogeneity
+                    && params.heuristic_compression != world.heuristic_compression
+                {
+                    world_for_model = world.clone();
+                    world_for_model.set_heuristic_compression(params.heuristic_compression);
+                    &world_for_model
+                } else {
+                    world
+                };
+                let field = distance_field(world, goal);
+                let stop = || cancel.load(Ordering::Relaxed) || Instant::now() >= deadline;
+                let seeds = seeds_for(world, spec, &checked, &field, &stop).paths;
+                let via_seeds = seeds.len();
+                // The shortest path first, then the via-point seeds (see crate::ga).
+                let mut seed_paths = Vec::with_capacity(1 + via_seeds);
+                seed_paths.push(checked.shortest.clone());
+                seed_paths.extend(seeds);
+                let problem = Problem {
+                    world,
+                    params,
+                    model,
+                    start,
+                    goal,
+                    t_exec: spec.t_exec_s,
+                    goal_field: &field,
+                    seed_paths: &seed_paths,
+                };
+                let options = GaOptions {
+                    seed: spec.seed,
+                    deadline: Some(deadline),
+                    cap_walks_by_budget: true,
+                    complete_walks_to_goal: true,
+                    max_path_cells: checked.max_path_cells(world),
+                    threads: spec.threads,
+                };
+                let result = ga::run(&problem, &options, cancel, progress);
+                let ga = Scored {
+                    path: result.best,
+                    evaluation: result.evaluation,
+                    source: PlanSource::Ga,
+                };
+                let mut evaluator = Evaluator::new(world, params, model, goal, spec.t_exec_s);
+                let chosen = best_of(&mut evaluator, ga, &checked.shortest, &seed_paths[1..]);
+                (
+                    chosen,
+                    result.generations,
+                    (result.evaluations, result.evaluated_genes),
+                    result.stop_reason,
+                    via_seeds,
+                )
+            }
+        };
+    let evaluation = chosen.evaluation;
+    let metrics = path_metrics(world, params, &chosen.path);
     Ok(PlanOutcome {
         t_eta_s: evaluation.t_eta,
         reaches_goal: evaluation.reaches_goal,
         within_budget: evaluation.t_eta <= spec.t_exec_s,
         fitness: evaluation.fitness,
         metrics,
-        path,
+        path: chosen.path,
         generations,
         evaluations,
+        evaluated_genes,
         planning: started.elapsed(),
         stop_reason,
+        source: chosen.source,
+        via_seeds,
     })
 }

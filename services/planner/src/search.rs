@@ -8,8 +8,11 @@ use std::collections::BinaryHeap;
 use crate::world::{Cell, World, MOVES};
 
 /// Move costs in integer units: 1000 per straight cell, 1414 per diagonal, so that A*
-/// works on exact integers and the octile heuristic never overestimates.
-const STRAIGHT: u32 = 1000;
+/// works on exact integers and the octile heuristic never overestimates. A path's cost
+/// in these units, divided by [`STRAIGHT`], is never more than its length in cells
+/// (1414 < 1000 · √2), so `v_lin · resolution · cost / STRAIGHT` is a lower bound of its
+/// t_ETA (Eq. 2), which [`crate::seeds`] uses to rule out via-points before building paths.
+pub const STRAIGHT: u32 = 1000;
 const DIAGONAL: u32 = 1414;
 
 fn move_cost(dir: usize) -> u32 {

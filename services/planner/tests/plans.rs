@@ -5,8 +5,8 @@ mod common;
 
 use std::sync::atomic::AtomicBool;
 
+use common::check_geometry;
 use proptest::prelude::*;
-use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanError, PlanOutcome, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
@@ -27,73 +27,6 @@ fn spec(
 
 fn run(world: &World, spec: &PlanSpec) -> PlanOutcome {
     plan(world, spec, &AtomicBool::new(false), |_, _| {}).expect("plan")
-}
-
-/// Paper 000 Eq. 2 written again from the cell centres in metres, without the
-/// planner's code: v_lin · Σ segment lengths + v_ang · Σ |heading changes|.
-fn independent_eta(world: &World, params: &GaParams, path: &[u32]) -> f64 {
-    let points: Vec<(f64, f64)> = path.iter().map(|&c| world.center(c)).collect();
-    let mut distance = 0.0;
-    let mut turning = 0.0;
-    let mut previous_heading: Option<f64> = None;
-    for pair in points.windows(2) {
-        let (dx, dy) = (pair[1].0 - pair[0].0, pair[1].1 - pair[0].1);
-        distance += dx.hypot(dy);
-        let heading = dy.atan2(dx);
-        if let Some(previous) = previous_heading {
-            let mut turn = (heading - previous).abs();
-            if turn > std::f64::consts::PI {
-                turn = 2.0 * std::f64::consts::PI - turn;
-            }
-            turning += turn;
-        }
-        previous_heading = Some(heading);
-    }
-    params.v_lin * distance + params.v_ang * turning
-}
-
-/// The geometry every returned path must have, checked independently of the planner.
-fn check_geometry(world: &World, spec: &PlanSpec, outcome: &PlanOutcome) {
-    let path = &outcome.path;
-    assert_eq!(
-        path.first().copied(),
-        world.cell_at(spec.start[0], spec.start[1]),
-        "starts at S"
-    );
-    for &cell in path {
-        assert!(
-            world.is_traversable(cell),
-            "cell {:?} is not free",
-            world.xy(cell)
-        );
-    }
-    for pair in path.windows(2) {
-        let ((ax, ay), (bx, by)) = (world.xy(pair[0]), world.xy(pair[1]));
-        assert_eq!(
-            ax.abs_diff(bx).max(ay.abs_diff(by)),
-            1,
-            "8-connected step {:?} → {:?}",
-            (ax, ay),
-            (bx, by)
-        );
-        if ax != bx && ay != by {
-            // No corner cutting: both orthogonal neighbours are free.
-            assert!(
-                world.is_traversable(world.cell(bx, ay))
-                    && world.is_traversable(world.cell(ax, by))
-            );
-        }
-    }
-    // An independent recomputation of the claims: the goal and the budget.
-    let goal = world.cell_at(spec.goal[0], spec.goal[1]);
-    assert_eq!(outcome.reaches_goal, path.last().copied() == goal);
-    let eta = independent_eta(world, &spec.params, path);
-    assert!(
-        (eta - outcome.t_eta_s).abs() < 1e-6,
-        "eta {eta} vs {}",
-        outcome.t_eta_s
-    );
-    assert_eq!(outcome.within_budget, eta <= spec.t_exec_s);
 }
 
 proptest! {

@@ -29,6 +29,11 @@ use crate::stack::{Stack, StackOptions};
 pub struct ModelBench {
     pub plan_s_median: f64,
     pub evals_per_s: f64,
+    /// Genes evaluated per second: the GA's speed per unit of work, which (unlike
+    /// `evals_per_s`) does not fall when the paths it works on are longer.
+    pub genes_per_s: f64,
+    /// Cells of the returned path.
+    pub path_cells_median: f64,
     pub generations: u32,
     pub distinct_information_median: f64,
 }
@@ -39,6 +44,8 @@ pub struct PlannerBench {
     pub model2_over_model1: f64,
     pub zenoh_overhead_ms_median: f64,
     pub runs: usize,
+    /// `paper` (paper 000's initialization, `--paper-init`) or `roam` (the default).
+    pub initialization: String,
 }
 
 pub const START: [f64; 2] = [-8.0, -8.0];
@@ -68,7 +75,9 @@ fn spec(model: PlannerModel, t_exec_s: f64, seed: u64, generations: u32) -> Plan
     PlanSpec::batch(START, GOAL, t_exec_s, model, generations, seed)
 }
 
-pub async fn planner(runs: usize) -> Result<PlannerBench, BenchError> {
+/// Runs the benchmark; `paper_initialization` plans the in-process runs with paper
+/// 000's initialization (no via-point seeds, walks that stop at the goal) to compare.
+pub async fn planner(runs: usize, paper_initialization: bool) -> Result<PlannerBench, BenchError> {
     let world = builtin_world()?;
     let never = AtomicBool::new(false);
     let shortest = plan(
@@ -87,16 +96,23 @@ pub async fn planner(runs: usize) -> Result<PlannerBench, BenchError> {
     ] {
         let mut seconds = Vec::new();
         let mut rates = Vec::new();
+        let mut gene_rates = Vec::new();
+        let mut cells = Vec::new();
         let mut info = Vec::new();
         let mut generations = 0;
         for run in 0..runs {
-            let s = spec(model, budget, run as u64, 2000);
+            let mut s = spec(model, budget, run as u64, 2000);
+            if paper_initialization {
+                s.params = s.params.with_paper_initialization();
+            }
             let started = Instant::now();
             let outcome = plan(&world, &s, &never, |_, _| {})
                 .map_err(|e| BenchError::Setup(e.to_string()))?;
             let elapsed = started.elapsed().as_secs_f64();
             seconds.push(elapsed);
             rates.push(outcome.evaluations as f64 / elapsed);
+            gene_rates.push(outcome.evaluated_genes as f64 / elapsed);
+            cells.push(outcome.path.len() as f64);
             info.push(outcome.metrics.distinct_information);
             generations = outcome.generations;
         }
@@ -105,6 +121,8 @@ pub async fn planner(runs: usize) -> Result<PlannerBench, BenchError> {
             ModelBench {
                 plan_s_median: median(&mut seconds),
                 evals_per_s: median(&mut rates),
+                genes_per_s: median(&mut gene_rates),
+                path_cells_median: median(&mut cells),
                 generations,
                 distinct_information_median: median(&mut info),
             },
@@ -117,6 +135,12 @@ pub async fn planner(runs: usize) -> Result<PlannerBench, BenchError> {
         model2_over_model1: ratio,
         zenoh_overhead_ms_median: overhead,
         runs,
+        initialization: if paper_initialization {
+            "paper"
+        } else {
+            "roam"
+        }
+        .to_owned(),
     })
 }
 

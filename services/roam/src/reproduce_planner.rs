@@ -12,6 +12,12 @@
 //! so 500 / 1000 / 1500, below Table I's 2000), which keeps every run reproducible bit
 //! for bit. t_exec = (1 − r) · T with T = 100 s by default (the paper: 240 s for a world
 //! whose shortest paths are longer; ours need about 30 s). Both are parameters.
+//!
+//! Initialization: roam's default (via-point seeds and the round-trip rule for walks,
+//! issue 14, see `roam_planner::seeds` and `roam_planner::ga`) unless
+//! [`ReproduceOptions::paper_initialization`] asks for paper 000's own (random walks
+//! that stop at the goal), which gives the figures this reproduction gave before, bit
+//! for bit.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -44,6 +50,8 @@ pub struct ReproduceOptions {
     pub total_s: f64,
     pub generations_per_t: f64,
     pub out_dir: PathBuf,
+    /// Plan with paper 000's initialization (§II.A.1) instead of roam's default.
+    pub paper_initialization: bool,
 }
 
 /// One configuration's results, as the issue's JSON names them.
@@ -75,6 +83,8 @@ pub struct Comparison {
 
 #[derive(Debug, Clone, Serialize)]
 pub struct Reproduction {
+    /// `paper` (§II.A.1's random walks) or `roam` (with via-point seeds and round trips).
+    pub initialization: String,
     pub rows: Vec<Row>,
     pub comparisons: Vec<Comparison>,
     pub pictures: Vec<PathBuf>,
@@ -110,7 +120,10 @@ pub fn run(options: &ReproduceOptions) -> Result<Reproduction, BenchError> {
                 let (mut u, mut d, mut info) = (Vec::new(), Vec::new(), Vec::new());
                 let (mut within, mut reached) = (0usize, 0usize);
                 for seed in 0..options.runs as u64 {
-                    let spec = PlanSpec::batch(START, goal, t_exec_s, model, generations, seed);
+                    let mut spec = PlanSpec::batch(START, goal, t_exec_s, model, generations, seed);
+                    if options.paper_initialization {
+                        spec.params = spec.params.with_paper_initialization();
+                    }
                     let outcome = plan(&world, &spec, &never, |_, _| {}).map_err(|e| {
                         BenchError::Setup(format!(
                             "{goal_name} {ratio_name} {}: {e}",
@@ -146,10 +159,19 @@ pub fn run(options: &ReproduceOptions) -> Result<Reproduction, BenchError> {
     let comparisons = compare(&rows);
     let pictures = draw(&world, &pictures_paths, &options.out_dir)?;
     Ok(Reproduction {
+        initialization: initialization_name(options).to_owned(),
         rows,
         comparisons,
         pictures,
     })
+}
+
+fn initialization_name(options: &ReproduceOptions) -> &'static str {
+    if options.paper_initialization {
+        "paper"
+    } else {
+        "roam"
+    }
 }
 
 fn find<'a>(rows: &'a [Row], goal: &str, ratio: &str, model: &str) -> Option<&'a Row> {
@@ -285,7 +307,8 @@ impl std::fmt::Display for Reproduction {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(
             f,
-            "paper 000 §III on the built-in world (start (-8, -8)); t_plan spent as generations"
+            "paper 000 §III on the built-in world (start (-8, -8)); t_plan spent as generations; {} initialization",
+            self.initialization
         )?;
         writeln!(
             f,

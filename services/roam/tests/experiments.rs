@@ -66,6 +66,36 @@ fn reproduce_planner_prints_every_row_and_draws_each_model() {
             "{model}: start and goal marked"
         );
     }
+    assert_eq!(value["initialization"], "roam");
+}
+
+/// `--paper-init` plans with paper 000's own initialization and says so.
+#[test]
+fn reproduce_planner_runs_the_papers_initialization_on_request() {
+    let out = tempfile::tempdir().expect("tmp");
+    let output = Command::new(ROAM)
+        .args([
+            "reproduce",
+            "planner",
+            "--json",
+            "--paper-init",
+            "--runs",
+            "1",
+            "--generations-per-t",
+            "40",
+            "--out",
+        ])
+        .arg(out.path())
+        .output()
+        .expect("run");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
+    assert_eq!(value["initialization"], "paper");
+    assert_eq!(value["rows"].as_array().map(Vec::len), Some(18));
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! The answering end of a query: decode the request, reply with a message or with the
 //! structured error.
 
-use roam_proto::{decode, encode, ErrorCode, ErrorReply, Message};
+use roam_proto::{decode, encode, excerpt, ErrorCode, ErrorReply, Message};
 use zenoh::query::Query;
 
 /// Decodes a query's payload as `T`, refusing payloads above `max_bytes` by name.
@@ -30,15 +30,15 @@ pub fn decode_request<T: Message>(query: &Query, max_bytes: usize) -> Result<T, 
 pub async fn send<T: Message>(query: &Query, message: &T) {
     let bytes = encode(message);
     if let Err(e) = query.reply(query.key_expr().clone(), bytes).await {
-        tracing::warn!(key = %query.key_expr(), "reply failed: {e}");
+        tracing::warn!(key = %excerpt(query.key_expr().as_str()), "reply failed: {e}");
     }
 }
 
 /// Replies with a structured error.
 pub async fn send_error(query: &Query, error: &ErrorReply) {
-    tracing::debug!(key = %query.key_expr(), %error, "refusing query");
+    tracing::debug!(key = %excerpt(query.key_expr().as_str()), %error, "refusing query");
     if let Err(e) = query.reply_err(encode(error)).await {
-        tracing::warn!(key = %query.key_expr(), "error reply failed: {e}");
+        tracing::warn!(key = %excerpt(query.key_expr().as_str()), "error reply failed: {e}");
     }
 }
 

@@ -64,6 +64,10 @@ pub(crate) enum BenchCommand {
         /// Plans per model.
         #[arg(long, default_value_t = 5)]
         runs: usize,
+        /// Plan with paper 000's own initialization (random walks that stop at the goal,
+        /// no via-point seeds), to compare with roam's default.
+        #[arg(long)]
+        paper_init: bool,
     },
 }
 
@@ -162,6 +166,10 @@ pub(crate) enum ReproduceCommand {
         /// Where the per-model pictures go.
         #[arg(long, default_value = "roam-reproduce/planner")]
         out: PathBuf,
+        /// Plan with paper 000's own initialization (random walks that stop at the goal,
+        /// no via-point seeds): the figures as they were before issue 14.
+        #[arg(long)]
+        paper_init: bool,
     },
 }
 
@@ -232,11 +240,15 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
                 tokio::task::spawn_blocking(move || roam_mapper::bench::bench(&options)).await??;
             print_json(&result, json)
         }
-        BenchCommand::Planner { json, runs } => {
+        BenchCommand::Planner {
+            json,
+            runs,
+            paper_init,
+        } => {
             if runs == 0 {
                 bail!("--runs must be at least 1");
             }
-            let result = roam::bench_planner::planner(runs).await?;
+            let result = roam::bench_planner::planner(runs, paper_init).await?;
             print_json(&result, json)
         }
     }
@@ -378,6 +390,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             total,
             generations_per_t,
             out,
+            paper_init,
         } => {
             if runs == 0
                 || !(total.is_finite() && total > 0.0)
@@ -390,6 +403,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 total_s: total,
                 generations_per_t,
                 out_dir: out,
+                paper_initialization: paper_init,
             };
             let result =
                 tokio::task::spawn_blocking(move || roam::reproduce_planner::run(&options))
