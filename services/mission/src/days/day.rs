@@ -232,9 +232,9 @@ impl DayRun<'_> {
         let map = self.planner.map(self.robot.change_map(), now);
         let seed = plan_seed(self.day_seed, window, *rank);
         *rank += 1;
-        let planned = self
-            .planner
-            .curious(map.as_ref(), from, task.at, budget, self.time_model(), seed);
+        let planned =
+            self.planner
+                .curious(map.as_ref(), from, task.at, budget, self.time_model(), seed);
         self.run_until(now + self.plan_cost_s, track)?;
         match planned {
             Ok(Some(plan)) => Ok((plan, budget)),

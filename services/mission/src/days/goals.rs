@@ -20,8 +20,8 @@ pub enum Target {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
-    Met,
-    Missed,
+    Holds,
+    DoesNotHold,
     /// The variants the figure needs did not run.
     NotMeasured,
 }
@@ -29,8 +29,8 @@ pub enum Verdict {
 impl Verdict {
     pub fn as_str(self) -> &'static str {
         match self {
-            Verdict::Met => "met",
-            Verdict::Missed => "missed",
+            Verdict::Holds => "holds",
+            Verdict::DoesNotHold => "does not hold",
             Verdict::NotMeasured => "not measured",
         }
     }
@@ -44,11 +44,12 @@ pub struct Goal {
     pub target: Target,
     pub threshold: f64,
     pub verdict: Verdict,
-    /// When missed: the figures that account for it.
+    /// When it does not hold: the figures that account for it.
     pub shortfall: Option<String>,
 }
 
-fn judge(figure: Option<f64>, target: Target, threshold: f64) -> Verdict {
+/// The verdict is the comparison of the figure with the threshold, nothing else.
+pub fn judge(figure: Option<f64>, target: Target, threshold: f64) -> Verdict {
     match figure {
         None => Verdict::NotMeasured,
         Some(f) => {
@@ -57,9 +58,9 @@ fn judge(figure: Option<f64>, target: Target, threshold: f64) -> Verdict {
                 Target::AtMost => f <= threshold,
             };
             if met {
-                Verdict::Met
+                Verdict::Holds
             } else {
-                Verdict::Missed
+                Verdict::DoesNotHold
             }
         }
     }
@@ -212,7 +213,7 @@ pub fn goals(
             target,
             threshold,
             verdict,
-            shortfall: (verdict == Verdict::Missed).then(why).flatten(),
+            shortfall: (verdict == Verdict::DoesNotHold).then(why).flatten(),
         });
     };
     goal(
@@ -241,7 +242,13 @@ pub fn goals(
         vs_shortest.and_then(|p| p.median_gain),
         Target::AtLeast,
         0.75,
-        &|| Some(information_shortfall(new?, of(Variant::Shortest)?, vs_shortest?)),
+        &|| {
+            Some(information_shortfall(
+                new?,
+                of(Variant::Shortest)?,
+                vs_shortest?,
+            ))
+        },
     );
     goal(
         "information against today's executive",
@@ -259,10 +266,13 @@ mod tests {
 
     #[test]
     fn verdicts_follow_the_figures() {
-        assert_eq!(judge(Some(0.91), Target::AtLeast, 0.90), Verdict::Met);
-        assert_eq!(judge(Some(0.89), Target::AtLeast, 0.90), Verdict::Missed);
-        assert_eq!(judge(Some(0.0), Target::AtMost, 0.0), Verdict::Met);
-        assert_eq!(judge(Some(1.0), Target::AtMost, 0.0), Verdict::Missed);
+        assert_eq!(judge(Some(0.91), Target::AtLeast, 0.90), Verdict::Holds);
+        assert_eq!(
+            judge(Some(0.89), Target::AtLeast, 0.90),
+            Verdict::DoesNotHold
+        );
+        assert_eq!(judge(Some(0.0), Target::AtMost, 0.0), Verdict::Holds);
+        assert_eq!(judge(Some(1.0), Target::AtMost, 0.0), Verdict::DoesNotHold);
         assert_eq!(judge(None, Target::AtLeast, 0.9), Verdict::NotMeasured);
         let none = goals(&[], None, None);
         assert_eq!(none.len(), 5);

@@ -42,6 +42,9 @@ pub mod variant;
 pub mod window;
 pub mod world;
 
+#[cfg(test)]
+mod tests;
+
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
@@ -57,6 +60,9 @@ use crate::calibration::CalibrationError;
 
 /// The most days one batch runs.
 pub const MAX_DAYS: usize = 10_000;
+
+/// The most a curious plan may cost on the mission clock, seconds (a window is minutes).
+pub const MAX_PLAN_COST_S: f64 = 600.0;
 
 /// What to run.
 #[derive(Debug, Clone, PartialEq)]
@@ -92,8 +98,13 @@ impl Default for DaysOptions {
 /// Why a batch could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum DaysError {
-    #[error("invalid options: {0}")]
-    Options(String),
+    /// An option out of its range, named as [`DaysOptions`] spells it.
+    #[error("{field} is {value}; give {limit}")]
+    Invalid {
+        field: &'static str,
+        value: String,
+        limit: String,
+    },
     #[error("the day's world: {0}")]
     World(String),
     #[error("driving: {0}")]
@@ -122,32 +133,41 @@ pub struct DaysReport {
     pub results: Vec<DayResult>,
 }
 
-fn check(options: &DaysOptions) -> Result<(), DaysError> {
-    let bad = |what: String| Err(DaysError::Options(what));
-    if options.days == 0 || options.days > MAX_DAYS {
-        return bad(format!(
-            "days is {}; give 1 to {MAX_DAYS} (max_days)",
-            options.days
-        ));
+/// The options' ranges; the first out of range is refused, naming its field and limit.
+fn check(o: &DaysOptions) -> Result<(), DaysError> {
+    let invalid = |field, value: &dyn std::fmt::Display, limit: String| {
+        Err(DaysError::Invalid {
+            field,
+            value: value.to_string(),
+            limit,
+        })
+    };
+    let max_generations = roam_planner::params::MAX_GENERATIONS;
+    if o.days == 0 || o.days > MAX_DAYS {
+        return invalid("days", &o.days, format!("1 to {MAX_DAYS} (MAX_DAYS)"));
     }
-    if options.generations == 0 || options.generations > roam_planner::params::MAX_GENERATIONS {
-        return bad(format!(
-            "generations is {}; give 1 to {}",
-            options.generations,
-            roam_planner::params::MAX_GENERATIONS
-        ));
+    if o.generations == 0 || o.generations > max_generations {
+        return invalid(
+            "generations",
+            &o.generations,
+            format!("1 to {max_generations}"),
+        );
     }
-    if !(options.w_loc.is_finite() && options.w_loc >= 0.0) {
-        return bad(format!("w_loc is {}; give 0 or more", options.w_loc));
+    if !(o.w_loc.is_finite() && o.w_loc >= 0.0) {
+        return invalid("w_loc", &o.w_loc, "a finite 0 or more".into());
     }
-    if !(options.plan_cost_s.is_finite() && (0.0..=600.0).contains(&options.plan_cost_s)) {
-        return bad(format!(
-            "plan_cost_s is {}; give 0 to 600 seconds",
-            options.plan_cost_s
-        ));
+    if !(o.plan_cost_s.is_finite() && (0.0..=MAX_PLAN_COST_S).contains(&o.plan_cost_s)) {
+        return invalid(
+            "plan_cost_s",
+            &o.plan_cost_s,
+            format!("0 to {MAX_PLAN_COST_S} seconds"),
+        );
     }
-    if options.variants.is_empty() {
-        return bad("no variants; give at least one".into());
+    if o.variants.is_empty() {
+        return invalid("variants", &"empty", "at least one".into());
+    }
+    if o.jobs == 0 {
+        return invalid("jobs", &o.jobs, "at least 1".into());
     }
     Ok(())
 }
@@ -210,13 +230,10 @@ pub fn report(options: &DaysOptions, world: &DayWorld, results: Vec<DayResult>) 
         .collect();
     let vs_shortest = summary::paired(&results, Variant::New, Variant::Shortest);
     let vs_today = summary::paired(&results, Variant::New, Variant::Today);
-    let effects = [
-        ("change", Variant::NewNoChange),
-        ("peb", Variant::NewNoPeb),
-    ]
-    .into_iter()
-    .filter_map(|(c, without)| summary::effect(&results, c, without))
-    .collect();
+    let effects = [("change", Variant::NewNoChange), ("peb", Variant::NewNoPeb)]
+        .into_iter()
+        .filter_map(|(c, without)| summary::effect(&results, c, without))
+        .collect();
     let goals = goals::goals(&summaries, vs_shortest.as_ref(), vs_today.as_ref());
     DaysReport {
         days: options.days,

@@ -111,7 +111,12 @@ impl Planner<'_> {
         spec
     }
 
-    fn planned(&self, world: &World, outcome: &roam_planner::plan::PlanOutcome, curious: bool) -> Planned {
+    fn planned(
+        &self,
+        world: &World,
+        outcome: &roam_planner::plan::PlanOutcome,
+        curious: bool,
+    ) -> Planned {
         let points = world.centers(&outcome.path);
         Planned {
             information: gathered(&self.world.planning, &self.world.params, &points),

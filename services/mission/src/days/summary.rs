@@ -117,7 +117,9 @@ pub fn days_of(results: &[DayResult], variant: Variant) -> Vec<&DayResult> {
 }
 
 fn per_day(days: &[&DayResult], f: impl Fn(&WindowResult) -> f64) -> Vec<f64> {
-    days.iter().map(|d| d.windows.iter().map(&f).sum()).collect()
+    days.iter()
+        .map(|d| d.windows.iter().map(&f).sum())
+        .collect()
 }
 
 /// A variant's figures; `None` when it did not run.
@@ -282,47 +284,7 @@ pub fn effect(results: &[DayResult], coupling: &'static str, without: Variant) -
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn window(i: usize, share: f64, info: f64, late: bool) -> WindowResult {
-        WindowResult {
-            window: i,
-            task: format!("t{i}"),
-            began_s: 0.0,
-            task_start_s: 100.0,
-            window_s: 100.0,
-            arrival_s: (!late).then_some(100.0 * share),
-            late,
-            driving_s: 100.0 * share,
-            share,
-            waited_for_plan_s: 1.0,
-            held_s: 0.0,
-            early_s: (!late).then_some(100.0 - 100.0 * share),
-            budget_s: 99.0,
-            curious: true,
-            first_plan_cells: 10,
-            ga_plans: 1,
-            driven_information: info,
-            planned_information: info * 1.25,
-            shortest_information: 1.0,
-            driven_over_planned: Some(0.8),
-            changing_cells_seen: 2.0,
-            peb_mean_m: Some(0.1),
-            halted_steps: 0,
-            estimate_rms_m: Some(0.05),
-            replans: vec!["slack"],
-            time_model: None,
-        }
-    }
-
-    fn day(variant: Variant, day: usize, info: f64, late: bool) -> DayResult {
-        DayResult {
-            day,
-            variant,
-            windows: vec![window(0, 0.5, info, false), window(1, 0.9, info, late)],
-            first_ranges: Vec::new(),
-            truth: Vec::new(),
-        }
-    }
+    use crate::days::tests::day;
 
     #[test]
     fn figures_come_from_the_windows_and_pairs_from_the_same_days() {

@@ -55,7 +55,11 @@ fn variants(out: &mut String, r: &DaysReport) {
 }
 
 fn by_window(out: &mut String, v: &VariantSummary) {
-    let _ = writeln!(out, "{} by window of the day (medians over days):", v.variant.name());
+    let _ = writeln!(
+        out,
+        "{} by window of the day (medians over days):",
+        v.variant.name()
+    );
     let _ = writeln!(
         out,
         "  {:<16} {:>6} {:>6} {:>7} {:>6} {:>6} {:>6} {:>5} {:>8} {:>7} {:>7} {:>7} {:>6} {:>5} {:>6} {:>6} {:>6}",
@@ -148,7 +152,13 @@ pub fn table(r: &DaysReport) -> String {
     if !r.effects.is_empty() {
         out.push_str("\neach coupling alone on the changing world (new against new without it, the same days):\n");
         for e in &r.effects {
-            let _ = writeln!(out, "  {} ({} vs {}):", e.coupling, e.with.name(), e.without.name());
+            let _ = writeln!(
+                out,
+                "  {} ({} vs {}):",
+                e.coupling,
+                e.with.name(),
+                e.without.name()
+            );
             for f in &e.figures {
                 let _ = writeln!(
                     out,

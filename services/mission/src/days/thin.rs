@@ -71,7 +71,11 @@ mod tests {
         let w = thin(&points, 1.0, open);
         assert_eq!(w.last(), points.last());
         assert!(w.contains(&[2.0, 0.0]), "the corner is kept: {w:?}");
-        for pair in std::iter::once(points[0]).chain(w.iter().copied()).collect::<Vec<_>>().windows(2) {
+        for pair in std::iter::once(points[0])
+            .chain(w.iter().copied())
+            .collect::<Vec<_>>()
+            .windows(2)
+        {
             assert!(distance(pair[0], pair[1]) <= 1.0 + 1e-9, "{pair:?}");
         }
         assert!(w.len() <= 6, "thinned: {w:?}");

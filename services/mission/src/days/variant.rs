@@ -127,9 +127,21 @@ mod tests {
         let no_change = Variant::NewNoChange.settings(2000.0);
         let no_peb = Variant::NewNoPeb.settings(2000.0);
         assert!(new.change && !no_change.change);
-        assert_eq!(Settings { change: true, ..no_change }, new);
+        assert_eq!(
+            Settings {
+                change: true,
+                ..no_change
+            },
+            new
+        );
         assert_eq!((new.w_loc, no_peb.w_loc), (2000.0, 0.0));
-        assert_eq!(Settings { w_loc: 2000.0, ..no_peb }, new);
+        assert_eq!(
+            Settings {
+                w_loc: 2000.0,
+                ..no_peb
+            },
+            new
+        );
         let today = Variant::Today.settings(2000.0);
         assert!(!today.calibrate && !today.slack && !today.preplan && today.w_loc == 0.0);
         assert_eq!(today.follow, Follow::Waypoints);

@@ -175,11 +175,8 @@ impl DayRun<'_> {
         let window_s = task.start_s - began;
         let driving_s = arrival.map_or(0.0, |at| at - first_sent_at);
         let planned = planned_path(&legs, arrival.is_some());
-        let planned_information = crate::information::gathered(
-            &self.world.planning,
-            &self.world.params,
-            &planned,
-        );
+        let planned_information =
+            crate::information::gathered(&self.world.planning, &self.world.params, &planned);
         let driven_information = track.information(self.world);
         let result = WindowResult {
             window: w,

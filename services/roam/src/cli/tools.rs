@@ -258,7 +258,6 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
     match command {
         ReproduceCommand::Mission {
             json,
-            missions,
             days: Some(days),
             variants,
             jobs,
@@ -266,7 +265,20 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             seed,
             generations,
             w_loc,
-        } => reproduce_days(json, days, &variants, jobs, plan_cost, seed, generations, w_loc).await,
+            ..
+        } => {
+            reproduce_days(
+                json,
+                days,
+                &variants,
+                jobs,
+                plan_cost,
+                seed,
+                generations,
+                w_loc,
+            )
+            .await
+        }
         ReproduceCommand::Mission {
             json,
             missions,
@@ -461,9 +473,6 @@ async fn reproduce_days(
             .collect::<anyhow::Result<_>>()?;
     }
     if let Some(jobs) = jobs {
-        if jobs == 0 {
-            bail!("--jobs must be at least 1");
-        }
         options.jobs = jobs;
     }
     let started = std::time::Instant::now();
