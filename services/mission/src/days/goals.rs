@@ -95,10 +95,10 @@ fn time_of(w: &WindowBreakdown) -> String {
     )
 }
 
-fn lowest<'a>(
-    new: &'a VariantSummary,
+fn lowest(
+    new: &VariantSummary,
     f: impl Fn(&WindowBreakdown) -> Option<f64>,
-) -> Option<&'a WindowBreakdown> {
+) -> Option<&WindowBreakdown> {
     new.by_window
         .iter()
         .filter(|w| f(w).is_some())
@@ -127,8 +127,15 @@ fn late_shortfall(new: &VariantSummary) -> String {
         .filter(|w| w.late > 0)
         .map(|w| {
             format!(
-                "w{} {}: {} late ({} never arrived, {} held for their PEB on the way)",
-                w.window, w.task, w.late, w.never_arrived, w.late_halted
+                "w{} {}: {} late ({} never arrived, {} held for their PEB on the way; the others by median {} s, at most {} s, their time model's error {})",
+                w.window,
+                w.task,
+                w.late,
+                w.never_arrived,
+                w.late_halted,
+                num(w.late_by_s_median, 1),
+                num(w.late_by_s_max, 1),
+                pct(w.late_model_error_median)
             )
         })
         .collect();

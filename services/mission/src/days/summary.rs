@@ -59,6 +59,12 @@ pub struct WindowBreakdown {
     pub never_arrived: usize,
     /// Late windows in which the controller held the robot for its PEB.
     pub late_halted: usize,
+    /// Over the windows that arrived late: by how much (arrival − task start), seconds.
+    pub late_by_s_median: Option<f64>,
+    pub late_by_s_max: Option<f64>,
+    /// Over the windows that arrived late: the time model's relative error on the drive
+    /// (negative: it promised a faster drive than the robot made).
+    pub late_model_error_median: Option<f64>,
     pub driven_over_planned_median: Option<f64>,
     pub driven_information_median: Option<f64>,
     pub planned_information_median: Option<f64>,
@@ -167,6 +173,10 @@ pub fn variant_summary(results: &[DayResult], variant: Variant) -> Option<Varian
 fn breakdown(window: usize, ws: &[&WindowResult]) -> Option<WindowBreakdown> {
     let first = ws.first()?;
     let late: Vec<&&WindowResult> = ws.iter().filter(|w| w.late).collect();
+    let late_by: Vec<f64> = late
+        .iter()
+        .filter_map(|w| w.arrival_s.map(|a| a - w.task_start_s))
+        .collect();
     let model = |f: fn(&super::measure::TimeModelUse) -> f64| {
         median(ws.iter().filter_map(|w| w.time_model.as_ref().map(f)))
     };
@@ -183,6 +193,12 @@ fn breakdown(window: usize, ws: &[&WindowResult]) -> Option<WindowBreakdown> {
         late: late.len(),
         never_arrived: late.iter().filter(|w| w.arrival_s.is_none()).count(),
         late_halted: late.iter().filter(|w| w.halted_steps > 0).count(),
+        late_by_s_median: median(late_by.iter().copied()),
+        late_by_s_max: late_by.iter().copied().reduce(f64::max),
+        late_model_error_median: median(
+            late.iter()
+                .filter_map(|w| w.time_model.as_ref().map(|m| m.error)),
+        ),
         driven_over_planned_median: median(ws.iter().filter_map(|w| w.driven_over_planned)),
         driven_information_median: median(ws.iter().map(|w| w.driven_information)),
         planned_information_median: median(ws.iter().map(|w| w.planned_information)),
@@ -197,11 +213,7 @@ fn breakdown(window: usize, ws: &[&WindowResult]) -> Option<WindowBreakdown> {
 }
 
 /// Pairs the days two variants both ran.
-fn pairs<'a>(
-    results: &'a [DayResult],
-    of: Variant,
-    against: Variant,
-) -> Vec<(&'a DayResult, &'a DayResult)> {
+fn pairs(results: &[DayResult], of: Variant, against: Variant) -> Vec<(&DayResult, &DayResult)> {
     let others = days_of(results, against);
     days_of(results, of)
         .into_iter()

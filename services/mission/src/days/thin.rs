@@ -63,11 +63,10 @@ mod tests {
         let mut points: Vec<[f64; 2]> = (0..=10).map(|i| [0.2 * f64::from(i), 0.0]).collect();
         points.extend((1..=10).map(|i| [2.0, 0.2 * f64::from(i)]));
         // The inside of the corner is a wall: nothing cuts across it.
-        let open = |a: [f64; 2], b: [f64; 2]| {
-            let below_diagonal = |p: [f64; 2]| p[0] < 1.99 && p[1] > 0.01;
-            !(below_diagonal(a) || below_diagonal(b))
-                && !(a[1] < 0.01 && b[0] > 1.99 && a[0] < 1.99 && b[1] > 0.01)
-        };
+        let inside = |p: [f64; 2]| p[0] < 1.99 && p[1] > 0.01;
+        let cuts_corner =
+            |a: [f64; 2], b: [f64; 2]| a[1] < 0.01 && a[0] < 1.99 && b[0] > 1.99 && b[1] > 0.01;
+        let open = |a: [f64; 2], b: [f64; 2]| !(inside(a) || inside(b) || cuts_corner(a, b));
         let w = thin(&points, 1.0, open);
         assert_eq!(w.last(), points.last());
         assert!(w.contains(&[2.0, 0.0]), "the corner is kept: {w:?}");
