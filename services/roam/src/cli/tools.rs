@@ -97,7 +97,7 @@ pub(crate) enum ReproduceCommand {
         #[arg(long)]
         jobs: Option<usize>,
         /// With --days: what a curious plan costs on the mission clock, seconds.
-        #[arg(long, default_value_t = 1.0)]
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         plan_cost: f64,
         #[arg(long, default_value_t = 0)]
         seed: u64,
