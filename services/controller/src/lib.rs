@@ -25,6 +25,7 @@
 //! | [`information`] | the PEB field of the anchors and f_is = unit(−∇PEB) |
 //! | [`controller`] | the per-robot state machine (Idle, Active, Completed, Stuck, HaltedPeb, StepLimit) |
 //! | [`episode`] | one batch run: sim → ranges → localization ([`roam_localization::Tracker`]) → controller → sim |
+//! | [`stepper`] | the same run one step at a time, missions changed between steps (the mission executive's day runner) |
 //! | [`experiments`] | ES1, ES2, ES3, the paper's figures and the comparison table |
 //! | [`render`] | PNGs like the paper's Figs. 2 and 3 |
 //! | [`service`] | the Zenoh adapter: missions and estimates in, commands and status out |
@@ -69,6 +70,7 @@ pub mod obstacle_field;
 pub mod params;
 pub mod render;
 pub mod service;
+pub mod stepper;
 pub mod weights;
 
 pub use controller::{Controller, Decision, MissionStatus};
@@ -76,4 +78,5 @@ pub use episode::{run_episode, Episode, PositionSource, RobotMission, RobotTrack
 pub use information::InformationField;
 pub use obstacle_field::ObstacleField;
 pub use params::{ApfParams, Follow, ParamError};
+pub use stepper::{RobotStep, StepOutcome, Stepper};
 pub use weights::{is_weight, Scheme};

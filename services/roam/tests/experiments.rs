@@ -313,6 +313,66 @@ fn reproduce_mission_compares_the_couplings() {
     }
 }
 
+#[test]
+fn reproduce_mission_days_reports_every_variant_window_and_goal_with_a_verdict() {
+    let (value, stderr) = run_json(
+        &[
+            "reproduce",
+            "mission",
+            "--json",
+            "--days",
+            "2",
+            "--generations",
+            "20",
+            "--jobs",
+            "2",
+        ],
+        None,
+    );
+    assert_eq!(value["days"], 2);
+    let variants: Vec<&str> = value["variants"]
+        .as_array()
+        .expect("variants")
+        .iter()
+        .filter_map(|v| v["variant"].as_str())
+        .collect();
+    assert_eq!(
+        variants,
+        ["today", "new", "new_no_change", "new_no_peb", "shortest"]
+    );
+    for v in value["variants"].as_array().expect("variants") {
+        assert_eq!(v["days"], 2);
+        assert_eq!(v["windows"], 8, "four windows a day: {v}");
+        let share = v["share_median"].as_f64().expect("share");
+        assert!((0.0..=1.0).contains(&share), "{share}");
+        assert_eq!(v["by_window"].as_array().expect("by window").len(), 4);
+    }
+    // Every goal has a figure, a threshold and a verdict, and a shortfall exactly when
+    // it does not hold.
+    let goals = value["goals"].as_array().expect("goals");
+    assert_eq!(goals.len(), 5);
+    for g in goals {
+        assert!(g["figure"].is_number(), "{g}");
+        assert!(g["threshold"].is_number(), "{g}");
+        let verdict = g["verdict"].as_str().expect("verdict");
+        assert!(["holds", "does_not_hold"].contains(&verdict), "{g}");
+        assert_eq!(
+            g["shortfall"].is_string(),
+            verdict == "does_not_hold",
+            "{g}"
+        );
+    }
+    let effects: Vec<&str> = value["effects"]
+        .as_array()
+        .expect("effects")
+        .iter()
+        .filter_map(|e| e["coupling"].as_str())
+        .collect();
+    assert_eq!(effects, ["change", "peb"]);
+    assert_eq!(value["results"].as_array().expect("results").len(), 10);
+    assert!(stderr.contains("2 days x 5 variants"), "{stderr}");
+}
+
 /// Runs `roam <args> [--out DIR]`, asserts it succeeded, and returns its stdout as JSON
 /// with its stderr.
 fn run_json(args: &[&str], out: Option<&std::path::Path>) -> (serde_json::Value, String) {

@@ -75,12 +75,30 @@ pub(crate) enum BenchCommand {
 pub(crate) enum ReproduceCommand {
     /// The papers joined: seeded downtime missions in the built-in world, planned on the
     /// static information map, with the PEB localizability cost, and the shortest path.
+    /// With --days N: the executive's whole day (tasks::day() on the day world) N times
+    /// per variant (today's executive, the new one, the new one without each coupling,
+    /// the shortest path) against issue 14's goals.
     Mission {
-        /// Print {"missions", "variants": [{"variant", "information", "on_time_share", "peb_mean_m"}]}.
+        /// Print {"missions", "variants": [{"variant", "information", "on_time_share", "peb_mean_m"}]};
+        /// with --days, the days' report (variants, goals with verdicts, every window).
         #[arg(long)]
         json: bool,
         #[arg(long, default_value_t = 20)]
         missions: usize,
+        /// Run the executive's day this many times per variant instead of the missions.
+        #[arg(long)]
+        days: Option<usize>,
+        /// With --days: the variants to run, comma-separated (default all:
+        /// today,new,new_no_change,new_no_peb,shortest).
+        #[arg(long, value_delimiter = ',')]
+        variants: Vec<String>,
+        /// With --days: threads the days run on (default: the machine's cores; the
+        /// report does not depend on it).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// With --days: what a curious plan costs on the mission clock, seconds.
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        plan_cost: f64,
         #[arg(long, default_value_t = 0)]
         seed: u64,
         /// GA generations per plan.
@@ -240,10 +258,35 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
     match command {
         ReproduceCommand::Mission {
             json,
-            missions,
+            days: Some(days),
+            variants,
+            jobs,
+            plan_cost,
             seed,
             generations,
             w_loc,
+            ..
+        } => {
+            reproduce_days(
+                json,
+                days,
+                &variants,
+                jobs,
+                plan_cost,
+                seed,
+                generations,
+                w_loc,
+            )
+            .await
+        }
+        ReproduceCommand::Mission {
+            json,
+            missions,
+            days: None,
+            seed,
+            generations,
+            w_loc,
+            ..
         } => {
             if missions == 0 || generations == 0 || !(w_loc.is_finite() && w_loc >= 0.0) {
                 bail!("--missions and --generations must be at least 1, --w-loc 0 or more");
@@ -392,6 +435,69 @@ fn print_json<T: serde::Serialize>(value: &T, compact: bool) -> anyhow::Result<(
         println!("{}", serde_json::to_string(value)?);
     } else {
         println!("{}", serde_json::to_string_pretty(value)?);
+    }
+    Ok(())
+}
+
+/// `roam reproduce mission --days N`: the days' batch, its table or JSON on stdout and
+/// its progress and runtime on stderr (so the JSON repeats bit for bit).
+#[allow(clippy::too_many_arguments)]
+async fn reproduce_days(
+    json: bool,
+    days: usize,
+    variants: &[String],
+    jobs: Option<usize>,
+    plan_cost: f64,
+    seed: u64,
+    generations: u32,
+    w_loc: f64,
+) -> anyhow::Result<()> {
+    use roam_mission::days::{self, DaysOptions, Variant};
+    let mut options = DaysOptions {
+        days,
+        seed,
+        generations,
+        w_loc,
+        plan_cost_s: plan_cost,
+        ..DaysOptions::default()
+    };
+    if !variants.is_empty() {
+        options.variants = variants
+            .iter()
+            .map(|name| {
+                Variant::parse(name).ok_or_else(|| {
+                    let all: Vec<&str> = Variant::ALL.iter().map(|v| v.name()).collect();
+                    anyhow::anyhow!("no variant {name:?}; give some of {}", all.join(","))
+                })
+            })
+            .collect::<anyhow::Result<_>>()?;
+    }
+    if let Some(jobs) = jobs {
+        options.jobs = jobs;
+    }
+    let started = std::time::Instant::now();
+    let run = options.clone();
+    let report = tokio::task::spawn_blocking(move || {
+        days::run(&run, &|done, total| {
+            eprint!("\rthe executive's days: {done}/{total} (variant, day)   ");
+            if done == total {
+                eprintln!();
+            }
+        })
+    })
+    .await??;
+    let wall_s = started.elapsed().as_secs_f64();
+    eprintln!(
+        "{} days x {} variants in {wall_s:.1} s ({:.2} s per day, {} threads)",
+        options.days,
+        report.variants.len(),
+        wall_s / options.days as f64,
+        options.jobs
+    );
+    if json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print!("{}", days::table::table(&report));
     }
     Ok(())
 }
