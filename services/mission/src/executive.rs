@@ -34,6 +34,7 @@ use zenoh::qos::CongestionControl;
 use crate::calibration::{path_measure, store, Calibration, CalibrationConfig, TimeModel};
 use crate::information::gathered;
 use crate::inputs::{listen, lock, wait_for_world, Inputs};
+use crate::margin::ArrivalMargin;
 use crate::path::{distance, mission_waypoints};
 use crate::tasks::{self, Task, TaskError};
 use crate::watch::{Decision, Reason, Status, Watch, WatchParams};
@@ -76,11 +77,9 @@ pub struct ExecutiveConfig {
     pub slack_s: f64,
     /// Mission seconds between two slack replans at least.
     pub slack_interval_s: f64,
-    /// What a plan leaves unspent of the time to the task: this share of it, and at
-    /// least `arrival_margin_min_s`. A curious plan fills its budget (round trips and
-    /// via-points make sure of it), so any error of the time model or a slow stretch
-    /// would make the robot late; the margin absorbs them, and the slack rule gives
-    /// back what the robot did not need.
+    /// What a plan leaves unspent of the time to the task: this share of it (or the
+    /// robot's recent underestimate if more), and at least `arrival_margin_min_s`
+    /// ([`crate::margin`]).
     pub arrival_margin_share: f64,
     pub arrival_margin_min_s: f64,
     /// Plan with paper 000 Eq. 2's v_lin and v_ang fitted to what this robot drove
@@ -92,6 +91,29 @@ pub struct ExecutiveConfig {
     /// v_lin 2.0 s/m and v_ang 1.0 s/rad by default; a robot's datasheet figures where
     /// they are known. Bounded as the calibration's fits are.
     pub time_model_prior: TimeModel,
+}
+
+impl ExecutiveConfig {
+    /// The replan policy's parameters for plans made with `model`.
+    pub fn watch_params(&self, model: TimeModel) -> WatchParams {
+        let expected = 1.0 / model.v_lin;
+        WatchParams {
+            off_path_m: self.off_path_m,
+            speed_m_per_s: self.speed_m_per_s.min(expected),
+            expected_speed_m_per_s: expected,
+            max_replans: self.max_replans,
+            give_up_after_s: self.give_up_after_s,
+            controller_silence_s: self.controller_silence_s,
+            slack_s: self.slack_s,
+            slack_interval_s: self.slack_interval_s,
+            behind: true,
+        }
+    }
+
+    /// The arrival margin this config asks for ([`crate::margin`]).
+    pub fn margin(&self) -> ArrivalMargin {
+        ArrivalMargin::new(self.arrival_margin_share, self.arrival_margin_min_s)
+    }
 }
 
 impl Default for ExecutiveConfig {
@@ -112,7 +134,7 @@ impl Default for ExecutiveConfig {
             controller_silence_s: 3.0,
             slack_s: 10.0,
             slack_interval_s: 10.0,
-            arrival_margin_share: 0.05,
+            arrival_margin_share: 0.08,
             arrival_margin_min_s: 2.0,
             calibrate: true,
             calibration_file: None,
@@ -202,10 +224,6 @@ const PREPLAN_FROM_M: f64 = 0.5;
 /// A curious plan is expected to take this times the slowest recent one, plus
 /// [`PLAN_WALL_SLACK_S`].
 const PLAN_WALL_MARGIN: f64 = 1.5;
-/// The arrival margin's largest share of the time to a task, whatever the model's error.
-const MAX_ARRIVAL_MARGIN_SHARE: f64 = 0.25;
-/// How much of the last underestimate the next window still remembers.
-const UNDERESTIMATE_MEMORY: f64 = 0.5;
 const PLAN_WALL_SLACK_S: f64 = 0.05;
 
 /// How long the executive waits for the sim's clock at its start.
@@ -265,10 +283,8 @@ struct Run<'a> {
     calibration: Calibration,
     /// Wall seconds the recent curious plans took (request to reply), the slowest.
     plan_wall_s: std::sync::Mutex<Option<f64>>,
-    /// How much longer than its time model predicted the robot's recent drives took, as
-    /// a share (0 when the model was right or pessimistic), forgetting slowly: the
-    /// arrival margin is at least this.
-    underestimate: f64,
+    /// What each plan leaves unspent of the time to its task ([`crate::margin`]).
+    margin: ArrivalMargin,
     /// The next window's plans, made while the robot did its task.
     preplanned: Option<Preplanned>,
     /// This executive's own tag in its mission ids (from its Zenoh session id), so a
@@ -292,17 +308,7 @@ impl Run<'_> {
     }
 
     fn watch_params(&self) -> WatchParams {
-        let expected = 1.0 / self.time_model().v_lin;
-        WatchParams {
-            off_path_m: self.config.off_path_m,
-            speed_m_per_s: self.config.speed_m_per_s.min(expected),
-            expected_speed_m_per_s: expected,
-            max_replans: self.config.max_replans,
-            give_up_after_s: self.config.give_up_after_s,
-            controller_silence_s: self.config.controller_silence_s,
-            slack_s: self.config.slack_s,
-            slack_interval_s: self.config.slack_interval_s,
-        }
+        self.config.watch_params(self.time_model())
     }
 
     /// What a curious plan costs on the mission clock: the wall time the last ones
@@ -364,13 +370,7 @@ impl Run<'_> {
     ) -> Result<(Plan, f64), ClientError> {
         let earliest = self.now() + self.planning_cost_s();
         let time_left = task.start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
-        let share = self
-            .config
-            .arrival_margin_share
-            .max(self.underestimate)
-            .min(MAX_ARRIVAL_MARGIN_SHARE);
-        let margin = (time_left * share).max(self.config.arrival_margin_min_s);
-        let budget = time_left - margin;
+        let budget = self.margin.budget(time_left);
         if !curious || budget <= shortest.t_eta_s {
             return Ok((shortest.clone(), budget));
         }
@@ -503,10 +503,7 @@ impl Run<'_> {
             model.eta(d, theta)
         });
         if let Some((_, took_s)) = drive {
-            if predicted_s > 0.0 && took_s.is_finite() {
-                let error = (took_s / predicted_s - 1.0).max(0.0);
-                self.underestimate = error.max(UNDERESTIMATE_MEMORY * self.underestimate);
-            }
+            self.margin.learn(predicted_s, took_s);
         }
         if let (true, Some((points, took_s))) = (self.config.calibrate, drive) {
             let (d, theta) = path_measure(points);
@@ -841,7 +838,7 @@ pub async fn run(
         missions_sent: 0,
         calibration: load_calibration(config)?,
         plan_wall_s: std::sync::Mutex::new(None),
-        underestimate: 0.0,
+        margin: config.margin(),
         preplanned: None,
         tag: session.zid().to_string().chars().take(8).collect(),
     };

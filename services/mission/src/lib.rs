@@ -31,6 +31,7 @@ pub mod executive;
 pub mod experiment;
 pub mod information;
 mod inputs;
+pub mod margin;
 pub mod path;
 pub mod service;
 pub mod tasks;

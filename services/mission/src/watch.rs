@@ -46,8 +46,10 @@ pub struct WatchParams {
     pub controller_silence_s: f64,
     /// Arriving this much earlier than the task's start is slack to spend, seconds.
     pub slack_s: f64,
-    /// Mission seconds between two slack replans at least.
+    /// Mission seconds between two slack replans at least (and two behind ones).
     pub slack_interval_s: f64,
+    /// The behind rule is on (off: today's executive before it, in the batch of days).
+    pub behind: bool,
 }
 
 /// Why the window's plan changes.
@@ -213,7 +215,7 @@ impl Watch {
                     return self.replan(Reason::EtaSlipped, false);
                 }
                 let spaced = now_s - self.planned_at_s >= self.params.slack_interval_s;
-                if let Some(pace) = progress {
+                if let (Some(pace), true) = (progress, self.params.behind) {
                     if spaced && eta_slips(now_s, distance_left_m, pace, self.task_start_s) {
                         return self.replan(Reason::Behind, true);
                     }
@@ -270,6 +272,7 @@ mod tests {
             controller_silence_s: 3.0,
             slack_s: 10.0,
             slack_interval_s: 5.0,
+            behind: true,
         }
     }
 

@@ -12,22 +12,11 @@ use super::variant::{Settings, Variant};
 use super::world::DayWorld;
 use super::{DaysError, DaysOptions};
 use crate::calibration::{Calibration, CalibrationConfig, TimeModel};
+use crate::executive::ExecutiveConfig;
+use crate::margin::ArrivalMargin;
 use crate::path::mission_waypoints;
 use crate::tasks::Task;
 use crate::watch::WatchParams;
-
-/// The executive's own settings (`ExecutiveConfig::default()`), which every variant
-/// shares: waypoints at most 1 m apart, pushed off beyond 1.5 m, a top speed of
-/// 0.5 m/s for the ETA slip, 5 replans per window, given up 60 s after the task's
-/// start, a silent controller after 3 s, slack beyond 10 s at most every 10 s.
-const WAYPOINT_SPACING_M: f64 = 1.0;
-const OFF_PATH_M: f64 = 1.5;
-const SPEED_M_PER_S: f64 = 0.5;
-const MAX_REPLANS: u32 = 5;
-pub(super) const GIVE_UP_AFTER_S: f64 = 60.0;
-const CONTROLLER_SILENCE_S: f64 = 3.0;
-const SLACK_S: f64 = 10.0;
-const SLACK_INTERVAL_S: f64 = 10.0;
 
 /// How often the executive asks again for a window's first plans when none came
 /// (its `PLAN_RETRY`), mission seconds.
@@ -71,6 +60,10 @@ pub(super) struct DayRun<'a> {
     pub planner: Planner<'a>,
     pub robot: Robot,
     pub calibration: Calibration,
+    /// The executive's own settings (`ExecutiveConfig::default()`: waypoint spacing,
+    /// the replan policy's thresholds, the arrival margin), which every variant shares.
+    pub executive: ExecutiveConfig,
+    pub margin: ArrivalMargin,
     pub plan_cost_s: f64,
     pub day_seed: u64,
     pub preplanned: Option<Preplanned>,
@@ -91,6 +84,7 @@ pub fn run_day(
     day: usize,
 ) -> Result<DayResult, DaysError> {
     let settings = variant.settings(options.w_loc);
+    let executive = ExecutiveConfig::default();
     let seed = day_seed(options.seed, day);
     let apf = ApfParams {
         follow: settings.follow,
@@ -107,6 +101,12 @@ pub fn run_day(
         },
         robot: Robot::new(world, &apf, mix(seed ^ SIM_STREAM))?,
         calibration: Calibration::new(TimeModel::table_i(), CalibrationConfig::default())?,
+        margin: if settings.arrival_guard {
+            executive.margin()
+        } else {
+            ArrivalMargin::none()
+        },
+        executive,
         plan_cost_s: options.plan_cost_s,
         day_seed: seed,
         preplanned: None,
@@ -159,20 +159,14 @@ impl DayRun<'_> {
 
     /// The watch's parameters, as the executive makes them from its config and model.
     pub fn watch_params(&self) -> WatchParams {
-        let expected = 1.0 / self.time_model().v_lin;
         WatchParams {
-            off_path_m: OFF_PATH_M,
-            speed_m_per_s: SPEED_M_PER_S.min(expected),
-            expected_speed_m_per_s: expected,
-            max_replans: MAX_REPLANS,
-            give_up_after_s: GIVE_UP_AFTER_S,
-            controller_silence_s: CONTROLLER_SILENCE_S,
             slack_s: if self.settings.slack {
-                SLACK_S
+                self.executive.slack_s
             } else {
                 f64::INFINITY
             },
-            slack_interval_s: SLACK_INTERVAL_S,
+            behind: self.settings.arrival_guard,
+            ..self.executive.watch_params(self.time_model())
         }
     }
 
@@ -180,10 +174,12 @@ impl DayRun<'_> {
     /// thinning to mutually visible points (`follow: waypoints`).
     pub fn waypoints(&self, plan: &Planned) -> Vec<[f64; 2]> {
         match self.settings.follow {
-            Follow::Path => mission_waypoints(&plan.points, WAYPOINT_SPACING_M),
-            Follow::Waypoints => super::thin::thin(&plan.points, WAYPOINT_SPACING_M, |a, b| {
-                super::thin::clear(&self.world.planning, a, b)
-            }),
+            Follow::Path => mission_waypoints(&plan.points, self.executive.waypoint_spacing_m),
+            Follow::Waypoints => {
+                super::thin::thin(&plan.points, self.executive.waypoint_spacing_m, |a, b| {
+                    super::thin::clear(&self.world.planning, a, b)
+                })
+            }
         }
     }
 
@@ -225,7 +221,8 @@ impl DayRun<'_> {
     ) -> Result<(Planned, f64), DaysError> {
         let now = self.robot.now_s();
         let earliest = now + self.plan_cost_s;
-        let budget = task.start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
+        let time_left = task.start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
+        let budget = self.margin.budget(time_left);
         if !(curious && self.settings.curious) || budget <= shortest.t_eta_s {
             return Ok((shortest.clone(), budget));
         }
@@ -274,7 +271,7 @@ impl DayRun<'_> {
                 )?;
                 return Ok(Some((shortest, plan, budget)));
             }
-            if self.robot.now_s() > task.start_s + GIVE_UP_AFTER_S {
+            if self.robot.now_s() > task.start_s + self.executive.give_up_after_s {
                 return Ok(None);
             }
             let until = self.robot.now_s() + PLAN_RETRY_S;

@@ -13,8 +13,9 @@ use serde::Serialize;
 /// - `new`: the time model calibrated from each arrived mission
 ///   ([`crate::calibration::Calibration::add_planned`]), every turn of the plan sent
 ///   ([`crate::path::mission_waypoints`]) and followed as a path, the slack rule
-///   ([`crate::watch`]), the next window planned during the task, the PEB cost (W_loc)
-///   and the change coupling (module [`super::planning`]).
+///   ([`crate::watch`]), the next window planned during the task, the arrival margin
+///   and the behind rule, the PEB cost (W_loc) and the change coupling (module
+///   [`super::planning`]).
 /// - `new_no_change`, `new_no_peb`: `new` without one coupling, so that each one's
 ///   effect shows alone.
 /// - `shortest`: the shortest path in every window (the information ratio's baseline),
@@ -46,6 +47,9 @@ pub struct Settings {
     pub change: bool,
     /// Ask for curious plans at all (`false`: the shortest path always).
     pub curious: bool,
+    /// Plans leave the executive's arrival margin unspent ([`crate::margin`]) and the
+    /// behind rule replans when the robot falls behind its plan ([`crate::watch`]).
+    pub arrival_guard: bool,
 }
 
 impl Variant {
@@ -83,6 +87,7 @@ impl Variant {
             w_loc,
             change: true,
             curious: true,
+            arrival_guard: true,
         };
         match self {
             Variant::Today => Settings {
@@ -93,6 +98,7 @@ impl Variant {
                 w_loc: 0.0,
                 change: false,
                 curious: true,
+                arrival_guard: false,
             },
             Variant::New => new,
             Variant::NewNoChange => Settings {
@@ -107,6 +113,7 @@ impl Variant {
                 w_loc: 0.0,
                 change: false,
                 curious: false,
+                arrival_guard: false,
                 ..new
             },
         }

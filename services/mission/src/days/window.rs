@@ -28,6 +28,7 @@ pub fn reason_name(reason: Reason) -> &'static str {
         Reason::EtaSlipped => "late",
         Reason::PushedOffPath => "off_path",
         Reason::Slack => "slack",
+        Reason::Behind => "behind",
     }
 }
 
@@ -160,6 +161,7 @@ impl DayRun<'_> {
                 self.calibration.add_planned(d, theta, took_s);
             }
             let predicted_s = model.eta(d, theta);
+            self.margin.learn(predicted_s, took_s);
             TimeModelUse {
                 v_lin: model.v_lin,
                 v_ang: model.v_ang,
