@@ -84,15 +84,18 @@ mod tests {
 
     #[test]
     fn the_peb_matches_the_closed_form_and_is_none_without_a_fix() {
-        // Two orthogonal anchors within d0: F = diag(1/σ², 1/σ²), PEB = σ√2.
-        let f = field(&[[10.0, 0.0], [0.0, 10.0]]);
+        // Three anchors within d0 on the axes: F = diag(2/σ², 1/σ²), PEB = σ√(1/2 + 1).
+        let f = field(&[[10.0, 0.0], [0.0, 10.0], [-10.0, 0.0]]);
         let peb = f.peb_m([0.0, 0.0]).expect("finite");
-        assert!((peb - 0.1 * 2f64.sqrt()).abs() < 1e-12, "{peb}");
-        // One anchor only: singular.
+        assert!((peb - 0.1 * 1.5f64.sqrt()).abs() < 1e-12, "{peb}");
+        // Two anchors: an invertible FIM, but no fix (the estimator needs three).
+        let two = field(&[[10.0, 0.0], [0.0, 10.0]]);
+        assert_eq!(two.peb_m([0.0, 0.0]), None);
+        // No anchor in range.
         assert_eq!(f.peb_m([100.0, 0.0]), None);
         assert_eq!(f.is_force([100.0, 0.0]), [0.0, 0.0]);
         assert_eq!(f.peb_m([f64::NAN, 0.0]), None);
-        assert_eq!(f.coverage([0.0, 0.0]), 2);
+        assert_eq!(f.coverage([0.0, 0.0]), 3);
         assert_eq!(f.coverage([100.0, 0.0]), 0);
     }
 

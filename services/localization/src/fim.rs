@@ -20,6 +20,15 @@ use crate::model::{RangingModel, MIN_DISTANCE_M};
 /// The default reciprocal condition number below which a FIM counts as singular.
 pub const DEFAULT_MIN_RCOND: f64 = 1e-9;
 
+/// The fewest anchors in range the estimator fixes a position from (WLS, `crate::wls`):
+/// two range circles meet in two points, so two anchors leave the position ambiguous.
+/// The bound follows the estimator (issue 18: one rule): with fewer anchors the PEB is
+/// +∞ and the bound degraded, although the FIM of two non-collinear anchors is
+/// invertible. Paper 002 §2.2 does not say; with its bound finite on two-anchor ground,
+/// the IS field, the `peb` layer and the planner's W_loc cost called localizable a
+/// place where the robot had no fix, and the controller's guard held it there.
+pub const MIN_FIX_ANCHORS: usize = 3;
+
 /// How the FIM is formed and when it counts as singular.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FimOptions {
@@ -108,7 +117,7 @@ pub fn fim_from(
 }
 
 /// The CRB and PEB of a FIM (paper 002 §2.2: CRB = F⁻¹, PEB = √tr(F⁻¹)), degraded when
-/// F is singular or ill-conditioned (λ_min/λ_max ≤ `min_rcond`, computed in closed form
+/// fewer than [`MIN_FIX_ANCHORS`] anchors contributed, when F is singular or ill-conditioned (λ_min/λ_max ≤ `min_rcond`, computed in closed form
 /// for the symmetric 2 × 2 matrix) or anything is not finite.
 pub fn bound_from_fim(f: Matrix2<f64>, anchors_used: usize, options: &FimOptions) -> Bound {
     let degraded = Bound {
@@ -118,6 +127,9 @@ pub fn bound_from_fim(f: Matrix2<f64>, anchors_used: usize, options: &FimOptions
         anchors_used,
         degraded: true,
     };
+    if anchors_used < MIN_FIX_ANCHORS {
+        return degraded;
+    }
     let (a, b, c) = (f[(0, 0)], 0.5 * (f[(0, 1)] + f[(1, 0)]), f[(1, 1)]);
     let tr = a + c;
     if !(tr.is_finite() && tr > 0.0 && b.is_finite()) {

@@ -21,7 +21,7 @@ pub use field::{
     bounds_at, crb_field, peb_field, peb_gradient, CrbField, GridRegion, PebField,
     DEFAULT_GRADIENT_STEP_M,
 };
-pub use fim::{bound, bound_from_fim, fim, Bound, FimOptions};
+pub use fim::{bound, bound_from_fim, fim, Bound, FimOptions, MIN_FIX_ANCHORS};
 pub use model::RangingModel;
 pub use nalgebra;
 pub use roam_sim::noise::ToaNoise;

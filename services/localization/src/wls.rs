@@ -20,7 +20,7 @@
 use nalgebra::{Matrix2, Vector2};
 
 use crate::error::LocalizationError;
-use crate::fim::{bound_from_fim, fim_from, FimOptions};
+use crate::fim::{bound_from_fim, fim_from, FimOptions, MIN_FIX_ANCHORS};
 use crate::model::{RangingModel, MIN_DISTANCE_M};
 
 /// The most ranges one estimate takes.
@@ -173,7 +173,7 @@ pub fn estimate(
         }
     };
 
-    if used.len() < 3 {
+    if used.len() < MIN_FIX_ANCHORS {
         return Ok(fail(
             Degraded::TooFewAnchors { usable: used.len() },
             0,

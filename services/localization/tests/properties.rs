@@ -6,6 +6,7 @@
 use proptest::prelude::*;
 use roam_localization::{
     bound, estimate, peb_field, FimOptions, GridRegion, Range, RangingModel, ToaNoise, WlsOptions,
+    MIN_FIX_ANCHORS,
 };
 
 /// A constellation: 1–10 anchors, either anywhere or (to hit exact singularity) on one
@@ -82,21 +83,22 @@ proptest! {
             let tr = b.fim.trace();
             prop_assert!(b.peb >= 2.0 / tr.sqrt() * (1.0 - 1e-12), "PEB {} < 2/sqrt(tr F) {}", b.peb, 2.0 / tr.sqrt());
         }
-        // Degraded exactly when singular: fewer than two anchors in range, or all in line
-        // with the point, is singular; any pair at more than 0.05 rad is not (with these
-        // parameters the weights differ by at most ~2000×, so λ_min/λ_max stays above
-        // 1e-7, far from the 1e-9 threshold).
+        // Degraded exactly when the estimator has no fix: fewer than MIN_FIX_ANCHORS (3)
+        // anchors in range, or all in line with the point (singular); three or more
+        // with any pair at more than 0.05 rad are not (with these parameters the weights
+        // differ by at most ~2000×, so λ_min/λ_max stays above 1e-7, far from the 1e-9
+        // threshold).
         let (s, n) = max_sine(&model, p);
-        if n < 2 || (collinear && s < 1e-7) {
-            prop_assert!(b.degraded, "singular FIM not degraded: {b:?}");
+        if n < MIN_FIX_ANCHORS || (collinear && s < 1e-7) {
+            prop_assert!(b.degraded, "no fix, yet not degraded: n {n} {b:?}");
         }
-        if n >= 2 && s > 0.05 {
+        if n >= MIN_FIX_ANCHORS && s > 0.05 {
             prop_assert!(!b.degraded, "regular FIM degraded: n {n} s {s} {b:?}");
         }
         // And against an independent eigen-decomposition.
         let eig = b.fim.symmetric_eigen().eigenvalues;
         let (lo, hi) = (eig.min(), eig.max());
-        if hi > 0.0 && lo / hi > 1e-8 {
+        if n >= MIN_FIX_ANCHORS && hi > 0.0 && lo / hi > 1e-8 {
             prop_assert!(!b.degraded);
         }
         if hi <= 0.0 || lo / hi < 1e-10 {
