@@ -370,11 +370,24 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
     };
     let say = |line: &str| eprintln!("roam demo: {line}");
     let report = roam::demo::run(&options, &say).await?;
+    let driven_shares: Vec<String> = report
+        .windows
+        .iter()
+        .map(|w| {
+            w.time_model
+                .map_or("-".to_owned(), |m| format!("{:.0}%", m.driven_share * 100.0))
+        })
+        .collect();
     println!(
-        "on time: {}   information: {:.0} (shortest path: {:.0})   mean PEB: {}",
+        "on time: {}   share of each window driven: {}",
         if report.on_time { "yes" } else { "no" },
+        driven_shares.join(" ")
+    );
+    println!(
+        "information: {:.0} (shortest paths: {:.0}; today's executive planned: {:.0})   mean PEB: {}",
         report.information,
         report.information_shortest_path,
+        report.information_todays_plans,
         report
             .peb_mean_m
             .map_or("-".to_owned(), |p| format!("{p:.3} m"))
