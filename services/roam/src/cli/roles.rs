@@ -374,8 +374,9 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
         .windows
         .iter()
         .map(|w| {
-            w.time_model
-                .map_or("-".to_owned(), |m| format!("{:.0}%", m.driven_share * 100.0))
+            w.time_model.map_or("-".to_owned(), |m| {
+                format!("{:.0}%", m.driven_share * 100.0)
+            })
         })
         .collect();
     println!(
