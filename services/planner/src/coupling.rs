@@ -41,26 +41,7 @@ pub fn couple(information: &[u8], change: &[u8]) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use roam_proto::map::{GridMeta, Origin};
-
-    fn layer(name: &str, width: u32, cells: Cells) -> Layer {
-        Layer {
-            name: name.to_owned(),
-            version: 1,
-            derived_from: None,
-            meta: GridMeta {
-                width,
-                height: 1,
-                resolution: 0.2,
-                origin: Origin {
-                    x: 0.0,
-                    y: 0.0,
-                    yaw: 0.0,
-                },
-            },
-            cells,
-        }
-    }
+    use crate::maps::tests::layer;
 
     #[test]
     fn a_changed_cell_is_worth_at_least_its_change_and_the_rest_keeps_its_score() {
@@ -72,12 +53,12 @@ mod tests {
 
     #[test]
     fn only_a_u8_layer_on_the_same_grid_is_coupled() {
-        let info = layer("information", 3, Cells::U8(vec![1, 2, 3]));
-        let change = layer("change_information", 3, Cells::U8(vec![0, 0, 9]));
+        let info = layer("information", 1, Cells::U8(vec![1, 2, 3]));
+        let change = layer("change_information", 1, Cells::U8(vec![0, 0, 9]));
         assert!(usable(&change, &info).is_some());
-        let wider = layer("change_information", 4, Cells::U8(vec![0; 4]));
+        let wider = layer("change_information", 1, Cells::U8(vec![0; 4]));
         assert!(usable(&wider, &info).is_none());
-        let floats = layer("change_information", 3, Cells::F32(vec![0.0; 3]));
+        let floats = layer("change_information", 1, Cells::F32(vec![0.0; 3]));
         assert!(usable(&floats, &info).is_none());
     }
 }

@@ -60,10 +60,10 @@ impl MapCache {
     }
 
     /// The layer names this cache follows.
-    pub fn layers(&self) -> Vec<&str> {
+    pub fn layers(&self) -> Vec<String> {
         let mut names = vec![INFLATED, self.information_layer.as_str(), PEB];
         names.extend(self.change_layer.as_deref());
-        names
+        names.into_iter().map(str::to_owned).collect()
     }
 
     /// Takes a new layer; rebuilds the world when both layers are present and agree in
@@ -191,17 +191,19 @@ impl MapCache {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use roam_proto::map::{GridMeta, Origin};
 
-    fn layer(name: &str, version: u64, cells: Cells) -> Layer {
+    /// A one-row layer of `cells.len()` cells.
+    pub(crate) fn layer(name: &str, version: u64, cells: Cells) -> Layer {
+        let width = cells.len() as u32;
         Layer {
             name: name.to_owned(),
             version,
             derived_from: None,
             meta: GridMeta {
-                width: 4,
+                width,
                 height: 1,
                 resolution: 0.2,
                 origin: Origin {
@@ -219,7 +221,7 @@ mod tests {
         let mut cache = MapCache::new(4).coupling_change(Some("change_information"));
         assert_eq!(
             cache.layers(),
-            vec![INFLATED, INFORMATION, PEB, "change_information"]
+            [INFLATED, INFORMATION, PEB, "change_information"].map(str::to_owned)
         );
         cache.update(layer(INFLATED, 1, Cells::I8(vec![0; 4])));
         let first = cache
@@ -246,7 +248,10 @@ mod tests {
     #[test]
     fn an_uncoupled_cache_ignores_the_change_layer() {
         let mut cache = MapCache::new(4);
-        assert_eq!(cache.layers(), vec![INFLATED, INFORMATION, PEB]);
+        assert_eq!(
+            cache.layers(),
+            [INFLATED, INFORMATION, PEB].map(str::to_owned)
+        );
         cache.update(layer(INFLATED, 1, Cells::I8(vec![0; 4])));
         cache.update(layer(INFORMATION, 1, Cells::U8(vec![1; 4])));
         assert_eq!(

@@ -155,12 +155,7 @@ pub async fn run(
     let root = config.root.as_str();
 
     // Maps: follow publications, and fetch the current layers until we have them.
-    let layers: Vec<String> = state
-        .maps()
-        .layers()
-        .into_iter()
-        .map(str::to_owned)
-        .collect();
+    let layers = state.maps().layers();
     for layer in &layers {
         service
             .subscribe(
@@ -275,12 +270,7 @@ fn take_cancel(state: &State, request: &CancelPlan) {
 /// Gets the two layers from the map server, retrying until both arrive.
 async fn fetch_maps(state: Arc<State>, requester: Requester, cancel: CancellationToken) {
     loop {
-        let layers: Vec<String> = state
-            .maps()
-            .layers()
-            .into_iter()
-            .map(str::to_owned)
-            .collect();
+        let layers = state.maps().layers();
         for name in &layers {
             match requester
                 .request::<Layer, Layer>(&keys::map_layer(&state.root, name), None)
