@@ -237,7 +237,9 @@ fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
         let share = w["time_model"]["driven_share"]
             .as_f64()
             .expect("driven share");
-        assert!((0.0..=1.0).contains(&share), "{w}");
+        // A late robot drove past the task's start: more than the window.
+        let on_time = w["on_time"].as_bool().expect("on time");
+        assert!(share >= 0.0 && (share <= 1.0 || !on_time), "{w}");
         assert!(
             w["time_model"]["v_lin"].as_f64().is_some_and(|v| v > 0.0),
             "{w}"
