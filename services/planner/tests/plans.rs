@@ -87,7 +87,7 @@ fn the_same_seed_gives_the_same_path_bit_for_bit() {
 }
 
 #[test]
-fn curious_plans_reach_the_goal_in_budget_and_gather_more_than_the_shortest_path() {
+fn curious_plans_use_the_budget_and_gather_more_than_the_shortest_path() {
     let world = common::builtin_world();
     let shortest = run(
         &world,
@@ -109,8 +109,11 @@ fn curious_plans_reach_the_goal_in_budget_and_gather_more_than_the_shortest_path
         let s = spec(model, [-8.0, -8.0], [-2.0, 4.0], budget, 7, 400);
         let outcome = run(&world, &s);
         check_geometry(&world, &s, &outcome);
+        // On time at the goal is forced by the shortest-path seed (issue 18) and checked
+        // by `check_geometry`; using the budget is not: the shortest path drives half
+        // of it, and only F5 (Eq. 7) pushes the GA further.
         assert!(
-            outcome.reaches_goal && outcome.within_budget,
+            outcome.t_eta_s >= 0.8 * budget,
             "{model:?}: eta {} of {budget}",
             outcome.t_eta_s
         );

@@ -133,6 +133,20 @@ fn reproduce_planner_runs_the_papers_initialization_on_request() {
     assert_eq!(value["seeding"].as_array().map(Vec::len), Some(0));
 }
 
+/// An ES row's figures: its success share in 0..=1, and RMSE, steps and distance
+/// positive numbers when some run succeeded, null when none did. (Checking only that
+/// the keys exist passed with null, or with a string.)
+fn check_figures(row: &serde_json::Value) {
+    let share = row["success_rate"].as_f64().expect("a share");
+    assert!((0.0..=1.0).contains(&share), "{row}");
+    for field in ["rmse_m", "steps", "distance_m"] {
+        match row[field].as_f64() {
+            Some(v) => assert!(share > 0.0 && v > 0.0, "{field}: {row}"),
+            None => assert!(share == 0.0 && row[field].is_null(), "{field}: {row}"),
+        }
+    }
+}
+
 #[test]
 fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
     let out = tempfile::tempdir().expect("tmp");
@@ -159,9 +173,7 @@ fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
         ["plain", "fixed", "cutoff", "linear", "sinusoidal"]
     );
     for row in es1 {
-        for field in ["success_rate", "rmse_m", "steps", "distance_m"] {
-            assert!(row.get(field).is_some(), "{field} missing in {row}");
-        }
+        check_figures(row);
     }
     let es2 = value["es2"].as_array().expect("es2");
     assert_eq!(es2.len(), 4 * 10, "four IS schemes × z_is 0.0..0.9");
@@ -170,9 +182,17 @@ fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
         .all(|r| r["steps"].as_f64().is_some() && r["z_is"].as_f64().is_some()));
     let es3 = value["es3"].as_array().expect("es3");
     for row in es3 {
+        check_figures(row);
+        let compared = row["missions_compared"].as_u64().expect("a count");
         for field in ["rmse_change_pct", "steps_change_pct", "distance_change_pct"] {
-            assert!(row.get(field).is_some(), "{field} missing in {row}");
+            let finite = row[field].as_f64().is_some_and(f64::is_finite);
+            assert!(finite || row[field].is_null(), "{field}: {row}");
         }
+        assert_eq!(
+            row["steps_change_pct"].as_f64().is_some(),
+            compared > 0,
+            "a change exactly where a mission was compared: {row}"
+        );
     }
     for picture in [
         "es1_trajectories.png",
