@@ -197,7 +197,15 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
     let remote = ask(&client, &running.harness.root, &req)
         .await
         .expect("plan");
-    assert!(remote.reaches_goal && remote.within_budget, "{remote:?}");
+    // Reaching the goal on time is forced by the shortest-path seed (issue 18); what
+    // is not forced is that 80 generations use the budget, as F5 asks (Eq. 7): the
+    // shortest path drives about a third of it.
+    assert!(
+        remote.t_eta_s >= 0.75 * req.t_exec_s,
+        "{} s of {} s",
+        remote.t_eta_s,
+        req.t_exec_s
+    );
     assert_eq!(remote.generations, 80);
     assert_eq!(remote.stop_reason, StopReason::MaxGenerations);
     assert_eq!(
@@ -541,7 +549,9 @@ async fn a_round_trip_through_zenoh_uses_the_budget() {
         let remote = ask(&client, &running.harness.root, &req)
             .await
             .expect("plan");
-        assert!(remote.reaches_goal && remote.within_budget, "{remote:?}");
+        // A loop that uses the budget: the lower bound is what can fail (standing
+        // still, the paper's rule, drives 0 s); the shortest-path seed already forces
+        // the end at S and the upper bound.
         assert!(
             remote.t_eta_s >= 0.8 * req.t_exec_s && remote.t_eta_s <= req.t_exec_s,
             "{goal:?}: {} s of {} s",
@@ -596,18 +606,25 @@ async fn progress_is_published_and_a_plan_can_be_cancelled() {
         .expect("plan");
     assert_eq!(plan.stop_reason, StopReason::Cancelled);
     assert!(plan.generations < 50_000);
-    assert!(plan.reaches_goal, "the best path so far is returned");
-    // The last progress message says done.
-    let done = loop {
+    // Progress runs until a message says done; the last generation it reports is the
+    // plan's, with the plan's fitness: the best path so far is what was returned.
+    loop {
         let sample = within("final progress", subscriber.recv_async())
             .await
             .expect("sample");
         let progress: PlanProgress = decode(&sample.payload().to_bytes()).expect("progress");
+        seen.extend(progress.best_fitness);
         if progress.done {
-            break progress;
+            break;
         }
-    };
-    assert!(done.done);
+    }
+    let (last_generation, last_best) = *seen.last().expect("progress");
+    assert_eq!(last_generation, plan.generations, "{seen:?}");
+    assert_eq!(
+        last_best.to_bits(),
+        plan.fitness.total.to_bits(),
+        "{plan:?}"
+    );
     running.stop().await;
 }
 
@@ -815,8 +832,8 @@ async fn maximal_requests_are_cut_at_the_cpu_budget_or_refused() {
         .iter()
         .map(|plan| {
             assert_eq!(plan.stop_reason, StopReason::Budget, "{plan:?}");
-            assert!(plan.reaches_goal, "the best path so far");
-            assert!(plan.generations < 9000);
+            // Cut, not refused: it ran generations before the grant ended it.
+            assert!((1..9000).contains(&plan.generations), "{plan:?}");
             plan.budget_s.expect("the grant is in the reply")
         })
         .collect();

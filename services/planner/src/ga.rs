@@ -13,7 +13,9 @@
 //!   One more choice: the shortest path (which the request was checked against, so it
 //!   fits the budget) joins the first population. The GA therefore always holds a path
 //!   that reaches the goal in time, and a tight budget cannot end in an over-budget
-//!   plan just because no random walk happened to fit.
+//!   plan just because no random walk happened to fit. These three choices (budget cap,
+//!   finish at G, shortest path) force "on time at the goal";
+//!   [`GaParams::random_walks_only`] turns all three off, for the reproduction.
 //! - Round trips (roam, issue 14; [`GaParams::walk_end_share`], default 0.5): a walk
 //!   ends only once its t_ETA (Eq. 2, summed as it walks) has reached
 //!   `walk_end_share · t_exec`. Before that, arriving at G does not end it (it walks on

@@ -66,6 +66,17 @@ pub struct GaParams {
     /// walk was the one cell S and the robot was told to stand still. 0 is the paper's
     /// rule. Default 0.5.
     pub walk_end_share: f64,
+    /// Paper 000 §II.A.1 to the letter: the first population is random walks only,
+    /// each of a length drawn between the Manhattan distance and the map's cell count
+    /// (cut at the chromosome bound, [`crate::ga::GaOptions::max_path_cells`]) and
+    /// stopping there or at G; no shortest path, no via-point seeds, walks not finished
+    /// at G, and the plan is the GA's best even where the shortest path is fitter
+    /// ([`crate::best`] is skipped). roam's seeding guarantees that a plan reaches the
+    /// goal on time; this switch shows what the paper's own start gives without that
+    /// guarantee (`roam reproduce planner` runs both). Not a request field: a service
+    /// that can return a path that misses the goal is a reproduction, not a planner.
+    /// Default false. See [`GaParams::with_random_walks_only`].
+    pub random_walks_only: bool,
 }
 
 impl Default for GaParams {
@@ -91,6 +102,7 @@ impl Default for GaParams {
             w_loc: 0.0,
             via_share: DEFAULT_VIA_SHARE,
             walk_end_share: DEFAULT_WALK_END_SHARE,
+            random_walks_only: false,
         }
     }
 }
@@ -249,6 +261,17 @@ impl GaParams {
         }
     }
 
+    /// These parameters with paper 000's initialization to the letter (see
+    /// [`GaParams::random_walks_only`]): [`GaParams::with_paper_initialization`]
+    /// without the shortest path, without finishing walks at G, and without the
+    /// fallback to the shortest path after the GA.
+    pub fn with_random_walks_only(self) -> GaParams {
+        GaParams {
+            random_walks_only: true,
+            ..self.with_paper_initialization()
+        }
+    }
+
     /// Whether the first population is paper 000's (see
     /// [`GaParams::with_paper_initialization`]).
     pub fn is_paper_initialization(&self) -> bool {
@@ -362,6 +385,12 @@ mod tests {
                 ..paper
             },
             roam
+        );
+        let strict = roam.clone().with_random_walks_only();
+        assert!(strict.is_paper_initialization() && strict.random_walks_only);
+        assert!(
+            !paper.random_walks_only,
+            "the shortest path stays by default"
         );
     }
 }

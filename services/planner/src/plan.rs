@@ -356,11 +356,20 @@ pub fn plan(
                 };
                 let field = distance_field(world, goal);
                 let stop = || cancel.load(Ordering::Relaxed) || Instant::now() >= deadline;
-                let seeds = seeds_for(world, spec, &checked, &field, &stop).paths;
+                // Paper 000 to the letter (GaParams::random_walks_only): random walks
+                // only, nothing seeded and nothing to fall back on.
+                let strict = params.random_walks_only;
+                let seeds = if strict {
+                    Vec::new()
+                } else {
+                    seeds_for(world, spec, &checked, &field, &stop).paths
+                };
                 let via_seeds = seeds.len();
                 // The shortest path first, then the via-point seeds (see crate::ga).
                 let mut seed_paths = Vec::with_capacity(1 + via_seeds);
-                seed_paths.push(checked.shortest.clone());
+                if !strict {
+                    seed_paths.push(checked.shortest.clone());
+                }
                 seed_paths.extend(seeds);
                 let problem = Problem {
                     world,
@@ -375,9 +384,17 @@ pub fn plan(
                 let options = GaOptions {
                     seed: spec.seed,
                     deadline: Some(deadline),
-                    cap_walks_by_budget: true,
-                    complete_walks_to_goal: true,
-                    max_path_cells: checked.max_path_cells(world),
+                    cap_walks_by_budget: !strict,
+                    complete_walks_to_goal: !strict,
+                    // The paper's walks may be as long as the map has cells (§II.A.1);
+                    // roam bounds chromosomes by the budget (crate::limits). Only the
+                    // reproduction sets `random_walks_only` (no request can), so the
+                    // size promise to requesters holds.
+                    max_path_cells: if strict {
+                        checked.max_path_cells(world).max(world.traversable_count())
+                    } else {
+                        checked.max_path_cells(world)
+                    },
                     threads: spec.threads,
                 };
                 let result = ga::run(&problem, &options, cancel, progress);
@@ -386,8 +403,12 @@ pub fn plan(
                     evaluation: result.evaluation,
                     source: PlanSource::Ga,
                 };
-                let mut evaluator = Evaluator::new(world, params, model, goal, spec.t_exec_s);
-                let chosen = best_of(&mut evaluator, ga, &checked.shortest, &seed_paths[1..]);
+                let chosen = if strict {
+                    ga
+                } else {
+                    let mut evaluator = Evaluator::new(world, params, model, goal, spec.t_exec_s);
+                    best_of(&mut evaluator, ga, &checked.shortest, &seed_paths[1..])
+                };
                 (
                     chosen,
                     result.generations,

@@ -7,6 +7,7 @@ use std::sync::atomic::AtomicBool;
 
 use common::check_geometry;
 use proptest::prelude::*;
+use roam_planner::best::PlanSource;
 use roam_planner::plan::{plan, PlanError, PlanOutcome, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
@@ -86,7 +87,7 @@ fn the_same_seed_gives_the_same_path_bit_for_bit() {
 }
 
 #[test]
-fn curious_plans_reach_the_goal_in_budget_and_gather_more_than_the_shortest_path() {
+fn curious_plans_use_the_budget_and_gather_more_than_the_shortest_path() {
     let world = common::builtin_world();
     let shortest = run(
         &world,
@@ -108,8 +109,11 @@ fn curious_plans_reach_the_goal_in_budget_and_gather_more_than_the_shortest_path
         let s = spec(model, [-8.0, -8.0], [-2.0, 4.0], budget, 7, 400);
         let outcome = run(&world, &s);
         check_geometry(&world, &s, &outcome);
+        // On time at the goal is forced by the shortest-path seed (issue 18) and checked
+        // by `check_geometry`; using the budget is not: the shortest path drives half
+        // of it, and only F5 (Eq. 7) pushes the GA further.
         assert!(
-            outcome.reaches_goal && outcome.within_budget,
+            outcome.t_eta_s >= 0.8 * budget,
             "{model:?}: eta {} of {budget}",
             outcome.t_eta_s
         );
@@ -259,4 +263,31 @@ fn the_localizability_cost_keeps_plans_out_of_poorly_covered_cells() {
         "the costed plan crosses {along} m of PEB, the free one {}",
         cost_along(&free.path)
     );
+}
+
+/// `GaParams::random_walks_only` (paper 000 §II.A.1 to the letter) seeds nothing and
+/// falls back on nothing: the plan is the GA's own, and still a legal path from S.
+/// Without the shortest path the first population's walks reach G (12 m away) only
+/// after hundreds of random cells, far over a 60 s budget, and W_3 > W_2 (Table I)
+/// keeps the late arrival over any on-time walk that stops short: after 50
+/// generations the plan is at G but late. With the shortest path seeded (roam's
+/// default) it is on time, so this fails if anything seeds it.
+#[test]
+fn the_papers_own_initialization_seeds_nothing() {
+    let world = common::builtin_world();
+    for model in [PlannerModel::Model0, PlannerModel::Model1] {
+        let mut s = spec(model, [-8.0, -8.0], [-2.0, 4.0], 60.0, 3, 50);
+        let roam = run(&world, &s);
+        assert!(roam.within_budget && roam.reaches_goal, "{model:?}");
+        s.params = s.params.with_random_walks_only();
+        let outcome = run(&world, &s);
+        check_geometry(&world, &s, &outcome);
+        assert_eq!(outcome.via_seeds, 0, "{model:?}");
+        assert_eq!(outcome.source, PlanSource::Ga, "{model:?}");
+        assert!(
+            outcome.reaches_goal && !outcome.within_budget,
+            "{model:?}: {} s of 60 s",
+            outcome.t_eta_s
+        );
+    }
 }

@@ -13,11 +13,14 @@
 //! for bit. t_exec = (1 − r) · T with T = 100 s by default (the paper: 240 s for a world
 //! whose shortest paths are longer; ours need about 30 s). Both are parameters.
 //!
-//! Initialization: roam's default (via-point seeds and the round-trip rule for walks,
-//! issue 14, see `roam_planner::seeds` and `roam_planner::ga`) unless
-//! [`ReproduceOptions::paper_initialization`] asks for paper 000's own (random walks
-//! that stop at the goal), which gives the figures this reproduction gave before, bit
-//! for bit.
+//! Initialization: every run plans with roam's default (via-point seeds, the
+//! round-trip rule, the shortest path in the first population, walks finished at G,
+//! issue 14, see `roam_planner::seeds` and `roam_planner::ga`) and with paper 000's own
+//! (§II.A.1: random walks only, see `GaParams::random_walks_only`), on the same seeds,
+//! and prints the two side by side ([`seeding`]): roam's seeding forces "within budget"
+//! and "reached goal" to 100% (the shortest path is in every first population, elitism
+//! keeps it, and W_2 + W_3 outweigh any reachable F1), the paper's does not.
+//! [`ReproduceOptions::initializations`] may ask for one of them only.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -33,6 +36,12 @@ use serde::Serialize;
 use crate::bench::BenchError;
 use crate::bench_planner::builtin_world;
 
+mod claims;
+mod seeding;
+
+pub use claims::{Comparison, PaperFigure, Verdict};
+pub use seeding::SeedingRow;
+
 /// The start and the paper's two goals (Fig. 5).
 pub const START: [f64; 2] = [-8.0, -8.0];
 pub const GOALS: [(&str, [f64; 2]); 2] = [("goal1", [-2.0, 4.0]), ("goal2", [6.0, -7.0])];
@@ -44,14 +53,41 @@ pub const MODELS: [PlannerModel; 3] = [
     PlannerModel::Model2,
 ];
 
+/// How the GA's first population is built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Initialization {
+    /// roam's default (`GaParams::default`).
+    Roam,
+    /// Paper 000 §II.A.1 to the letter (`GaParams::with_random_walks_only`).
+    Paper,
+}
+
+impl Initialization {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Initialization::Roam => "roam",
+            Initialization::Paper => "paper",
+        }
+    }
+
+    fn params(self, params: roam_planner::params::GaParams) -> roam_planner::params::GaParams {
+        match self {
+            Initialization::Roam => params,
+            Initialization::Paper => params.with_random_walks_only(),
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct ReproduceOptions {
     pub runs: usize,
     pub total_s: f64,
     pub generations_per_t: f64,
     pub out_dir: PathBuf,
-    /// Plan with paper 000's initialization (§II.A.1) instead of roam's default.
-    pub paper_initialization: bool,
+    /// The initializations to run, in order; the first one's paths are drawn as
+    /// `model{0,1,2}.png`, the others' as `<name>-model{0,1,2}.png`.
+    pub initializations: Vec<Initialization>,
 }
 
 /// One configuration's results, as the issue's JSON names them.
@@ -72,21 +108,20 @@ pub struct Row {
     pub t_exec_s: f64,
 }
 
-/// Our figure next to the paper's for one claim.
+/// One initialization's rows and the paper's claims judged on them.
 #[derive(Debug, Clone, Serialize)]
-pub struct Comparison {
-    pub claim: String,
-    pub paper: String,
-    pub ours: String,
-    pub holds: bool,
+pub struct InitializationRun {
+    pub initialization: Initialization,
+    pub rows: Vec<Row>,
+    pub comparisons: Vec<Comparison>,
 }
 
 #[derive(Debug, Clone, Serialize)]
 pub struct Reproduction {
-    /// `paper` (§II.A.1's random walks) or `roam` (with via-point seeds and round trips).
-    pub initialization: String,
-    pub rows: Vec<Row>,
-    pub comparisons: Vec<Comparison>,
+    /// Each initialization asked for, in order.
+    pub initializations: Vec<InitializationRun>,
+    /// roam's and the paper's initialization side by side, when both ran.
+    pub seeding: Vec<SeedingRow>,
     pub pictures: Vec<PathBuf>,
 }
 
@@ -109,9 +144,52 @@ fn mean(values: &[f64]) -> f64 {
 
 pub fn run(options: &ReproduceOptions) -> Result<Reproduction, BenchError> {
     let world = builtin_world()?;
+    let mut initializations = Vec::new();
+    let mut pictures = Vec::new();
+    for (n, init) in options.initializations.iter().enumerate() {
+        let (rows, paths) = run_one(&world, options, *init)?;
+        let prefix = if n == 0 {
+            String::new()
+        } else {
+            format!("{}-", init.as_str())
+        };
+        pictures.extend(draw(&world, &paths, &options.out_dir, &prefix)?);
+        initializations.push(InitializationRun {
+            initialization: *init,
+            comparisons: claims::compare(&rows),
+            rows,
+        });
+    }
+    let by = |which| {
+        initializations
+            .iter()
+            .find(|r| r.initialization == which)
+            .map(|r| r.rows.as_slice())
+    };
+    let seeding = match (by(Initialization::Roam), by(Initialization::Paper)) {
+        (Some(roam), Some(paper)) => seeding::side_by_side(roam, paper),
+        _ => Vec::new(),
+    };
+    Ok(Reproduction {
+        initializations,
+        seeding,
+        pictures,
+    })
+}
+
+/// A path to draw, with the model that planned it.
+type Drawn = (PlannerModel, Vec<u32>);
+
+/// Every configuration with one initialization; returns the rows and the paths drawn
+/// (Goal 2, 40/60, seed 0).
+fn run_one(
+    world: &World,
+    options: &ReproduceOptions,
+    init: Initialization,
+) -> Result<(Vec<Row>, Vec<Drawn>), BenchError> {
     let never = AtomicBool::new(false);
     let mut rows = Vec::new();
-    let mut pictures_paths: Vec<(PlannerModel, Vec<u32>)> = Vec::new();
+    let mut pictures_paths: Vec<Drawn> = Vec::new();
     for (goal_name, goal) in GOALS {
         for (ratio_name, plan_share) in RATIOS {
             let t_exec_s = (1.0 - plan_share) * options.total_s;
@@ -121,12 +199,11 @@ pub fn run(options: &ReproduceOptions) -> Result<Reproduction, BenchError> {
                 let (mut within, mut reached) = (0usize, 0usize);
                 for seed in 0..options.runs as u64 {
                     let mut spec = PlanSpec::batch(START, goal, t_exec_s, model, generations, seed);
-                    if options.paper_initialization {
-                        spec.params = spec.params.with_paper_initialization();
-                    }
-                    let outcome = plan(&world, &spec, &never, |_, _| {}).map_err(|e| {
+                    spec.params = init.params(spec.params);
+                    let outcome = plan(world, &spec, &never, |_, _| {}).map_err(|e| {
                         BenchError::Setup(format!(
-                            "{goal_name} {ratio_name} {}: {e}",
+                            "{} {goal_name} {ratio_name} {}: {e}",
+                            init.as_str(),
                             model.as_str()
                         ))
                     })?;
@@ -156,129 +233,14 @@ pub fn run(options: &ReproduceOptions) -> Result<Reproduction, BenchError> {
             }
         }
     }
-    let comparisons = compare(&rows);
-    let pictures = draw(&world, &pictures_paths, &options.out_dir)?;
-    Ok(Reproduction {
-        initialization: initialization_name(options).to_owned(),
-        rows,
-        comparisons,
-        pictures,
-    })
-}
-
-fn initialization_name(options: &ReproduceOptions) -> &'static str {
-    if options.paper_initialization {
-        "paper"
-    } else {
-        "roam"
-    }
-}
-
-fn find<'a>(rows: &'a [Row], goal: &str, ratio: &str, model: &str) -> Option<&'a Row> {
-    rows.iter()
-        .find(|r| r.goal == goal && r.ratio == ratio && r.model == model)
-}
-
-fn pct(a: f64, b: f64) -> f64 {
-    (a / b - 1.0) * 100.0
-}
-
-/// The best configuration of a model for a goal: the highest median U_ges among the
-/// configurations whose runs all fit the budget (the paper greys out the others).
-fn best_valid<'a>(rows: &'a [Row], goal: &str, model: &str) -> Option<&'a Row> {
-    rows.iter()
-        .filter(|r| r.goal == goal && r.model == model && r.within_budget >= 1.0)
-        .max_by(|a, b| a.u_ges_median.total_cmp(&b.u_ges_median))
-}
-
-/// The paper's claims (§III.B and the abstract), ours next to theirs.
-fn compare(rows: &[Row]) -> Vec<Comparison> {
-    let mut out = Vec::new();
-    let (mut best_median, mut best_mean, mut fixed, mut m2, mut configs) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for (goal, _) in GOALS {
-        if let (Some(m1), Some(m0)) = (
-            best_valid(rows, goal, "model1"),
-            best_valid(rows, goal, "model0"),
-        ) {
-            best_median.push(pct(m1.u_ges_median, m0.u_ges_median));
-            best_mean.push(pct(m1.u_ges_mean, m0.u_ges_mean));
-            configs.push(format!("{goal}: I {} vs 0 {}", m1.ratio, m0.ratio));
-        }
-        if let (Some(m1), Some(m0)) = (
-            find(rows, goal, "40/60", "model1"),
-            find(rows, goal, "20/80", "model0"),
-        ) {
-            fixed.push(pct(m1.u_ges_median, m0.u_ges_median));
-        }
-        if let (Some(m2_best), Some(m0)) = (
-            best_valid(rows, goal, "model2"),
-            best_valid(rows, goal, "model0"),
-        ) {
-            m2.push(pct(m2_best.u_ges_median, m0.u_ges_median));
-        }
-    }
-    let fmt = |v: &[f64]| {
-        v.iter()
-            .map(|g| format!("{g:+.2}%"))
-            .collect::<Vec<_>>()
-            .join(" / ")
-    };
-    out.push(Comparison {
-        claim: format!(
-            "best valid Model I vs best valid Model 0, median U_ges, goal 1 / goal 2 ({})",
-            configs.join("; ")
-        ),
-        paper: "+10.29% to +33.61% (I 40/60 vs 0 20/80)".into(),
-        ours: fmt(&best_median),
-        holds: best_median.len() == GOALS.len() && best_median.iter().all(|g| *g >= 10.0),
-    });
-    out.push(Comparison {
-        claim: "best valid Model I vs best valid Model 0, mean U_ges".into(),
-        paper: "+14.37% to +29.14%".into(),
-        ours: fmt(&best_mean),
-        holds: best_mean.len() == GOALS.len() && best_mean.iter().all(|g| *g > 0.0),
-    });
-    out.push(Comparison {
-        claim: "Model I at 40/60 vs Model 0 at 20/80 (the paper's best pair), median U_ges".into(),
-        paper: "+10.29% to +33.61%".into(),
-        ours: fmt(&fixed),
-        holds: fixed.iter().all(|g| *g >= 10.0),
-    });
-    out.push(Comparison {
-        claim: "best valid Model II vs best valid Model 0, median U_ges".into(),
-        paper: "-18.96% to -26.30% (Model II starved of generations)".into(),
-        ours: fmt(&m2),
-        holds: true,
-    });
-    let budget = |model: &str| {
-        let cfgs: Vec<&Row> = rows.iter().filter(|r| r.model == model).collect();
-        let violating = cfgs.iter().filter(|r| r.within_budget < 1.0).count();
-        (violating, cfgs.len())
-    };
-    let (v1, n1) = budget("model1");
-    out.push(Comparison {
-        claim: "Model I configurations with any run over budget".into(),
-        paper: "0 of 6".into(),
-        ours: format!("{v1} of {n1}"),
-        holds: v1 == 0,
-    });
-    for (model, paper) in [("model0", "1 of 6 (60/40, goal 2)"), ("model2", "3 of 6")] {
-        let (v, n) = budget(model);
-        out.push(Comparison {
-            claim: format!("{model} configurations with any run over budget"),
-            paper: paper.into(),
-            ours: format!("{v} of {n}"),
-            holds: true,
-        });
-    }
-    out
+    Ok((rows, pictures_paths))
 }
 
 fn draw(
     world: &World,
-    paths: &[(PlannerModel, Vec<u32>)],
+    paths: &[Drawn],
     out_dir: &Path,
+    prefix: &str,
 ) -> Result<Vec<PathBuf>, BenchError> {
     let content = map_file::builtin(DEFAULT_LIMITS.max_layer_cells)
         .map_err(|e| BenchError::Setup(e.to_string()))?;
@@ -294,7 +256,7 @@ fn draw(
         for end in [cells.first(), cells.last()].into_iter().flatten() {
             draw_marker(&mut image, world.meta.height, *end, scale, MARKER);
         }
-        let file = out_dir.join(format!("{}.png", model.as_str()));
+        let file = out_dir.join(format!("{prefix}{}.png", model.as_str()));
         image
             .save(&file)
             .map_err(|e| BenchError::Setup(format!("{}: {e}", file.display())))?;
@@ -305,10 +267,26 @@ fn draw(
 
 impl std::fmt::Display for Reproduction {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for run in &self.initializations {
+            write!(f, "{run}")?;
+            writeln!(f)?;
+        }
+        if !self.seeding.is_empty() {
+            write!(f, "{}", seeding::Table(&self.seeding))?;
+        }
+        for p in &self.pictures {
+            writeln!(f, "picture: {}", p.display())?;
+        }
+        Ok(())
+    }
+}
+
+impl std::fmt::Display for InitializationRun {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(
             f,
             "paper 000 §III on the built-in world (start (-8, -8)); t_plan spent as generations; {} initialization",
-            self.initialization
+            self.initialization.as_str()
         )?;
         writeln!(
             f,
@@ -340,19 +318,16 @@ impl std::fmt::Display for Reproduction {
                 r.reached_goal * 100.0
             )?;
         }
-        writeln!(f, "\nclaims, ours next to the paper's:")?;
+        writeln!(f, "claims, ours next to the paper's:")?;
         for c in &self.comparisons {
             writeln!(
                 f,
-                "  {:<70} paper {:<40} ours {}{}",
+                "  {:<70} paper {:<40} ours {:<18} {}",
                 c.claim,
                 c.paper,
                 c.ours,
-                if c.holds { "" } else { "   (does not hold)" }
+                c.verdict.as_str()
             )?;
-        }
-        for p in &self.pictures {
-            writeln!(f, "picture: {}", p.display())?;
         }
         Ok(())
     }

@@ -34,7 +34,15 @@ fn reproduce_planner_prints_every_row_and_draws_each_model() {
         String::from_utf8_lossy(&output.stderr)
     );
     let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
-    let rows = value["rows"].as_array().expect("rows");
+    let runs = value["initializations"]
+        .as_array()
+        .expect("initializations");
+    let names: Vec<&str> = runs
+        .iter()
+        .filter_map(|r| r["initialization"].as_str())
+        .collect();
+    assert_eq!(names, ["roam", "paper"], "both by default, roam's first");
+    let rows = runs[0]["rows"].as_array().expect("rows");
     assert_eq!(rows.len(), 2 * 3 * 3, "2 goals × 3 ratios × 3 models");
     for row in rows {
         for field in [
@@ -51,10 +59,29 @@ fn reproduce_planner_prints_every_row_and_draws_each_model() {
         }
         assert!(row["u_ges_median"].as_f64().expect("number") > 0.0);
     }
-    assert!(!value["comparisons"]
-        .as_array()
-        .expect("comparisons")
-        .is_empty());
+    // Every verdict is one the rule computes; none is missing.
+    for run in runs {
+        let comparisons = run["comparisons"].as_array().expect("comparisons");
+        assert_eq!(comparisons.len(), 7, "{run}");
+        for c in comparisons {
+            let verdict = c["verdict"].as_str().expect("verdict");
+            assert!(
+                ["holds", "same_direction", "does_not_hold", "no_data"].contains(&verdict),
+                "{c}"
+            );
+        }
+    }
+    // Side by side: each configuration under both, shares in 0..=1.
+    let seeding = value["seeding"].as_array().expect("seeding");
+    assert_eq!(seeding.len(), 18);
+    for row in seeding {
+        for init in ["roam", "paper"] {
+            for share in ["within_budget", "reached_goal"] {
+                let v = row[init][share].as_f64().expect("a share");
+                assert!((0.0..=1.0).contains(&v), "{row}");
+            }
+        }
+    }
     for model in ["model0", "model1", "model2"] {
         let png = out.path().join(format!("{model}.png"));
         assert!(
@@ -66,10 +93,13 @@ fn reproduce_planner_prints_every_row_and_draws_each_model() {
             "{model}: start and goal marked"
         );
     }
-    assert_eq!(value["initialization"], "roam");
+    for model in ["model0", "model1", "model2"] {
+        let png = out.path().join(format!("paper-{model}.png"));
+        assert!(png.exists(), "the paper's paths are drawn too");
+    }
 }
 
-/// `--paper-init` plans with paper 000's own initialization and says so.
+/// `--paper-init` plans with paper 000's own initialization only and says so.
 #[test]
 fn reproduce_planner_runs_the_papers_initialization_on_request() {
     let out = tempfile::tempdir().expect("tmp");
@@ -94,8 +124,27 @@ fn reproduce_planner_runs_the_papers_initialization_on_request() {
         String::from_utf8_lossy(&output.stderr)
     );
     let value: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
-    assert_eq!(value["initialization"], "paper");
-    assert_eq!(value["rows"].as_array().map(Vec::len), Some(18));
+    let runs = value["initializations"]
+        .as_array()
+        .expect("initializations");
+    assert_eq!(runs.len(), 1);
+    assert_eq!(runs[0]["initialization"], "paper");
+    assert_eq!(runs[0]["rows"].as_array().map(Vec::len), Some(18));
+    assert_eq!(value["seeding"].as_array().map(Vec::len), Some(0));
+}
+
+/// An ES row's figures: its success share in 0..=1, and RMSE, steps and distance
+/// positive numbers when some run succeeded, null when none did. (Checking only that
+/// the keys exist passed with null, or with a string.)
+fn check_figures(row: &serde_json::Value) {
+    let share = row["success_rate"].as_f64().expect("a share");
+    assert!((0.0..=1.0).contains(&share), "{row}");
+    for field in ["rmse_m", "steps", "distance_m"] {
+        match row[field].as_f64() {
+            Some(v) => assert!(share > 0.0 && v > 0.0, "{field}: {row}"),
+            None => assert!(share == 0.0 && row[field].is_null(), "{field}: {row}"),
+        }
+    }
 }
 
 #[test]
@@ -124,9 +173,7 @@ fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
         ["plain", "fixed", "cutoff", "linear", "sinusoidal"]
     );
     for row in es1 {
-        for field in ["success_rate", "rmse_m", "steps", "distance_m"] {
-            assert!(row.get(field).is_some(), "{field} missing in {row}");
-        }
+        check_figures(row);
     }
     let es2 = value["es2"].as_array().expect("es2");
     assert_eq!(es2.len(), 4 * 10, "four IS schemes × z_is 0.0..0.9");
@@ -135,9 +182,17 @@ fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
         .all(|r| r["steps"].as_f64().is_some() && r["z_is"].as_f64().is_some()));
     let es3 = value["es3"].as_array().expect("es3");
     for row in es3 {
+        check_figures(row);
+        let compared = row["missions_compared"].as_u64().expect("a count");
         for field in ["rmse_change_pct", "steps_change_pct", "distance_change_pct"] {
-            assert!(row.get(field).is_some(), "{field} missing in {row}");
+            let finite = row[field].as_f64().is_some_and(f64::is_finite);
+            assert!(finite || row[field].is_null(), "{field}: {row}");
         }
+        assert_eq!(
+            row["steps_change_pct"].as_f64().is_some(),
+            compared > 0,
+            "a change exactly where a mission was compared: {row}"
+        );
     }
     for picture in [
         "es1_trajectories.png",

@@ -39,6 +39,12 @@ pub struct Es1Row {
     /// Mean distance of the successful runs, metres.
     pub distance_m: Option<f64>,
     pub runs: usize,
+    /// Runs that did not reach B.
+    pub failures: usize,
+    /// Mean steps of all runs (a failed run until it was given up).
+    pub steps_all: Option<f64>,
+    /// Mean distance of all runs, metres.
+    pub distance_all_m: Option<f64>,
 }
 
 /// ES1's rows (one per scheme, in [`Scheme::ALL`]'s order) and each scheme's first run.
@@ -78,7 +84,7 @@ pub fn es1(scenario: &Scenario, options: &RunOptions<'_>) -> Result<Es1Outcome, 
         &jobs,
         options.threads,
         |&(scheme, run)| {
-            let seed = run_seed(options.seed, "es1", scheme, 0, run);
+            let seed = run_seed(options.seed, "es1", 0, run);
             run_episode(
                 &setup,
                 &params(scheme),
@@ -114,6 +120,9 @@ pub fn es1(scenario: &Scenario, options: &RunOptions<'_>) -> Result<Es1Outcome, 
             steps: s.steps,
             distance_m: s.distance_m,
             runs: s.runs,
+            failures: s.failures,
+            steps_all: s.steps_all,
+            distance_all_m: s.distance_all_m,
         });
     }
     Ok(Es1Outcome { rows, trajectories })

@@ -7,9 +7,9 @@
 //! (`max_peb_m = ∞`): the middles of ES2's legs are covered by two anchors nearly in line
 //! with the robot, where the PEB is far above roam's default bound.
 //!
-//! A run's seed depends on the scheme and the run, not on z_is: the same noise at every
-//! z_is of a scheme (common random numbers), so a curve over z_is shows the effect of
-//! z_is rather than of the noise.
+//! A run's seed depends on the run only, not on the scheme or z_is: the same noise at
+//! every point (common random numbers, see [`super`]), so a curve over z_is, and the gap
+//! between two schemes' curves, shows their effect rather than the noise's.
 
 use roam_map_server::scenario::Scenario;
 use serde::Serialize;
@@ -92,7 +92,7 @@ pub fn es2(
         options.threads,
         |&(scheme, z, run)| {
             let z_is = z_values[z];
-            let seed = run_seed(options.seed, "es2", scheme, 0, run);
+            let seed = run_seed(options.seed, "es2", 0, run);
             run_episode(
                 &setup,
                 &params(scheme, z_is),

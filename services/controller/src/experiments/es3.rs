@@ -19,7 +19,9 @@
 //! that mission: 100 · (scheme − plain)/plain. Steps and distance are means over the
 //! successful runs; a mission where either side has no successful run (or plain's value
 //! is 0) is left out of that metric's average, and `missions_compared` says how many
-//! were used.
+//! were used. Beside them, `failures` counts the failed runs and `steps_all_change_pct`
+//! makes the same comparison over all runs, failed ones included at the step where they
+//! were given up.
 
 use rand_chacha::rand_core::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -69,6 +71,12 @@ pub struct Es3Row {
     pub distance_m: Option<f64>,
     /// Missions in the steps average (both sides had a successful run).
     pub missions_compared: usize,
+    /// Runs (over all missions) in which a robot missed a waypoint.
+    pub failures: usize,
+    /// Mean over missions of the change of the mean steps of ALL runs (a failed run
+    /// until it was given up, e.g. at the step limit) against plain APF's, %: beside
+    /// `steps_change_pct`, which leaves failed runs out.
+    pub steps_all_change_pct: Option<f64>,
 }
 
 /// ES3's rows (one per scheme, plain first), the missions, and every (scheme, mission)
@@ -197,7 +205,7 @@ pub fn es3(
         &jobs,
         options.threads,
         |&(scheme, m, run)| {
-            let seed = run_seed(options.seed, "es3", scheme, m, run);
+            let seed = run_seed(options.seed, "es3", m, run);
             run_episode(
                 &setup,
                 &params(scheme),
@@ -249,6 +257,10 @@ pub fn es3(
                 missions_compared: pairs()
                     .filter(|(s, p)| change_pct(s.steps, p.steps).is_some())
                     .count(),
+                failures: mine.iter().map(|s| s.failures).sum(),
+                steps_all_change_pct: mean(
+                    pairs().filter_map(|(s, p)| change_pct(s.steps_all, p.steps_all)),
+                ),
             }
         })
         .collect();

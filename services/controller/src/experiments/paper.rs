@@ -147,8 +147,18 @@ pub fn comparison_table(ours: &Reproduction) -> String {
     );
     let _ = writeln!(
         out,
-        "{:<11} {:>8} {:>8} | {:>9} {:>9} | {:>8} {:>9} | {:>9} {:>9}",
-        "scheme", "success", "paper", "RMSE m", "paper", "steps", "paper", "dist m", "paper"
+        "{:<11} {:>8} {:>8} | {:>9} {:>9} | {:>8} {:>9} | {:>9} {:>9} | {:>6} {:>9}",
+        "scheme",
+        "success",
+        "paper",
+        "RMSE m",
+        "paper",
+        "steps",
+        "paper",
+        "dist m",
+        "paper",
+        "failed",
+        "all steps"
     );
     for row in &ours.es1 {
         let paper = PAPER_ES1.iter().find(|p| p.scheme == row.scheme);
@@ -161,7 +171,7 @@ pub fn comparison_table(ours: &Reproduction) -> String {
         });
         let _ = writeln!(
             out,
-            "{:<11} {:>7.0}% {:>8} | {:>9} {:>9} | {:>8} {:>9} | {:>9} {:>9}",
+            "{:<11} {:>7.0}% {:>8} | {:>9} {:>9} | {:>8} {:>9} | {:>9} {:>9} | {:>6} {:>9}",
             row.scheme.name(),
             100.0 * row.success_rate,
             paper.map_or("", |p| if p.success { "yes" } else { "fails" }),
@@ -175,6 +185,8 @@ pub fn comparison_table(ours: &Reproduction) -> String {
             },
             num(row.distance_m, 2),
             num(paper.and_then(|p| p.distance_m), 2),
+            row.failures,
+            num(row.steps_all, 0),
         );
     }
     let _ = writeln!(out);
@@ -227,14 +239,23 @@ pub fn comparison_table(ours: &Reproduction) -> String {
     );
     let _ = writeln!(
         out,
-        "{:<11} {:>8} | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9}",
-        "scheme", "success", "RMSE", "paper", "steps", "paper", "distance", "paper"
+        "{:<11} {:>8} | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>6} {:>9}",
+        "scheme",
+        "success",
+        "RMSE",
+        "paper",
+        "steps",
+        "paper",
+        "distance",
+        "paper",
+        "failed",
+        "all steps"
     );
     for row in &ours.es3 {
         let paper = PAPER_ES3.iter().find(|p| p.scheme == row.scheme);
         let _ = writeln!(
             out,
-            "{:<11} {:>7.0}% | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9}",
+            "{:<11} {:>7.0}% | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>6} {:>9}",
             row.scheme.name(),
             100.0 * row.success_rate,
             pct(row.rmse_change_pct),
@@ -243,6 +264,8 @@ pub fn comparison_table(ours: &Reproduction) -> String {
             pct(paper.and_then(|p| p.steps_change_pct)),
             pct(row.distance_change_pct),
             pct(paper.and_then(|p| p.distance_change_pct)),
+            row.failures,
+            pct(row.steps_all_change_pct),
         );
     }
     out
@@ -264,6 +287,9 @@ mod tests {
                 steps: Some(336.4),
                 distance_m: Some(59.87),
                 runs: 100,
+                failures: 1,
+                steps_all: Some(340.0),
+                distance_all_m: Some(60.0),
             }],
             es2: vec![
                 Es2Row {
@@ -295,6 +321,8 @@ mod tests {
                 steps: None,
                 distance_m: None,
                 missions_compared: 10,
+                failures: 90,
+                steps_all_change_pct: Some(700.0),
             }],
             es1_trajectories: Vec::new(),
             es2_trajectories: Vec::new(),
@@ -317,7 +345,9 @@ mod tests {
             .lines()
             .rfind(|l| l.starts_with("fixed"))
             .expect("ES3 row");
-        for cell in ["91%", "+3.6 %", "+662.0 %", "+388.9 %", "+68.4 %"] {
+        for cell in [
+            "91%", "+3.6 %", "+662.0 %", "+388.9 %", "+68.4 %", " 90 ", "+700.0 %",
+        ] {
             assert!(line.contains(cell), "{cell} in {line}");
         }
         assert!(t.contains("4.4 %"));

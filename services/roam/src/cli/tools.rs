@@ -166,8 +166,11 @@ pub(crate) enum ReproduceCommand {
         /// Where the per-model pictures go.
         #[arg(long, default_value = "roam-reproduce/planner")]
         out: PathBuf,
-        /// Plan with paper 000's own initialization (random walks that stop at the goal,
-        /// no via-point seeds): the figures as they were before issue 14.
+        /// Which first populations to plan with: roam's and paper 000's own (random
+        /// walks only, no shortest-path seed) side by side, or one of them.
+        #[arg(long, default_value = "both", value_parser = ["both", "roam", "paper"])]
+        init: String,
+        /// Shorthand for `--init paper`.
         #[arg(long)]
         paper_init: bool,
     },
@@ -402,8 +405,15 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             total,
             generations_per_t,
             out,
+            init,
             paper_init,
         } => {
+            use roam::reproduce_planner::Initialization;
+            let initializations = match (paper_init, init.as_str()) {
+                (true, _) | (false, "paper") => vec![Initialization::Paper],
+                (false, "roam") => vec![Initialization::Roam],
+                _ => vec![Initialization::Roam, Initialization::Paper],
+            };
             if runs == 0
                 || !(total.is_finite() && total > 0.0)
                 || !(generations_per_t.is_finite() && generations_per_t >= 1.0)
@@ -415,7 +425,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 total_s: total,
                 generations_per_t,
                 out_dir: out,
-                paper_initialization: paper_init,
+                initializations,
             };
             let result =
                 tokio::task::spawn_blocking(move || roam::reproduce_planner::run(&options))
