@@ -170,14 +170,22 @@ async fn a_peb_field_on_es1_shows_the_well_covered_area() {
     let (Cells::F32(xx), Cells::F32(yy)) = (crb.xx, crb.yy) else {
         panic!("f32 CRB cells")
     };
+    let mut compared = 0;
     for i in 0..12 {
         let trace = xx[i] + yy[i];
+        // No fix (fewer than three anchors in range): unbounded both ways.
+        if small_peb[i].is_infinite() {
+            assert!(trace.is_infinite(), "cell {i}: PEB inf vs tr CRB {trace}");
+            continue;
+        }
+        compared += 1;
         assert!(
             (small_peb[i] * small_peb[i] - trace).abs() <= 1e-4 * trace.max(1e-6),
             "cell {i}: PEB² {} vs tr CRB {trace}",
             small_peb[i] * small_peb[i]
         );
     }
+    assert!(compared > 0, "no bounded cell in the region to compare");
 
     // The picture: covered cells are coloured by PEB, uncovered ones grey.
     let out = tempfile::tempdir().expect("tmp");
