@@ -58,7 +58,7 @@ bounded() {
 }
 
 # ---- prerequisites -------------------------------------------------------------------
-command -v podman >/dev/null 2>&1 || die "podman is not installed (apt-get install podman runc netavark aardvark-dns)"
+command -v podman >/dev/null 2>&1 || die "podman is not installed (apt-get install podman runc netavark aardvark-dns iptables)"
 if command -v podman-compose >/dev/null 2>&1; then
     pc=(podman-compose)
 else
