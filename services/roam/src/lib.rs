@@ -15,3 +15,4 @@ pub mod reproduce_apf;
 pub mod reproduce_planner;
 pub mod router;
 pub mod stack;
+pub mod verdict;

@@ -39,7 +39,7 @@ use crate::bench_planner::builtin_world;
 mod claims;
 mod seeding;
 
-pub use claims::{Comparison, PaperFigure, Verdict};
+pub use crate::verdict::{Comparison, PaperFigure, Verdict};
 pub use seeding::SeedingRow;
 
 /// The start and the paper's two goals (Fig. 5).

@@ -2,128 +2,17 @@
 //! computed from both figures: no verdict is written by hand, so a row says "does not
 //! hold" whenever our figures contradict the paper's.
 //!
-//! The rule, one for every claim:
-//! - a relative change (percent): **holds** when each of ours (one per goal) lies in the
-//!   paper's range, **same direction** when each has the sign of the paper's range but
-//!   some lie outside it, **does not hold** otherwise (any of ours with the other sign,
-//!   or zero where the paper reports a change);
-//! - a count of configurations: **holds** when ours equals the paper's, **same
-//!   direction** when both are zero or both are not, **does not hold** otherwise;
-//! - **no data** when a goal has no figure (no configuration qualified, e.g. none of a
-//!   model's configurations kept every run within budget).
-
-use serde::Serialize;
+//! The rule is [`crate::verdict`]'s, one for every reproduction: a relative change holds
+//! when each goal's lies in the paper's range, a count of configurations when it equals
+//! the paper's; **no data** when a goal has no figure (no configuration qualified, e.g.
+//! none of a model's configurations kept every run within budget).
 
 use super::{Row, GOALS};
-
-/// How our figures relate to the paper's.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Verdict {
-    Holds,
-    SameDirection,
-    DoesNotHold,
-    NoData,
-}
-
-impl Verdict {
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Verdict::Holds => "holds",
-            Verdict::SameDirection => "same direction, outside the paper's range",
-            Verdict::DoesNotHold => "does not hold",
-            Verdict::NoData => "no data",
-        }
-    }
-}
-
-/// What the paper reports for one claim, as a figure ours can be judged against.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum PaperFigure {
-    /// A relative change in percent over the paper's goals, `lo ≤ hi`.
-    Percent { lo: f64, hi: f64 },
-    /// A number of configurations.
-    Count(usize),
-}
-
-impl PaperFigure {
-    /// The verdict for `ours`, one figure per goal (`expected` of them), by the module
-    /// doc's rule.
-    pub fn judge(&self, ours: &[f64], expected: usize) -> Verdict {
-        if ours.len() < expected || ours.is_empty() || ours.iter().any(|v| !v.is_finite()) {
-            return Verdict::NoData;
-        }
-        match *self {
-            PaperFigure::Percent { lo, hi } => {
-                if ours.iter().all(|v| (lo..=hi).contains(v)) {
-                    Verdict::Holds
-                } else if lo.signum() == hi.signum()
-                    && lo != 0.0
-                    && ours.iter().all(|v| *v != 0.0 && v.signum() == lo.signum())
-                {
-                    Verdict::SameDirection
-                } else {
-                    Verdict::DoesNotHold
-                }
-            }
-            PaperFigure::Count(paper) => {
-                let paper = paper as f64;
-                if ours.iter().all(|v| *v == paper) {
-                    Verdict::Holds
-                } else if ours.iter().all(|v| (*v > 0.0) == (paper > 0.0)) {
-                    Verdict::SameDirection
-                } else {
-                    Verdict::DoesNotHold
-                }
-            }
-        }
-    }
-
-    fn describe(&self) -> String {
-        match *self {
-            PaperFigure::Percent { lo, hi } => format!("{lo:+.2}% to {hi:+.2}%"),
-            PaperFigure::Count(n) => format!("{n} of 6"),
-        }
-    }
-}
-
-/// Our figure next to the paper's for one claim.
-#[derive(Debug, Clone, Serialize)]
-pub struct Comparison {
-    pub claim: String,
-    pub paper: String,
-    pub ours: String,
-    pub verdict: Verdict,
-}
-
-fn comparison(
-    claim: String,
-    paper: PaperFigure,
-    note: &str,
-    ours: &[f64],
-    ours_text: String,
-    expected: usize,
-) -> Comparison {
-    let mut paper_text = paper.describe();
-    if !note.is_empty() {
-        paper_text = format!("{paper_text} ({note})");
-    }
-    Comparison {
-        claim,
-        paper: paper_text,
-        ours: ours_text,
-        verdict: paper.judge(ours, expected),
-    }
-}
+use crate::verdict::{percent_change, Comparison, PaperFigure};
 
 fn find<'a>(rows: &'a [Row], goal: &str, ratio: &str, model: &str) -> Option<&'a Row> {
     rows.iter()
         .find(|r| r.goal == goal && r.ratio == ratio && r.model == model)
-}
-
-/// Relative change of `a` over `b`, percent.
-fn pct(a: f64, b: f64) -> f64 {
-    (a / b - 1.0) * 100.0
 }
 
 /// The best configuration of a model for a goal: the highest median U_ges among the
@@ -154,32 +43,32 @@ pub fn compare(rows: &[Row]) -> Vec<Comparison> {
             best_valid(rows, goal, "model1"),
             best_valid(rows, goal, "model0"),
         ) {
-            best_median.push(pct(m1.u_ges_median, m0.u_ges_median));
-            best_mean.push(pct(m1.u_ges_mean, m0.u_ges_mean));
+            best_median.push(percent_change(m1.u_ges_median, m0.u_ges_median));
+            best_mean.push(percent_change(m1.u_ges_mean, m0.u_ges_mean));
             configs.push(format!("{goal}: I {} vs 0 {}", m1.ratio, m0.ratio));
         }
         if let (Some(m1), Some(m0)) = (
             find(rows, goal, "40/60", "model1"),
             find(rows, goal, "20/80", "model0"),
         ) {
-            fixed.push(pct(m1.u_ges_median, m0.u_ges_median));
+            fixed.push(percent_change(m1.u_ges_median, m0.u_ges_median));
         }
         if let (Some(m2_best), Some(m0)) = (
             best_valid(rows, goal, "model2"),
             best_valid(rows, goal, "model0"),
         ) {
-            m2.push(pct(m2_best.u_ges_median, m0.u_ges_median));
+            m2.push(percent_change(m2_best.u_ges_median, m0.u_ges_median));
         }
     }
     // Table II's spreads over the two goals.
-    let model1_gain = PaperFigure::Percent {
+    let model1_gain = PaperFigure::Range {
         lo: 10.29,
         hi: 33.61,
     };
     let mut out = vec![
-        comparison(
+        Comparison::judged(
             format!(
-                "best valid Model I vs best valid Model 0, median U_ges, goal 1 / goal 2 ({})",
+                "best valid Model I vs best valid Model 0, median U_ges % change, goal 1 / goal 2 ({})",
                 configs.join("; ")
             ),
             model1_gain,
@@ -188,9 +77,9 @@ pub fn compare(rows: &[Row]) -> Vec<Comparison> {
             percents(&best_median),
             goals,
         ),
-        comparison(
-            "best valid Model I vs best valid Model 0, mean U_ges".into(),
-            PaperFigure::Percent {
+        Comparison::judged(
+            "best valid Model I vs best valid Model 0, mean U_ges % change",
+            PaperFigure::Range {
                 lo: 14.37,
                 hi: 29.14,
             },
@@ -199,17 +88,17 @@ pub fn compare(rows: &[Row]) -> Vec<Comparison> {
             percents(&best_mean),
             goals,
         ),
-        comparison(
-            "Model I at 40/60 vs Model 0 at 20/80 (the paper's best pair), median U_ges".into(),
+        Comparison::judged(
+            "Model I at 40/60 vs Model 0 at 20/80 (the paper's best pair), median U_ges % change",
             model1_gain,
             "",
             &fixed,
             percents(&fixed),
             goals,
         ),
-        comparison(
-            "best valid Model II vs best valid Model 0, median U_ges".into(),
-            PaperFigure::Percent {
+        Comparison::judged(
+            "best valid Model II vs best valid Model 0, median U_ges % change",
+            PaperFigure::Range {
                 lo: -26.30,
                 hi: -18.96,
             },
@@ -226,9 +115,12 @@ pub fn compare(rows: &[Row]) -> Vec<Comparison> {
     ] {
         let cfgs: Vec<&Row> = rows.iter().filter(|r| r.model == model).collect();
         let violating = cfgs.iter().filter(|r| r.within_budget < 1.0).count();
-        out.push(comparison(
+        out.push(Comparison::judged(
             format!("{model} configurations with any run over budget"),
-            PaperFigure::Count(paper),
+            PaperFigure::Count {
+                paper,
+                of: cfgs.len(),
+            },
             note,
             &[violating as f64],
             format!("{violating} of {}", cfgs.len()),
@@ -241,39 +133,7 @@ pub fn compare(rows: &[Row]) -> Vec<Comparison> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    const RANGE: PaperFigure = PaperFigure::Percent {
-        lo: -26.30,
-        hi: -18.96,
-    };
-
-    #[test]
-    fn a_change_against_the_papers_sign_does_not_hold() {
-        assert_eq!(RANGE.judge(&[29.0, 43.0], 2), Verdict::DoesNotHold);
-        assert_eq!(RANGE.judge(&[-20.0, 43.0], 2), Verdict::DoesNotHold);
-        assert_eq!(RANGE.judge(&[-20.0, 0.0], 2), Verdict::DoesNotHold);
-        assert_eq!(RANGE.judge(&[-20.0, -25.0], 2), Verdict::Holds);
-        assert_eq!(RANGE.judge(&[-20.0, -40.0], 2), Verdict::SameDirection);
-    }
-
-    #[test]
-    fn a_missing_goal_is_no_data_not_a_verdict() {
-        assert_eq!(RANGE.judge(&[-20.0], 2), Verdict::NoData);
-        assert_eq!(RANGE.judge(&[], 2), Verdict::NoData);
-        assert_eq!(RANGE.judge(&[f64::NAN, -20.0], 2), Verdict::NoData);
-    }
-
-    #[test]
-    fn counts_must_match_the_paper() {
-        assert_eq!(PaperFigure::Count(1).judge(&[0.0], 1), Verdict::DoesNotHold);
-        assert_eq!(PaperFigure::Count(3).judge(&[0.0], 1), Verdict::DoesNotHold);
-        assert_eq!(PaperFigure::Count(0).judge(&[0.0], 1), Verdict::Holds);
-        assert_eq!(PaperFigure::Count(0).judge(&[2.0], 1), Verdict::DoesNotHold);
-        assert_eq!(
-            PaperFigure::Count(3).judge(&[5.0], 1),
-            Verdict::SameDirection
-        );
-    }
+    use crate::verdict::Verdict;
 
     fn row(goal: &str, ratio: &str, model: &str, u: f64, within: f64) -> Row {
         Row {
