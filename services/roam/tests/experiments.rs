@@ -368,6 +368,29 @@ fn reproduce_mission_compares_the_couplings() {
         assert!((0.0..=1.0).contains(&share));
         assert!(v["peb_mean_m"].as_f64().expect("peb") > 0.0);
     }
+    // Every joining claim is judged, by the rule, from the figures above.
+    let claims = value["claims"].as_array().expect("claims");
+    assert_eq!(claims.len(), 5, "{claims:?}");
+    for c in claims {
+        let verdict = c["verdict"].as_str().expect("verdict");
+        assert!(
+            ["holds", "does_not_hold", "no_data"].contains(&verdict),
+            "{c}"
+        );
+        assert!(!c["ours"].as_str().expect("ours").is_empty(), "{c}");
+    }
+    let on_time = value["variants"][0]["on_time_share"]
+        .as_f64()
+        .expect("share");
+    let judged = claims
+        .iter()
+        .find(|c| {
+            c["claim"]
+                .as_str()
+                .is_some_and(|t| t.contains("within its budget"))
+        })
+        .expect("the budget claim");
+    assert_eq!(judged["verdict"] == "holds", on_time >= 1.0, "{judged}");
 }
 
 #[test]

@@ -309,10 +309,16 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 })
             })
             .await??;
+            let report = roam::reproduce_mission::MissionReport {
+                claims: roam::reproduce_mission::claims(&result),
+                reproduction: result,
+            };
             if json {
-                println!("{}", serde_json::to_string(&result)?);
+                println!("{}", serde_json::to_string(&report)?);
             } else {
-                print!("{}", roam_mission::experiment::table(&result));
+                print!("{}", roam_mission::experiment::table(&report.reproduction));
+                println!("claims, ours judged:");
+                print!("{}", roam::verdict::lines(&report.claims));
             }
             Ok(())
         }

@@ -178,6 +178,9 @@ mod tests {
         assert_eq!(verdict("model0 configurations"), Some(Verdict::DoesNotHold));
         assert_eq!(verdict("model2 configurations"), Some(Verdict::DoesNotHold));
         assert_eq!(verdict("model1 configurations"), Some(Verdict::Holds));
-        assert_eq!(verdict("median U_ges % change, goal 1"), Some(Verdict::Holds));
+        assert_eq!(
+            verdict("median U_ges % change, goal 1"),
+            Some(Verdict::Holds)
+        );
     }
 }
