@@ -10,13 +10,13 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
 use roam::router::Router;
-use roam::stack::wait_for_liveliness;
 use roam_controller::service::ControllerConfig;
 use roam_localization::service::LocalizationConfig;
 use roam_map_server::MapServerConfig;
 use roam_mapper::service::MapperConfig;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
+use roam_runtime::wait_for_liveliness;
 use roam_runtime::{Requester, SessionArgs};
 use roam_sim::service::SimConfig;
 use tokio::task::JoinHandle;

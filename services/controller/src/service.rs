@@ -157,11 +157,11 @@ struct State {
 
 impl State {
     fn robots(&self) -> MutexGuard<'_, HashMap<String, Driven>> {
-        self.robots.lock().unwrap_or_else(|p| p.into_inner())
+        roam_runtime::lock(&self.robots)
     }
 
     fn seen(&self) -> MutexGuard<'_, HashMap<String, Instant>> {
-        self.seen.lock().unwrap_or_else(|p| p.into_inner())
+        roam_runtime::lock(&self.seen)
     }
 
     /// Notes an estimate of `robot`; when [`MAX_ROBOTS`] robots are noted, the one
@@ -178,7 +178,7 @@ impl State {
 
     /// Holds a mission until the robot's first estimate.
     fn hold(&self, robot: &str, mission: Mission) {
-        let mut held = self.held.lock().unwrap_or_else(|p| p.into_inner());
+        let mut held = roam_runtime::lock(&self.held);
         if !held.contains_key(robot) && held.len() >= MAX_HELD_MISSIONS {
             if let Some(oldest) = held
                 .iter()
@@ -193,7 +193,7 @@ impl State {
 
     /// The mission held for `robot`, if one is and it has not expired.
     fn take_held(&self, robot: &str) -> Option<Mission> {
-        let mut held = self.held.lock().unwrap_or_else(|p| p.into_inner());
+        let mut held = roam_runtime::lock(&self.held);
         let (at, mission) = held.remove(robot)?;
         (at.elapsed() < self.release_after).then_some(mission)
     }
@@ -439,11 +439,7 @@ async fn watchdog(state: Arc<State>, cancel: CancellationToken) {
 fn release_gone(state: &State) {
     let release_after = state.release_after;
     state.seen().retain(|_, t| t.elapsed() < release_after);
-    state
-        .held
-        .lock()
-        .unwrap_or_else(|p| p.into_inner())
-        .retain(|_, (t, _)| t.elapsed() < release_after);
+    roam_runtime::lock(&state.held).retain(|_, (t, _)| t.elapsed() < release_after);
     state.robots().retain(|robot, d| {
         let keep = d.last_estimate.elapsed() < release_after;
         if !keep {

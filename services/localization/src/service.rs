@@ -210,12 +210,7 @@ fn on_scan(state: &State, key: &str, scan: RangeScan) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "ignoring a scan: {e}"),
     };
-    let message = match state
-        .tracker
-        .lock()
-        .unwrap_or_else(|p| p.into_inner())
-        .on_scan(&scan)
-    {
+    let message = match roam_runtime::lock(&state.tracker).on_scan(&scan) {
         Ok(m) => m,
         Err(e) => return limited_warn!(state.warnings, robot, %robot, "ignoring a scan: {e}"),
     };

@@ -67,13 +67,11 @@ impl State {
     fn store(&self) -> MutexGuard<'_, LayerStore> {
         // A panic while holding the lock would be a bug; the store is still consistent
         // because changes are staged and installed at the end.
-        self.store
-            .lock()
-            .unwrap_or_else(|poisoned| poisoned.into_inner())
+        roam_runtime::lock(&self.store)
     }
 
     fn cache(&self) -> MutexGuard<'_, HashMap<String, (u64, ZBytes)>> {
-        self.encoded.lock().unwrap_or_else(|p| p.into_inner())
+        roam_runtime::lock(&self.encoded)
     }
 
     /// The encoded layer (as the store holds it now), from the cache when its version

@@ -35,12 +35,7 @@ pub struct WorldGuard {
 impl WorldGuard {
     /// `Err` when the map server's world turned out to be another.
     pub fn outcome(&self) -> Result<(), WorldMismatch> {
-        match self
-            .mismatch
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .clone()
-        {
+        match roam_runtime::lock(&self.mismatch).clone() {
             Some(mismatch) => Err(mismatch),
             None => Ok(()),
         }
@@ -70,7 +65,7 @@ pub fn guard(service: &Service, mine: WorldId) -> WorldGuard {
                             map_server: theirs,
                         };
                         tracing::error!("{mismatch}");
-                        *found.lock().unwrap_or_else(|p| p.into_inner()) = Some(mismatch);
+                        *roam_runtime::lock(&found) = Some(mismatch);
                         cancel.cancel();
                     }
                     Some(_) => tracing::debug!(service = name, "on the map server's world"),

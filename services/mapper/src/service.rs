@@ -135,7 +135,7 @@ struct State {
 
 impl State {
     fn mapping(&self) -> MutexGuard<'_, Mapping> {
-        self.mapping.lock().unwrap_or_else(|p| p.into_inner())
+        roam_runtime::lock(&self.mapping)
     }
 
     fn put<T: Message>(&self, key: &str, message: &T) {

@@ -33,11 +33,12 @@ use zenoh::qos::CongestionControl;
 
 use crate::calibration::{path_measure, store, Calibration, CalibrationConfig, TimeModel};
 use crate::information::gathered;
-use crate::inputs::{listen, lock, wait_for_world, Inputs};
+use crate::inputs::{listen, wait_for_world, Inputs};
 use crate::margin::ArrivalMargin;
 use crate::path::{distance, mission_waypoints};
 use crate::tasks::{self, Task, TaskError};
 use crate::watch::{Decision, Reason, Status, Watch, WatchParams};
+use roam_runtime::lock;
 
 /// How the executive plans and watches.
 #[derive(Debug, Clone, PartialEq, Deserialize)]

@@ -2,7 +2,9 @@
 //! controller's status on the robot, and the world (the map server's inflated and
 //! information layers) it thins and scores paths on.
 
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
+
+use roam_runtime::lock;
 use std::time::{Duration, Instant};
 
 use roam_map_server::grid::Grid;
@@ -57,10 +59,6 @@ impl Clock {
             _ => 1.0,
         }
     }
-}
-
-pub(crate) fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(|p| p.into_inner())
 }
 
 async fn fetch_world(requester: &Requester, root: &str) -> Result<World, ExecutiveError> {

@@ -119,7 +119,7 @@ impl CpuBudget {
     }
 
     fn refilled(&self, now: Instant) -> std::sync::MutexGuard<'_, Bucket> {
-        let mut bucket = self.bucket.lock().unwrap_or_else(|p| p.into_inner());
+        let mut bucket = roam_runtime::lock(&self.bucket);
         let elapsed = now.saturating_duration_since(bucket.at).as_secs_f64();
         bucket.tokens = (bucket.tokens + elapsed * self.config.plan_seconds_per_second)
             .min(self.config.plan_seconds_burst);

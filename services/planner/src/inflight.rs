@@ -54,7 +54,7 @@ impl std::fmt::Debug for InFlight {
 
 impl InFlight {
     fn lock(&self) -> MutexGuard<'_, HashMap<String, Entry>> {
-        self.plans.lock().unwrap_or_else(|p| p.into_inner())
+        roam_runtime::lock(&self.plans)
     }
 
     /// Registers a plan; returns the flag that stops it. A request id already in flight

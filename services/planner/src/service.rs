@@ -72,7 +72,7 @@ struct State {
 
 impl State {
     fn maps(&self) -> MutexGuard<'_, MapCache> {
-        self.maps.lock().unwrap_or_else(|p| p.into_inner())
+        roam_runtime::lock(&self.maps)
     }
 }
 

@@ -229,7 +229,7 @@ async fn drive(
         .declare_subscriber(keys::robot_truth(&root, "robot"))
         .callback(move |sample| {
             if let Ok(t) = decode::<GroundTruth>(&sample.payload().to_bytes()) {
-                let mut path = recorded.lock().unwrap_or_else(|p| p.into_inner());
+                let mut path = roam_runtime::lock(&recorded);
                 // About 25 minutes of sim time at the sim's 0.4 s step: far beyond the demo.
                 if path.len() < 4096 {
                     path.push(t.at);
@@ -279,7 +279,7 @@ async fn drive(
     };
     let cancel = CancellationToken::new();
     let outcomes = executive::run(&session, &root, &config, &cancel, &say, &|_| {}).await?;
-    let driven = truth.lock().unwrap_or_else(|p| p.into_inner()).clone();
+    let driven = roam_runtime::lock(&truth).clone();
 
     let picture = options.out_dir.join("world.png");
     let anchors: Vec<[f64; 2]> = roam_sim::service::load_scenario(Some(world))

@@ -18,7 +18,7 @@ use roam_map_server::MapServerConfig;
 use roam_mapper::service::MapperConfig;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
-use roam_runtime::SessionArgs;
+use roam_runtime::{wait_for_liveliness, LivelinessWait, SessionArgs};
 use roam_sim::service::SimConfig;
 use tokio::task::JoinSet;
 use tokio_util::sync::CancellationToken;
@@ -311,30 +311,4 @@ pub async fn wait_until_live(
             LivelinessWait::Timeout => StackError::NotUp { service, timeout },
             LivelinessWait::Zenoh(reason) => StackError::Liveliness(reason),
         })
-}
-
-/// Why waiting for a liveliness token ended without it.
-#[derive(Debug)]
-pub enum LivelinessWait {
-    Timeout,
-    Zenoh(String),
-}
-
-/// Waits until a liveliness token matching `key` exists.
-pub async fn wait_for_liveliness(
-    session: &zenoh::Session,
-    key: &str,
-    timeout: Duration,
-) -> Result<(), LivelinessWait> {
-    let subscriber = session
-        .liveliness()
-        .declare_subscriber(key)
-        .history(true)
-        .await
-        .map_err(|e| LivelinessWait::Zenoh(e.to_string()))?;
-    match tokio::time::timeout(timeout, subscriber.recv_async()).await {
-        Ok(Ok(_)) => Ok(()),
-        Ok(Err(e)) => Err(LivelinessWait::Zenoh(e.to_string())),
-        Err(_) => Err(LivelinessWait::Timeout),
-    }
 }

@@ -5,7 +5,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use roam::router::free_loopback_port;
-use roam::stack::wait_for_liveliness;
+use roam_runtime::wait_for_liveliness;
 use roam_runtime::SessionArgs;
 
 const ROAM: &str = env!("CARGO_BIN_EXE_roam");

@@ -9,10 +9,16 @@
 //! - [`reply`] and [`client`]: the two ends of a query, with roam's codec and error reply;
 //! - [`routing`]: the robot a message is for is the one its key names;
 //! - [`telemetry`]: tracing from `RUST_LOG`;
-//! - [`warn_limit`]: warnings about wire data, a few lines per source and a count.
+//! - [`warn_limit`]: warnings about wire data, a few lines per source and a count;
+//! - [`publish`]: put with the congestion control named at each call, failures logged;
+//! - [`lock`]: shared state under a mutex, usable after a panicked holder;
+//! - [`liveliness`]: waiting until a service's token is seen.
 
 pub mod client;
 pub mod config_file;
+pub mod liveliness;
+pub mod lock;
+pub mod publish;
 pub mod reply;
 pub mod routing;
 pub mod service;
@@ -22,5 +28,8 @@ pub mod telemetry;
 pub mod warn_limit;
 
 pub use client::{ClientError, Requester};
+pub use liveliness::{wait_for_liveliness, LivelinessWait};
+pub use lock::lock;
+pub use publish::{publish, publish_bytes, publish_wait, Delivery};
 pub use service::{PayloadBudget, Service, ServiceError};
 pub use session::{SessionArgs, SessionError};

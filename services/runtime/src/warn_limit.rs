@@ -45,7 +45,7 @@ impl WarnLimiter {
     }
 
     fn allow_at(&self, source: &str, now: Instant) -> Option<u64> {
-        let mut buckets = self.buckets.lock().unwrap_or_else(|p| p.into_inner());
+        let mut buckets = crate::lock(&self.buckets);
         if !buckets.contains_key(source) && buckets.len() >= MAX_SOURCES {
             buckets.retain(|_, b| now.duration_since(b.window_start) < WINDOW);
         }

@@ -142,7 +142,7 @@ struct State {
 
 impl State {
     fn control(&self) -> MutexGuard<'_, Control> {
-        self.control.lock().unwrap_or_else(|p| p.into_inner())
+        roam_runtime::lock(&self.control)
     }
 
     fn status(&self) -> SimStatus {

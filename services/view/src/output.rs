@@ -106,14 +106,14 @@ impl Latch {
     }
 
     fn keep(&self, channel: &Arc<RawChannel>, bytes: Arc<[u8]>) {
-        let mut last = self.last.lock().unwrap_or_else(|p| p.into_inner());
+        let mut last = roam_runtime::lock(&self.last);
         Self::kept(&mut last, channel).whole = Some(bytes);
     }
 
     /// Keeps `bytes` as robot `robot`'s message; a new robot beyond
     /// [`MAX_LATCHED_KEYS`] is not kept (the callers evict robots before that).
     fn keep_robot(&self, channel: &Arc<RawChannel>, robot: &str, bytes: Arc<[u8]>) {
-        let mut last = self.last.lock().unwrap_or_else(|p| p.into_inner());
+        let mut last = roam_runtime::lock(&self.last);
         let robots = &mut Self::kept(&mut last, channel).robots;
         if robots.len() < MAX_LATCHED_KEYS || robots.contains_key(robot) {
             robots.insert(robot.to_owned(), bytes);
@@ -121,14 +121,14 @@ impl Latch {
     }
 
     fn forget_robot(&self, channel: &Arc<RawChannel>, robot: &str) {
-        let mut last = self.last.lock().unwrap_or_else(|p| p.into_inner());
+        let mut last = roam_runtime::lock(&self.last);
         if let Some(kept) = last.get_mut(&channel.id()) {
             kept.robots.remove(robot);
         }
     }
 
     fn replay(&self, id: ChannelId) -> Option<(Arc<RawChannel>, Vec<Vec<u8>>)> {
-        let last = self.last.lock().unwrap_or_else(|p| p.into_inner());
+        let last = roam_runtime::lock(&self.last);
         last.get(&id)
             .map(|kept| (kept.channel.clone(), kept.replay()))
     }
@@ -352,7 +352,7 @@ impl Outputs {
     /// Stops the WebSocket server (waiting up to 2 s for its clients) and finishes the
     /// MCAP file (its summary and index are written here: the file is complete only after).
     pub(crate) async fn stop(&self) -> Result<(), ViewError> {
-        let server = self.server.lock().unwrap_or_else(|p| p.into_inner()).take();
+        let server = roam_runtime::lock(&self.server).take();
         if let Some(server) = server {
             if tokio::time::timeout(STOP_GRACE, server.stop().wait())
                 .await
@@ -361,7 +361,7 @@ impl Outputs {
                 tracing::warn!("roam view: WebSocket clients did not close within {STOP_GRACE:?}");
             }
         }
-        let recording = self.mcap.lock().unwrap_or_else(|p| p.into_inner()).take();
+        let recording = roam_runtime::lock(&self.mcap).take();
         if let Some((path, handle)) = recording {
             let finish = tokio::task::spawn_blocking(move || {
                 let writer = handle.close().map_err(|e| e.to_string())?;

@@ -86,7 +86,7 @@ pub(crate) async fn connect(endpoint: &str) -> zenoh::Session {
 
 /// Waits until `<root>/@live/<service>/*` holds a token.
 pub(crate) async fn wait_live(session: &zenoh::Session, root: &str, service: &str) {
-    roam::stack::wait_for_liveliness(
+    roam_runtime::wait_for_liveliness(
         session,
         &keys::liveliness_of(root, service),
         Duration::from_secs(60),

@@ -407,7 +407,7 @@ struct LogWriter(std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
 
 impl std::io::Write for LogWriter {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        let mut logs = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        let mut logs = roam_runtime::lock(&self.0);
         logs.extend_from_slice(buf);
         Ok(buf.len())
     }
