@@ -342,7 +342,7 @@ fn layers_through(endpoint: &str, root: &str) -> serde_json::Value {
     }
 }
 
-/// The README's recipe for running a service on another machine: a router, a map
+/// deploy/README.md's recipe for running a service on another machine: a router, a map
 /// server connected to it in client mode, and a client that asks through the router.
 #[test]
 fn a_router_process_connects_a_map_server_and_a_client() {

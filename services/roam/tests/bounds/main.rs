@@ -18,7 +18,7 @@
 //!   that do not exist and one with a 1 MB id: nothing is commanded, and their peaks stay
 //!   under [`CONTROLLER_PEAK_MIB`] and [`VIEW_PEAK_MIB`].
 //!
-//! The figures are printed as one JSON line (`bounds: {...}`); the README quotes them.
+//! The figures are printed as one JSON line (`bounds: {...}`); services/roam/README.md quotes them.
 //! The binary is the test profile's (debug), so the figures are a debug build's.
 
 mod liveliness;
