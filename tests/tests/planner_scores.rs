@@ -90,7 +90,7 @@ async fn scores_above_100_plan_as_if_clamped_to_100() {
         clamped.distinct_information.to_bits()
     );
     assert_eq!(
-        serde_json::to_value(&bright.fitness).expect("fitness"),
-        serde_json::to_value(&clamped.fitness).expect("fitness")
+        serde_json::to_value(bright.fitness).expect("fitness"),
+        serde_json::to_value(clamped.fitness).expect("fitness")
     );
 }

@@ -25,6 +25,7 @@
 //! The watchdog runs on wall time because a stalled estimate stream is exactly when sim
 //! time stops being informative.
 
+use roam_runtime::Delivery;
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -38,14 +39,12 @@ use roam_proto::controller::{
 };
 use roam_proto::localization::PositionEstimate;
 use roam_proto::sim::RobotCommand;
-use roam_proto::{encode, excerpt, keys, Message};
+use roam_proto::{excerpt, keys, Message};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{limited_warn, routing, Service, ServiceError};
 use roam_sim::service::load_scenario;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
-use zenoh::qos::CongestionControl;
-use zenoh::Wait;
 
 use crate::controller::{Controller, Decision, MissionStatus};
 use crate::information::InformationField;
@@ -208,15 +207,9 @@ impl State {
                 .is_some_and(|t| t.elapsed() < self.release_after)
     }
 
+    /// Commands, goals and statuses are state a robot must not miss: delivered.
     fn put<T: Message>(&self, key: &str, message: &T) {
-        let sent = self
-            .session
-            .put(key, encode(message))
-            .congestion_control(CongestionControl::Block)
-            .wait();
-        if let Err(e) = sent {
-            tracing::warn!(%key, "publishing failed: {e}");
-        }
+        roam_runtime::publish_wait(&self.session, key, message, Delivery::Reliable);
     }
 
     fn command(&self, robot: &str, u: [f64; 2], step: Option<u64>) {

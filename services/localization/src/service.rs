@@ -12,6 +12,7 @@
 //! anchors the robot heard; the sensing model (σ, d0, K, range) and the default
 //! constellation for PEB queries come from the configured scenario.
 
+use roam_runtime::Delivery;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -22,14 +23,13 @@ use roam_proto::cells::Cells;
 use roam_proto::localization::{CrbCells, PebAt, PebQuery, PebReply, PebWhere};
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
 use roam_proto::sim::{NamedPoint, RangeScan};
-use roam_proto::{encode, keys, ErrorCode, ErrorReply};
+use roam_proto::{keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
 use roam_sim::service::load_scenario;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
-use zenoh::Wait;
 
 use crate::field::{
     bounds_at, crb_field, peb_field, peb_gradient, GridRegion, DEFAULT_GRADIENT_STEP_M,
@@ -215,9 +215,8 @@ fn on_scan(state: &State, key: &str, scan: RangeScan) {
         Err(e) => return limited_warn!(state.warnings, robot, %robot, "ignoring a scan: {e}"),
     };
     let key = keys::robot_estimate(&state.root, robot);
-    if let Err(e) = state.session.put(&key, encode(&message)).wait() {
-        tracing::warn!(%key, "publishing the estimate failed: {e}");
-    }
+    // The next scan's estimate supersedes this one.
+    roam_runtime::publish_wait(&state.session, &key, &message, Delivery::Latest);
 }
 
 async fn answer_peb(state: Arc<State>, query: Query) {

@@ -9,6 +9,7 @@
 //! | `<root>/map/layers` | queryable | → `LayerList` |
 //! | `<root>/map/load` | queryable | `LoadMap` → `LayerList` |
 
+use roam_runtime::Delivery;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, MutexGuard};
 
@@ -19,7 +20,6 @@ use roam_runtime::{reply, PayloadBudget, Service, ServiceError};
 use tokio_util::sync::CancellationToken;
 use zenoh::bytes::ZBytes;
 use zenoh::key_expr::KeyExpr;
-use zenoh::qos::CongestionControl;
 use zenoh::query::Query;
 use zenoh::Session;
 
@@ -106,14 +106,8 @@ impl State {
                 continue;
             };
             let key = keys::map_layer(&self.root, name);
-            if let Err(e) = self
-                .session
-                .put(&key, bytes)
-                .congestion_control(CongestionControl::Block)
-                .await
-            {
-                tracing::warn!(%key, "publishing the layer failed: {e}");
-            }
+            // A layer version is delivered: subscribers plan and drive on it.
+            roam_runtime::publish_bytes(&self.session, &key, bytes, Delivery::Reliable).await;
         }
     }
 }

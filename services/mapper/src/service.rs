@@ -16,6 +16,7 @@
 //! most once per `publish_period_s` (wall time), and only when something was observed
 //! since the last send: a map server is never flooded, whatever the robots' rate.
 
+use roam_runtime::Delivery;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -31,15 +32,13 @@ use roam_proto::mapper::{
     CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER, RECENCY_LAYER,
 };
 use roam_proto::sim::{LocalObservation, RobotCommand, SimClock};
-use roam_proto::{encode, keys, ErrorReply, Message};
+use roam_proto::{keys, ErrorReply, Message};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
 use roam_sim::service::load_scenario;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
-use zenoh::qos::CongestionControl;
 use zenoh::query::Query;
-use zenoh::Wait;
 
 use crate::change_map::{ChangeMap, MapParams, ObservationWindow};
 use crate::epoch::Epochs;
@@ -138,15 +137,9 @@ impl State {
         roam_runtime::lock(&self.mapping)
     }
 
+    /// Commands, goals and statuses are state a robot must not miss: delivered.
     fn put<T: Message>(&self, key: &str, message: &T) {
-        let sent = self
-            .session
-            .put(key, encode(message))
-            .congestion_control(CongestionControl::Block)
-            .wait();
-        if let Err(e) = sent {
-            tracing::warn!(%key, "publishing failed: {e}");
-        }
+        roam_runtime::publish_wait(&self.session, key, message, Delivery::Reliable);
     }
 }
 

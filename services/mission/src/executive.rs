@@ -16,6 +16,7 @@
 //! 20× charges a 0.5 s plan 10 s of downtime); the driving budget t_exec is the time to
 //! the task's start minus that.
 
+use roam_runtime::Delivery;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -23,13 +24,12 @@ use roam_planner::client::PlannerClient;
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
 use roam_proto::controller::{Mission, MissionState};
+use roam_proto::keys;
 use roam_proto::mission::{TimeModelReport, WindowReport};
 use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
-use roam_proto::{encode, keys};
 use roam_runtime::{ClientError, Requester};
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
-use zenoh::qos::CongestionControl;
 
 use crate::calibration::{path_measure, store, Calibration, CalibrationConfig, TimeModel};
 use crate::information::gathered;
@@ -395,13 +395,7 @@ impl Run<'_> {
             waypoints,
         };
         let key = keys::robot_mission(self.root, &self.config.robot);
-        if let Err(e) = zenoh::Wait::wait(
-            self.session
-                .put(&key, encode(&mission))
-                .congestion_control(CongestionControl::Block),
-        ) {
-            tracing::warn!(%key, "sending the mission failed: {e}");
-        }
+        roam_runtime::publish_wait(self.session, &key, &mission, Delivery::Reliable);
         id
     }
 

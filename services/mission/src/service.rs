@@ -3,14 +3,13 @@
 //! `<root>/robot/<id>/mission_report` as each window ends, and stays up (answering to
 //! liveliness) until it is stopped.
 
+use roam_runtime::Delivery;
 use std::path::PathBuf;
 
-use roam_proto::{encode, keys};
+use roam_proto::keys;
 use roam_runtime::{Service, ServiceError};
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
-use zenoh::qos::CongestionControl;
-use zenoh::Wait;
 
 use crate::executive::{self, ExecutiveConfig, ExecutiveError, Progress};
 
@@ -106,13 +105,7 @@ pub async fn run(
     let session = service.session().clone();
     let key = keys::robot_mission_report(&config.root, &config.executive.robot);
     let publish = |outcome: &executive::WindowOutcome| {
-        let sent = session
-            .put(&key, encode(&outcome.report))
-            .congestion_control(CongestionControl::Block)
-            .wait();
-        if let Err(e) = sent {
-            tracing::warn!(%key, "publishing the window report failed: {e}");
-        }
+        roam_runtime::publish_wait(&session, &key, &outcome.report, Delivery::Reliable);
     };
     match executive::run(
         &session,

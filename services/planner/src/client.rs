@@ -14,6 +14,7 @@
 //! future is dropped before its reply (the caller gave up) is cancelled with its token,
 //! so the planner does not keep computing a path nobody waits for.
 
+use roam_runtime::Delivery;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 
@@ -96,10 +97,9 @@ impl Drop for CancelOnDrop<'_> {
         let session = self.client.session.clone();
         let key = keys::planner_cancel(&self.client.root, &ticket.request_id);
         let message = encode(&ticket.cancel_message());
+        // Delivered: a lost cancel keeps an instance busy until the plan's deadline.
         runtime.spawn(async move {
-            if let Err(e) = session.put(&key, message).await {
-                tracing::debug!("cancelling an abandoned plan failed: {e}");
-            }
+            roam_runtime::publish_bytes(&session, &key, message, Delivery::Reliable).await;
         });
     }
 }

@@ -13,6 +13,7 @@
 //! budget ([`crate::budget`]). Request ids and tokens are [`crate::token`]'s; who may
 //! cancel is [`crate::inflight`]'s.
 
+use roam_runtime::Delivery;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
@@ -20,12 +21,11 @@ use std::time::{Duration, Instant};
 use roam_proto::excerpt;
 use roam_proto::map::Layer;
 use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, StopReason};
-use roam_proto::{encode, keys, ErrorCode, ErrorReply};
+use roam_proto::{keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, Requester, Service, ServiceError};
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
-use zenoh::Wait;
 
 use crate::budget::{CpuBudget, Exhausted};
 use crate::config::PlannerConfig;
@@ -433,9 +433,8 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
             best_fitness: std::mem::take(batch),
             done,
         };
-        if let Err(e) = state.session.put(&progress_key, encode(&message)).wait() {
-            tracing::debug!("progress publication failed: {e}");
-        }
+        // The next batch of progress supersedes this one.
+        roam_runtime::publish_wait(&state.session, &progress_key, &message, Delivery::Latest);
     };
     let mut outcome = plan(&world, &spec, &stop, |generation, best| {
         batch.push((generation, best));

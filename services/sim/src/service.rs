@@ -13,6 +13,7 @@
 //! a `step` request from the same session is in that step: lock-step runs are
 //! reproducible through the service, bit for bit.
 
+use roam_runtime::Delivery;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -24,13 +25,12 @@ use roam_map_server::scenario::{self, Scenario, ScenarioError};
 use roam_map_server::store::DEFAULT_LIMITS;
 use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::sim::{RobotCommand, SimClock, SimControl, SimStatus};
-use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply, Message};
+use roam_proto::{decode, keys, ErrorCode, ErrorReply, Message};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, Service, ServiceError};
 use serde::Deserialize;
 use tokio::time::Instant;
 use tokio_util::sync::CancellationToken;
-use zenoh::qos::CongestionControl;
 use zenoh::query::Query;
 
 use crate::messages::{points, robot_messages, RobotMessages};
@@ -393,15 +393,10 @@ fn step_once(state: &State) -> Result<(SimClock, Vec<RobotMessages>), ErrorReply
     Ok((clock, messages))
 }
 
+/// Every reading of a step is delivered: a robot's localization and controller run in
+/// lock-step on them.
 async fn put<T: Message>(state: &State, key: &str, message: &T) {
-    if let Err(e) = state
-        .session
-        .put(key, encode(message))
-        .congestion_control(CongestionControl::Block)
-        .await
-    {
-        tracing::warn!(%key, "publication failed: {e}");
-    }
+    roam_runtime::publish(&state.session, key, message, Delivery::Reliable).await;
 }
 
 async fn publish(state: &State, clock: SimClock, robots: Vec<RobotMessages>) {
