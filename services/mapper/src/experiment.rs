@@ -3,14 +3,27 @@
 //! The shipped grid world `config/scenarios/grid004.yaml` (25 × 25 cells of 1 m, the
 //! robot at the centre, the two blocks with the paper's periods), `repetitions` runs
 //! (paper: 5) of `steps` steps for each mode: curious (the learner picks), recency only,
-//! Poisson only. Each run: the sim steps, the robot's observation goes into a fresh
-//! [`ChangeMap`], its [`Explorer`] answers the next command; the robot's cell is the
-//! sim's true pose (the paper's noise-free odometry).
+//! Poisson only (the paper's three), and the uniform mix (roam's baseline for the
+//! learner: 50/50 each episode). Each run: the sim steps, the robot's observation goes
+//! into a fresh [`ChangeMap`], its [`Explorer`] answers the next command; the robot's
+//! cell is the sim's true pose (the paper's noise-free odometry).
 //!
-//! **Seeds.** A run's seed is `seed::derive(options.seed, [mode index, repetition])`,
-//! the same for the sim and the explorer (which take their own streams from it); runs
-//! are spread over threads but stored by run, so the output is the same for any number
-//! of threads.
+//! **Seeds and common random numbers.** Repetition r's seed is
+//! `seed::derive(options.seed, [r])` ([`run_seed`]) for *every* mode: the mode is left
+//! out on purpose, so the modes are compared on the same random numbers rather than on
+//! different ones (issue 18: with the mode in the seed, a difference between two modes
+//! mixed their effect with their luck, and 5 repetitions are few to average luck out).
+//! The sim and the explorer take their own labelled streams of that seed (the sim's
+//! `"world"` and `"robot/<name>"`, the explorer's `"tiles"` and `"explorer/…"`, see
+//! [`crate::seed`] and [`crate::explorer`]), so no consumer's draws depend on another's:
+//! the sim's world is the same in every mode (on grid004 the blocks are scripted and
+//! the motion noise-free, so it is the same anyway), the tilings are the same, and
+//! episode k's strategy draw is the same number in every mode. Curious and the uniform
+//! mix therefore make the same choice in every episode where the learner's P(recency)
+//! lies on the same side of that draw as 1/2, and two modes run step for step alike
+//! until their first different choice (the robots' paths part then, and with them the
+//! goal and random-step draws). Runs are spread over threads but stored by run, so the
+//! output is the same for any number of threads.
 //!
 //! **Metrics**, every `sample_every` steps and at t = 0 (the paper's x-axis is not
 //! readable; time in seconds of sim time here):
@@ -35,7 +48,7 @@ use serde::Serialize;
 
 use crate::change_map::{ChangeMap, MapParams, MAX_MAP_CELLS};
 use crate::error::MapperError;
-use crate::explorer::{Explorer, ExplorerParams};
+use crate::explorer::{Explorer, ExplorerParams, ExplorerStep};
 use crate::learner::Mode;
 use crate::seed;
 use crate::truth::{true_rates, TrueRates, TruthError};
@@ -55,7 +68,7 @@ pub const MAX_THREADS: usize = 256;
 
 /// Default steps per run: long enough for every strategy's error curve to level off
 /// on grid004 (see the crate doc for the figures), and the full default run
-/// (3 modes × 5 repetitions) stays in a few seconds.
+/// (4 modes × 5 repetitions) stays in a few seconds.
 pub const DEFAULT_STEPS: u64 = 5000;
 
 /// The experiment's options.
@@ -137,7 +150,7 @@ impl ExperimentOptions {
             );
         }
         if self.modes.is_empty() || self.modes.len() > Mode::ALL.len() {
-            return bad("modes", "give one to three modes".into());
+            return bad("modes", format!("give one to {} modes", Mode::ALL.len()));
         }
         self.explorer.check().map_err(ExperimentError::Mapper)
     }
@@ -173,7 +186,7 @@ pub struct Progress {
 /// One mode's summary: the JSON's `strategies` entries.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StrategySummary {
-    /// `curious`, `recency` or `poisson`.
+    /// `curious`, `recency`, `poisson` or `uniform`.
     pub name: String,
     /// Area under the mean rate-error curve, (events/s)·s.
     pub rate_error_auc: f64,
@@ -280,7 +293,7 @@ pub fn run(
                 if failed.load(Ordering::Relaxed) {
                     break;
                 }
-                let result = run_one(scenario, &truth, options, mode, repetition);
+                let result = run_one(scenario, &truth, options, mode, repetition, &mut |_| {});
                 failed.fetch_or(result.is_err(), Ordering::Relaxed);
                 let _ = slots[j].set(result);
                 progress(Progress {
@@ -357,10 +370,35 @@ pub fn run(
     })
 }
 
-/// The seed of a run.
-pub fn run_seed(base: u64, mode: Mode, repetition: usize) -> u64 {
-    let m = Mode::ALL.iter().position(|&x| x == mode).unwrap_or(0) as u64;
-    seed::derive(base, &[m, repetition as u64])
+/// The seed of repetition `repetition`, the same for every mode (common random
+/// numbers, module doc).
+pub fn run_seed(base: u64, repetition: usize) -> u64 {
+    seed::derive(base, &[repetition as u64])
+}
+
+/// What a traced run shows after each step: the sim after the step, the map after the
+/// robot's observation, the explorer and its answer.
+#[derive(Debug)]
+pub struct StepView<'a> {
+    pub step: u64,
+    pub sim: &'a Sim,
+    pub map: &'a ChangeMap,
+    pub explorer: &'a Explorer,
+    pub next: &'a ExplorerStep,
+}
+
+/// One run of `mode`, repetition `repetition`, as [`run`] makes it, calling `watch`
+/// after every step (for tests and measurements of the runs' insides).
+pub fn trace(
+    scenario: &Scenario,
+    options: &ExperimentOptions,
+    mode: Mode,
+    repetition: usize,
+    watch: &mut dyn FnMut(StepView),
+) -> Result<RunSummary, ExperimentError> {
+    options.check()?;
+    let truth = true_rates(scenario, scenario.file.time.step_s)?;
+    run_one(scenario, &truth, options, mode, repetition, watch).map(|r| r.summary)
 }
 
 fn run_one(
@@ -369,8 +407,9 @@ fn run_one(
     options: &ExperimentOptions,
     mode: Mode,
     repetition: usize,
+    watch: &mut dyn FnMut(StepView),
 ) -> Result<RunResult, ExperimentError> {
-    let seed = run_seed(options.seed, mode, repetition);
+    let seed = run_seed(options.seed, repetition);
     let mut sim = Sim::new(scenario, seed)?;
     let robot = scenario
         .file
@@ -430,6 +469,13 @@ fn run_one(
             reward_n += 1;
         }
         u = next.u;
+        watch(StepView {
+            step,
+            sim: &sim,
+            map: &map,
+            explorer: &explorer,
+            next: &next,
+        });
         if step % options.sample_every == 0 || step == options.steps {
             time_s.push(report.time_s);
             rate_error.push(rate_error_of(&map, truth));

@@ -8,7 +8,8 @@
 //! **An episode** (one iteration of §4's loop):
 //! 1. The strategy: uniformly at random for the first episode (curious mode), then by
 //!    the learner's softmax at the features of the update that ended the previous one;
-//!    fixed in the single-strategy modes.
+//!    fixed in the single-strategy modes, 50/50 every episode in the uniform mix. Every
+//!    mode draws exactly one number per episode for it ([`Strategy::pick`]).
 //! 2. The goal: sampled from the strategy's weights (recency r^c or P_c(E > 0)) over
 //!    patches ([`crate::goals`]).
 //! 3. Navigation: one wavefront step per update toward the goal, or as close as
@@ -29,6 +30,14 @@
 //!
 //! The robot's cell is given by the caller: paper 004 uses noise-free odometry (the batch
 //! experiment passes the sim's true pose, the service the pose an observation carries).
+//!
+//! **Random streams.** Each kind of draw has its own labelled stream of the explorer's
+//! seed ([`crate::seed`]): `"tiles"` (the tilings' offsets), `"explorer/strategy"` (one
+//! draw per episode), `"explorer/goals"` (goal sampling) and `"explorer/steps"` (local
+//! random steps). Two explorers with one seed in different modes then see the same
+//! numbers for the same purpose: episode k's strategy draw is the same number in
+//! every mode, and until their choices part, their goals and random steps are too
+//! (common random numbers, see [`crate::experiment`]).
 
 use rand::{Rng, RngCore};
 use rand_chacha::ChaCha8Rng;
@@ -199,8 +208,12 @@ pub struct Explorer {
     params: ExplorerParams,
     mode: Mode,
     learner: Learner,
-    /// Strategy choices, goals and random steps.
-    rng: ChaCha8Rng,
+    /// One draw per episode for its strategy.
+    strategy_rng: ChaCha8Rng,
+    /// Goal sampling.
+    goal_rng: ChaCha8Rng,
+    /// Local random steps.
+    step_rng: ChaCha8Rng,
     wave: Wavefront,
     episode: Option<Episode>,
     episodes_ended: u64,
@@ -209,8 +222,8 @@ pub struct Explorer {
 }
 
 impl Explorer {
-    /// An explorer whose every random choice comes from `seed` (stream `"tiles"` for the
-    /// tile offsets, `"explorer"` for the rest).
+    /// An explorer whose every random choice comes from `seed`, one labelled stream per
+    /// kind of draw (module doc).
     pub fn new(params: ExplorerParams, mode: Mode, seed: u64) -> Result<Explorer, MapperError> {
         params.check()?;
         let learner = Learner::new(&params.learner, &mut seed::stream(seed, "tiles"))?;
@@ -218,7 +231,9 @@ impl Explorer {
             params,
             mode,
             learner,
-            rng: seed::stream(seed, "explorer"),
+            strategy_rng: seed::stream(seed, "explorer/strategy"),
+            goal_rng: seed::stream(seed, "explorer/goals"),
+            step_rng: seed::stream(seed, "explorer/steps"),
             wave: Wavefront::new(),
             episode: None,
             episodes_ended: 0,
@@ -336,8 +351,9 @@ impl Explorer {
         }
     }
 
-    /// A new episode: its strategy (uniform for the first in curious mode, the softmax
-    /// after) and its goal (the robot's own cell if every cell is known occupied).
+    /// A new episode: its strategy ([`Mode::recency_probability`] against one draw of
+    /// the strategy stream, drawn in every mode so the draws stay aligned across modes)
+    /// and its goal (the robot's own cell if every cell is known occupied).
     fn start_episode(
         &mut self,
         map: &ChangeMap,
@@ -345,13 +361,11 @@ impl Explorer {
         t: f64,
         features: Features,
     ) -> Episode {
-        let strategy = match self.mode.forced() {
-            Some(s) => s,
-            None if self.started == [0, 0] => {
-                Strategy::ALL[self.rng.random_range(0..Strategy::ALL.len())]
-            }
-            None => self.learner.choose(features, &mut self.rng),
-        };
+        let u: f64 = self.strategy_rng.random();
+        let p = self
+            .mode
+            .recency_probability(&self.learner, features, self.started == [0, 0]);
+        let strategy = Strategy::pick(p, u);
         let weights = match strategy {
             Strategy::Recency => map.recency_layer(t),
             Strategy::Poisson => map.probability_layer(t),
@@ -362,7 +376,7 @@ impl Explorer {
             map.width(),
             map.height(),
             self.params.patch_cells,
-            &mut self.rng,
+            &mut self.goal_rng,
         )
         .unwrap_or(robot);
         self.started[match strategy {
@@ -412,7 +426,7 @@ impl Explorer {
         }
         if !ep.last_random {
             ep.last_random = true;
-            return Some(match random_neighbour(map, robot, &mut self.rng) {
+            return Some(match random_neighbour(map, robot, &mut self.step_rng) {
                 Some(next) => (Action::RandomStep, next, robot),
                 None => (Action::Wait, robot, robot),
             });

@@ -58,9 +58,23 @@ impl Strategy {
             Strategy::Poisson => 1,
         }
     }
+
+    /// Recency when `u` (uniform in [0, 1)) is below `p_recency`. Every mode decides
+    /// through this with one draw per episode, so modes that see the same `u` make the
+    /// same choice wherever their probabilities are on the same side of it (common
+    /// random numbers, see [`crate::experiment`]).
+    pub fn pick(p_recency: f64, u: f64) -> Strategy {
+        if u < p_recency {
+            Strategy::Recency
+        } else {
+            Strategy::Poisson
+        }
+    }
 }
 
-/// Who picks the strategy (§5 compares the three).
+/// Who picks the strategy. §5 compares the first three; [`Mode::Uniform`] is roam's
+/// baseline for the learner: the same mix of strategies with no learning, so a gain of
+/// curious over it is the learner's and not the mixing's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Mode {
@@ -70,25 +84,46 @@ pub enum Mode {
     RecencyOnly,
     /// Always change-based.
     PoissonOnly,
+    /// Each episode's strategy drawn 50/50, whatever was learned.
+    Uniform,
 }
 
 impl Mode {
-    pub const ALL: [Mode; 3] = [Mode::Curious, Mode::RecencyOnly, Mode::PoissonOnly];
+    pub const ALL: [Mode; 4] = [
+        Mode::Curious,
+        Mode::RecencyOnly,
+        Mode::PoissonOnly,
+        Mode::Uniform,
+    ];
 
     pub fn as_str(self) -> &'static str {
         match self {
             Mode::Curious => "curious",
             Mode::RecencyOnly => "recency",
             Mode::PoissonOnly => "poisson",
+            Mode::Uniform => "uniform",
         }
     }
 
-    /// The strategy the mode forces, `None` for curious.
+    /// The strategy the mode forces, `None` for the modes that draw one.
     pub fn forced(self) -> Option<Strategy> {
         match self {
-            Mode::Curious => None,
+            Mode::Curious | Mode::Uniform => None,
             Mode::RecencyOnly => Some(Strategy::Recency),
             Mode::PoissonOnly => Some(Strategy::Poisson),
+        }
+    }
+
+    /// P(recency) for an episode: the forced strategy's 1 or 0, 1/2 for the uniform mix
+    /// and for curious's first episode (paper 004 §4: "pick a strategy S uniformly at
+    /// random"), the learner's softmax at `f` after.
+    pub fn recency_probability(self, learner: &Learner, f: Features, first: bool) -> f64 {
+        match self {
+            Mode::RecencyOnly => 1.0,
+            Mode::PoissonOnly => 0.0,
+            Mode::Uniform => 0.5,
+            Mode::Curious if first => 0.5,
+            Mode::Curious => learner.probabilities(f)[0],
         }
     }
 }
@@ -300,13 +335,7 @@ impl Learner {
 
     /// Draws the next strategy from the softmax (one uniform draw).
     pub fn choose(&self, f: Features, rng: &mut impl RngCore) -> Strategy {
-        let probabilities = self.probabilities(f);
-        let u: f64 = rng.random();
-        if u < probabilities[0] {
-            Strategy::Recency
-        } else {
-            Strategy::Poisson
-        }
+        Strategy::pick(self.probabilities(f)[0], rng.random())
     }
 }
 

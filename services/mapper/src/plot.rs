@@ -4,8 +4,9 @@
 //! error axis to the largest mean error, the quality axis to 1; light grid lines mark
 //! quarters.
 //!
-//! Colours: curious [`CURIOUS`] red, recency [`RECENCY`] blue, Poisson [`POISSON`]
-//! green (drawn in that order reversed, so curious is on top); the blocks' cells and
+//! Colours: curious [`CURIOUS`] red, the uniform mix [`UNIFORM`] grey, recency
+//! [`RECENCY`] blue, Poisson [`POISSON`] green (drawn in that order reversed, so curious
+//! is on top and the uniform mix, its baseline, right under it); the blocks' cells and
 //! paths in [`BLOCK_PATHS`] (amber for the first block, purple for the second), the
 //! robots' starts in [`START`] (magenta), walls near-black.
 
@@ -21,6 +22,7 @@ use crate::learner::Mode;
 pub const CURIOUS: Rgb<u8> = Rgb([215, 40, 40]);
 pub const RECENCY: Rgb<u8> = Rgb([40, 90, 220]);
 pub const POISSON: Rgb<u8> = Rgb([20, 150, 60]);
+pub const UNIFORM: Rgb<u8> = Rgb([125, 125, 125]);
 /// One colour per block, in the scenario's order (repeating after four).
 pub const BLOCK_PATHS: [Rgb<u8>; 4] = [
     Rgb([240, 170, 0]),
@@ -47,6 +49,7 @@ pub fn colour(mode: Mode) -> Rgb<u8> {
         Mode::Curious => CURIOUS,
         Mode::RecencyOnly => RECENCY,
         Mode::PoissonOnly => POISSON,
+        Mode::Uniform => UNIFORM,
     }
 }
 
@@ -88,7 +91,12 @@ pub fn figure(scenario: &Scenario, r: &Reproduction) -> RgbImage {
     let mut series_error = Vec::new();
     let mut series_quality = Vec::new();
     // Curious last, so on top.
-    for mode in [Mode::PoissonOnly, Mode::RecencyOnly, Mode::Curious] {
+    for mode in [
+        Mode::PoissonOnly,
+        Mode::RecencyOnly,
+        Mode::Uniform,
+        Mode::Curious,
+    ] {
         if let Some(c) = r.curves.iter().find(|c| c.name == mode.as_str()) {
             series_error.push((colour(mode), c.rate_error.as_slice()));
             series_quality.push((colour(mode), c.map_quality.as_slice()));
