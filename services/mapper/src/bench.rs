@@ -116,7 +116,7 @@ pub fn bench(options: &BenchOptions) -> Result<BenchReport, MapperError> {
         meta,
         MapParams {
             observation_period_s: period * 1.5,
-            events_across_gaps: false,
+            ..MapParams::default()
         },
     )?;
     let mut rng = seed::stream(options.seed, "bench");

@@ -46,6 +46,15 @@ pub struct MapParams {
     /// (see [`crate::poisson`]; default false: only watched changes are events).
     #[serde(default)]
     pub events_across_gaps: bool,
+    /// Whether the learner's feature r = max_c r^c (paper 004 Eq. 4) runs over the cells
+    /// seen at least once only. The paper defines r^c = t_now − t_last^c through the
+    /// timestamp "each cell c that is observed" gets, and leaves a cell never observed
+    /// open. Default false: a cell never seen counts as the stalest
+    /// ([`ChangeMap::unseen_recency`]), as it does for recency goals; on grid004 four
+    /// wall corners are never seen, so r is then the run's clock, t − t_first + 1 s.
+    /// Leaving them out changed no result there (the crate doc's reproduction).
+    #[serde(default)]
+    pub r_over_seen_cells: bool,
 }
 
 impl Default for MapParams {
@@ -53,6 +62,7 @@ impl Default for MapParams {
         MapParams {
             observation_period_s: 1.0,
             events_across_gaps: false,
+            r_over_seen_cells: false,
         }
     }
 }
@@ -474,7 +484,7 @@ impl ChangeMap {
     }
 
     fn max_recency(&self, t: f64, min_t_last: f64) -> f64 {
-        if self.unseen > 0 {
+        if self.unseen > 0 && !self.params.r_over_seen_cells {
             self.unseen_recency(t)
         } else if min_t_last.is_finite() {
             (t - min_t_last).max(0.0)
