@@ -12,6 +12,7 @@ pub mod demo_today;
 pub mod peb_picture;
 pub mod report;
 pub mod reproduce_apf;
+pub mod reproduce_mapper;
 pub mod reproduce_mission;
 pub mod reproduce_planner;
 pub mod router;

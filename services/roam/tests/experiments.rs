@@ -207,7 +207,7 @@ fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
 }
 
 #[test]
-fn reproduce_mapper_prints_the_three_strategies_and_draws_fig_3() {
+fn reproduce_mapper_prints_the_four_modes_and_their_claims_and_draws_fig_3() {
     let out = tempfile::tempdir().expect("tmp");
     let (value, _) = run_json(
         &[
@@ -226,11 +226,32 @@ fn reproduce_mapper_prints_the_three_strategies_and_draws_fig_3() {
         .iter()
         .filter_map(|s| s["name"].as_str())
         .collect();
-    assert_eq!(names.len(), 3, "{names:?}");
+    assert_eq!(names, ["curious", "recency", "poisson", "uniform"]);
     for s in strategies {
         assert!(s["rate_error_auc"].as_f64().expect("auc") > 0.0);
         let quality = s["final_map_quality"].as_f64().expect("quality");
         assert!((0.0..=1.0).contains(&quality));
+    }
+    // The claims, each judged from the figures above: the AUC ones must agree with
+    // the strategies' AUCs.
+    let claims = value["claims"].as_array().expect("claims");
+    assert_eq!(claims.len(), 5, "{claims:?}");
+    let auc = |i: usize| strategies[i]["rate_error_auc"].as_f64().expect("auc");
+    for (claim, other) in [(0, 1), (1, 2), (4, 3)] {
+        let c = &claims[claim];
+        assert_eq!(
+            c["paper"].as_str().map(|p| p.starts_with("yes")),
+            Some(true)
+        );
+        let want = if auc(0) < auc(other) {
+            "holds"
+        } else {
+            "does_not_hold"
+        };
+        assert_eq!(c["verdict"], want, "{c}");
+    }
+    for c in claims {
+        assert!(c["claim"].is_string() && c["ours"].is_string(), "{c}");
     }
     let image = image::open(out.path().join("mapper_fig3.png")).expect("figure");
     assert!(image.width() > 100);

@@ -132,9 +132,11 @@ pub(crate) enum ReproduceCommand {
         #[arg(long, default_value = "roam-reproduce/apf")]
         out: PathBuf,
     },
-    /// Paper 004 §5: curious vs recency-only vs Poisson-only mapping on the grid world.
+    /// Paper 004 §5: curious vs recency-only vs Poisson-only mapping on the grid world,
+    /// with roam's uniform mix beside them, and the paper's claims judged.
     Mapper {
-        /// Print {"strategies": [{"name", "rate_error_auc", "final_map_quality"}], ...}.
+        /// Print {"strategies": [{"name", "rate_error_auc", "final_map_quality"}], ...,
+        /// "claims": [{"claim", "paper", "ours", "verdict"}]}.
         #[arg(long)]
         json: bool,
         /// Runs per strategy (the paper: 5).
@@ -397,10 +399,13 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 anyhow::Ok((result, picture))
             })
             .await??;
+            let judged = roam::reproduce_mapper::judge(result);
             if json {
-                println!("{}", serde_json::to_string(&result)?);
+                println!("{}", serde_json::to_string(&judged)?);
             } else {
-                print!("{}", roam_mapper::experiment::table(&result));
+                print!("{}", roam_mapper::experiment::table(&judged.reproduction));
+                println!("claims:");
+                print!("{}", roam::verdict::lines(&judged.claims));
                 println!("picture: {}", picture.display());
             }
             Ok(())
