@@ -97,7 +97,7 @@
 //! `examples/learning_probe.rs` (20 runs):
 //! - the feature r is the run's clock: four wall corners are never seen, so r =
 //!   t − t_first + 1 s and the learner meets each r-tile (100 s) for about two episodes
-//!   a run; at 85% of its choices one strategy has no value there yet, and its P(recency)
+//!   a run; at 85% of its choices a strategy has no value there yet, and its P(recency)
 //!   stays within 0.05 of 1/2 on average. Taking r over the cells seen
 //!   (`MapParams::r_over_seen_cells`, a reading of the paper as good) changes nothing
 //!   (77.2 vs 78.3);

@@ -404,7 +404,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 println!("{}", serde_json::to_string(&judged)?);
             } else {
                 print!("{}", roam_mapper::experiment::table(&judged.reproduction));
-                println!("claims:");
+                println!("claims, ours judged:");
                 print!("{}", roam::verdict::lines(&judged.claims));
                 println!("picture: {}", picture.display());
             }
