@@ -135,6 +135,10 @@ pub struct RobotTrack {
     pub estimate: Vec<[f64; 2]>,
     /// ‖p̂ − p‖ at each update, metres.
     pub error_m: Vec<f64>,
+    /// Consecutive updates the PEB guard was holding the robot when its mission ended
+    /// (0: it was not held). The experiments tell a failure the guard caused (a robot
+    /// held until it is given up) from one the robot drove into ([`crate::experiments::failure`]).
+    pub held_updates: u64,
 }
 
 /// The result of one episode.
@@ -198,6 +202,7 @@ pub fn run_episode(
                 truth: Vec::new(),
                 estimate: Vec::new(),
                 error_m: Vec::new(),
+                held_updates: 0,
             },
         };
         if driven.insert(m.robot.as_str(), d).is_some() {
@@ -236,6 +241,7 @@ pub fn run_episode(
                 .push((estimate.position[0] - truth[0]).hypot(estimate.position[1] - truth[1]));
             t.status = decision.status;
             t.steps = decision.steps;
+            t.held_updates = decision.halted_updates;
             t.success = decision.status == MissionStatus::Completed;
             d.done = decision.status.is_final()
                 || decision.status == MissionStatus::Idle

@@ -446,6 +446,7 @@ robots:
             std::env::temp_dir().join(format!("roam-controller-render-{}", std::process::id()));
         let r = Reproduction {
             es1: Vec::new(),
+            es1_no_guard: Vec::new(),
             es2: vec![
                 row(Scheme::Cutoff, 0.0, 600.0),
                 row(Scheme::Cutoff, 0.9, 650.0),

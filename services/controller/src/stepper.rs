@@ -218,6 +218,7 @@ mod tests {
                 truth: Vec::new(),
                 estimate: Vec::new(),
                 error_m: Vec::new(),
+                held_updates: 0,
             };
             let done = m.waypoints.is_empty();
             if done {
@@ -245,6 +246,7 @@ mod tests {
                     .push((e.position[0] - truth[0]).hypot(e.position[1] - truth[1]));
                 t.status = d.status;
                 t.steps = d.steps;
+                t.held_updates = d.halted_updates;
                 t.success = d.status == MissionStatus::Completed;
                 *done = d.status.is_final()
                     || d.status == MissionStatus::Idle

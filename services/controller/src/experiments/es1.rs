@@ -7,15 +7,21 @@
 //! Gauss–Newton from the closed-form linearised solution. At A the three anchors in range
 //! are a1 and the close pair a2, a4, which A sees in almost one direction; in 27 of 2000
 //! seeds checked, that first estimate converges to the range equations' second solution
-//! (near (29, 58), north of the pair and off the map), later estimates start from it,
-//! and the robot is driven on it until it leaves coverage and is held. Those runs fail
-//! whatever the scheme (paper 002 reports every IS run reaching B).
+//! (near (29, 58), north of the pair and off the map) and later estimates start from it.
+//! With roam's PEB guard on, such a robot is held at A until it is given up; with the
+//! guard off it is driven on the wrong position into the map's south wall, out of
+//! coverage. Those runs fail whatever the scheme, guard or not (with seed 0, run 8 of
+//! every scheme), and are counted apart ([`super::failure`]'s `wrong_first_fix`; paper
+//! 002 reports every IS run reaching B).
+//!
+//! ES1 runs twice, with roam's PEB guard on and off on the same seeds ([`super`]).
 
 use roam_map_server::scenario::Scenario;
 use serde::Serialize;
 
 use super::{
-    run_parallel, run_seed, summarize, ExperimentError, RunOptions, RunSummary, Trajectory,
+    run_parallel, run_seed, summarize, ExperimentError, FailureCauses, RunOptions, RunSummary,
+    Trajectory,
 };
 use crate::episode::{mission_from_waypoints, run_episode, PositionSource, Setup};
 use crate::params::ApfParams;
@@ -28,6 +34,9 @@ pub const Z_IS: f64 = 0.8;
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Es1Row {
     pub scheme: Scheme,
+    /// Whether roam's PEB guard was on (a finite `max_peb_m`); ES1 is run both ways
+    /// (see [`super`]).
+    pub guard: bool,
     /// Share of runs that reached B.
     pub success_rate: f64,
     /// The mission RMSE of the successful runs (see [`super`]), metres.
@@ -45,6 +54,8 @@ pub struct Es1Row {
     pub steps_all: Option<f64>,
     /// Mean distance of all runs, metres.
     pub distance_all_m: Option<f64>,
+    /// The failed runs by cause ([`super::failure`]).
+    pub causes: FailureCauses,
 }
 
 /// ES1's rows (one per scheme, in [`Scheme::ALL`]'s order) and each scheme's first run.
@@ -94,7 +105,7 @@ pub fn es1(scenario: &Scenario, options: &RunOptions<'_>) -> Result<Es1Outcome, 
             )
             .map(|e| {
                 let example = (run == 0).then(|| Trajectory::of(scheme, Z_IS, &e));
-                (RunSummary::of(&e), example)
+                (RunSummary::of(&e, &setup), example)
             })
         },
         |done| (options.progress)("es1", done, total),
@@ -114,6 +125,7 @@ pub fn es1(scenario: &Scenario, options: &RunOptions<'_>) -> Result<Es1Outcome, 
         let s = summarize(&runs);
         rows.push(Es1Row {
             scheme,
+            guard: options.params.max_peb_m.is_finite(),
             success_rate: s.success_rate,
             rmse_m: s.rmse_m,
             rmse_all_m: s.rmse_all_m,
@@ -123,6 +135,7 @@ pub fn es1(scenario: &Scenario, options: &RunOptions<'_>) -> Result<Es1Outcome, 
             failures: s.failures,
             steps_all: s.steps_all,
             distance_all_m: s.distance_all_m,
+            causes: s.causes,
         });
     }
     Ok(Es1Outcome { rows, trajectories })

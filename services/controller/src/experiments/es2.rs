@@ -110,7 +110,7 @@ pub fn es2(
                         Vec::new()
                     }
                 });
-                (RunSummary::of(&e), example)
+                (RunSummary::of(&e, &setup), example)
             })
         },
         |done| (options.progress)("es2", done, total),

@@ -30,8 +30,8 @@ use roam_sim::noise::uniform;
 use serde::Serialize;
 
 use super::{
-    fnv1a, run_parallel, run_seed, splitmix64, summarize, ExperimentError, RunOptions, RunSummary,
-    Summary,
+    fnv1a, run_parallel, run_seed, splitmix64, summarize, ExperimentError, FailureCauses,
+    RunOptions, RunSummary, Summary,
 };
 use crate::episode::{run_episode, PositionSource, RobotMission, Setup};
 use crate::params::ApfParams;
@@ -77,6 +77,8 @@ pub struct Es3Row {
     /// until it was given up, e.g. at the step limit) against plain APF's, %: beside
     /// `steps_change_pct`, which leaves failed runs out.
     pub steps_all_change_pct: Option<f64>,
+    /// The failed runs (over all missions) by cause ([`super::failure`]).
+    pub causes: FailureCauses,
 }
 
 /// ES3's rows (one per scheme, plain first), the missions, and every (scheme, mission)
@@ -213,7 +215,7 @@ pub fn es3(
                 &mission_list[m],
                 seed,
             )
-            .map(|e| RunSummary::of(&e))
+            .map(|e| RunSummary::of(&e, &setup))
         },
         |done| (options.progress)("es3", done, total),
     );
@@ -261,6 +263,9 @@ pub fn es3(
                 steps_all_change_pct: mean(
                     pairs().filter_map(|(s, p)| change_pct(s.steps_all, p.steps_all)),
                 ),
+                causes: mine
+                    .iter()
+                    .fold(FailureCauses::default(), |a, s| a.plus(&s.causes)),
             }
         })
         .collect();

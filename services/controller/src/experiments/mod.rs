@@ -1,5 +1,13 @@
 //! The reproduction of paper 002 §4: ES1 ([`es1`]), ES2 ([`es2`]) and ES3 ([`es3`]), the
-//! paper's published figures and the comparison table ([`paper`]).
+//! paper's published figures and the comparison table ([`paper`]), and why runs failed
+//! ([`failure`]).
+//!
+//! **ES1 twice.** ES1 runs with roam's PEB guard (the paper's parameters,
+//! [`paper::paper_params`]) and again with the guard off (`max_peb_m = ∞`) on the same
+//! seeds (issue 18): with the guard on, a robot that loses its fix is held until it is
+//! given up, a failure paper 002 does not have; only the run without it shows whether a
+//! scheme fails for the paper's reason (driving into poor coverage). Both are reported,
+//! each failure with its cause ([`failure`]).
 //!
 //! **Determinism and common random numbers.** Every run's seed is derived from the base
 //! seed and the run's place in the experiment ([`run_seed`]: experiment, mission, run),
@@ -17,7 +25,8 @@
 //! none succeeded), and beside them the failures are counted and RMSE, steps and
 //! distance are given over all runs (a failed run counts the steps and distance until it
 //! was given up, e.g. at the step limit), so a scheme whose failures are its slowest runs
-//! does not look faster for them. The mission RMSE is the
+//! does not look faster for them; each failure is put in one class ([`failure`]). The
+//! mission RMSE is the
 //! paper's: per step k, RMSE^k = √(mean over runs of ‖p̂_k − p_k‖²) (§4), averaged over
 //! the mission's steps. Runs end at different steps, so RMSE^k at step k is taken over
 //! the runs still on their mission at k, and the average runs over k = 1 … the longest
@@ -33,6 +42,7 @@
 pub mod es1;
 pub mod es2;
 pub mod es3;
+pub mod failure;
 pub mod paper;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -41,13 +51,14 @@ use std::sync::Mutex;
 use roam_map_server::scenario::Scenario;
 use serde::Serialize;
 
-use crate::episode::{Episode, EpisodeError};
+use crate::episode::{Episode, EpisodeError, Setup};
 use crate::params::{ApfParams, ParamError};
 use crate::weights::Scheme;
 
 pub use es1::{es1, Es1Outcome, Es1Row};
 pub use es2::{es2, Es2Outcome, Es2Row};
 pub use es3::{es3, Es3Outcome, Es3Row};
+pub use failure::{FailureCause, FailureCauses};
 
 /// How many runs, from which seed, on how many threads, reporting progress how.
 #[derive(Clone, Copy)]
@@ -187,10 +198,14 @@ pub struct RunSummary {
     /// The squared localization error at each step, averaged over the robots still on
     /// their missions then (module doc).
     pub squared_error: Vec<f64>,
+    /// Why the run failed ([`failure`]); `None` when it succeeded.
+    pub failure: Option<FailureCause>,
 }
 
 impl RunSummary {
-    pub fn of(episode: &Episode) -> RunSummary {
+    /// `episode` summarised; `setup` is its scenario's, for the coverage where a failed
+    /// robot ended.
+    pub fn of(episode: &Episode, setup: &Setup) -> RunSummary {
         let longest = episode
             .robots
             .iter()
@@ -212,6 +227,7 @@ impl RunSummary {
             steps: episode.robots.iter().map(|r| r.steps).max().unwrap_or(0),
             distance_m: episode.robots.iter().map(|r| r.distance_m).sum(),
             squared_error,
+            failure: failure::cause(episode, setup),
         }
     }
 }
@@ -236,6 +252,8 @@ pub struct Summary {
     pub steps_all: Option<f64>,
     /// Mean distance of all runs, metres.
     pub distance_all_m: Option<f64>,
+    /// The failed runs by cause ([`failure`]).
+    pub causes: FailureCauses,
 }
 
 /// The paper's mission RMSE over `runs` (module doc): RMSE^k over the runs still going
@@ -278,6 +296,7 @@ pub fn summarize(runs: &[RunSummary]) -> Summary {
         failures: runs.len() - ok.len(),
         steps_all: mean(runs.iter().map(|r| r.steps as f64).collect()),
         distance_all_m: mean(runs.iter().map(|r| r.distance_m).collect()),
+        causes: FailureCauses::count(runs.iter().filter_map(|r| r.failure)),
     }
 }
 
@@ -310,7 +329,10 @@ impl Trajectory {
 /// The whole reproduction: what `roam reproduce controller` prints and writes.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Reproduction {
+    /// ES1 with roam's PEB guard on (the paper's parameters).
     pub es1: Vec<Es1Row>,
+    /// ES1 on the same seeds with the guard off (`max_peb_m = ∞`, module doc).
+    pub es1_no_guard: Vec<Es1Row>,
     pub es2: Vec<Es2Row>,
     pub es3: Vec<Es3Row>,
     /// One run per configuration, for the figures (not serialized).
@@ -371,10 +393,22 @@ pub fn reproduce(
         progress: options.progress,
     };
     let one = es1(es1_scenario, &run(options.es1_runs))?;
+    let unguarded = ApfParams {
+        max_peb_m: f64::INFINITY,
+        ..options.params.clone()
+    };
+    let no_guard = es1(
+        es1_scenario,
+        &RunOptions {
+            params: &unguarded,
+            ..run(options.es1_runs)
+        },
+    )?;
     let two = es2(es2_scenario, &run(options.es2_runs), &es2::Z_IS)?;
     let three = es3(es3_scenario, &run(options.es3_runs), options.es3_missions)?;
     Ok(Reproduction {
         es1: one.rows,
+        es1_no_guard: no_guard.rows,
         es2: two.rows,
         es3: three.rows,
         es1_trajectories: one.trajectories,
@@ -428,6 +462,7 @@ mod tests {
             steps,
             distance_m,
             squared_error: errors.iter().map(|e| e * e).collect(),
+            failure: (!success).then_some(FailureCause::Other),
         }
     }
 
@@ -448,6 +483,8 @@ mod tests {
         assert!((s.rmse_m.expect("rmse") - (5f64.sqrt() + 2.0) / 2.0).abs() < 1e-12);
         // Steps and distance over the successful runs only.
         assert_eq!((s.steps, s.distance_m), (Some(11.0), Some(3.0)));
+        // The one failure, with its cause.
+        assert_eq!((s.failures, s.causes.other, s.causes.total()), (1, 1, 1));
         let none = summarize(&[run(false, 4, 9.0, &[])]);
         assert_eq!(
             (none.steps, none.distance_m, none.rmse_m),

@@ -5,7 +5,7 @@ use std::fmt::Write;
 
 use serde::Serialize;
 
-use super::{Es2Row, Reproduction};
+use super::{Es1Row, Es2Row, Reproduction};
 use crate::params::{ApfParams, Follow, DEFAULT_MAX_STEPS};
 use crate::weights::Scheme;
 
@@ -110,9 +110,10 @@ pub const PAPER_ES2: [&str; 4] = [
 
 /// The controller's parameters for the reproduction: paper 002 §4's values, and roam's
 /// stuck rule off (`stuck_window_steps = max_steps`), since the paper runs every mission
-/// until it completes or reaches max_steps. The PEB guard stays on: it is how a robot
-/// that lost its fix "cannot complete its mission" (ES1); a robot held for it is given up
-/// after the same window, i.e. at max_steps. The robot moves toward each waypoint in
+/// until it completes or reaches max_steps. roam's PEB guard (not in the paper) stays on,
+/// as the services run: a robot held for it is given up after the same window, i.e. at
+/// max_steps. That is a failure the paper does not have, so ES1 is also run with the
+/// guard off and both are reported ([`super::reproduce`], issue 18). The robot moves toward each waypoint in
 /// turn, as paper 002 §3 has it (`follow: waypoints`, explicitly: its experiments are
 /// about where the IS force takes the robot between waypoints, which following a path
 /// between them would undo).
@@ -137,17 +138,14 @@ fn es2_point(rows: &[Es2Row], scheme: Scheme, z: f64) -> Option<&Es2Row> {
         .find(|r| r.scheme == scheme && (r.z_is - z).abs() < 1e-9)
 }
 
-/// A plain-text table of `ours` next to paper 002's figures, one section per experiment.
-pub fn comparison_table(ours: &Reproduction) -> String {
-    let mut out = String::new();
+/// ES1's rows (one block: guard on or off) next to the paper's, with each failure's
+/// cause ([`super::failure`]).
+fn es1_block(out: &mut String, title: &str, rows: &[Es1Row]) {
     // Writing to a String cannot fail.
+    let _ = writeln!(out, "{title}");
     let _ = writeln!(
         out,
-        "ES1 (sparse coverage, A to B, z_is = 0.8, on estimates)"
-    );
-    let _ = writeln!(
-        out,
-        "{:<11} {:>8} {:>8} | {:>9} {:>9} | {:>8} {:>9} | {:>9} {:>9} | {:>6} {:>9}",
+        "{:<11} {:>8} {:>8} | {:>9} {:>9} | {:>8} {:>9} | {:>9} {:>9} | {:>6} {:>9} | {:>5} {:>9} {:>5} {:>8} {:>5}",
         "scheme",
         "success",
         "paper",
@@ -158,9 +156,14 @@ pub fn comparison_table(ours: &Reproduction) -> String {
         "dist m",
         "paper",
         "failed",
-        "all steps"
+        "all steps",
+        "first",
+        "held(unc)",
+        "uncov",
+        "diverged",
+        "other"
     );
-    for row in &ours.es1 {
+    for row in rows {
         let paper = PAPER_ES1.iter().find(|p| p.scheme == row.scheme);
         let paper_steps = paper.map_or_else(String::new, |p| {
             p.steps
@@ -169,9 +172,10 @@ pub fn comparison_table(ours: &Reproduction) -> String {
                 .collect::<Vec<_>>()
                 .join("/")
         });
+        let c = &row.causes;
         let _ = writeln!(
             out,
-            "{:<11} {:>7.0}% {:>8} | {:>9} {:>9} | {:>8} {:>9} | {:>9} {:>9} | {:>6} {:>9}",
+            "{:<11} {:>7.0}% {:>8} | {:>9} {:>9} | {:>8} {:>9} | {:>9} {:>9} | {:>6} {:>9} | {:>5} {:>9} {:>5} {:>8} {:>5}",
             row.scheme.name(),
             100.0 * row.success_rate,
             paper.map_or("", |p| if p.success { "yes" } else { "fails" }),
@@ -187,8 +191,38 @@ pub fn comparison_table(ours: &Reproduction) -> String {
             num(paper.and_then(|p| p.distance_m), 2),
             row.failures,
             num(row.steps_all, 0),
+            c.wrong_first_fix,
+            format!("{}({})", c.held_by_guard, c.held_out_of_coverage),
+            c.out_of_coverage,
+            c.estimate_diverged,
+            c.other,
         );
     }
+}
+
+/// A plain-text table of `ours` next to paper 002's figures, one section per experiment.
+pub fn comparison_table(ours: &Reproduction) -> String {
+    let mut out = String::new();
+    es1_block(
+        &mut out,
+        "ES1 (sparse coverage, A to B, z_is = 0.8, on estimates), roam's PEB guard on",
+        &ours.es1,
+    );
+    if !ours.es1_no_guard.is_empty() {
+        let _ = writeln!(out);
+        es1_block(
+            &mut out,
+            "ES1 with the PEB guard off (max_peb_m = inf), same seeds",
+            &ours.es1_no_guard,
+        );
+    }
+    let _ = writeln!(
+        out,
+        "failed runs by cause: first = first fix > {0:.0} m off; held(unc) = held by the \
+         PEB guard when given up (of them, where < 3 anchors reach); uncov = driving where \
+         < 3 anchors reach; diverged = estimate > {0:.0} m off at the end; other",
+        super::failure::DIVERGED_M
+    );
     let _ = writeln!(out);
     let _ = writeln!(
         out,
@@ -239,7 +273,7 @@ pub fn comparison_table(ours: &Reproduction) -> String {
     );
     let _ = writeln!(
         out,
-        "{:<11} {:>8} | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>6} {:>9}",
+        "{:<11} {:>8} | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>6} {:>9} | {:>9}",
         "scheme",
         "success",
         "RMSE",
@@ -249,13 +283,14 @@ pub fn comparison_table(ours: &Reproduction) -> String {
         "distance",
         "paper",
         "failed",
-        "all steps"
+        "all steps",
+        "held(unc)"
     );
     for row in &ours.es3 {
         let paper = PAPER_ES3.iter().find(|p| p.scheme == row.scheme);
         let _ = writeln!(
             out,
-            "{:<11} {:>7.0}% | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>6} {:>9}",
+            "{:<11} {:>7.0}% | {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>9} | {:>6} {:>9} | {:>9}",
             row.scheme.name(),
             100.0 * row.success_rate,
             pct(row.rmse_change_pct),
@@ -266,6 +301,10 @@ pub fn comparison_table(ours: &Reproduction) -> String {
             pct(paper.and_then(|p| p.distance_change_pct)),
             row.failures,
             pct(row.steps_all_change_pct),
+            format!(
+                "{}({})",
+                row.causes.held_by_guard, row.causes.held_out_of_coverage
+            ),
         );
     }
     out
@@ -274,23 +313,42 @@ pub fn comparison_table(ours: &Reproduction) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiments::{Es1Row, Es3Row};
+    use crate::experiments::{Es1Row, Es3Row, FailureCauses};
+
+    fn es1_row(guard: bool, failures: usize, causes: FailureCauses) -> Es1Row {
+        Es1Row {
+            scheme: Scheme::Linear,
+            guard,
+            success_rate: 0.99,
+            rmse_m: Some(0.2367),
+            rmse_all_m: None,
+            steps: Some(336.4),
+            distance_m: Some(59.87),
+            runs: 100,
+            failures,
+            steps_all: Some(340.0),
+            distance_all_m: Some(60.0),
+            causes,
+        }
+    }
 
     #[test]
     fn the_table_puts_ours_next_to_the_paper() {
+        let held = FailureCauses {
+            held_by_guard: 1,
+            held_out_of_coverage: 1,
+            ..FailureCauses::default()
+        };
+        let driven = FailureCauses {
+            wrong_first_fix: 3,
+            out_of_coverage: 4,
+            estimate_diverged: 2,
+            other: 1,
+            ..FailureCauses::default()
+        };
         let r = Reproduction {
-            es1: vec![Es1Row {
-                scheme: Scheme::Linear,
-                success_rate: 0.99,
-                rmse_m: Some(0.2367),
-                rmse_all_m: None,
-                steps: Some(336.4),
-                distance_m: Some(59.87),
-                runs: 100,
-                failures: 1,
-                steps_all: Some(340.0),
-                distance_all_m: Some(60.0),
-            }],
+            es1: vec![es1_row(true, 1, held)],
+            es1_no_guard: vec![es1_row(false, 7, driven)],
             es2: vec![
                 Es2Row {
                     scheme: Scheme::Fixed,
@@ -323,18 +381,33 @@ mod tests {
                 missions_compared: 10,
                 failures: 90,
                 steps_all_change_pct: Some(700.0),
+                causes: FailureCauses {
+                    held_by_guard: 88,
+                    held_out_of_coverage: 3,
+                    ..FailureCauses::default()
+                },
             }],
             es1_trajectories: Vec::new(),
             es2_trajectories: Vec::new(),
         };
         let t = comparison_table(&r);
-        let line = t
-            .lines()
-            .find(|l| l.starts_with("linear"))
-            .expect("ES1 row");
+        // The guarded and the unguarded ES1 rows (ES2's linear row comes third).
+        let es1: Vec<&str> = t.lines().filter(|l| l.starts_with("linear")).collect();
+        assert_eq!(es1.len(), 3, "{t}");
         for cell in ["99%", "yes", "0.237", "336", "296/318", "59.87", "59.56"] {
-            assert!(line.contains(cell), "{cell} in {line}");
+            assert!(es1[0].contains(cell), "{cell} in {}", es1[0]);
         }
+        // The causes, in their columns: first | held(unc) | uncov | diverged | other.
+        assert!(
+            es1[0].ends_with("|     0      1(1)     0        0     0"),
+            "{}",
+            es1[0]
+        );
+        assert!(
+            es1[1].ends_with("|     3      0(0)     4        2     1"),
+            "{}",
+            es1[1]
+        );
         assert!(t.contains("3196/139"), "{t}");
         assert!(t.contains("601/120"), "{t}");
         assert!(
@@ -346,11 +419,10 @@ mod tests {
             .rfind(|l| l.starts_with("fixed"))
             .expect("ES3 row");
         for cell in [
-            "91%", "+3.6 %", "+662.0 %", "+388.9 %", "+68.4 %", " 90 ", "+700.0 %",
+            "91%", "+3.6 %", "+662.0 %", "+388.9 %", "+68.4 %", " 90 ", "+700.0 %", "88(3)",
         ] {
             assert!(line.contains(cell), "{cell} in {line}");
         }
-        assert!(t.contains("4.4 %"));
     }
 
     #[test]
