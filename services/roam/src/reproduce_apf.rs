@@ -1,5 +1,6 @@
 //! `roam reproduce apf`: paper 002 §4's ES1–ES3 on the shipped scenarios (built into the
-//! binary, so it runs from anywhere), with progress on stderr and the pictures.
+//! binary, so it runs from anywhere), with progress on stderr, the pictures, and the
+//! paper's claims judged from the figures ([`claims`]).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -8,6 +9,11 @@ use roam_controller::episode::Setup;
 use roam_controller::experiments::{paper, reproduce, ReproduceOptions, Reproduction};
 use roam_map_server::scenario::{self, Scenario};
 use roam_map_server::store::DEFAULT_LIMITS;
+use serde::Serialize;
+
+use crate::verdict::Comparison;
+
+pub mod claims;
 
 const ES1: &str = include_str!("../../../config/scenarios/es1.yaml");
 const ES2: &str = include_str!("../../../config/scenarios/es2.yaml");
@@ -32,8 +38,38 @@ fn shipped(name: &str, text: &str) -> anyhow::Result<Scenario> {
     )?)
 }
 
-/// Runs the three experiments with the paper's parameters and writes the pictures.
-pub fn run(sizes: &Sizes) -> anyhow::Result<(Reproduction, Vec<PathBuf>)> {
+/// What `roam reproduce apf` prints: the reproduction (its keys at the top level of the
+/// JSON: `es1`, `es1_no_guard`, `es2`, `es3`) and the paper's claims with their verdicts.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Output {
+    #[serde(flatten)]
+    pub reproduction: Reproduction,
+    pub claims: Vec<Comparison>,
+}
+
+impl Output {
+    /// The claims judged from `reproduction`'s figures.
+    pub fn of(reproduction: Reproduction) -> Output {
+        let claims = claims::compare(&reproduction);
+        Output {
+            reproduction,
+            claims,
+        }
+    }
+
+    /// The comparison table, then the claims, for the terminal.
+    pub fn text(&self) -> String {
+        format!(
+            "{}\npaper 002's claims, judged from our figures:\n{}",
+            paper::comparison_table(&self.reproduction),
+            crate::verdict::lines(&self.claims)
+        )
+    }
+}
+
+/// Runs the three experiments with the paper's parameters, writes the pictures and
+/// judges the claims.
+pub fn run(sizes: &Sizes) -> anyhow::Result<(Output, Vec<PathBuf>)> {
     let es1 = shipped("es1.yaml", ES1)?;
     let es2 = shipped("es2.yaml", ES2)?;
     let es3 = shipped("es3.yaml", ES3)?;
@@ -72,5 +108,5 @@ pub fn run(sizes: &Sizes) -> anyhow::Result<(Reproduction, Vec<PathBuf>)> {
         &Setup::new(&es2)?,
         &sizes.out_dir,
     )?;
-    Ok((result, pictures))
+    Ok((Output::of(result), pictures))
 }

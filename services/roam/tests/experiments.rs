@@ -166,20 +166,46 @@ fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
         ],
         Some(out.path()),
     );
-    let es1 = value["es1"].as_array().expect("es1");
-    let schemes: Vec<&str> = es1.iter().filter_map(|r| r["scheme"].as_str()).collect();
-    assert_eq!(
-        schemes,
-        ["plain", "fixed", "cutoff", "linear", "sinusoidal"]
-    );
-    for row in es1 {
-        check_figures(row);
+    // ES1 with roam's PEB guard on and off, every scheme each, every failed run in one
+    // class of cause.
+    for (key, guard) in [("es1", true), ("es1_no_guard", false)] {
+        let rows = value[key].as_array().expect(key);
+        let schemes: Vec<&str> = rows.iter().filter_map(|r| r["scheme"].as_str()).collect();
+        assert_eq!(
+            schemes,
+            ["plain", "fixed", "cutoff", "linear", "sinusoidal"],
+            "{key}"
+        );
+        for row in rows {
+            check_figures(row);
+            assert_eq!(row["guard"].as_bool(), Some(guard), "{key}: {row}");
+            let failures = row["failures"].as_u64().expect("a count");
+            let c = &row["causes"];
+            let classes: Option<Vec<u64>> = [
+                "wrong_first_fix",
+                "held_by_guard",
+                "out_of_coverage",
+                "estimate_diverged",
+                "other",
+            ]
+            .iter()
+            .map(|f| c[*f].as_u64())
+            .collect();
+            assert_eq!(classes.map(|v| v.iter().sum()), Some(failures), "{row}");
+            if !guard {
+                assert_eq!(c["held_by_guard"].as_u64(), Some(0), "{row}");
+            }
+        }
     }
     let es2 = value["es2"].as_array().expect("es2");
     assert_eq!(es2.len(), 4 * 10, "four IS schemes × z_is 0.0..0.9");
-    assert!(es2
-        .iter()
-        .all(|r| r["steps"].as_f64().is_some() && r["z_is"].as_f64().is_some()));
+    for row in es2 {
+        let z = row["z_is"].as_f64().expect("a z_is");
+        assert!((0.0..=0.9 + 1e-9).contains(&z), "{row}");
+        // On true positions every ES2 run completes: steps and distance are numbers.
+        check_figures(row);
+        assert_eq!(row["success_rate"].as_f64(), Some(1.0), "{row}");
+    }
     let es3 = value["es3"].as_array().expect("es3");
     for row in es3 {
         check_figures(row);
@@ -204,6 +230,32 @@ fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
         assert!(image.width() > 100 && image.height() > 100);
     }
     assert!(stderr.contains("es3: 5/5 runs"), "progress on stderr");
+    // The claims: each a text, the paper's figure, ours and one of the four verdicts.
+    // Plain APF's ES1 claim exists for both runs, and with the guard on its verdict
+    // follows from its row (the paper: it fails).
+    let claims = value["claims"].as_array().expect("claims");
+    assert_eq!(claims.len(), 2 * 14 + 9 + 6);
+    for c in claims {
+        for f in ["claim", "paper", "ours"] {
+            assert!(c[f].as_str().is_some_and(|t| !t.is_empty()), "{f}: {c}");
+        }
+        let verdict = c["verdict"].as_str().expect("a verdict");
+        assert!(
+            ["holds", "same_direction", "does_not_hold", "no_data"].contains(&verdict),
+            "{c}"
+        );
+    }
+    let plain_rate = value["es1"][0]["success_rate"].as_f64().expect("a share");
+    let plain = claims
+        .iter()
+        .find(|c| c["claim"] == "ES1 (guard on): plain reaches B")
+        .expect("plain's claim");
+    let expected = if plain_rate >= 0.5 {
+        "does_not_hold"
+    } else {
+        "holds"
+    };
+    assert_eq!(plain["verdict"], expected, "{plain}");
 }
 
 #[test]

@@ -111,7 +111,8 @@ pub(crate) enum ReproduceCommand {
     /// Paper 002 §4: ES1-ES3 for plain APF and the fixed, cutoff, linear and sinusoidal
     /// information-seeking weights.
     Apf {
-        /// Print {"es1": [...], "es2": [...], "es3": [...]} as JSON.
+        /// Print {"es1": [...], "es1_no_guard": [...], "es2": [...], "es3": [...],
+        /// "claims": [...]} as JSON.
         #[arg(long)]
         json: bool,
         /// ES1 runs per scheme (the paper: 100).
@@ -350,10 +351,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             if json {
                 println!("{}", serde_json::to_string(&result)?);
             } else {
-                print!(
-                    "{}",
-                    roam_controller::experiments::paper::comparison_table(&result)
-                );
+                print!("{}", result.text());
                 for picture in pictures {
                     println!("picture: {}", picture.display());
                 }
