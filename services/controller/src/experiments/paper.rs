@@ -335,7 +335,7 @@ mod tests {
     #[test]
     fn the_table_puts_ours_next_to_the_paper() {
         let held = FailureCauses {
-            held_by_guard: 1,
+            held_by_guard: 2,
             held_out_of_coverage: 1,
             ..FailureCauses::default()
         };
@@ -347,7 +347,7 @@ mod tests {
             ..FailureCauses::default()
         };
         let r = Reproduction {
-            es1: vec![es1_row(true, 1, held)],
+            es1: vec![es1_row(true, 2, held)],
             es1_no_guard: vec![es1_row(false, 7, driven)],
             es2: vec![
                 Es2Row {
@@ -399,7 +399,7 @@ mod tests {
         }
         // The causes, in their columns: first | held(unc) | uncov | diverged | other.
         assert!(
-            es1[0].ends_with("|     0      1(1)     0        0     0"),
+            es1[0].ends_with("|     0      2(1)     0        0     0"),
             "{}",
             es1[0]
         );
