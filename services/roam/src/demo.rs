@@ -426,7 +426,10 @@ fn markdown(r: &DemoReport) -> String {
             .iter()
             .flatten()
             .find(|t| t.window == w.window)
-            .map_or("-".to_owned(), |t| format!("{:.0}", t.planned_information));
+            .map_or("-".to_owned(), |t| match t.refused {
+                Some(_) => "refused".to_owned(),
+                None => format!("{:.0}", t.planned_information),
+            });
         let ratio = if w.planned_information > 0.0 {
             format!("{:.2}", w.driven_information / w.planned_information)
         } else {

@@ -29,12 +29,16 @@ pub struct TodaysPlan {
     /// Information of the distinct cells the plan sees (paper 000 Eq. 3's window, the
     /// static map), as the report's other information figures.
     pub planned_information: f64,
-    /// Its t_ETA on Table I's time model, seconds.
-    pub t_eta_s: f64,
+    /// Its t_ETA on Table I's time model, seconds; `None` when refused.
+    pub t_eta_s: Option<f64>,
+    /// Why today's planner refused the window (e.g. the window, shortened by a late
+    /// arrival, is below the shortest path's ETA on Table I's slower time model); its
+    /// information is then 0.
+    pub refused: Option<String>,
 }
 
-/// Today's plan for each window that had a plan; `None` where today's planner refuses
-/// (the reason goes to the log).
+/// Today's plan for each window that had a plan (`None` for a window without a path),
+/// or today's planner's refusal.
 pub fn todays_plans(
     inflated: &Grid<i8>,
     information: &Grid<u8>,
@@ -71,11 +75,17 @@ pub fn todays_plans(
                 Ok(p) => Some(TodaysPlan {
                     window: r.window,
                     planned_information: p.metrics.distinct_information,
-                    t_eta_s: p.t_eta_s,
+                    t_eta_s: Some(p.t_eta_s),
+                    refused: None,
                 }),
                 Err(e) => {
                     tracing::warn!(window = r.window, "today's planner refuses: {e}");
-                    None
+                    Some(TodaysPlan {
+                        window: r.window,
+                        planned_information: 0.0,
+                        t_eta_s: None,
+                        refused: Some(e.to_string()),
+                    })
                 }
             }
         })
