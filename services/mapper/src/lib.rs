@@ -131,7 +131,7 @@ pub mod goals;
 pub mod learner;
 pub mod plot;
 pub mod poisson;
-pub mod seed;
+pub use roam_world::seed;
 pub mod service;
 pub mod truth;
 pub mod wavefront;

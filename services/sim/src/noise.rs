@@ -2,30 +2,13 @@
 //! 002's two noise models (TOA ranging, §2.1; transition noise, Eq. 1).
 
 use rand::RngCore;
-use rand_chacha::rand_core::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 use roam_map_server::scenario::SensingSpec;
 
 /// A ChaCha8 stream for one consumer (`"world"`, `"robot/<name>"`) of a sim seeded with
-/// `seed`: the seed is the key, the label picks one of ChaCha's 2⁶⁴ independent streams.
-/// Each consumer draws only from its own stream, so adding a robot, or a robot taking a
-/// different path, never changes what another robot or the world draws.
-pub fn stream(seed: u64, label: &str) -> ChaCha8Rng {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream(fnv1a(label.as_bytes()));
-    rng
-}
-
-/// 64-bit FNV-1a: a stable hash of a label (std's hashers may change between releases,
-/// which would change every stream).
-fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        hash ^= u64::from(b);
-        hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    hash
-}
+/// `seed` ([`roam_world::seed::stream`]): each consumer draws only from its own stream,
+/// so adding a robot, or a robot taking a different path, never changes what another
+/// robot or the world draws.
+pub use roam_world::seed::stream;
 
 /// A uniform number in [0, 1) with 53 random bits.
 pub fn uniform(rng: &mut impl RngCore) -> f64 {

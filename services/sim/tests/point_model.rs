@@ -5,16 +5,7 @@
 mod common;
 
 use roam_sim::{Command, Sim};
-
-/// 64-bit FNV-1a.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        hash ^= u64::from(b);
-        hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    hash
-}
+use roam_world::seed::fnv1a;
 
 /// Drives every robot for `steps`: slow circles, some commands beyond the top speed,
 /// some steps without a command, so that clipping, collisions and standing still are

@@ -30,8 +30,8 @@ use roam_sim::noise::uniform;
 use serde::Serialize;
 
 use super::{
-    fnv1a, run_parallel, run_seed, splitmix64, summarize, ExperimentError, FailureCauses,
-    RunOptions, RunSummary, Summary,
+    run_parallel, run_seed, summarize, ExperimentError, FailureCauses, RunOptions, RunSummary,
+    Summary,
 };
 use crate::episode::{run_episode, PositionSource, RobotMission, Setup};
 use crate::params::ApfParams;
@@ -129,7 +129,7 @@ pub fn sample_missions(
     let mut out = Vec::with_capacity(count);
     for m in 0..count {
         let label = format!("es3/missions/{m}");
-        let mut rng = ChaCha8Rng::seed_from_u64(splitmix64(seed ^ fnv1a(label.as_bytes())));
+        let mut rng = ChaCha8Rng::seed_from_u64(roam_world::seed::labelled(seed, &label));
         let mut mission = Vec::new();
         for robot in &setup.scenario.file.robots {
             let mut previous = robot.at;

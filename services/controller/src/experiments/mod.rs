@@ -129,26 +129,7 @@ impl RunOptions<'_> {
 /// is left out on purpose: every scheme meets the same noise (common random numbers,
 /// module doc).
 pub fn run_seed(base: u64, experiment: &str, mission: usize, run: usize) -> u64 {
-    let label = format!("{experiment}/{mission}/{run}");
-    splitmix64(base ^ fnv1a(label.as_bytes()))
-}
-
-/// 64-bit FNV-1a (stable across Rust releases, unlike std's hashers).
-pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        hash ^= u64::from(b);
-        hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    hash
-}
-
-/// SplitMix64's finaliser: spreads nearby inputs over the whole range.
-pub(crate) fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
+    roam_world::seed::labelled(base, &format!("{experiment}/{mission}/{run}"))
 }
 
 /// Runs `job` on every element of `jobs` over up to `threads` threads and returns the
