@@ -430,9 +430,10 @@ pub async fn run(
     .map_err(|e| MapperServiceError::Config(e.to_string()))?;
     let explorers = explore
         .iter()
-        .enumerate()
-        .map(|(i, robot)| {
-            let seed = config.seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        .map(|robot| {
+            // Seeded by the robot's name, not its place in the list: a robot explores
+            // the same way whichever other robots are explored beside it.
+            let seed = crate::seed::labelled(config.seed, &format!("explore/{robot}"));
             Explorer::new(config.explorer, Mode::Curious, seed)
                 .map(|e| (robot.clone(), e))
                 .map_err(|e| MapperServiceError::Config(e.to_string()))
