@@ -291,3 +291,55 @@ fn the_papers_own_initialization_seeds_nothing() {
         );
     }
 }
+
+/// Issue 16: the budget floor is the path of least Eq. 2 time, turns counted. From the
+/// start to Goal 2 of the built-in world the distance-shortest path zigzags (34.7 s)
+/// where a 32.4 s path exists; a budget between the two is admitted, every model plans
+/// within it, the `shortest` baseline returns the fastest path, and a budget below the
+/// fastest path is refused naming its time.
+#[test]
+fn the_fastest_path_floor_admits_a_budget_the_distance_shortest_path_would_refuse() {
+    use roam_planner::eta::path_eta;
+    use roam_planner::search::{fastest_path, shortest_path};
+    let world = common::builtin_world();
+    let params = roam_planner::params::GaParams::default();
+    let (start, goal) = ([-8.0, -8.0], [6.0, -7.0]);
+    let (s, g) = (
+        world.cell_at(start[0], start[1]).expect("start"),
+        world.cell_at(goal[0], goal[1]).expect("goal"),
+    );
+    let by_distance = path_eta(&world, &params, &shortest_path(&world, s, g).expect("path"));
+    let fastest = path_eta(
+        &world,
+        &params,
+        &fastest_path(&world, &params, s, g).expect("path"),
+    );
+    assert!(fastest < by_distance - 1.0, "{fastest} vs {by_distance}");
+    let budget = (fastest + by_distance) / 2.0;
+    for model in [
+        PlannerModel::Shortest,
+        PlannerModel::Model0,
+        PlannerModel::Model1,
+        PlannerModel::Model2,
+    ] {
+        let outcome = run(&world, &spec(model, start, goal, budget, 3, 20));
+        assert!(outcome.within_budget && outcome.reaches_goal, "{model:?}");
+        assert!(outcome.t_eta_s <= budget);
+        if model == PlannerModel::Shortest {
+            assert_eq!(outcome.t_eta_s.to_bits(), fastest.to_bits());
+        }
+    }
+    let refused = plan(
+        &world,
+        &spec(PlannerModel::Model1, start, goal, fastest - 0.1, 3, 20),
+        &AtomicBool::new(false),
+        |_, _| {},
+    );
+    match refused {
+        Err(e @ PlanError::BudgetTooShort { needed_s, .. }) => {
+            assert_eq!(needed_s.to_bits(), fastest.to_bits());
+            assert!(e.to_string().contains(&format!("{fastest:.1} s")), "{e}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
