@@ -151,7 +151,9 @@ pub enum StopReason {
 pub struct Plan {
     pub request_id: String,
     pub model: PlannerModel,
-    /// Grid cells `[x, y]` from start to end, 8-connected.
+    /// Map cells `[x, y]` (the `inflated` layer's grid) from start to end, 8-connected
+    /// without cutting corners, every one free: the path the robot drives, also when
+    /// the planner plans at a coarser resolution (`planning_resolution_m`).
     pub cells: Vec<[u32; 2]>,
     /// The cells' centres in world metres.
     pub points: Vec<[f64; 2]>,
@@ -170,6 +172,10 @@ pub struct Plan {
     pub generations: u32,
     pub planning_ms: f64,
     pub stop_reason: StopReason,
+    /// The resolution the plan was made at, metres: paper 000's 0.2 by default, or the
+    /// map's where that is coarser. `cells` are map cells whatever this is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub planning_resolution_m: Option<f64>,
     /// With `stop_reason: budget`: the wall seconds the CPU budget granted.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub budget_s: Option<f64>,

@@ -365,6 +365,7 @@ mod planner_messages {
                         generations,
                         planning_ms,
                         stop_reason,
+                        planning_resolution_m: budget_s.map(f64::abs),
                         budget_s,
                         seed,
                         map_version,

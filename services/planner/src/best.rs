@@ -31,6 +31,40 @@ pub struct Scored {
     pub source: PlanSource,
 }
 
+/// The GA's result, the shortest path and the seeds, fittest first; the earlier on a
+/// tie (the GA's first), so the first is [`best_of`]'s. A plan at a coarser planning
+/// resolution drives them in this order until one fits (`crate::plan`).
+pub fn ranked(
+    evaluator: &mut Evaluator<'_>,
+    ga: Scored,
+    shortest: &[Cell],
+    seeds: &[Vec<Cell>],
+) -> Vec<Scored> {
+    let mut all = Vec::with_capacity(2 + seeds.len());
+    all.push(ga);
+    let others = std::iter::once((PlanSource::Shortest, shortest)).chain(
+        seeds
+            .iter()
+            .enumerate()
+            .map(|(n, path)| (PlanSource::ViaSeed(n), path.as_slice())),
+    );
+    for (source, path) in others {
+        all.push(Scored {
+            evaluation: evaluator.evaluate(path),
+            path: path.to_vec(),
+            source,
+        });
+    }
+    // Stable: ties keep their order.
+    all.sort_by(|a, b| {
+        b.evaluation
+            .fitness
+            .total
+            .total_cmp(&a.evaluation.fitness.total)
+    });
+    all
+}
+
 /// The fittest of the GA's result, the shortest path and the seeds; the earlier on a
 /// tie (the GA's first), so a GA that has them all returns its own path.
 pub fn best_of(

@@ -7,6 +7,7 @@
 //! map_history: 4               # map versions kept for requests that name one
 //! information_layer: information  # or change_information: plan on the mapper's P(E>0)
 //! change_layer: change_information # optional: plan on max(information, change) (crate::coupling)
+//! planning_resolution_m: 0.2   # optional; default 0.2 (paper 000), or the map's if coarser (crate::resolution)
 //! # What one plan may cost, checked before any work (crate::limits):
 //! max_population_cells: 4000000   # population × longest path the budget allows
 //! max_plan_cost: 4000000000       # population × generations × that path length
@@ -42,6 +43,12 @@ pub struct PlannerConfig {
     /// information map: the planner plans on max(I_xy, C_xy) cell by cell
     /// ([`crate::coupling`]). Off by default.
     pub change_layer: Option<String>,
+    /// The resolution the planner plans at, metres ([`crate::resolution`]): planning
+    /// cells of a whole number of map cells, the path driven on the map's cells. Absent:
+    /// paper 000's 0.2 m, or the map's resolution where that is coarser. Finer than the
+    /// map's, or coarser than [`crate::resolution::MAX_PLANNING_RESOLUTION_M`], is
+    /// refused naming `planning_resolution_m`.
+    pub planning_resolution_m: Option<f64>,
     /// Most genes a plan's population may hold: population × the longest path its
     /// budget allows (Eq. 2, [`crate::limits`]). Refused `limit_exceeded` above it.
     pub max_population_cells: u64,
@@ -69,6 +76,7 @@ impl Default for PlannerConfig {
             map_history: 4,
             information_layer: crate::maps::INFORMATION.to_owned(),
             change_layer: None,
+            planning_resolution_m: None,
             max_population_cells: limits.max_population_cells,
             max_plan_cost: limits.max_plan_cost,
             max_plan_seconds: budget.max_plan_seconds,

@@ -11,12 +11,24 @@ use crate::world::{Cell, World};
 /// Seconds of one move of `dir` after a move of `prev_dir`.
 #[inline]
 pub fn step_time(world: &World, params: &GaParams, prev_dir: Option<usize>, dir: usize) -> f64 {
+    step_time_at(world.meta.resolution, params, prev_dir, dir)
+}
+
+/// Seconds of one move of `dir` after a move of `prev_dir` on cells of `resolution`
+/// metres (the fine map's, for the path the robot drives).
+#[inline]
+pub fn step_time_at(
+    resolution: f64,
+    params: &GaParams,
+    prev_dir: Option<usize>,
+    dir: usize,
+) -> f64 {
     let cells = if dir % 2 == 1 {
         std::f64::consts::SQRT_2
     } else {
         1.0
     };
-    let distance = cells * world.meta.resolution;
+    let distance = cells * resolution;
     let turn = prev_dir.map_or(0.0, |p| {
         let diff = p.abs_diff(dir);
         diff.min(8 - diff) as f64 * std::f64::consts::FRAC_PI_4

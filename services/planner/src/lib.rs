@@ -12,7 +12,10 @@
 //!   round-trip rule for random walks;
 //! - [`seeds`]: via-point seeds, paths through informative cells within the budget;
 //! - [`best`]: the plan is never below the shortest path or a seed;
-//! - [`search`]: the shortest-path baseline (A*, octile) and the distance field;
+//! - [`search`]: the fastest path (Eq. 2 over cell and heading: the baseline and the
+//!   budget floor), the distance-shortest path and the distance field;
+//! - [`resolution`]: the planning grid at a resolution apart from the map's, and the
+//!   path the robot drives on the map's cells;
 //! - [`limits`]: what one plan may cost (path length from Eq. 2, memory, work);
 //! - [`plan`]: one request end to end, with the checks that refuse bad requests.
 //!
@@ -35,6 +38,7 @@ pub mod maps;
 pub mod metrics;
 pub mod params;
 pub mod plan;
+pub mod resolution;
 pub mod search;
 pub mod seeds;
 pub mod service;

@@ -11,7 +11,8 @@ use roam_proto::map::Layer;
 use roam_proto::planner::MapVersion;
 
 use crate::coupling;
-use crate::world::World;
+use crate::resolution::PAPER_RESOLUTION_M;
+use crate::world::{World, WorldError};
 
 /// The layer names the planner reads.
 pub const INFLATED: &str = "inflated";
@@ -36,6 +37,11 @@ pub struct MapCache {
     /// The change layer coupled into the information map, if any, and its latest.
     change_layer: Option<String>,
     change: Option<Layer>,
+    /// The planning resolution ([`crate::resolution`]); `None`: paper 000's 0.2 m, or
+    /// the map's resolution where that is coarser.
+    planning_resolution_m: Option<f64>,
+    /// Why the latest layers gave no world, when they did not.
+    last_error: Option<WorldError>,
 }
 
 impl MapCache {
@@ -57,6 +63,24 @@ impl MapCache {
     pub fn coupling_change(mut self, change_layer: Option<&str>) -> Self {
         self.change_layer = change_layer.map(str::to_owned);
         self
+    }
+
+    /// This cache planning at `planning_resolution_m` (see the field).
+    pub fn planning_at(mut self, planning_resolution_m: Option<f64>) -> Self {
+        self.planning_resolution_m = planning_resolution_m;
+        self
+    }
+
+    /// The planning resolution for a map of `map_resolution` metres.
+    pub fn planning_resolution(&self, map_resolution: f64) -> f64 {
+        self.planning_resolution_m
+            .unwrap_or(PAPER_RESOLUTION_M.max(map_resolution))
+    }
+
+    /// Why the latest layers gave no world (e.g. a planning resolution finer than the
+    /// map's), if they did not.
+    pub fn last_error(&self) -> Option<&WorldError> {
+        self.last_error.as_ref()
     }
 
     /// The layer names this cache follows.
@@ -126,8 +150,10 @@ impl MapCache {
                 _ => info.clone(),
             },
         };
-        match World::new(&occ, &info, DEFAULT_COMPRESSION) {
+        let planning = self.planning_resolution(inflated.meta.resolution);
+        match World::at_resolution(&occ, &info, DEFAULT_COMPRESSION, planning) {
             Ok(mut world) => {
+                self.last_error = None;
                 if let Some(c) = world.clamped {
                     let (x, y, score) = c.first;
                     tracing::warn!(
@@ -151,6 +177,7 @@ impl MapCache {
             }
             Err(e) => {
                 tracing::warn!("cannot plan on map {version:?}: {e}");
+                self.last_error = Some(e);
                 None
             }
         }

@@ -25,13 +25,14 @@ use std::time::{Duration, Instant};
 use roam_proto::planner::{FitnessTerms, PlannerModel, StopReason};
 use roam_proto::{ErrorCode, ErrorReply};
 
-use crate::best::{best_of, PlanSource, Scored};
-use crate::curiosity::{Evaluator, Model};
+use crate::best::{ranked, PlanSource, Scored};
+use crate::curiosity::{Evaluation, Evaluator, Model};
 use crate::eta::path_eta;
 use crate::ga::{self, GaOptions, Problem};
 use crate::limits::{self, LimitError, PlanLimits, PlanSize};
 use crate::metrics::{path_metrics, PathMetrics};
 use crate::params::{GaParams, ParamError};
+use crate::resolution::{self, Anchor, FineCell};
 use crate::search::{distance_field, fastest_path, shortest_path};
 use crate::seeds::{self, SeedProblem, ViaSeeds};
 use crate::world::{Cell, World, MOVES};
@@ -89,7 +90,16 @@ impl PlanSpec {
 /// A plan before it becomes a message.
 #[derive(Debug, Clone)]
 pub struct PlanOutcome {
+    /// The planned path on the planning grid (the world's cells).
     pub path: Vec<Cell>,
+    /// The path the robot drives, in map cells `[x, y]`: `path` itself at the map's
+    /// resolution, else its refinement on the map's cells ([`crate::resolution::refine`]).
+    pub cells: Vec<[u32; 2]>,
+    /// The centres of `cells` in world metres.
+    pub points: Vec<[f64; 2]>,
+    /// The planning grid's resolution, metres.
+    pub planning_resolution_m: f64,
+    /// Eq. 2 on the path the robot drives (`cells`).
     pub t_eta_s: f64,
     pub reaches_goal: bool,
     pub within_budget: bool,
@@ -125,6 +135,8 @@ pub enum PlanError {
     Blocked { which: &'static str, x: f64, y: f64 },
     #[error("there is no path from the start to the goal on this map")]
     NoPath,
+    #[error("the {which} ({x}, {y}) is free on the map but in a pocket of free space that no planning cell reaches (its planning cell's free space is elsewhere, behind an obstacle thinner than a planning cell, and no neighbouring planning cell touches it); move it, or plan at a finer planning_resolution_m")]
+    Pocket { which: &'static str, x: f64, y: f64 },
     #[error("the start ({x}, {y}) is also the goal, so the plan is a round trip, but no legal move leaves the start's cell (its 8 neighbours are obstacles, their inflation, or corners that cannot be cut): no loop fits any t_exec_s; move the start to open floor, or ask model shortest to stay")]
     Enclosed { x: f64, y: f64 },
     #[error("the budget t_exec = {given_s:.1} s is {short_by_s:.1} s shorter than the fastest path's ETA of {needed_s:.1} s (Eq. 2, turns counted); give at least {needed_s:.1} s")]
@@ -173,9 +185,15 @@ impl PlanError {
     }
 }
 
-fn locate(world: &World, which: &'static str, [x, y]: [f64; 2]) -> Result<Cell, PlanError> {
-    let meta = world.meta;
-    let cell = world.cell_at(x, y).ok_or(PlanError::OffMap {
+/// Where a start or goal is: its planning cell, and on a world at a coarser planning
+/// resolution how its map cell joins that cell ([`crate::resolution::locate`]).
+fn locate(
+    world: &World,
+    which: &'static str,
+    [x, y]: [f64; 2],
+) -> Result<(Cell, Option<Anchor>), PlanError> {
+    let meta = world.fine.as_ref().map_or(world.meta, |f| f.meta);
+    let off = || PlanError::OffMap {
         which,
         x,
         y,
@@ -183,11 +201,20 @@ fn locate(world: &World, which: &'static str, [x, y]: [f64; 2]) -> Result<Cell, 
         x1: meta.origin.x + f64::from(meta.width) * meta.resolution,
         y0: meta.origin.y,
         y1: meta.origin.y + f64::from(meta.height) * meta.resolution,
-    })?;
-    if !world.is_traversable(cell) {
+    };
+    let Some(fine) = &world.fine else {
+        let cell = world.cell_at(x, y).ok_or_else(off)?;
+        if !world.is_traversable(cell) {
+            return Err(PlanError::Blocked { which, x, y });
+        }
+        return Ok((cell, None));
+    };
+    let cell = fine.cell_at(x, y).ok_or_else(off)?;
+    if !fine.is_free(cell) {
         return Err(PlanError::Blocked { which, x, y });
     }
-    Ok(cell)
+    let anchor = resolution::locate(fine, world, cell).ok_or(PlanError::Pocket { which, x, y })?;
+    Ok((anchor.cell, Some(anchor)))
 }
 
 /// Checks a request's numbers before any work.
@@ -237,6 +264,15 @@ struct Checked {
     shortest: Vec<Cell>,
     /// The GA's size; `None` for the baseline.
     size: Option<PlanSize>,
+    /// On a world at a coarser planning resolution: how the start and goal join the
+    /// planning grid, and the fastest path as the robot drives it (the floor).
+    anchors: Option<(Anchor, Anchor)>,
+    fastest_driven: Option<Vec<FineCell>>,
+    /// The budget the planning grid plans with: t_exec less what driving the fastest
+    /// path on the map's cells takes beyond its planning-grid ETA (the legs to and from
+    /// the start's and goal's map cells), so that plans fit when driven. t_exec itself
+    /// at the map's resolution.
+    planning_budget_s: f64,
 }
 
 impl Checked {
@@ -252,8 +288,8 @@ impl Checked {
 /// Everything [`plan`] refuses before any work, and the shortest path.
 fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
     check_spec(spec)?;
-    let start = locate(world, "start", spec.start)?;
-    let goal = locate(world, "goal", spec.goal)?;
+    let (start, start_anchor) = locate(world, "start", spec.start)?;
+    let (goal, goal_anchor) = locate(world, "goal", spec.goal)?;
     let params = &spec.params;
     // The GA's size, before any search: the baseline has no population to bound.
     let size = match Model::of(spec.model) {
@@ -273,7 +309,16 @@ fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
         });
     }
     let fastest = fastest_path(world, params, start, goal).ok_or(PlanError::NoPath)?;
-    let needed = path_eta(world, params, &fastest);
+    let planned_eta = path_eta(world, params, &fastest);
+    let (needed, fastest_driven, anchors) = match (&world.fine, start_anchor, goal_anchor) {
+        (Some(fine), Some(a), Some(b)) => {
+            let driven =
+                resolution::refine(fine, params, &fastest, &a, &b).ok_or(PlanError::NoPath)?;
+            (fine.eta(params, &driven), Some(driven), Some((a, b)))
+        }
+        _ => (planned_eta, None, None),
+    };
+    let planning_budget_s = spec.t_exec_s - (needed - planned_eta).max(0.0);
     if needed > spec.t_exec_s {
         return Err(PlanError::BudgetTooShort {
             given_s: spec.t_exec_s,
@@ -283,7 +328,7 @@ fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
     }
     let shortest = match size {
         Some(_) => match shortest_path(world, start, goal) {
-            Some(path) if path_eta(world, params, &path) <= spec.t_exec_s => path,
+            Some(path) if path_eta(world, params, &path) <= planning_budget_s => path,
             _ => fastest.clone(),
         },
         None => fastest.clone(),
@@ -294,6 +339,9 @@ fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
         fastest,
         shortest,
         size,
+        anchors,
+        fastest_driven,
+        planning_budget_s,
     })
 }
 
@@ -321,7 +369,7 @@ fn seeds_for(
         params: &spec.params,
         start: checked.start,
         goal: checked.goal,
-        t_exec: spec.t_exec_s,
+        t_exec: checked.planning_budget_s,
         goal_field,
         max_path_cells: checked.max_path_cells(world),
     };
@@ -341,33 +389,42 @@ pub fn plan(
     let params = &spec.params;
     let (start, goal) = (checked.start, checked.goal);
     let deadline = started + Duration::from_secs_f64(spec.deadline_s);
-    let (chosen, generations, (evaluations, evaluated_genes), stop_reason, via_seeds) =
+    let budget = checked.planning_budget_s;
+    let world_for_model;
+    let world = if Model::of(spec.model) == Some(Model::Heterogeneity)
+        && params.heuristic_compression != world.heuristic_compression
+    {
+        let mut w = world.clone();
+        w.set_heuristic_compression(params.heuristic_compression);
+        world_for_model = w;
+        &world_for_model
+    } else {
+        world
+    };
+    let (ranked, scoring, generations, (evaluations, evaluated_genes), stop_reason, via_seeds) =
         match Model::of(spec.model) {
             None => {
                 // The baseline's fitness terms are scored with Model I, the paper's best,
                 // so that they compare with the curious plans.
-                let mut evaluator =
-                    Evaluator::new(world, params, Model::Novelty, goal, spec.t_exec_s);
+                let mut evaluator = Evaluator::new(world, params, Model::Novelty, goal, budget);
                 let evaluation = evaluator.evaluate(&checked.fastest);
                 let genes = checked.fastest.len() as u64;
                 let chosen = Scored {
-                    path: checked.fastest,
+                    path: checked.fastest.clone(),
                     evaluation,
                     source: PlanSource::Shortest,
                 };
-                (chosen, 0, (1, genes), StopReason::Complete, 0)
+                let ranked = vec![chosen];
+                (
+                    ranked,
+                    Model::Novelty,
+                    0,
+                    (1, genes),
+                    StopReason::Complete,
+                    0,
+                )
             }
             Some(model) => {
-                let mut world_for_model;
-                let world = if model == Model::Heterogeneity
-                    && params.heuristic_compression != world.heuristic_compression
-                {
-                    world_for_model = world.clone();
-                    world_for_model.set_heuristic_compression(params.heuristic_compression);
-                    &world_for_model
-                } else {
-                    world
-                };
                 let field = distance_field(world, goal);
                 let stop = || cancel.load(Ordering::Relaxed) || Instant::now() >= deadline;
                 // Paper 000 to the letter (GaParams::random_walks_only): random walks
@@ -391,7 +448,7 @@ pub fn plan(
                     model,
                     start,
                     goal,
-                    t_exec: spec.t_exec_s,
+                    t_exec: budget,
                     goal_field: &field,
                     seed_paths: &seed_paths,
                 };
@@ -417,14 +474,15 @@ pub fn plan(
                     evaluation: result.evaluation,
                     source: PlanSource::Ga,
                 };
-                let chosen = if strict {
-                    ga
+                let ranked = if strict {
+                    vec![ga]
                 } else {
-                    let mut evaluator = Evaluator::new(world, params, model, goal, spec.t_exec_s);
-                    best_of(&mut evaluator, ga, &checked.shortest, &seed_paths[1..])
+                    let mut evaluator = Evaluator::new(world, params, model, goal, budget);
+                    ranked(&mut evaluator, ga, &checked.shortest, &seed_paths[1..])
                 };
                 (
-                    chosen,
+                    ranked,
+                    model,
                     result.generations,
                     (result.evaluations, result.evaluated_genes),
                     result.stop_reason,
@@ -432,21 +490,109 @@ pub fn plan(
                 )
             }
         };
-    let evaluation = chosen.evaluation;
-    let metrics = path_metrics(world, params, &chosen.path);
+    let driven = drive(world, spec, &checked, scoring, ranked);
     Ok(PlanOutcome {
-        t_eta_s: evaluation.t_eta,
-        reaches_goal: evaluation.reaches_goal,
-        within_budget: evaluation.t_eta <= spec.t_exec_s,
-        fitness: evaluation.fitness,
-        metrics,
-        path: chosen.path,
+        t_eta_s: driven.t_eta_s,
+        reaches_goal: driven.chosen.evaluation.reaches_goal,
+        within_budget: driven.t_eta_s <= spec.t_exec_s,
+        fitness: driven.chosen.evaluation.fitness,
+        metrics: driven.metrics,
+        path: driven.chosen.path,
+        cells: driven.cells,
+        points: driven.points,
+        planning_resolution_m: world.meta.resolution,
         generations,
         evaluations,
         evaluated_genes,
         planning: started.elapsed(),
         stop_reason,
-        source: chosen.source,
+        source: driven.chosen.source,
         via_seeds,
     })
+}
+
+/// The plan as the robot drives it.
+struct Driven {
+    chosen: Scored,
+    t_eta_s: f64,
+    metrics: PathMetrics,
+    cells: Vec<[u32; 2]>,
+    points: Vec<[f64; 2]>,
+}
+
+/// How many of the fittest candidates are driven on the map's cells, at most, before
+/// falling back on the fastest path (each is one search of at most `L · k² · 9` states).
+pub const MAX_DRIVEN_CANDIDATES: usize = 8;
+
+/// The fittest candidate, as driven. At the map's resolution that is `ranked[0]` as it
+/// is. At a coarser planning resolution each candidate, fittest first, is refined onto
+/// the map's cells ([`resolution::refine`]) until one fits t_exec when driven (Eq. 2 on
+/// the map's cells); the fastest path, which the budget was checked against as driven,
+/// is the last resort. Its fitness is scored on the planning cells the driven path
+/// passes through, with the time terms (Eqs. 4, 6, 7) of the driven t_ETA, and U_ges,
+/// D and the distinct information on those planning cells (Eqs. 11, 12).
+fn drive(
+    world: &World,
+    spec: &PlanSpec,
+    checked: &Checked,
+    model: Model,
+    ranked: Vec<Scored>,
+) -> Driven {
+    let params = &spec.params;
+    let (Some(fine), Some((start, goal)), Some(fastest)) =
+        (&world.fine, &checked.anchors, &checked.fastest_driven)
+    else {
+        let chosen = ranked.into_iter().next().unwrap_or_else(|| Scored {
+            path: checked.fastest.clone(),
+            evaluation: Evaluator::new(world, params, model, checked.goal, spec.t_exec_s)
+                .evaluate(&checked.fastest),
+            source: PlanSource::Shortest,
+        });
+        return Driven {
+            t_eta_s: chosen.evaluation.t_eta,
+            metrics: path_metrics(world, params, &chosen.path),
+            cells: world.grid_cells(&chosen.path),
+            points: world.centers(&chosen.path),
+            chosen,
+        };
+    };
+    let (path, source) = ranked
+        .iter()
+        .take(MAX_DRIVEN_CANDIDATES)
+        .find_map(|candidate| {
+            let driven = resolution::refine(fine, params, &candidate.path, start, goal)?;
+            (fine.eta(params, &driven) <= spec.t_exec_s).then_some((driven, candidate.source))
+        })
+        .unwrap_or_else(|| (fastest.clone(), PlanSource::Shortest));
+    let t_eta_s = fine.eta(params, &path);
+    let planned = fine.planning_cells(&path);
+    let mut evaluator = Evaluator::new(world, params, model, checked.goal, spec.t_exec_s);
+    let evaluation = with_driven_time(evaluator.evaluate(&planned), t_eta_s, params, spec.t_exec_s);
+    Driven {
+        metrics: path_metrics(world, params, &planned),
+        cells: fine.grid_cells(&path),
+        points: fine.centers(&path),
+        t_eta_s,
+        chosen: Scored {
+            path: planned,
+            evaluation,
+            source,
+        },
+    }
+}
+
+/// An evaluation with its time terms (Eqs. 4, 6, 7) recomputed for the driven t_ETA.
+fn with_driven_time(mut e: Evaluation, t: f64, params: &GaParams, t_exec: f64) -> Evaluation {
+    let f = &mut e.fitness;
+    f.f2_on_time = if t < t_exec { params.w2 } else { 0.0 };
+    f.f4_overtime = -params.w4 * (t - t_exec).max(0.0);
+    f.f5_idle = -params.w5 * (t_exec - t).max(0.0);
+    f.total = f.f1_information
+        + f.f2_on_time
+        + f.f3_goal
+        + f.f4_overtime
+        + f.f5_idle
+        + f.f6_localizability;
+    e.t_eta = t;
+    e
 }

@@ -124,7 +124,7 @@ pub fn descend_to_goal(world: &World, field: &[u32], path: &mut Vec<Cell>) -> bo
 
 /// A cost that orders by [`f64::total_cmp`], for the heaps of the time searches.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Seconds(f64);
+pub(crate) struct Seconds(pub(crate) f64);
 
 impl Eq for Seconds {}
 
@@ -249,11 +249,11 @@ pub fn fastest_path(
             reached = Some(s);
             break;
         }
-        for dir in 0..MOVES.len() {
+        for (dir, &dt) in step[heading].iter().enumerate() {
             let Some(next) = world.step(cell, dir) else {
                 continue;
             };
-            let nt = t + step[heading][dir];
+            let nt = t + dt;
             let ns = state(next, dir);
             if nt < labels.time(ns) {
                 labels.set(ns, nt, heading as u8);

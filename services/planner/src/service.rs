@@ -54,6 +54,18 @@ pub enum PlannerError {
     Service(#[from] ServiceError),
     #[error("invalid config: {0}")]
     Config(String),
+    #[error("invalid config: {0}")]
+    Setting(#[from] SettingError),
+}
+
+/// A config setting outside its range: its name (as in the config file), the value
+/// and what is allowed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{name} = {value} is out of range; use {allowed}")]
+pub struct SettingError {
+    pub name: &'static str,
+    pub value: String,
+    pub allowed: String,
 }
 
 struct State {
@@ -108,6 +120,17 @@ fn check_config(config: &PlannerConfig) -> Result<(), PlannerError> {
         }
     }
     config.budget().validate().map_err(PlannerError::Config)?;
+    if let Some(value) = config.planning_resolution_m {
+        use crate::resolution::MAX_PLANNING_RESOLUTION_M;
+        if !(value.is_finite() && value > 0.0 && value <= MAX_PLANNING_RESOLUTION_M) {
+            return Err(SettingError {
+                name: crate::resolution::LIMIT_NAME,
+                value: value.to_string(),
+                allowed: format!("(0, {MAX_PLANNING_RESOLUTION_M}] metres, at least the map's resolution (paper 000: 0.2), or leave it out"),
+            }
+            .into());
+        }
+    }
     keys::check_name("information_layer", &config.information_layer)
         .map_err(|e| PlannerError::Config(e.to_string()))?;
     if let Some(change) = &config.change_layer {
@@ -143,7 +166,8 @@ pub async fn run(
         session: service.session().clone(),
         maps: Mutex::new(
             MapCache::with_information(config.map_history, &config.information_layer)
-                .coupling_change(config.change_layer.as_deref()),
+                .coupling_change(config.change_layer.as_deref())
+                .planning_at(config.planning_resolution_m),
         ),
         in_flight: AtomicUsize::new(0),
         max_in_flight: config.max_concurrent_plans,
@@ -398,7 +422,10 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
                         ErrorCode::NotFound,
                         format!("map version {v:?} is unknown to this planner; it has {have:?}; omit map_version to plan on the latest"),
                     ),
-                    None => ErrorReply::new(ErrorCode::Unavailable, "the planner has no map yet; is the map server running under the same root?"),
+                    None => match maps.last_error() {
+                        Some(e) => ErrorReply::new(ErrorCode::Unavailable, format!("the planner cannot plan on the map it has: {e}")),
+                        None => ErrorReply::new(ErrorCode::Unavailable, "the planner has no map yet; is the map server running under the same root?"),
+                    },
                 });
             }
         }
@@ -473,13 +500,12 @@ pub fn to_message(
     instance: &str,
     outcome: PlanOutcome,
 ) -> Plan {
-    let cells = world.grid_cells(&outcome.path);
-    let points = world.centers(&outcome.path);
     Plan {
         request_id,
         model: request.model,
-        cells,
-        points,
+        cells: outcome.cells,
+        points: outcome.points,
+        planning_resolution_m: Some(world.meta.resolution),
         t_eta_s: outcome.t_eta_s,
         reaches_goal: outcome.reaches_goal,
         within_budget: outcome.within_budget,

@@ -1,5 +1,11 @@
-//! The planning grid: which cells the robot may occupy, their information scores, and
-//! the heuristic blocks of Model II.
+//! The planning grid: which cells the robot may occupy, which moves between them are
+//! legal, their information scores, and the heuristic blocks of Model II.
+//!
+//! A world is at the map's resolution ([`World::new`]) or at a coarser planning
+//! resolution derived from it ([`World::at_resolution`], [`crate::resolution`]): then
+//! it also holds the fine map it came from, on which the reply's path is driven.
+
+use std::sync::Arc;
 
 use roam_map_server::grid::{cell_center, world_to_cell, Grid};
 use roam_map_server::layers::block_size;
@@ -27,8 +33,15 @@ pub struct World {
     width: usize,
     height: usize,
     /// A cell is traversable when the inflated occupancy is free (0). Unknown cells
-    /// are not: a plan never counts on space nobody has seen.
+    /// are not: a plan never counts on space nobody has seen. (At a coarser planning
+    /// resolution: when the robot can stand in it, [`crate::resolution`].)
     traversable: Vec<bool>,
+    /// The legal moves out of each cell, bit `d` for [`MOVES`]`[d]`: onto a traversable
+    /// cell on the map, and for a diagonal without cutting a corner (both orthogonal
+    /// neighbours traversable). At a coarser planning resolution: where the fine map
+    /// has a legal step from one cell's free space into the other's
+    /// ([`crate::resolution`]). Symmetric: a legal move a → b implies b → a.
+    moves: Vec<u8>,
     /// Information scores I_xy, 0..=[`MAX_INFORMATION_SCORE`]: higher scores of the
     /// layer were clamped (see [`World::clamped`]).
     pub information: Vec<u8>,
@@ -47,6 +60,9 @@ pub struct World {
     pub localizability: Vec<f32>,
     /// Index difference of each move: `dx + dy · width`.
     move_offsets: [i64; 8],
+    /// The map this grid was derived from, when it plans at a coarser resolution than
+    /// the map's ([`World::at_resolution`]); `None` when it plans on the map's own cells.
+    pub fine: Option<Arc<crate::resolution::FineMap>>,
 }
 
 /// The highest information score I_xy (paper 000's scores, the map server's
@@ -69,6 +85,39 @@ pub struct Clamped {
     pub first: (usize, usize, u8),
 }
 
+/// The legal moves of every cell of a `w × h` grid (see [`World`]'s `moves`): onto a
+/// traversable cell on the map, diagonals without cutting a corner.
+pub(crate) fn grid_moves(w: usize, h: usize, traversable: &[bool]) -> Vec<u8> {
+    let mut moves = vec![0u8; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            if !traversable[y * w + x] {
+                // A cell the robot cannot stand on has no moves out: only a start there
+                // could use them, and a start there is refused.
+                continue;
+            }
+            let free = |x: i64, y: i64| {
+                x >= 0
+                    && y >= 0
+                    && x < w as i64
+                    && y < h as i64
+                    && traversable[y as usize * w + x as usize]
+            };
+            let mut mask = 0u8;
+            for (d, &(dx, dy)) in MOVES.iter().enumerate() {
+                let (nx, ny) = (x as i64 + i64::from(dx), y as i64 + i64::from(dy));
+                if free(nx, ny)
+                    && (dx == 0 || dy == 0 || (free(nx, y as i64) && free(x as i64, ny)))
+                {
+                    mask |= 1 << d;
+                }
+            }
+            moves[y * w + x] = mask;
+        }
+    }
+    moves
+}
+
 /// The PEB a cell without a position fix counts as in the localizability cost, metres:
 /// large against the decimetres of a covered area, finite so paths still compare.
 pub const MAX_LOCALIZABILITY_COST_M: f32 = 10.0;
@@ -80,6 +129,8 @@ pub enum WorldError {
     SizeMismatch(u32, u32, u32, u32),
     #[error("the map has no cells")]
     Empty,
+    #[error(transparent)]
+    Resolution(#[from] crate::resolution::ResolutionError),
 }
 
 impl World {
@@ -102,7 +153,63 @@ impl World {
         if w == 0 || h == 0 {
             return Err(WorldError::Empty);
         }
-        let traversable = inflated.cells.iter().map(|&c| c == 0).collect();
+        let traversable: Vec<bool> = inflated.cells.iter().map(|&c| c == 0).collect();
+        let moves = grid_moves(w, h, &traversable);
+        World::from_parts(
+            inflated.meta,
+            traversable,
+            moves,
+            information,
+            heuristic_compression,
+            None,
+        )
+    }
+
+    /// The planning grid of `inflated` and `information` at `planning_resolution_m`
+    /// ([`crate::resolution`]): the map's own cells when that is the map's resolution
+    /// (to rounding, [`crate::resolution::cell_factor`]), else cells of a whole number
+    /// of map cells, holding the fine map to drive on. A planning resolution finer than
+    /// the map's or coarser than [`crate::resolution::MAX_PLANNING_RESOLUTION_M`] is
+    /// refused naming the limit.
+    pub fn at_resolution(
+        inflated: &Grid<i8>,
+        information: &Grid<u8>,
+        heuristic_compression: f64,
+        planning_resolution_m: f64,
+    ) -> Result<World, WorldError> {
+        let factor =
+            crate::resolution::cell_factor(inflated.meta.resolution, planning_resolution_m)?;
+        if factor == 1 {
+            return World::new(inflated, information, heuristic_compression);
+        }
+        if (information.width(), information.height()) != (inflated.width(), inflated.height()) {
+            return Err(WorldError::SizeMismatch(
+                inflated.meta.width,
+                inflated.meta.height,
+                information.meta.width,
+                information.meta.height,
+            ));
+        }
+        if inflated.width() == 0 || inflated.height() == 0 {
+            return Err(WorldError::Empty);
+        }
+        crate::resolution::coarse_world(inflated, information, heuristic_compression, factor)
+    }
+
+    /// A world from its parts: what [`World::new`] and [`crate::resolution`] build.
+    /// Scores above [`MAX_INFORMATION_SCORE`] are clamped and reported in `clamped`.
+    pub(crate) fn from_parts(
+        meta: GridMeta,
+        traversable: Vec<bool>,
+        moves: Vec<u8>,
+        information: &Grid<u8>,
+        heuristic_compression: f64,
+        fine: Option<Arc<crate::resolution::FineMap>>,
+    ) -> Result<World, WorldError> {
+        let (w, h) = (meta.width as usize, meta.height as usize);
+        if w == 0 || h == 0 {
+            return Err(WorldError::Empty);
+        }
         let over = information
             .cells
             .iter()
@@ -117,10 +224,11 @@ impl World {
                 first: (i % w, i / w, information.cells[i]),
             });
         let mut world = World {
-            meta: inflated.meta,
+            meta,
             width: w,
             height: h,
             traversable,
+            moves,
             information: information
                 .cells
                 .iter()
@@ -135,29 +243,32 @@ impl World {
             move_offsets: std::array::from_fn(|d| {
                 i64::from(MOVES[d].0) + i64::from(MOVES[d].1) * w as i64
             }),
+            fine,
         };
         world.set_heuristic_compression(heuristic_compression);
         Ok(world)
     }
 
-    /// Sets the PEB per cell for the localizability cost (row-major, the world's size;
-    /// anything else clears it). NaN and values above [`MAX_LOCALIZABILITY_COST_M`]
-    /// (an unbounded PEB: no fix there) count as that cap.
+    /// Sets the PEB per cell for the localizability cost (row-major, the world's size,
+    /// or the fine map's on a world at a coarser planning resolution, where a planning
+    /// cell takes the worst PEB of the free space it stands for; anything else clears
+    /// it). NaN and values above [`MAX_LOCALIZABILITY_COST_M`] (an unbounded PEB: no fix
+    /// there) count as that cap.
     pub fn set_localizability(&mut self, peb: &[f32]) {
-        if peb.len() != self.cell_count() {
+        let capped = |v: f32| {
+            if v.is_nan() {
+                MAX_LOCALIZABILITY_COST_M
+            } else {
+                v.clamp(0.0, MAX_LOCALIZABILITY_COST_M)
+            }
+        };
+        if peb.len() == self.cell_count() {
+            self.localizability = peb.iter().map(|&v| capped(v)).collect();
+        } else if let Some(fine) = self.fine.as_ref().filter(|f| f.cell_count() == peb.len()) {
+            self.localizability = fine.worst_per_cell(peb, capped, self.cell_count());
+        } else {
             self.localizability.clear();
-            return;
         }
-        self.localizability = peb
-            .iter()
-            .map(|&v| {
-                if v.is_nan() {
-                    MAX_LOCALIZABILITY_COST_M
-                } else {
-                    v.clamp(0.0, MAX_LOCALIZABILITY_COST_M)
-                }
-            })
-            .collect();
     }
 
     /// Recomputes the heuristic blocks for compression `c_h` (see
@@ -250,24 +361,16 @@ impl World {
     /// not cutting a corner (both orthogonal neighbours traversable).
     #[inline]
     pub fn step(&self, from: Cell, dir: usize) -> Option<Cell> {
-        let (dx, dy) = MOVES[dir];
-        let (x, y) = self.xy(from);
-        let (nx, ny) = (x as i64 + i64::from(dx), y as i64 + i64::from(dy));
-        if nx < 0 || ny < 0 || nx >= self.width as i64 || ny >= self.height as i64 {
-            return None;
-        }
-        let to = self.cell(nx as usize, ny as usize);
-        if !self.traversable[to as usize] {
-            return None;
-        }
-        if dx != 0 && dy != 0 {
-            let side_a = self.cell(nx as usize, y);
-            let side_b = self.cell(x, ny as usize);
-            if !self.traversable[side_a as usize] || !self.traversable[side_b as usize] {
-                return None;
-            }
-        }
-        Some(to)
+        let mask = *self.moves.get(from as usize)?;
+        (mask & (1 << dir) != 0).then(|| (i64::from(from) + self.move_offsets[dir]) as Cell)
+    }
+
+    /// The resolution the robot drives at: the fine map's when this world plans at a
+    /// coarser one, else its own.
+    pub fn map_resolution(&self) -> f64 {
+        self.fine
+            .as_ref()
+            .map_or(self.meta.resolution, |f| f.meta.resolution)
     }
 
     /// The direction index of the move from `a` to `b` if they are 8-neighbours.
