@@ -28,8 +28,10 @@ pub enum ErrorCode {
     CorruptFile,
     /// The service is shutting down; try again later or elsewhere.
     Unavailable,
-    /// The service has as much work in flight as its limit allows; try another
-    /// instance or later. Never queued: the refusal is immediate.
+    /// The service has as much work in flight as its limit allows, or (a planner)
+    /// cannot serve the request from its queue within the request's deadline; try
+    /// another instance or later. The refusal is immediate; `expected_wait_s` says how
+    /// long the service expects it would have been.
     Busy,
     /// A bug or an I/O failure on the service's side; the message says what failed.
     Internal,
@@ -76,6 +78,11 @@ pub struct ErrorReply {
     pub message: String,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub limit: Option<LimitHit>,
+    /// With `busy`: the seconds the service expects before it could serve the request
+    /// (a queue's expected wait, a budget's refill), so a client can choose another
+    /// instance or retry then.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub expected_wait_s: Option<f64>,
 }
 
 impl ErrorReply {
@@ -84,12 +91,23 @@ impl ErrorReply {
             code,
             message: message.into(),
             limit: None,
+            expected_wait_s: None,
         }
     }
 
     /// The same reply with another code (e.g. `busy` for a limit on work in flight).
     pub fn with_code(mut self, code: ErrorCode) -> Self {
         self.code = code;
+        self
+    }
+
+    /// The same reply with the service's expected wait (see `expected_wait_s`).
+    pub fn with_expected_wait(mut self, seconds: f64) -> Self {
+        self.expected_wait_s = Some(if seconds.is_finite() {
+            seconds.max(0.0)
+        } else {
+            f64::MAX
+        });
         self
     }
 
@@ -103,6 +121,7 @@ impl ErrorReply {
                 max,
                 actual,
             }),
+            expected_wait_s: None,
         }
     }
 }
@@ -116,6 +135,9 @@ impl std::fmt::Display for ErrorReply {
                 " (limit {}: at most {}, got {})",
                 limit.name, limit.max, limit.actual
             )?;
+        }
+        if let Some(wait) = self.expected_wait_s {
+            write!(f, " (expected wait {wait:.2} s)")?;
         }
         Ok(())
     }

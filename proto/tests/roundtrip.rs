@@ -105,11 +105,14 @@ fn error_reply() -> impl Strategy<Value = ErrorReply> {
             actual,
         }),
     );
-    (code, ".{0,80}", limit).prop_map(|(code, message, limit)| ErrorReply {
-        code,
-        message,
-        limit,
-    })
+    (code, ".{0,80}", limit, prop::option::of(0.0..1e6f64)).prop_map(
+        |(code, message, limit, expected_wait_s)| ErrorReply {
+            code,
+            message,
+            limit,
+            expected_wait_s,
+        },
+    )
 }
 
 fn round_trips<T: Message + PartialEq + std::fmt::Debug>(message: &T) {

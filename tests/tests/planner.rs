@@ -301,7 +301,7 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
     assert!(
         short
             .message
-            .contains("shorter than the shortest path's ETA"),
+            .contains("shorter than the fastest path's ETA"),
         "{}",
         short.message
     );
@@ -628,6 +628,9 @@ async fn progress_is_published_and_a_plan_can_be_cancelled() {
     running.stop().await;
 }
 
+/// A request that cannot make its deadline behind the plan in progress is refused
+/// `busy` at once, with the instance's expected wait (issue 16: what can wait is
+/// queued; `tests/planner_scale.rs`).
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_full_planner_refuses_at_once_with_busy() {
     let running = boot(&[("tiny", 1)]).await;
@@ -637,16 +640,21 @@ async fn a_full_planner_refuses_at_once_with_busy() {
     let (subscriber, pending) = start_endless_plan(&client, &root, id, Some(TOKEN_A)).await;
     planning(&subscriber).await;
     let started = std::time::Instant::now();
-    let busy = refusal(&client, &root, &request([-8.0, -8.0], [6.0, -7.0], 80.0, 5)).await;
+    let hurried = PlanRequest {
+        deadline_s: 2.0,
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 5)
+    };
+    let busy = refusal(&client, &root, &hurried).await;
     assert_eq!(busy.code, ErrorCode::Busy);
     assert!(
         started.elapsed() < Duration::from_secs(2),
         "refused at once, not queued"
     );
-    assert_eq!(
-        busy.limit.map(|l| l.name),
-        Some("max_concurrent_plans".to_owned())
-    );
+    let wait = busy
+        .expected_wait_s
+        .expect("the expected wait is in the error");
+    assert!(wait > 2.0, "{busy}");
+    assert!(busy.message.contains("deadline_s"), "{}", busy.message);
     cancel(&client, &root, id, Some(TOKEN_A)).await;
     within("hog", pending).await.expect("join").expect("plan");
     running.stop().await;

@@ -5,6 +5,7 @@
 //! naming the limit. Real map server and planners in process, used only as a client.
 
 use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
 
 use roam_map_server::layers::inflate;
 use roam_map_server::store::DEFAULT_LIMITS;
@@ -12,8 +13,10 @@ use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_planner::PlannerConfig;
-use roam_proto::keys;
-use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
+use roam_proto::planner::{
+    CancelPlan, GaOverrides, Plan, PlanProgress, PlanRequest, PlannerModel, StopReason,
+};
+use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::{ClientError, Requester};
 use roam_tests::{repo_path, within, Harness, RunningService};
 
@@ -156,4 +159,293 @@ async fn a_coarse_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
     let again = ask(&client, &root, &req).await.expect("plan");
     assert_eq!(again.cells, remote.cells);
     running.stop().await;
+}
+
+type Replies = zenoh::handlers::FifoChannelHandler<zenoh::query::Reply>;
+
+/// Sends `request` on `instance`'s own key; returns once the query is out, so queries
+/// sent one after another from one session arrive in that order.
+async fn dispatch(
+    session: &zenoh::Session,
+    root: &str,
+    instance: &str,
+    request: &PlanRequest,
+) -> Replies {
+    within(
+        "send",
+        session
+            .get(keys::planner_plan_at(root, instance))
+            .payload(encode(request))
+            .timeout(Duration::from_secs(120)),
+    )
+    .await
+    .expect("query sent")
+}
+
+/// The answer in `replies`, and when it came.
+async fn answer(replies: Replies) -> (Result<Plan, ErrorReply>, Instant) {
+    let reply = tokio::time::timeout(Duration::from_secs(120), replies.recv_async())
+        .await
+        .expect("an answer within 120 s")
+        .expect("a reply");
+    let at = Instant::now();
+    let result = match reply.result() {
+        Ok(sample) => Ok(decode::<Plan>(&sample.payload().to_bytes()).expect("plan")),
+        Err(error) => Err(decode::<ErrorReply>(&error.payload().to_bytes()).expect("error")),
+    };
+    (result, at)
+}
+
+const TOKEN: &str = "0123456789abcdef0123456789abcdef";
+
+async fn cancel(session: &zenoh::Session, root: &str, id: &str) {
+    within(
+        "cancel",
+        session.put(
+            keys::planner_cancel(root, id),
+            encode(&CancelPlan {
+                request_id: id.to_owned(),
+                token: Some(TOKEN.to_owned()),
+            }),
+        ),
+    )
+    .await
+    .expect("cancel put");
+}
+
+/// One plan at a time: behind a plan in progress, four requests with 60 s deadlines
+/// wait in the queue and are answered in the order they arrived, each within its
+/// deadline; a request whose deadline the queue cannot make is refused `busy` at once
+/// with the expected wait; a cancel reaches a queued request, which is answered at once
+/// (the fastest path, `stop_reason: cancelled`, no generations) while the plan ahead
+/// of it still runs.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn queued_requests_are_answered_in_order_and_a_late_one_is_refused_at_once() {
+    let running = boot(
+        None,
+        vec![PlannerConfig {
+            max_concurrent_plans: 1,
+            ..planner("one")
+        }],
+    )
+    .await;
+    let root = running.harness.root.clone();
+    let session = running.harness.client().await.session().clone();
+    // A plan that runs until it is cancelled (50,000 generations: a cost of 2e9, about
+    // 20 s at the rate an instance assumes before it has measured one).
+    let hog = PlanRequest {
+        request_id: Some("hog".into()),
+        cancel_token: Some(TOKEN.into()),
+        params: GaOverrides {
+            max_generations: Some(50_000),
+            ..GaOverrides::default()
+        },
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 1)
+    };
+    let progress = within(
+        "subscribe",
+        session.declare_subscriber(keys::planner_progress(&root, "hog")),
+    )
+    .await
+    .expect("subscriber");
+    let hog_replies = dispatch(&session, &root, "one", &hog).await;
+    within("the hog plans", progress.recv_async())
+        .await
+        .expect("progress");
+
+    let sent = Instant::now();
+    let mut queued = Vec::new();
+    for k in 0..4 {
+        let req = PlanRequest {
+            request_id: Some(format!("queued-{k}")),
+            seed: k,
+            ..request([-8.0, -8.0], [-2.0, 4.0], 60.0, 30)
+        };
+        // Each answer is stamped as it arrives, whatever order they are read in.
+        let replies = dispatch(&session, &root, "one", &req).await;
+        queued.push(tokio::spawn(answer(replies)));
+    }
+    // Cannot make 2 s behind a plan expected to take 20 s: refused at once.
+    let hurried = PlanRequest {
+        request_id: Some("hurried".into()),
+        deadline_s: 2.0,
+        ..request([-8.0, -8.0], [-2.0, 4.0], 60.0, 30)
+    };
+    let asked = Instant::now();
+    let (refused, at) = answer(dispatch(&session, &root, "one", &hurried).await).await;
+    let refused = refused.expect_err("refused");
+    assert_eq!(refused.code, ErrorCode::Busy, "{refused}");
+    assert!(at - asked < Duration::from_secs(2), "refused at once");
+    assert!(
+        refused.expected_wait_s.is_some_and(|w| w > 2.0),
+        "{refused}"
+    );
+
+    // A cancellable request, queued last, then cancelled: out of the queue at once.
+    let doomed = PlanRequest {
+        request_id: Some("doomed".into()),
+        cancel_token: Some(TOKEN.into()),
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 30)
+    };
+    let doomed_progress = within(
+        "subscribe",
+        session.declare_subscriber(keys::planner_progress(&root, "doomed")),
+    )
+    .await
+    .expect("subscriber");
+    let doomed_replies = dispatch(&session, &root, "one", &doomed).await;
+    // A queued request's progress says so: an empty batch.
+    let queued_note = within("queued", doomed_progress.recv_async())
+        .await
+        .expect("progress");
+    let note: PlanProgress = decode(&queued_note.payload().to_bytes()).expect("progress");
+    assert!(note.best_fitness.is_empty() && !note.done);
+    cancel(&session, &root, "doomed").await;
+    let (doomed, _) = answer(doomed_replies).await;
+    let doomed = doomed.expect("a cancelled queued request gets its floor");
+    assert_eq!(doomed.stop_reason, StopReason::Cancelled);
+    assert_eq!(doomed.generations, 0);
+    assert!(doomed.within_budget && doomed.reaches_goal);
+    assert!(
+        matches!(hog_replies.try_recv(), Ok(None)),
+        "the plan ahead of it still runs"
+    );
+
+    cancel(&session, &root, "hog").await;
+    let (hog, _) = answer(hog_replies).await;
+    assert_eq!(hog.expect("hog").stop_reason, StopReason::Cancelled);
+    let mut times = Vec::new();
+    for (k, pending) in queued.into_iter().enumerate() {
+        let (plan, at) = within("a queued answer", pending).await.expect("join");
+        let plan = plan.unwrap_or_else(|e| panic!("queued-{k}: {e}"));
+        assert_eq!(plan.request_id, format!("queued-{k}"));
+        assert_eq!(plan.stop_reason, StopReason::MaxGenerations, "{k}");
+        assert!(at - sent < Duration::from_secs(60), "within its deadline");
+        times.push(at);
+    }
+    assert!(times.windows(2).all(|w| w[0] <= w[1]), "answered in order");
+    running.stop().await;
+}
+
+/// A queue length of 0 or 10⁹ and an absurd planning resolution are refused at startup,
+/// naming the setting and what is allowed.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn bad_queue_lengths_and_planning_resolutions_are_refused_naming_the_limit() {
+    use roam_planner::service::{check_config, PlannerError};
+    for (config, name) in [
+        (
+            PlannerConfig {
+                max_queued_plans: 0,
+                ..PlannerConfig::default()
+            },
+            "max_queued_plans",
+        ),
+        (
+            PlannerConfig {
+                max_queued_plans: 1_000_000_000,
+                ..PlannerConfig::default()
+            },
+            "max_queued_plans",
+        ),
+        (
+            PlannerConfig {
+                planning_resolution_m: Some(50.0),
+                ..PlannerConfig::default()
+            },
+            "planning_resolution_m",
+        ),
+        (
+            PlannerConfig {
+                planning_resolution_m: Some(0.0),
+                ..PlannerConfig::default()
+            },
+            "planning_resolution_m",
+        ),
+    ] {
+        match check_config(&config) {
+            Err(PlannerError::Setting(e)) => {
+                assert_eq!(e.name, name);
+                assert!(
+                    e.to_string().contains(name) && e.to_string().contains("use "),
+                    "{e}"
+                );
+            }
+            other => panic!("{name}: {other:?}"),
+        }
+        // The service refuses to start with it, before it opens a session.
+        let harness = Harness::start().await;
+        let outcome = within(
+            "a refused start",
+            roam_planner::run(
+                config,
+                harness.client_config(),
+                tokio_util::sync::CancellationToken::new(),
+            ),
+        )
+        .await;
+        assert!(
+            matches!(outcome, Err(PlannerError::Setting(_))),
+            "{outcome:?}"
+        );
+        harness.close().await;
+    }
+    let limit = roam_planner::queue::MAX_QUEUED_PLANS;
+    let edge = PlannerConfig {
+        max_queued_plans: limit,
+        ..PlannerConfig::default()
+    };
+    assert!(check_config(&edge).is_ok());
+}
+
+/// A planning resolution finer than the map's: the planner has no world to plan on, and
+/// says why in every refusal, naming the setting and the map's resolution.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_planning_resolution_finer_than_the_map_is_refused_in_every_reply() {
+    let harness = Harness::start().await;
+    let map_server = harness
+        .start_map_server(roam_map_server::MapServerConfig {
+            map: Some(repo_path(DEPOT)),
+            ..harness.map_server_config()
+        })
+        .await;
+    let config = PlannerConfig {
+        root: harness.root.clone(),
+        planning_resolution_m: Some(0.02),
+        ..planner("fine")
+    };
+    let cancel = tokio_util::sync::CancellationToken::new();
+    let service = tokio::spawn(roam_planner::run(
+        config,
+        harness.client_config(),
+        cancel.clone(),
+    ));
+    let client = harness.client().await;
+    // The planner answers on the shared key before it has a world; ask until it says why.
+    let mut reason = None;
+    for _ in 0..100 {
+        match client
+            .request::<PlanRequest, Plan>(
+                &keys::planner_plan(&harness.root),
+                Some(&request([3.0, 8.0], [20.0, 9.0], 80.0, 5)),
+            )
+            .await
+        {
+            Err(ClientError::Refused(e)) if e.message.contains("planning_resolution_m") => {
+                reason = Some(e);
+                break;
+            }
+            Err(_) => tokio::time::sleep(Duration::from_millis(100)).await,
+            Ok(plan) => panic!("planned at {:?}", plan.planning_resolution_m),
+        }
+    }
+    let reason = reason.expect("a refusal naming planning_resolution_m");
+    assert_eq!(reason.code, ErrorCode::Unavailable);
+    assert!(reason.message.contains("0.05 m"), "{}", reason.message);
+    cancel.cancel();
+    within("planner stops", service)
+        .await
+        .expect("join")
+        .expect("stops");
+    map_server.stop().await.1.expect("map server stops");
+    harness.close().await;
 }

@@ -3,7 +3,8 @@
 //! ```yaml
 //! root: roam
 //! instance: planner-a          # default: the Zenoh session id
-//! max_concurrent_plans: 2      # more are refused at once with `busy`
+//! max_concurrent_plans: 2      # plans computed at once; the next ones queue
+//! max_queued_plans: 64         # 1..=10000; a request that cannot make its deadline is refused `busy` at once
 //! map_history: 4               # map versions kept for requests that name one
 //! information_layer: information  # or change_information: plan on the mapper's P(E>0)
 //! change_layer: change_information # optional: plan on max(information, change) (crate::coupling)
@@ -28,9 +29,13 @@ use crate::limits::PlanLimits;
 pub struct PlannerConfig {
     pub root: String,
     pub instance: Option<String>,
-    /// Plans computed at once by this instance; the next request is refused with
-    /// `busy` immediately, never queued.
+    /// Plans computed at once by this instance; the next requests wait in its queue
+    /// ([`crate::queue`]).
     pub max_concurrent_plans: usize,
+    /// Requests the queue holds at most (1..=[`crate::queue::MAX_QUEUED_PLANS`]); a
+    /// request is admitted when its expected wait plus planning fits its deadline, and
+    /// refused `busy` at once otherwise, with the expected wait.
+    pub max_queued_plans: usize,
     /// How many map versions to keep for requests that name a `map_version`.
     pub map_history: usize,
     /// The u8 layer the planner takes as paper 000's information map I_xy: the map
@@ -73,6 +78,7 @@ impl Default for PlannerConfig {
             root: roam_proto::keys::DEFAULT_ROOT.to_owned(),
             instance: None,
             max_concurrent_plans: 2,
+            max_queued_plans: 64,
             map_history: 4,
             information_layer: crate::maps::INFORMATION.to_owned(),
             change_layer: None,

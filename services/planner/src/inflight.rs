@@ -10,10 +10,14 @@ use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
+use tokio_util::sync::CancellationToken;
+
 use crate::token::tokens_match;
 
 struct Entry {
     stop: Arc<AtomicBool>,
+    /// Cancelled with `stop`: wakes a request waiting in the queue.
+    wake: CancellationToken,
     token: Option<String>,
 }
 
@@ -57,26 +61,29 @@ impl InFlight {
         roam_runtime::lock(&self.plans)
     }
 
-    /// Registers a plan; returns the flag that stops it. A request id already in flight
+    /// Registers a plan (queued or planning); returns the flag that stops it and the
+    /// token that wakes it while it waits in the queue. A request id already in flight
     /// is refused.
     pub fn register(
         &self,
         request_id: &str,
         token: Option<String>,
-    ) -> Result<Arc<AtomicBool>, AlreadyInFlight> {
+    ) -> Result<(Arc<AtomicBool>, CancellationToken), AlreadyInFlight> {
         let mut plans = self.lock();
         if plans.contains_key(request_id) {
             return Err(AlreadyInFlight);
         }
         let stop = Arc::new(AtomicBool::new(false));
+        let wake = CancellationToken::new();
         plans.insert(
             request_id.to_owned(),
             Entry {
                 stop: stop.clone(),
+                wake: wake.clone(),
                 token,
             },
         );
-        Ok(stop)
+        Ok((stop, wake))
     }
 
     /// Forgets a plan (it has ended).
@@ -99,6 +106,7 @@ impl InFlight {
         };
         if tokens_match(expected, given) {
             entry.stop.store(true, Ordering::Relaxed);
+            entry.wake.cancel();
             CancelVerdict::Cancelled
         } else {
             CancelVerdict::WrongToken
@@ -109,6 +117,7 @@ impl InFlight {
     pub fn stop_all(&self) {
         for entry in self.lock().values() {
             entry.stop.store(true, Ordering::Relaxed);
+            entry.wake.cancel();
         }
     }
 
@@ -130,7 +139,7 @@ mod tests {
     #[test]
     fn only_the_requesters_token_cancels() {
         let inflight = InFlight::default();
-        let stop = inflight
+        let (stop, wake) = inflight
             .register("trip", Some(TOKEN.into()))
             .expect("registered");
         assert_eq!(
@@ -143,17 +152,19 @@ mod tests {
             CancelVerdict::Unknown
         );
         assert!(!stop.load(Ordering::Relaxed), "refused cancels do nothing");
+        assert!(!wake.is_cancelled());
         assert_eq!(
             inflight.cancel("trip", Some(TOKEN)),
             CancelVerdict::Cancelled
         );
         assert!(stop.load(Ordering::Relaxed));
+        assert!(wake.is_cancelled(), "a queued request wakes");
     }
 
     #[test]
     fn a_plan_without_a_token_cannot_be_cancelled_but_stops_at_shutdown() {
         let inflight = InFlight::default();
-        let stop = inflight.register("open", None).expect("registered");
+        let (stop, wake) = inflight.register("open", None).expect("registered");
         assert_eq!(
             inflight.cancel("open", Some(TOKEN)),
             CancelVerdict::NotCancellable
@@ -161,7 +172,7 @@ mod tests {
         assert_eq!(inflight.cancel("open", None), CancelVerdict::NotCancellable);
         assert!(!stop.load(Ordering::Relaxed));
         inflight.stop_all();
-        assert!(stop.load(Ordering::Relaxed));
+        assert!(stop.load(Ordering::Relaxed) && wake.is_cancelled());
     }
 
     #[test]

@@ -20,6 +20,7 @@
 //! - [`plan`]: one request end to end, with the checks that refuse bad requests.
 //!
 //! [`service`] is the thin Zenoh adapter, with what it needs against other clients:
+//! [`queue`] (a bounded queue served in order, admission by expected wait),
 //! [`budget`] (the CPU budget across clients), [`token`] and [`inflight`] (request
 //! ids, cancel tokens, who may cancel); bounded logs and echoes of untrusted input come
 //! from `roam_runtime::warn_limit` and `roam_proto::excerpt`, shared by every service.
@@ -38,6 +39,7 @@ pub mod maps;
 pub mod metrics;
 pub mod params;
 pub mod plan;
+pub mod queue;
 pub mod resolution;
 pub mod search;
 pub mod seeds;

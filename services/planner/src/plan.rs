@@ -251,6 +251,25 @@ pub fn check_spec(spec: &PlanSpec) -> Result<(), PlanError> {
     Ok(())
 }
 
+/// The work of a plan for the queue ([`crate::queue::units`]): its GA's cost
+/// ([`crate::limits`], 0 for the baseline), or the limit it exceeds.
+pub fn work(world: &World, spec: &PlanSpec) -> Result<f64, PlanError> {
+    let cost = match Model::of(spec.model) {
+        Some(_) => {
+            limits::check(
+                &spec.params,
+                world.meta.resolution,
+                spec.t_exec_s,
+                world.cell_count(),
+                &spec.limits,
+            )?
+            .cost
+        }
+        None => 0,
+    };
+    Ok(crate::queue::units(cost))
+}
+
 /// A request that passed every check before planning.
 struct Checked {
     start: Cell,

@@ -14,13 +14,13 @@
 //! cancel is [`crate::inflight`]'s.
 
 use roam_runtime::Delivery;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use roam_proto::excerpt;
 use roam_proto::map::Layer;
-use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, StopReason};
+use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, PlannerModel, StopReason};
 use roam_proto::{keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, Requester, Service, ServiceError};
@@ -34,6 +34,7 @@ use crate::limits::PlanLimits;
 use crate::maps::MapCache;
 use crate::params::GaParams;
 use crate::plan::{check_spec, plan, PlanOutcome, PlanSpec};
+use crate::queue::{PlanQueue, QueueConfig, Refusal, Turn, MAX_QUEUED_PLANS};
 use crate::token;
 use crate::world::World;
 
@@ -73,8 +74,10 @@ struct State {
     instance: String,
     session: zenoh::Session,
     maps: Mutex<MapCache>,
-    in_flight: AtomicUsize,
-    max_in_flight: usize,
+    /// Plans running and queued (`max_concurrent_plans`, `max_queued_plans`).
+    queue: PlanQueue,
+    /// Plan requests received so far: each one's number is its place in the queue.
+    arrivals: AtomicU64,
     plans: InFlight,
     limits: PlanLimits,
     budget: CpuBudget,
@@ -88,28 +91,35 @@ impl State {
     }
 }
 
-/// Frees a plan slot and its entry in the table of plans in flight however the plan
-/// ends.
-struct Slot<'a> {
-    state: &'a State,
-    request_id: Option<String>,
+/// Removes a request from the table of plans in flight however it ends.
+struct Registration<'a> {
+    plans: &'a InFlight,
+    request_id: String,
 }
 
-impl Drop for Slot<'_> {
+impl Drop for Registration<'_> {
     fn drop(&mut self) {
-        if let Some(id) = &self.request_id {
-            self.state.plans.remove(id);
-        }
-        self.state.in_flight.fetch_sub(1, Ordering::AcqRel);
+        self.plans.remove(&self.request_id);
     }
 }
 
 /// Checks the config's numbers; names the first that is wrong.
-fn check_config(config: &PlannerConfig) -> Result<(), PlannerError> {
+pub fn check_config(config: &PlannerConfig) -> Result<(), PlannerError> {
     if config.max_concurrent_plans == 0 {
         return Err(PlannerError::Config(
             "max_concurrent_plans must be at least 1".into(),
         ));
+    }
+    if !(1..=MAX_QUEUED_PLANS).contains(&config.max_queued_plans) {
+        return Err(SettingError {
+            name: "max_queued_plans",
+            value: config.max_queued_plans.to_string(),
+            allowed: format!(
+                "1..={MAX_QUEUED_PLANS} requests (each holds up to {} KiB while it waits)",
+                MAX_REQUEST_BYTES / 1024
+            ),
+        }
+        .into());
     }
     for (name, value) in [
         ("max_plan_cost", config.max_plan_cost),
@@ -169,8 +179,11 @@ pub async fn run(
                 .coupling_change(config.change_layer.as_deref())
                 .planning_at(config.planning_resolution_m),
         ),
-        in_flight: AtomicUsize::new(0),
-        max_in_flight: config.max_concurrent_plans,
+        queue: PlanQueue::new(QueueConfig {
+            max_concurrent_plans: config.max_concurrent_plans,
+            max_queued_plans: config.max_queued_plans,
+        }),
+        arrivals: AtomicU64::new(0),
         plans: InFlight::default(),
         limits: config.limits(),
         budget: CpuBudget::new(config.budget(), Instant::now()),
@@ -217,14 +230,17 @@ pub async fn run(
     let own = service
         .declare_queryable(&keys::planner_plan_at(root, service.instance()))
         .await?;
-    service.serve(shared, state.clone(), |s, q| async move {
-        answer_plan(s, q).await
-    });
-    service.serve(
-        own,
-        state.clone(),
-        |s, q| async move { answer_plan(s, q).await },
-    );
+    // Each request in the queue holds its query: room for all of them, and for the
+    // refusals of a burst, which are answered at once.
+    let max_in_flight = config.max_concurrent_plans + config.max_queued_plans + 64;
+    for queryable in [shared, own] {
+        service.serve_up_to(queryable, max_in_flight, state.clone(), |s, q| {
+            // Arrival order, taken as the query is received: the queue serves in it.
+            let seq = s.arrivals.fetch_add(1, Ordering::Relaxed);
+            let arrived = Instant::now();
+            async move { answer_plan(s, q, seq, arrived).await }
+        });
+    }
     // The liveliness token means "ready to plan", so it waits for the first map.
     loop {
         if state.maps().world(None).is_some() {
@@ -314,24 +330,228 @@ async fn fetch_maps(state: Arc<State>, requester: Requester, cancel: Cancellatio
     }
 }
 
-async fn answer_plan(state: Arc<State>, query: Query) {
+async fn answer_plan(state: Arc<State>, query: Query, seq: u64, arrived: Instant) {
     let request = match reply::decode_request::<PlanRequest>(&query, MAX_REQUEST_BYTES) {
         Ok(r) => r,
         // The codec's refusals quote the payload only as a bounded excerpt.
         Err(e) => return reply::send_error(&query, &e).await,
     };
-    let result = tokio::task::spawn_blocking({
-        let state = state.clone();
-        move || plan_request(&state, request)
-    })
-    .await
-    .unwrap_or_else(|e| {
-        Err(ErrorReply::new(
-            ErrorCode::Internal,
-            format!("the planning task failed: {e}"),
-        ))
-    });
+    let result = serve_plan(&state, request, seq, arrived).await;
     reply::send_result(&query, result).await;
+}
+
+/// A request checked and registered, ready for the queue.
+struct Prepared<'a> {
+    request: PlanRequest,
+    request_id: String,
+    registration: Registration<'a>,
+    stop: Arc<AtomicBool>,
+    /// Cancelled with `stop`: wakes the request while it waits in the queue.
+    wake: CancellationToken,
+    map_version: roam_proto::planner::MapVersion,
+    world: Arc<World>,
+    spec: PlanSpec,
+    /// Its work for the queue ([`crate::queue::units`]).
+    units: f64,
+}
+
+/// Admits a request to the queue or refuses it at once, waits for its turn, plans.
+async fn serve_plan(
+    state: &Arc<State>,
+    request: PlanRequest,
+    seq: u64,
+    arrived: Instant,
+) -> Result<Plan, ErrorReply> {
+    let prepared = prepare(state, request)?;
+    let max_plan_s = state.budget.config().max_plan_seconds;
+    let mut ticket = state
+        .queue
+        .admit(
+            seq,
+            prepared.units,
+            prepared.spec.deadline_s,
+            max_plan_s,
+            arrived,
+        )
+        .map_err(|refusal| busy(state, refusal))?;
+    if ticket.queued {
+        // An empty progress message: the request is queued (its requester may cancel it).
+        let message = PlanProgress {
+            request_id: prepared.request_id.clone(),
+            best_fitness: Vec::new(),
+            done: false,
+        };
+        let key = keys::planner_progress(&state.root, &prepared.request_id);
+        roam_runtime::publish(&state.session, &key, &message, Delivery::Latest).await;
+    }
+    let turn = ticket.wait_turn(&prepared.wake).await;
+    let Prepared {
+        request,
+        request_id,
+        registration,
+        stop,
+        map_version,
+        world,
+        mut spec,
+        ..
+    } = prepared;
+    let cancelled_in_queue = turn == Turn::Cancelled;
+    let mut ticket = Some(ticket);
+    if cancelled_in_queue {
+        // Out of the queue at once; the reply is the floor (below), no GA.
+        ticket = None;
+        spec.model = PlannerModel::Shortest;
+    } else if let Some(ticket) = &ticket {
+        // The deadline counts from the request's arrival: the wait was part of it.
+        spec.deadline_s = ticket
+            .remaining_s(spec.deadline_s, Instant::now())
+            .max(MIN_PLAN_S);
+    }
+    let outcome = tokio::task::spawn_blocking({
+        let state = state.clone();
+        move || {
+            let result = plan_now(
+                &state,
+                &request,
+                request_id,
+                map_version,
+                &world,
+                spec,
+                &stop,
+            );
+            (result, request)
+        }
+    })
+    .await;
+    drop(registration);
+    let (result, request) = match outcome {
+        Ok(done) => done,
+        Err(e) => {
+            return Err(ErrorReply::new(
+                ErrorCode::Internal,
+                format!("the planning task failed: {e}"),
+            ))
+        }
+    };
+    let (mut plan, share) = result?;
+    if cancelled_in_queue {
+        plan.model = request.model;
+        plan.stop_reason = StopReason::Cancelled;
+        plan.generations = 0;
+    }
+    if let Some(ticket) = ticket {
+        ticket.finish(share, Instant::now());
+    }
+    Ok(plan)
+}
+
+/// The least planning time a request that waited in the queue is given, seconds (its
+/// deadline may have run out while it waited, if the wait was longer than expected):
+/// the GA then returns its first generation's best.
+const MIN_PLAN_S: f64 = 0.01;
+
+/// Checks a request against this instance's state and registers it.
+fn prepare(state: &State, request: PlanRequest) -> Result<Prepared<'_>, ErrorReply> {
+    let request_id = request_id(&request)?;
+    if let Some(token) = &request.cancel_token {
+        token::check_token(token)
+            .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
+    }
+    let (stop, wake) = state
+        .plans
+        .register(&request_id, request.cancel_token.clone())
+        .map_err(|_| {
+            ErrorReply::new(
+                ErrorCode::InvalidRequest,
+                format!(
+                    "request id '{}' is already being planned on this instance; use a fresh id, or omit it",
+                    excerpt(&request_id)
+                ),
+            )
+        })?;
+    let registration = Registration {
+        plans: &state.plans,
+        request_id: request_id.clone(),
+    };
+    let (map_version, world) = {
+        let maps = state.maps();
+        match maps.world(request.map_version) {
+            Some(w) => w,
+            None => {
+                let have = maps.versions();
+                return Err(match request.map_version {
+                    Some(v) => ErrorReply::new(
+                        ErrorCode::NotFound,
+                        format!("map version {v:?} is unknown to this planner; it has {have:?}; omit map_version to plan on the latest"),
+                    ),
+                    None => match maps.last_error() {
+                        Some(e) => ErrorReply::new(ErrorCode::Unavailable, format!("the planner cannot plan on the map it has: {e}")),
+                        None => ErrorReply::new(ErrorCode::Unavailable, "the planner has no map yet; is the map server running under the same root?"),
+                    },
+                });
+            }
+        }
+    };
+    let params = GaParams::with_overrides(&request.params)
+        .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
+    let spec = PlanSpec {
+        start: request.start,
+        goal: request.goal,
+        t_exec_s: request.t_exec_s,
+        deadline_s: request.deadline_s,
+        model: request.model,
+        params,
+        seed: request.seed,
+        threads: crate::ga::default_threads(),
+        limits: state.limits,
+    };
+    // The numbers and the plan's size, before it is queued: what is refused for its
+    // content is refused at once, not after a wait.
+    check_spec(&spec).map_err(|e| e.to_reply())?;
+    let units = crate::plan::work(&world, &spec).map_err(|e| e.to_reply())?;
+    Ok(Prepared {
+        request,
+        request_id,
+        registration,
+        stop,
+        wake,
+        map_version,
+        world,
+        spec,
+        units,
+    })
+}
+
+/// The refusal of a request the queue cannot serve within its deadline.
+fn busy(state: &State, refusal: Refusal) -> ErrorReply {
+    let (running, queued) = state.queue.load();
+    let wait = refusal.expected_wait_s();
+    let reply = match refusal {
+        Refusal::Full { queued, .. } => {
+            let max = state.queue.config().max_queued_plans;
+            ErrorReply::limit(
+                "max_queued_plans",
+                max as u64,
+                queued as u64 + 1,
+                format!(
+                    "planner {} has {queued} requests queued, its max_queued_plans, and {running} planning; the expected wait is {wait:.2} s: ask another instance or retry",
+                    state.instance
+                ),
+            )
+        }
+        Refusal::Late {
+            expected_plan_s,
+            deadline_s,
+            ..
+        } => ErrorReply::new(
+            ErrorCode::Busy,
+            format!(
+                "planner {} expects a wait of {wait:.2} s ({queued} queued, {running} planning) and about {expected_plan_s:.2} s of planning: past the deadline_s of {deadline_s} s; ask another instance, retry, or give a longer deadline_s",
+                state.instance
+            ),
+        ),
+    };
+    reply.with_code(ErrorCode::Busy).with_expected_wait(wait)
 }
 
 /// The request's id, checked, or a fresh unguessable one ([`token::random_hex128`]).
@@ -370,81 +590,21 @@ fn exhausted(state: &State, e: Exhausted) -> ErrorReply {
         ),
     )
     .with_code(ErrorCode::Busy)
+    .with_expected_wait(e.retry_in_s)
 }
 
-/// Checks a request against this instance's state, plans, and builds the reply.
-fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply> {
-    // A bounded number of plans at once; the next is refused now, never queued.
-    let running = state.in_flight.fetch_add(1, Ordering::AcqRel);
-    let mut slot = Slot {
-        state,
-        request_id: None,
-    };
-    if running >= state.max_in_flight {
-        return Err(ErrorReply::limit(
-            "max_concurrent_plans",
-            state.max_in_flight as u64,
-            running as u64 + 1,
-            format!(
-                "planner {} is busy with {running} plans; ask another instance or retry",
-                state.instance
-            ),
-        )
-        .with_code(ErrorCode::Busy));
-    }
-    let request_id = request_id(&request)?;
-    if let Some(token) = &request.cancel_token {
-        token::check_token(token)
-            .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
-    }
-    let stop = state
-        .plans
-        .register(&request_id, request.cancel_token.clone())
-        .map_err(|_| {
-            ErrorReply::new(
-                ErrorCode::InvalidRequest,
-                format!(
-                    "request id '{}' is already being planned on this instance; use a fresh id, or omit it",
-                    excerpt(&request_id)
-                ),
-            )
-        })?;
-    slot.request_id = Some(request_id.clone());
-
-    let (map_version, world) = {
-        let maps = state.maps();
-        match maps.world(request.map_version) {
-            Some(w) => w,
-            None => {
-                let have = maps.versions();
-                return Err(match request.map_version {
-                    Some(v) => ErrorReply::new(
-                        ErrorCode::NotFound,
-                        format!("map version {v:?} is unknown to this planner; it has {have:?}; omit map_version to plan on the latest"),
-                    ),
-                    None => match maps.last_error() {
-                        Some(e) => ErrorReply::new(ErrorCode::Unavailable, format!("the planner cannot plan on the map it has: {e}")),
-                        None => ErrorReply::new(ErrorCode::Unavailable, "the planner has no map yet; is the map server running under the same root?"),
-                    },
-                });
-            }
-        }
-    };
-    let params = GaParams::with_overrides(&request.params)
-        .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
-    let mut spec = PlanSpec {
-        start: request.start,
-        goal: request.goal,
-        t_exec_s: request.t_exec_s,
-        deadline_s: request.deadline_s,
-        model: request.model,
-        params,
-        seed: request.seed,
-        threads: crate::ga::default_threads(),
-        limits: state.limits,
-    };
-    // The deadline is checked before the budget takes it as the grant it asks for.
-    check_spec(&spec).map_err(|e| e.to_reply())?;
+/// Plans a request whose turn has come (or the floor of one cancelled in the queue),
+/// within the CPU budget, and builds the reply; with the share of its generations it
+/// ran, for the queue's rate.
+fn plan_now(
+    state: &State,
+    request: &PlanRequest,
+    request_id: String,
+    map_version: roam_proto::planner::MapVersion,
+    world: &World,
+    mut spec: PlanSpec,
+    stop: &AtomicBool,
+) -> Result<(Plan, f64), ErrorReply> {
     let grant = state
         .budget
         .grant(spec.deadline_s, Instant::now())
@@ -463,7 +623,7 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
         // The next batch of progress supersedes this one.
         roam_runtime::publish_wait(&state.session, &progress_key, &message, Delivery::Latest);
     };
-    let mut outcome = plan(&world, &spec, &stop, |generation, best| {
+    let mut outcome = plan(world, &spec, stop, |generation, best| {
         batch.push((generation, best));
         if last_sent.elapsed() >= PROGRESS_PERIOD {
             publish(&mut batch, false);
@@ -479,16 +639,21 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
         outcome.stop_reason = StopReason::Budget;
         granted_s
     });
+    let share = if spec.params.max_generations == 0 || outcome.generations == 0 {
+        1.0
+    } else {
+        f64::from(outcome.generations) / f64::from(spec.params.max_generations)
+    };
     let mut plan = to_message(
-        &world,
-        &request,
-        request_id,
+        world,
+        request,
+        request_id.clone(),
         map_version,
         &state.instance,
         outcome,
     );
     plan.budget_s = budget_s;
-    Ok(plan)
+    Ok((plan, share))
 }
 
 /// The reply message of an outcome.

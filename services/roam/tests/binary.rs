@@ -305,7 +305,7 @@ fn roam_plan_asks_a_running_stack_and_draws_the_path() {
         .expect("run roam plan");
     assert!(!refused.status.success());
     assert!(
-        String::from_utf8_lossy(&refused.stderr).contains("shorter than the shortest path's ETA")
+        String::from_utf8_lossy(&refused.stderr).contains("shorter than the fastest path's ETA")
     );
     drop(stack);
 }

@@ -232,6 +232,24 @@ impl Service {
         self.serve_within(queryable, None, state, handler)
     }
 
+    /// [`Service::serve`] with at most `max_in_flight` queries handled at once instead
+    /// of [`MAX_IN_FLIGHT`]: for a service that keeps its own bounded queue of requests
+    /// (the planner's), so that each request in its queue holds its query and the ones
+    /// beyond are refused by the service at once rather than left in Zenoh's channel.
+    pub fn serve_up_to<S, F, Fut>(
+        &self,
+        queryable: Queryable<FifoChannelHandler<Query>>,
+        max_in_flight: usize,
+        state: S,
+        handler: F,
+    ) where
+        S: Clone + Send + Sync + 'static,
+        F: Fn(S, Query) -> Fut + Send + Sync + 'static,
+        Fut: Future<Output = ()> + Send + 'static,
+    {
+        self.serve_loop(queryable, None, max_in_flight.max(1), state, handler)
+    }
+
     /// [`Service::serve`], with the payloads of the queries being handled at once
     /// bounded by `budget`: a query waits (in Zenoh's channel) until the payloads in work
     /// leave room for its own. Decoding, checking and answering a request costs a few
@@ -249,10 +267,25 @@ impl Service {
         F: Fn(S, Query) -> Fut + Send + Sync + 'static,
         Fut: Future<Output = ()> + Send + 'static,
     {
+        self.serve_loop(queryable, budget, MAX_IN_FLIGHT, state, handler)
+    }
+
+    fn serve_loop<S, F, Fut>(
+        &self,
+        queryable: Queryable<FifoChannelHandler<Query>>,
+        budget: Option<PayloadBudget>,
+        max_in_flight: usize,
+        state: S,
+        handler: F,
+    ) where
+        S: Clone + Send + Sync + 'static,
+        F: Fn(S, Query) -> Fut + Send + Sync + 'static,
+        Fut: Future<Output = ()> + Send + 'static,
+    {
         let cancel = self.cancel.clone();
         let tracker = self.tasks.clone();
         let name = self.name;
-        let permits = Arc::new(Semaphore::new(MAX_IN_FLIGHT));
+        let permits = Arc::new(Semaphore::new(max_in_flight));
         self.tasks.spawn(async move {
             loop {
                 let permit = tokio::select! {
