@@ -8,7 +8,8 @@ use crate::codec::Message;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PlannerModel {
-    /// Shortest path by distance (A*, octile heuristic): the information-blind baseline.
+    /// The fastest path by Eq. 2 (distance and turns): the information-blind baseline,
+    /// and the floor every budget is checked against.
     Shortest,
     /// GA with Model 0, coverage: a constant gain per newly perceived cell (Eq. 8).
     Model0,
@@ -16,6 +17,10 @@ pub enum PlannerModel {
     Model1,
     /// GA with Model II, heterogeneity |H − I| against the heuristic map (Eq. 10).
     Model2,
+    /// Not a GA: greedy insertion of informative via-points by information per second,
+    /// with local improvement, within the budget; scored with Model I (Eq. 9). roam's
+    /// peer for the GA (issue 16), not paper 000's.
+    Greedy,
 }
 
 impl PlannerModel {
@@ -25,6 +30,7 @@ impl PlannerModel {
             PlannerModel::Model0 => "model0",
             PlannerModel::Model1 => "model1",
             PlannerModel::Model2 => "model2",
+            PlannerModel::Greedy => "greedy",
         }
     }
 }

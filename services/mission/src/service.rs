@@ -24,7 +24,7 @@ pub const SERVICE_NAME: &str = "mission";
 ///   tasks:
 ///     - { name: goal1, at: [-2.0, 4.0], start_s: 75.0 }
 ///     - { name: goal2, at: [6.0, -7.0], start_s: 165.0, duration_s: 5.0 }
-///   model: model1        # model0 | model1 | model2 | shortest
+///   model: model1        # model0 | model1 | model2 | greedy | shortest
 ///   plan_deadline_s: 1.0
 ///   w_loc: 2000          # the PEB localizability cost in the planner's fitness (default off)
 /// ```

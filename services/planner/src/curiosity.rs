@@ -51,6 +51,8 @@ impl Model {
             PlannerModel::Model0 => Some(Model::Coverage),
             PlannerModel::Model1 => Some(Model::Novelty),
             PlannerModel::Model2 => Some(Model::Heterogeneity),
+            // The greedy planner scores with Model I (crate::greedy).
+            PlannerModel::Greedy => Some(Model::Novelty),
         }
     }
 }

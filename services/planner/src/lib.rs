@@ -11,6 +11,8 @@
 //! - [`ga`]: initialisation, layered selection, crossover, mutation (§II.A), with roam's
 //!   round-trip rule for random walks;
 //! - [`seeds`]: via-point seeds, paths through informative cells within the budget;
+//! - [`greedy`]: a peer for the GA, via-points by information per second (model
+//!   `greedy`);
 //! - [`best`]: the plan is never below the shortest path or a seed;
 //! - [`search`]: the fastest path (Eq. 2 over cell and heading: the baseline and the
 //!   budget floor), the distance-shortest path and the distance field;
@@ -33,6 +35,7 @@ pub mod coupling;
 pub mod curiosity;
 pub mod eta;
 pub mod ga;
+pub mod greedy;
 pub mod inflight;
 pub mod limits;
 pub mod maps;

@@ -29,6 +29,7 @@ use crate::best::{ranked, PlanSource, Scored};
 use crate::curiosity::{Evaluation, Evaluator, Model};
 use crate::eta::path_eta;
 use crate::ga::{self, GaOptions, Problem};
+use crate::greedy::{self, GreedyProblem};
 use crate::limits::{self, LimitError, PlanLimits, PlanSize};
 use crate::metrics::{path_metrics, PathMetrics};
 use crate::params::{GaParams, ParamError};
@@ -256,18 +257,36 @@ pub fn check_spec(spec: &PlanSpec) -> Result<(), PlanError> {
 pub fn work(world: &World, spec: &PlanSpec) -> Result<f64, PlanError> {
     let cost = match Model::of(spec.model) {
         Some(_) => {
-            limits::check(
-                &spec.params,
+            let size = limits::check(
+                &sized_params(spec),
                 world.meta.resolution,
                 spec.t_exec_s,
                 world.cell_count(),
                 &spec.limits,
-            )?
-            .cost
+            )?;
+            if spec.model == PlannerModel::Greedy {
+                (size.path_cells as u64).saturating_mul(greedy::WORK_EVALUATIONS)
+            } else {
+                size.cost
+            }
         }
         None => 0,
     };
     Ok(crate::queue::units(cost))
+}
+
+/// The parameters a plan is sized by ([`crate::limits`]): the request's, except that
+/// the greedy planner has no population or generations (one route at a time).
+fn sized_params(spec: &PlanSpec) -> GaParams {
+    if spec.model == PlannerModel::Greedy {
+        GaParams {
+            population: 1,
+            max_generations: 1,
+            ..spec.params.clone()
+        }
+    } else {
+        spec.params.clone()
+    }
 }
 
 /// A request that passed every check before planning.
@@ -313,7 +332,7 @@ fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
     // The GA's size, before any search: the baseline has no population to bound.
     let size = match Model::of(spec.model) {
         Some(_) => Some(limits::check(
-            params,
+            &sized_params(spec),
             world.meta.resolution,
             spec.t_exec_s,
             world.cell_count(),
@@ -440,6 +459,40 @@ pub fn plan(
                     0,
                     (1, genes),
                     StopReason::Complete,
+                    0,
+                )
+            }
+            Some(_) if spec.model == PlannerModel::Greedy => {
+                let field = distance_field(world, goal);
+                let problem = GreedyProblem {
+                    world,
+                    params,
+                    start,
+                    goal,
+                    t_exec: budget,
+                    floor: &checked.shortest,
+                    goal_field: &field,
+                };
+                let result = greedy::run(&problem, deadline, cancel);
+                let mut progress = progress;
+                progress(result.rounds, result.evaluation.fitness.total);
+                let stop_reason = match (result.interrupted, cancel.load(Ordering::Relaxed)) {
+                    (false, _) => StopReason::Complete,
+                    (true, true) => StopReason::Cancelled,
+                    (true, false) => StopReason::Deadline,
+                };
+                let found = Scored {
+                    path: result.path,
+                    evaluation: result.evaluation,
+                    source: PlanSource::Ga,
+                };
+                let mut evaluator = Evaluator::new(world, params, Model::Novelty, goal, budget);
+                (
+                    ranked(&mut evaluator, found, &checked.shortest, &[]),
+                    Model::Novelty,
+                    result.rounds,
+                    (result.evaluations, result.evaluated_genes),
+                    stop_reason,
                     0,
                 )
             }

@@ -18,7 +18,7 @@ import sys
 
 import zenoh
 
-MODELS = ("shortest", "model0", "model1", "model2")
+MODELS = ("shortest", "model0", "model1", "model2", "greedy")
 
 
 def point(text):

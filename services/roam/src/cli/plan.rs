@@ -26,7 +26,8 @@ pub(crate) struct PlanArgs {
     /// Seconds the robot has to drive (t_exec).
     #[arg(long)]
     budget: f64,
-    /// Curiosity model: 0, 1, 2 or shortest.
+    /// Curiosity model: 0, 1, 2, greedy (not a GA: via-points by information per
+    /// second) or shortest (the fastest path).
     #[arg(long, default_value = "1", value_parser = parse_model)]
     model: PlannerModel,
     /// Seconds the planner may take (t_plan).
@@ -65,7 +66,10 @@ pub(crate) fn parse_model(text: &str) -> Result<PlannerModel, String> {
         "1" | "model1" => Ok(PlannerModel::Model1),
         "2" | "model2" => Ok(PlannerModel::Model2),
         "shortest" => Ok(PlannerModel::Shortest),
-        other => Err(format!("'{other}' is not a model; use 0, 1, 2 or shortest")),
+        "greedy" => Ok(PlannerModel::Greedy),
+        other => Err(format!(
+            "'{other}' is not a model; use 0, 1, 2, greedy or shortest"
+        )),
     }
 }
 

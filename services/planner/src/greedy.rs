@@ -1,0 +1,334 @@
+//! A peer for the GA (issue 16): greedy insertion of informative via-points by
+//! information per second, with local improvement, within the budget. Model `greedy`.
+//!
+//! Paper 000 compares its GA only with a coverage GA (Model 0) and the shortest path. A
+//! user would ask whether a simple informative-path heuristic does as well, so roam
+//! plans one in the same service, scored by the same fitness (Eqs. 1, 3–7 with Model
+//! I, Eq. 9) on the same planning grid:
+//!
+//! 1. **Candidates.** Cells on a lattice a perception window apart (so no two show the
+//!    same cells), traversable, in reach of the budget (the distance from S plus the
+//!    distance to G, at v_lin, a lower bound of Eq. 2, fits t_exec), whose window holds
+//!    information. At most [`MAX_CANDIDATES`], the most informative first.
+//! 2. **Greedy insertion.** The route starts as the floor path (the shortest path that
+//!    fits, else the fastest). Each round, every unused candidate is tried at the place
+//!    in the route where it adds the least distance; its legs are shortest paths (the
+//!    descents along the distance fields of the route's stops). The one with the most
+//!    new model information per second of added Eq. 2 time whose route still fits
+//!    t_exec is inserted, and its field computed. Rounds go on until nothing fits or
+//!    adds information.
+//! 3. **Local improvement.** Then, until nothing improves or the deadline: each
+//!    via-point in turn is removed and the candidate (or none) that makes the fittest
+//!    route in its place is put back, if that is fitter than the route was (Eq. 1, the
+//!    GA's objective).
+//!
+//! No randomness: the same request gives the same route. Memory: one distance field per
+//! stop, at most [`crate::seeds::MAX_FIELD_ENTRIES`] entries in all, so a huge planning
+//! grid gets fewer via-points, never more memory. Work: a round evaluates each
+//! candidate once (O(L · window) each).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use crate::curiosity::{Evaluation, Evaluator, Model};
+use crate::params::GaParams;
+use crate::search::{descend_to_goal, distance_field, STRAIGHT};
+use crate::seeds::MAX_FIELD_ENTRIES;
+use crate::world::{Cell, World};
+
+/// Most candidates tried per round.
+pub const MAX_CANDIDATES: usize = 400;
+/// Most via-points on a route.
+pub const MAX_VIAS: usize = 48;
+/// The work of one greedy plan in evaluations of a longest path, for the queue's
+/// estimate (`crate::plan::work`): a few dozen rounds over the candidates.
+pub const WORK_EVALUATIONS: u64 = (MAX_CANDIDATES as u64) * 40;
+
+/// What the greedy planner needs.
+#[derive(Debug)]
+pub struct GreedyProblem<'a> {
+    pub world: &'a World,
+    pub params: &'a GaParams,
+    pub start: Cell,
+    pub goal: Cell,
+    pub t_exec: f64,
+    /// The route it starts from: a path from S to G within t_exec.
+    pub floor: &'a [Cell],
+    /// Cost to G from every cell ([`distance_field`]).
+    pub goal_field: &'a [u32],
+}
+
+/// What it returns.
+#[derive(Debug, Clone)]
+pub struct GreedyResult {
+    pub path: Vec<Cell>,
+    pub evaluation: Evaluation,
+    /// Rounds of insertion and improvement done.
+    pub rounds: u32,
+    /// Evaluations done.
+    pub evaluations: u64,
+    pub evaluated_genes: u64,
+    /// Whether it stopped at its deadline or a cancel rather than when nothing improved.
+    pub interrupted: bool,
+}
+
+struct Route<'a> {
+    world: &'a World,
+    /// S, the via-points, G.
+    stops: Vec<Cell>,
+    /// The distance field of each stop (the cost to it from every cell).
+    fields: Vec<std::rc::Rc<Vec<u32>>>,
+}
+
+impl Route<'_> {
+    /// The path through `stops` (with `extra` inserted before index `at`, if any).
+    fn path(&self, extra: Option<(usize, Cell)>, skip: Option<usize>) -> Option<Vec<Cell>> {
+        let mut stops: Vec<(Cell, Option<&[u32]>)> = self
+            .stops
+            .iter()
+            .zip(&self.fields)
+            .enumerate()
+            .filter(|(i, _)| Some(*i) != skip)
+            .map(|(_, (&c, f))| (c, Some(f.as_slice())))
+            .collect();
+        if let Some((at, cell)) = extra {
+            let at = if skip.is_some_and(|s| s < at) {
+                at - 1
+            } else {
+                at
+            };
+            stops.insert(at, (cell, None));
+        }
+        let mut path = vec![stops[0].0];
+        for pair in stops.windows(2) {
+            let ((_, fa), (b, fb)) = (pair[0], pair[1]);
+            match fb {
+                Some(f) => {
+                    if !descend_to_goal(self.world, f, &mut path) {
+                        return None;
+                    }
+                }
+                None => {
+                    // b has no field yet: descend from b to a on a's field, reversed.
+                    let f = fa?;
+                    let mut back = vec![b];
+                    if !descend_to_goal(self.world, f, &mut back) {
+                        return None;
+                    }
+                    path.extend(back.iter().rev().skip(1));
+                }
+            }
+        }
+        Some(path)
+    }
+
+    /// Where inserting `v` adds the least distance (cost units), and how much.
+    fn cheapest_place(&self, v: Cell) -> Option<(usize, u64)> {
+        (1..self.stops.len())
+            .filter_map(|i| {
+                let (fa, fb) = (&self.fields[i - 1], &self.fields[i]);
+                let (av, vb) = (fa[v as usize], fb[v as usize]);
+                let ab = fb[self.stops[i - 1] as usize];
+                (av != u32::MAX && vb != u32::MAX && ab != u32::MAX).then(|| {
+                    let added = (u64::from(av) + u64::from(vb)).saturating_sub(u64::from(ab));
+                    (i, added)
+                })
+            })
+            .min_by_key(|&(i, added)| (added, i))
+    }
+}
+
+/// The candidates of step 1, most informative first.
+fn candidates(problem: &GreedyProblem<'_>, start_field: &[u32]) -> Vec<Cell> {
+    let world = problem.world;
+    let window = problem.params.window();
+    let side = window
+        .iter()
+        .map(|&(x, _)| x)
+        .max()
+        .zip(window.iter().map(|&(x, _)| x).min())
+        .map_or(1, |(hi, lo)| (hi - lo + 1).max(1) as usize);
+    let per_unit = problem.params.v_lin * world.meta.resolution / f64::from(STRAIGHT);
+    let (w, h) = (world.width() as i32, world.height() as i32);
+    let mut found: Vec<(u64, Cell)> = Vec::new();
+    for y in (side / 2..world.height()).step_by(side) {
+        for x in (side / 2..world.width()).step_by(side) {
+            let c = world.cell(x, y);
+            let (s, g) = (start_field[c as usize], problem.goal_field[c as usize]);
+            if !world.is_traversable(c) || s == u32::MAX || g == u32::MAX {
+                continue;
+            }
+            if (f64::from(s) + f64::from(g)) * per_unit > problem.t_exec {
+                continue;
+            }
+            let value: u64 = window
+                .iter()
+                .filter_map(|&(dx, dy)| {
+                    let (nx, ny) = (x as i32 + dx, y as i32 + dy);
+                    (nx >= 0 && ny >= 0 && nx < w && ny < h)
+                        .then(|| u64::from(world.information[(ny * w + nx) as usize]))
+                })
+                .sum();
+            if value > 0 && c != problem.start && c != problem.goal {
+                found.push((value, c));
+            }
+        }
+    }
+    found.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    found.truncate(MAX_CANDIDATES);
+    found.into_iter().map(|(_, c)| c).collect()
+}
+
+/// Plans (see the module doc) until nothing improves, `deadline`, or `cancel`.
+pub fn run(problem: &GreedyProblem<'_>, deadline: Instant, cancel: &AtomicBool) -> GreedyResult {
+    let world = problem.world;
+    let mut evaluator = Evaluator::new(
+        world,
+        problem.params,
+        Model::Novelty,
+        problem.goal,
+        problem.t_exec,
+    );
+    let mut evaluations = 0u64;
+    let mut genes = 0u64;
+    let mut evaluate = |path: &[Cell], evaluator: &mut Evaluator<'_>| {
+        evaluations += 1;
+        genes += path.len() as u64;
+        evaluator.evaluate(path)
+    };
+    let floor = problem.floor.to_vec();
+    let mut best_eval = evaluate(&floor, &mut evaluator);
+    let mut best_path = floor;
+    let stop = || cancel.load(Ordering::Relaxed) || Instant::now() >= deadline;
+    let start_field = std::rc::Rc::new(distance_field(world, problem.start));
+    let goal_field = std::rc::Rc::new(problem.goal_field.to_vec());
+    let pool = candidates(problem, &start_field);
+    let max_vias = MAX_VIAS.min((MAX_FIELD_ENTRIES / world.cell_count().max(1)).saturating_sub(2));
+    let mut route = Route {
+        world,
+        stops: vec![problem.start, problem.goal],
+        fields: vec![start_field, goal_field],
+    };
+    // The route as routed (its legs are shortest paths, not the floor path itself).
+    let Some(routed) = route.path(None, None) else {
+        return GreedyResult {
+            path: best_path,
+            evaluation: best_eval,
+            rounds: 0,
+            evaluations,
+            evaluated_genes: genes,
+            interrupted: false,
+        };
+    };
+    let mut current = evaluate(&routed, &mut evaluator);
+    let mut current_path = routed;
+    let mut used = vec![false; pool.len()];
+    let mut rounds = 0u32;
+    let mut interrupted = false;
+    let fits = |e: &Evaluation| e.t_eta <= problem.t_exec && e.reaches_goal;
+    // Step 2: insertion by information per second.
+    while route.stops.len() - 2 < max_vias {
+        if stop() {
+            interrupted = true;
+            break;
+        }
+        rounds += 1;
+        let mut pick: Option<(f64, usize, usize, Vec<Cell>, Evaluation)> = None;
+        for (k, &v) in pool.iter().enumerate() {
+            if used[k] || route.stops.contains(&v) {
+                continue;
+            }
+            let Some((at, _)) = route.cheapest_place(v) else {
+                continue;
+            };
+            let Some(path) = route.path(Some((at, v)), None) else {
+                continue;
+            };
+            let e = evaluate(&path, &mut evaluator);
+            let gained = e.model_information - current.model_information;
+            if !fits(&e) || gained <= 0.0 {
+                continue;
+            }
+            let seconds = (e.t_eta - current.t_eta).max(1e-6);
+            let rate = gained / seconds;
+            if pick.as_ref().is_none_or(|p| rate > p.0) {
+                pick = Some((rate, k, at, path, e));
+            }
+        }
+        let Some((_, k, at, path, e)) = pick else {
+            break;
+        };
+        used[k] = true;
+        route.stops.insert(at, pool[k]);
+        route
+            .fields
+            .insert(at, std::rc::Rc::new(distance_field(world, pool[k])));
+        current = e;
+        current_path = path;
+    }
+    // Step 3: remove each via-point and put back the fittest replacement, or none.
+    let mut improved = true;
+    while improved && !interrupted {
+        improved = false;
+        let mut i = 1;
+        while i + 1 < route.stops.len() {
+            if stop() {
+                interrupted = true;
+                break;
+            }
+            rounds += 1;
+            let mut best: Option<(f64, Option<usize>, Vec<Cell>, Evaluation)> = None;
+            if let Some(path) = route.path(None, Some(i)) {
+                let e = evaluate(&path, &mut evaluator);
+                if fits(&e) {
+                    best = Some((e.fitness.total, None, path, e));
+                }
+            }
+            for (k, &v) in pool.iter().enumerate() {
+                if used[k] || route.stops.contains(&v) {
+                    continue;
+                }
+                let Some(path) = route.path(Some((i, v)), Some(i)) else {
+                    continue;
+                };
+                let e = evaluate(&path, &mut evaluator);
+                if fits(&e) && best.as_ref().is_none_or(|b| e.fitness.total > b.0) {
+                    best = Some((e.fitness.total, Some(k), path, e));
+                }
+            }
+            match best {
+                Some((total, replacement, path, e)) if total > current.fitness.total => {
+                    let removed = route.stops.remove(i);
+                    route.fields.remove(i);
+                    if let Some(k) = pool.iter().position(|&c| c == removed) {
+                        used[k] = false;
+                    }
+                    if let Some(k) = replacement {
+                        used[k] = true;
+                        route.stops.insert(i, pool[k]);
+                        route
+                            .fields
+                            .insert(i, std::rc::Rc::new(distance_field(world, pool[k])));
+                        i += 1;
+                    }
+                    current = e;
+                    current_path = path;
+                    improved = true;
+                }
+                _ => i += 1,
+            }
+        }
+    }
+    if fits(&current) && current.fitness.total > best_eval.fitness.total {
+        best_eval = current;
+        best_path = current_path;
+    }
+    GreedyResult {
+        path: best_path,
+        evaluation: best_eval,
+        rounds,
+        evaluations,
+        evaluated_genes: genes,
+        interrupted,
+    }
+}
