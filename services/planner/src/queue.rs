@@ -34,8 +34,10 @@ use tokio_util::sync::CancellationToken;
 pub const MAX_QUEUED_PLANS: usize = 10_000;
 /// The units of what every plan does besides the GA's generations.
 pub const OVERHEAD_UNITS: f64 = 2.0e6;
-/// The seconds per unit an instance assumes before its first plan ends: 10 ns, about
-/// what the paper's workload measures on one 2-core machine (Model I, 0.2 m cells).
+/// The seconds per unit one plan alone takes, as an instance assumes before its first
+/// plan ends: 10 ns, about what the paper's workload measures on a 2-core machine
+/// (Model I, 0.2 m cells). Its plans share the cores, so the instance starts from this
+/// times `max_concurrent_plans`.
 pub const PRIOR_SECONDS_PER_UNIT: f64 = 1.0e-8;
 /// The weight of the newest measurement in the rate's average.
 pub const RATE_WEIGHT: f64 = 0.3;
@@ -166,9 +168,16 @@ pub struct PlanQueue {
 
 impl PlanQueue {
     pub fn new(config: QueueConfig) -> Self {
+        let shared = config.max_concurrent_plans.max(1) as f64;
         PlanQueue {
             config,
-            inner: Mutex::new(Inner::default()),
+            inner: Mutex::new(Inner {
+                rate: Rate {
+                    seconds_per_unit: PRIOR_SECONDS_PER_UNIT * shared,
+                    samples: 0,
+                },
+                ..Inner::default()
+            }),
             changed: tokio::sync::Notify::new(),
         }
     }
@@ -365,12 +374,15 @@ mod tests {
         })
     }
 
-    /// 1 s of work at the prior rate.
+    /// 1 s of work at the prior rate of a queue of one slot (`queue(1, ..)`); tests of
+    /// two slots divide by two.
     const ONE_S: f64 = 1.0 / PRIOR_SECONDS_PER_UNIT;
 
     #[test]
     fn the_expected_wait_fills_the_slots_in_order() {
         let q = queue(2, 10);
+        // Two slots share the cores: the prior rate is twice one plan's.
+        const ONE_S: f64 = super::tests::ONE_S / 2.0;
         let now = Instant::now();
         let mut a = q.admit(1, 2.0 * ONE_S, 30.0, 30.0, now).expect("a");
         assert!(a.try_start(now));

@@ -3,9 +3,12 @@
 //! arguments and calls in here, so the integration tests boot exactly what users run.
 
 pub mod bench;
+pub mod bench_fleet;
 pub mod bench_load;
 pub mod bench_localization;
+pub mod bench_peer;
 pub mod bench_planner;
+pub mod bench_scaling;
 pub mod bench_sim;
 pub mod demo;
 pub mod demo_today;

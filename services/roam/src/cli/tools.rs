@@ -45,6 +45,23 @@ pub(crate) enum BenchCommand {
         /// Concurrent plan requests.
         #[arg(long, default_value_t = 100)]
         requests: usize,
+        /// Each request's deadline, seconds.
+        #[arg(long, default_value_t = 1.0)]
+        deadline_s: f64,
+    },
+    /// Robots in closed loop through Zenoh (sim → localization → controller → sim) at a
+    /// fixed rate: steps on time, CPU share and memory per robot.
+    Fleet {
+        #[arg(long)]
+        json: bool,
+        #[arg(long, default_value_t = 100)]
+        robots: usize,
+        /// Steps per second.
+        #[arg(long, default_value_t = 10.0)]
+        rate_hz: f64,
+        /// How long to run, seconds.
+        #[arg(long, default_value_t = 20.0)]
+        seconds: f64,
     },
     /// Change-map observation updates per second on a 1000 x 1000 map (paper 004 §3).
     Mapper {
@@ -68,6 +85,14 @@ pub(crate) enum BenchCommand {
         /// no via-point seeds), to compare with roam's default.
         #[arg(long)]
         paper_init: bool,
+        /// Instead: the same world at 0.2, 0.1, 0.05 and 0.03 m and a 1.7-million-cell
+        /// warehouse, planned at 0.2 m and at the map's resolution, and the memory of a
+        /// planner holding the warehouse.
+        #[arg(long, conflicts_with = "peer")]
+        scaling: bool,
+        /// Instead: model greedy against Model I at equal wall time on several worlds.
+        #[arg(long)]
+        peer: bool,
     },
 }
 
@@ -222,11 +247,34 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             let result = roam::bench_sim::sim(robots, rate_hz, seconds).await?;
             print_json(&result, json)
         }
-        BenchCommand::Load { json, requests } => {
+        BenchCommand::Load {
+            json,
+            requests,
+            deadline_s,
+        } => {
             if requests == 0 || requests > roam::bench_load::MAX_REQUESTS {
                 bail!("--requests must be 1..={}", roam::bench_load::MAX_REQUESTS);
             }
-            let result = roam::bench_load::load(requests).await?;
+            if !(deadline_s.is_finite() && deadline_s > 0.0 && deadline_s <= 600.0) {
+                bail!("--deadline-s must be in (0, 600] seconds");
+            }
+            let result = roam::bench_load::load(requests, deadline_s).await?;
+            print_json(&result, json)
+        }
+        BenchCommand::Fleet {
+            json,
+            robots,
+            rate_hz,
+            seconds,
+        } => {
+            if robots == 0
+                || robots > roam_sim::sim::MAX_ROBOTS
+                || !(rate_hz.is_finite() && rate_hz > 0.0)
+                || !(seconds.is_finite() && seconds > 0.0)
+            {
+                bail!("--robots must be 1..=1000, --rate-hz and --seconds positive");
+            }
+            let result = roam::bench_fleet::fleet(robots, rate_hz, seconds).await?;
             print_json(&result, json)
         }
         BenchCommand::Mapper {
@@ -250,9 +298,22 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             json,
             runs,
             paper_init,
+            scaling,
+            peer,
         } => {
             if runs == 0 {
                 bail!("--runs must be at least 1");
+            }
+            if scaling {
+                let result =
+                    tokio::task::spawn_blocking(move || roam::bench_scaling::scaling(runs))
+                        .await??;
+                return print_json(&result, json);
+            }
+            if peer {
+                let result =
+                    tokio::task::spawn_blocking(move || roam::bench_peer::peer(runs)).await??;
+                return print_json(&result, json);
             }
             let result = roam::bench_planner::planner(runs, paper_init).await?;
             print_json(&result, json)
