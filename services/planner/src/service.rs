@@ -364,12 +364,14 @@ async fn serve_plan(
 ) -> Result<Plan, ErrorReply> {
     let prepared = prepare(state, request)?;
     let max_plan_s = state.budget.config().max_plan_seconds;
+    // The reply must reach the requester within its deadline: the plan ends earlier.
+    let margin = reply_margin_s(prepared.spec.deadline_s);
     let mut ticket = state
         .queue
         .admit(
             seq,
             prepared.units,
-            prepared.spec.deadline_s,
+            prepared.spec.deadline_s - margin,
             max_plan_s,
             arrived,
         )
@@ -395,17 +397,17 @@ async fn serve_plan(
         mut spec,
         ..
     } = prepared;
-    let cancelled_in_queue = turn == Turn::Cancelled;
+    // The deadline counts from the request's arrival: the wait was part of it.
+    let left = ticket.remaining_s(spec.deadline_s - margin, Instant::now());
+    let (cancelled_in_queue, out_of_time) = (turn == Turn::Cancelled, left < MIN_PLAN_S);
     let mut ticket = Some(ticket);
-    if cancelled_in_queue {
-        // Out of the queue at once; the reply is the floor (below), no GA.
+    if cancelled_in_queue || out_of_time {
+        // Out of the queue at once; the reply is the floor (below), no GA: a usable
+        // path now rather than a plan after the deadline.
         ticket = None;
         spec.model = PlannerModel::Shortest;
-    } else if let Some(ticket) = &ticket {
-        // The deadline counts from the request's arrival: the wait was part of it.
-        spec.deadline_s = ticket
-            .remaining_s(spec.deadline_s, Instant::now())
-            .max(MIN_PLAN_S);
+    } else {
+        spec.deadline_s = left;
     }
     let outcome = tokio::task::spawn_blocking({
         let state = state.clone();
@@ -434,9 +436,13 @@ async fn serve_plan(
         }
     };
     let (mut plan, share) = result?;
-    if cancelled_in_queue {
+    if cancelled_in_queue || out_of_time {
         plan.model = request.model;
-        plan.stop_reason = StopReason::Cancelled;
+        plan.stop_reason = if cancelled_in_queue {
+            StopReason::Cancelled
+        } else {
+            StopReason::Deadline
+        };
         plan.generations = 0;
     }
     if let Some(ticket) = ticket {
@@ -445,10 +451,18 @@ async fn serve_plan(
     Ok(plan)
 }
 
-/// The least planning time a request that waited in the queue is given, seconds (its
-/// deadline may have run out while it waited, if the wait was longer than expected):
-/// the GA then returns its first generation's best.
+/// The least planning time worth starting a GA for, seconds: a request whose deadline
+/// has (nearly) run out in the queue, because the wait was longer than expected, is
+/// answered with the fastest path at once instead (`stop_reason: deadline`,
+/// `generations: 0`).
 const MIN_PLAN_S: f64 = 0.01;
+
+/// What a plan leaves of its deadline for the reply to reach the requester (and for the
+/// work after the GA: driving the path, the metrics): a tenth of the deadline, at most
+/// 0.1 s.
+pub fn reply_margin_s(deadline_s: f64) -> f64 {
+    (0.1 * deadline_s).min(0.1)
+}
 
 /// Checks a request against this instance's state and registers it.
 fn prepare(state: &State, request: PlanRequest) -> Result<Prepared<'_>, ErrorReply> {

@@ -70,8 +70,8 @@ fn setup<E: std::fmt::Display>(e: E) -> BenchError {
     BenchError::Setup(e.to_string())
 }
 
-/// CPU seconds used by this process so far, `None` off Linux.
-fn process_cpu_seconds() -> Option<f64> {
+/// CPU seconds used by this process so far (100 Hz ticks), `None` off Linux.
+pub fn process_cpu_seconds() -> Option<f64> {
     let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
     let rest = stat.rsplit_once(')')?.1;
     let fields: Vec<&str> = rest.split_whitespace().collect();
@@ -233,6 +233,38 @@ async fn run(
                 }),
             )
             .await?;
+    }
+    // One lock-step step, so that every robot has an estimate before its mission: the
+    // controller holds at most 64 missions for robots it has not heard of yet.
+    let estimated = Arc::new(Mutex::new(std::collections::HashSet::new()));
+    let estimates = {
+        let estimated = estimated.clone();
+        let root = root.to_owned();
+        session
+            .declare_subscriber(keys::robot_estimate_any(&root))
+            .callback(move |sample| {
+                if let Some(robot) = keys::robot_of(&root, sample.key_expr().as_str()) {
+                    roam_runtime::lock(&estimated).insert(robot.to_owned());
+                }
+            })
+            .await
+            .map_err(setup)?
+    };
+    let waited = tokio::time::timeout(Duration::from_secs(30), async {
+        while roam_runtime::lock(&estimated).len() < robots {
+            let _ = client
+                .request::<SimControl, SimStatus>(&control_key, Some(&SimControl::Step { n: 1 }))
+                .await;
+            tokio::time::sleep(Duration::from_millis(200)).await;
+        }
+    })
+    .await;
+    drop(estimates);
+    if waited.is_err() {
+        return Err(BenchError::Setup(format!(
+            "only {} of {robots} robots were estimated",
+            roam_runtime::lock(&estimated).len()
+        )));
     }
     for (k, &at) in places.iter().enumerate() {
         let name = format!("fleet-{k}");

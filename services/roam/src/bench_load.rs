@@ -91,6 +91,18 @@ pub async fn load(requests: usize, deadline_s: f64) -> Result<LoadBench, BenchEr
     let deadline = Duration::from_secs_f64(deadline_s);
     let patience = deadline + Duration::from_secs(5);
     let client = PlannerClient::new(stack.router.session.clone(), &stack.root);
+    // Both instances' tokens seen first, so the burst is spread over both.
+    let seen = tokio::time::timeout(Duration::from_secs(30), async {
+        while client.live_instances().await.map_or(0, |i| i.len()) < planners {
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
+    })
+    .await;
+    if seen.is_err() {
+        return Err(BenchError::Setup(format!(
+            "fewer than {planners} planner instances announced themselves"
+        )));
+    }
     let client = std::sync::Arc::new(client);
     let started = Instant::now();
     let mut tasks = JoinSet::new();

@@ -31,6 +31,7 @@ use roam_proto::planner::PlannerModel;
 use serde::Serialize;
 
 use crate::bench::BenchError;
+use crate::bench_fleet::process_cpu_seconds;
 use crate::bench_load::peak_rss_mib;
 use crate::bench_planner::{builtin_world, GOAL, START};
 
@@ -42,6 +43,8 @@ pub const PLANNING_M: f64 = 0.2;
 #[derive(Debug, Clone, Serialize)]
 pub struct ScalingRow {
     pub world: String,
+    /// Ratios are to the row of the same family on its 0.2 m map planned at 0.2 m.
+    pub family: String,
     pub map_resolution_m: f64,
     pub map_cells: usize,
     /// The resolution planned at: the planning grid's.
@@ -52,6 +55,11 @@ pub struct ScalingRow {
     pub plan_s_median: f64,
     /// `plan_s_median` over the 0.2 m world's planned at 0.2 m, in this run.
     pub ratio_to_paper_scale: f64,
+    /// CPU seconds of the process per plan (all its evaluation threads; the machine is
+    /// shared, so wall time carries other work's load, CPU time does not).
+    pub plan_cpu_s_median: f64,
+    /// `plan_cpu_s_median` over the 0.2 m world's planned at 0.2 m.
+    pub cpu_ratio_to_paper_scale: f64,
     pub distinct_information_ref_median: f64,
     pub t_eta_s_median: f64,
     pub budget_s: f64,
@@ -123,10 +131,14 @@ pub fn builtin_at(resolution: f64) -> Result<(Grid<i8>, Grid<u8>), BenchError> {
 /// (80), the aisles beside them (40), a loading area (60), 10 elsewhere. Inflated by a
 /// 0.25 m robot radius.
 pub fn warehouse() -> (Grid<i8>, Grid<u8>) {
-    let resolution = 0.03;
+    warehouse_at(0.03)
+}
+
+/// The same warehouse at `resolution` metres.
+pub fn warehouse_at(resolution: f64) -> (Grid<i8>, Grid<u8>) {
     let meta = GridMeta {
-        width: 1000,
-        height: 1700,
+        width: (30.0 / resolution).round() as u32,
+        height: (51.0 / resolution).round() as u32,
         resolution,
         origin: Origin::default(),
     };
@@ -188,9 +200,9 @@ fn reference_information(reference: &World, outcome: &PlanOutcome) -> f64 {
 /// The paper's workload on `world`, `runs` seeds.
 #[allow(clippy::too_many_arguments)]
 fn row(
+    family: &str,
     name: &str,
-    inflated: &Grid<i8>,
-    information: &Grid<u8>,
+    (inflated, information): (&Grid<i8>, &Grid<u8>),
     planning_m: f64,
     trip: ([f64; 2], [f64; 2]),
     budget_s: f64,
@@ -204,11 +216,16 @@ fn row(
     let (mut seconds, mut info, mut eta, mut cells) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut within = 0;
+    let mut cpu = Vec::new();
     for seed in 0..runs as u64 {
         let spec = PlanSpec::batch(trip.0, trip.1, budget_s, PlannerModel::Model1, 2000, seed);
         let started = Instant::now();
+        let cpu_before = process_cpu_seconds();
         let outcome = plan(&world, &spec, &never, |_, _| {}).map_err(setup)?;
         seconds.push(started.elapsed().as_secs_f64());
+        if let (Some(a), Some(b)) = (cpu_before, process_cpu_seconds()) {
+            cpu.push(b - a);
+        }
         info.push(reference_information(reference, &outcome));
         eta.push(outcome.t_eta_s);
         cells.push(outcome.cells.len() as f64);
@@ -216,6 +233,7 @@ fn row(
     }
     Ok(ScalingRow {
         world: name.to_owned(),
+        family: family.to_owned(),
         map_resolution_m: inflated.meta.resolution,
         map_cells: inflated.cells.len(),
         planning_resolution_m: world.meta.resolution,
@@ -223,6 +241,8 @@ fn row(
         build_s,
         plan_s_median: median(&mut seconds),
         ratio_to_paper_scale: f64::NAN,
+        plan_cpu_s_median: median(&mut cpu),
+        cpu_ratio_to_paper_scale: f64::NAN,
         distinct_information_ref_median: median(&mut info),
         t_eta_s_median: median(&mut eta),
         budget_s,
@@ -312,55 +332,59 @@ pub fn scaling(runs: usize) -> Result<ScalingBench, BenchError> {
     .map_err(setup)?;
     let budget = 2.0 * floor.t_eta_s;
     let (mut coarse, mut native) = (Vec::new(), Vec::new());
+    let builtin = "built-in";
     for resolution in RESOLUTIONS {
         let (inflated, information) = builtin_at(resolution)?;
         let name = format!("built-in at {resolution} m");
         eprintln!("scaling: {name}");
+        let (trip, at) = ((START, GOAL), (&inflated, &information));
         coarse.push(row(
-            &name,
-            &inflated,
-            &information,
-            PLANNING_M,
-            (START, GOAL),
-            budget,
-            &reference,
-            runs,
+            builtin, &name, at, PLANNING_M, trip, budget, &reference, runs,
         )?);
         native.push(row(
-            &name,
-            &inflated,
-            &information,
-            resolution,
-            (START, GOAL),
-            budget,
-            &reference,
-            runs,
+            builtin, &name, at, resolution, trip, budget, &reference, runs,
         )?);
     }
     eprintln!("scaling: the 1.7-million-cell warehouse");
     let (inflated, information) = warehouse();
     // Its own yardstick: the warehouse's information at 0.2 m.
     let wh_reference = World::at_resolution(&inflated, &information, 0.25, 0.21).map_err(setup)?;
-    let wh_floor = plan(
-        &wh_reference,
-        &PlanSpec::batch(
-            WAREHOUSE_START,
-            WAREHOUSE_GOAL,
-            86_400.0,
-            PlannerModel::Shortest,
-            1,
-            0,
-        ),
-        &never,
-        |_, _| {},
-    )
-    .map_err(setup)?;
+    let floor_spec = PlanSpec::batch(
+        WAREHOUSE_START,
+        WAREHOUSE_GOAL,
+        86_400.0,
+        PlannerModel::Shortest,
+        1,
+        0,
+    );
+    let wh_floor = plan(&wh_reference, &floor_spec, &never, |_, _| {}).map_err(setup)?;
     let wh_budget = 2.0 * wh_floor.t_eta_s;
     let trip = (WAREHOUSE_START, WAREHOUSE_GOAL);
-    coarse.push(row(
+    // The same warehouse drawn at 0.2 m: the family's paper-scale row.
+    let (paper_inflated, paper_information) = warehouse_at(0.2);
+    let wh = "warehouse";
+    let (paper_map, fine_map) = (
+        (&paper_inflated, &paper_information),
+        (&inflated, &information),
+    );
+    let (at_02, at_003) = (
+        "warehouse 30 x 51 m at 0.2 m",
         "warehouse 30 x 51 m at 0.03 m",
-        &inflated,
-        &information,
+    );
+    coarse.push(row(
+        wh,
+        at_02,
+        paper_map,
+        PLANNING_M,
+        trip,
+        wh_budget,
+        &wh_reference,
+        runs,
+    )?);
+    coarse.push(row(
+        wh,
+        at_003,
+        fine_map,
         PLANNING_M,
         trip,
         wh_budget,
@@ -368,18 +392,27 @@ pub fn scaling(runs: usize) -> Result<ScalingBench, BenchError> {
         runs,
     )?);
     native.push(row(
-        "warehouse 30 x 51 m at 0.03 m",
-        &inflated,
-        &information,
+        wh,
+        at_003,
+        fine_map,
         0.03,
         trip,
         wh_budget,
         &wh_reference,
         runs,
     )?);
-    let paper = coarse[0].plan_s_median;
-    for r in coarse.iter_mut().chain(native.iter_mut()) {
-        r.ratio_to_paper_scale = r.plan_s_median / paper;
+    for family in [builtin, wh] {
+        let Some(paper) = coarse.iter().find(|r| r.family == family).cloned() else {
+            continue;
+        };
+        for r in coarse
+            .iter_mut()
+            .chain(native.iter_mut())
+            .filter(|r| r.family == family)
+        {
+            r.ratio_to_paper_scale = r.plan_s_median / paper.plan_s_median;
+            r.cpu_ratio_to_paper_scale = r.plan_cpu_s_median / paper.plan_cpu_s_median;
+        }
     }
     Ok(ScalingBench {
         planned_coarse: coarse,
