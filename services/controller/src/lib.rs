@@ -63,6 +63,7 @@ pub mod forces;
 pub mod information;
 pub mod obstacle_field;
 pub mod params;
+#[cfg(feature = "zenoh")]
 pub mod service;
 pub mod weights;
 

@@ -12,6 +12,7 @@ pub mod error;
 pub mod field;
 pub mod fim;
 pub mod model;
+#[cfg(feature = "zenoh")]
 pub mod service;
 pub mod tracker;
 pub mod wls;

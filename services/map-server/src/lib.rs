@@ -13,8 +13,10 @@ pub mod derived;
 pub mod edits;
 pub mod map_file;
 pub mod persist;
+#[cfg(feature = "zenoh")]
 pub mod service;
 pub mod store;
 
 pub use config::MapServerConfig;
+#[cfg(feature = "zenoh")]
 pub use service::{run, MapServerError, SERVICE_NAME};

@@ -127,6 +127,7 @@ pub mod goals;
 pub mod learner;
 pub mod poisson;
 pub use roam_world::seed;
+#[cfg(feature = "zenoh")]
 pub mod service;
 pub mod wavefront;
 

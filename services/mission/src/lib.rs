@@ -26,11 +26,14 @@
 //! - [`service`]: `roam mission`, the executive as a service that publishes its reports.
 
 pub mod calibration;
+#[cfg(feature = "zenoh")]
 pub mod executive;
 pub mod information;
+#[cfg(feature = "zenoh")]
 mod inputs;
 pub mod margin;
 pub mod path;
+#[cfg(feature = "zenoh")]
 pub mod service;
 pub mod tasks;
 pub mod watch;

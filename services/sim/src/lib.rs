@@ -34,6 +34,7 @@ pub mod raster;
 pub mod render;
 pub mod robot;
 pub mod sensors;
+#[cfg(feature = "zenoh")]
 pub mod service;
 pub mod sim;
 pub mod snapshot;
