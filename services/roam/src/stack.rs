@@ -43,6 +43,9 @@ pub struct StackOptions {
     pub sim_rate: Option<f64>,
     /// The controller's parameters (default: paper 002's).
     pub apf: Option<roam_controller::params::ApfParams>,
+    /// Run the ROS 2 node too (`roam ros2`: roam's topics and services on rmw_zenoh's
+    /// keys, through the stack's router); its `root` is the stack's.
+    pub ros2: Option<roam_ros2::node::Ros2Config>,
 }
 
 /// The services `Stack::start` runs on a world with a sim world, in start order.
@@ -228,6 +231,22 @@ impl Stack {
             ),
         );
         running.push(roam_mapper::service::SERVICE_NAME);
+        if let Some(ros2) = &options.ros2 {
+            let ros2_config = roam_ros2::node::Ros2Config {
+                root: root.clone(),
+                ..ros2.clone()
+            };
+            spawn(
+                &mut services,
+                roam_ros2::node::SERVICE_NAME,
+                roam_ros2::node::run(
+                    ros2_config,
+                    client.zenoh_config(None)?,
+                    cancel.child_token(),
+                ),
+            );
+            running.push(roam_ros2::node::SERVICE_NAME);
+        }
 
         let mut stack = Stack {
             router,

@@ -49,6 +49,15 @@ pub fn encode<T: Serialize>(message: &T) -> Result<Vec<u8>, CdrError> {
     Ok(out)
 }
 
+/// Decodes the first fields of a payload as a `T` (a message's head, e.g. a map's header
+/// and size, read before its cells), ignoring what follows them.
+pub fn decode_prefix<T: DeserializeOwned>(
+    payload: &[u8],
+    what: &'static str,
+) -> Result<T, CdrError> {
+    decode_inner(payload, what, usize::MAX).map(|(message, _)| message)
+}
+
 /// Decodes a `T` (named `what` in errors) from a payload of at most `max` bytes. Up to 3
 /// bytes of padding may follow the message (CDR writers pad to 4); more is refused.
 pub fn decode<T: DeserializeOwned>(
@@ -56,6 +65,19 @@ pub fn decode<T: DeserializeOwned>(
     what: &'static str,
     max: usize,
 ) -> Result<T, CdrError> {
+    let (message, extra) = decode_inner(payload, what, max)?;
+    if extra > 3 {
+        return Err(CdrError::Trailing { what, extra });
+    }
+    Ok(message)
+}
+
+/// Decodes a `T` and says how many bytes followed it.
+fn decode_inner<T: DeserializeOwned>(
+    payload: &[u8],
+    what: &'static str,
+    max: usize,
+) -> Result<(T, usize), CdrError> {
     if payload.len() > max {
         return Err(CdrError::TooLarge {
             what,
@@ -77,11 +99,7 @@ pub fn decode<T: DeserializeOwned>(
         [0x00, 0x00] => codec::from_bytes::<T, BigEndian>(body).map_err(invalid)?,
         other => return Err(CdrError::Encapsulation(other)),
     };
-    let extra = body.len() - used.min(body.len());
-    if extra > 3 {
-        return Err(CdrError::Trailing { what, extra });
-    }
-    Ok(message)
+    Ok((message, body.len() - used.min(body.len())))
 }
 
 #[cfg(test)]

@@ -15,10 +15,13 @@
 //! With the default feature `zenoh`, [`node`] is the thin adapter: the `roam ros2` role.
 
 pub mod attachment;
+pub mod bag;
 pub mod cdr;
 pub mod convert;
 pub mod hash;
 pub mod msg;
 pub mod names;
+#[cfg(feature = "zenoh")]
+pub mod node;
 pub mod types;
 pub mod wire;
