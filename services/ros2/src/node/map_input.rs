@@ -69,6 +69,8 @@ pub(super) async fn declare(
     };
     let maps = session
         .declare_subscriber(endpoint.key.clone())
+        // As rmw_zenoh's `ignore_local_publications`: never roam's own samples.
+        .allowed_origin(zenoh::sample::Locality::Remote)
         .history(
             HistoryConfig::default()
                 .detect_late_publishers()

@@ -128,11 +128,16 @@ pub async fn run(
         name: config.node_name.clone(),
         enclave: String::new(),
     };
+    let taken = match &config.map_input {
+        Some(topic) => Some(names::qualify(&config.namespace, topic)?),
+        None => None,
+    };
     let output = Arc::new(Output::new(
         session.clone(),
         node.clone(),
         config.offer,
         bag,
+        taken,
     ));
     let node_token = if config.offer {
         Some(output.declare_node().await?)

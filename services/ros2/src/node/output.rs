@@ -40,6 +40,9 @@ pub struct Output {
     next_id: AtomicU32,
     publishers: tokio::sync::Mutex<BTreeMap<String, RosPublisher>>,
     bag: Mutex<Option<Bag>>,
+    /// A topic roam takes from ROS 2 (`--ros2-map`) is not also published by roam: its
+    /// publisher there is the ROS node's, and roam's own map would come back to it.
+    taken: Option<String>,
     pub(crate) warnings: roam_runtime::warn_limit::WarnLimiter,
 }
 
@@ -53,8 +56,15 @@ impl std::fmt::Debug for Output {
 }
 
 impl Output {
-    pub(crate) fn new(session: Session, node: NodeInfo, offer: bool, bag: Option<Bag>) -> Output {
+    pub(crate) fn new(
+        session: Session,
+        node: NodeInfo,
+        offer: bool,
+        bag: Option<Bag>,
+        taken: Option<String>,
+    ) -> Output {
         Output {
+            taken,
             session,
             node,
             offer,
@@ -172,7 +182,9 @@ impl Output {
             Err(e) => return tracing::warn!(topic = name, "roam ros2: not sent: {e}"),
         };
         let now = attachment::now_ns();
-        if self.offer {
+        let taken =
+            self.taken.is_some() && names::qualify(&self.node.namespace, name).ok() == self.taken;
+        if self.offer && !taken {
             let mut publishers = self.publishers.lock().await;
             if !publishers.contains_key(name) {
                 if publishers.len() >= MAX_TOPICS {
