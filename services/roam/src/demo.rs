@@ -50,6 +50,8 @@ pub struct DemoOptions {
     pub record: Option<PathBuf>,
     /// Who may connect to the live view.
     pub view_access: roam_view::Access,
+    /// Offer the demo to ROS 2 (`roam ros2` in the stack).
+    pub ros2: Option<roam_ros2::node::Ros2Config>,
 }
 
 impl Default for DemoOptions {
@@ -62,6 +64,7 @@ impl Default for DemoOptions {
             view: None,
             record: None,
             view_access: roam_view::Access::default(),
+            ros2: None,
         }
     }
 }
@@ -146,6 +149,7 @@ pub async fn run(
             planners: 1,
             sim_rate: Some(options.rate),
             apf: Some(indoor_apf()),
+            ros2: options.ros2.clone(),
             ..StackOptions::default()
         },
         Duration::from_secs(30),

@@ -1,7 +1,8 @@
 //! The role table: every service roam runs, what configures it, how it announces
 //! itself and how it runs.
 //!
-//! A role is a service with its config. The `roam` binary builds one from a config file
+//! A role is a service with its config: the map server, the planner, the sim,
+//! localization, the controller, the mapper, the mission executive, and the ROS 2 node. The `roam` binary builds one from a config file
 //! and its flags (`roam planner --config …`), [`crate::Stack`] builds one per service it
 //! runs, and the integration tests build them from test configs; all three then start
 //! it the same way: [`Role::run`] with a Zenoh config and a cancellation token, and
@@ -18,6 +19,7 @@ use roam_mapper::service::MapperConfig;
 use roam_mission::service::MissionConfig;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
+use roam_ros2::node::Ros2Config;
 use roam_sim::service::SimConfig;
 use tokio_util::sync::CancellationToken;
 
@@ -60,7 +62,8 @@ role_config!(
     LocalizationConfig,
     ControllerConfig,
     MapperConfig,
-    MissionConfig
+    MissionConfig,
+    Ros2Config
 );
 
 /// One service of roam with its config.
@@ -73,6 +76,8 @@ pub enum Role {
     Controller(Box<ControllerConfig>),
     Mapper(Box<MapperConfig>),
     Mission(Box<MissionConfig>),
+    /// roam in a ROS 2 system over rmw_zenoh (`roam ros2`).
+    Ros2(Box<Ros2Config>),
 }
 
 /// A running role: it ends with the service, with its error as text.
@@ -89,6 +94,7 @@ macro_rules! each_role {
             Role::Controller($config) => $body,
             Role::Mapper($config) => $body,
             Role::Mission($config) => $body,
+            Role::Ros2($config) => $body,
         }
     };
 }
@@ -112,6 +118,7 @@ impl Role {
             Role::Controller(_) => roam_controller::service::SERVICE_NAME,
             Role::Mapper(_) => roam_mapper::service::SERVICE_NAME,
             Role::Mission(_) => roam_mission::service::SERVICE_NAME,
+            Role::Ros2(_) => roam_ros2::node::SERVICE_NAME,
         }
     }
 
@@ -156,6 +163,7 @@ impl Role {
             Role::Controller(c) => boxed(roam_controller::service::run(*c, zenoh, cancel)),
             Role::Mapper(c) => boxed(roam_mapper::service::run(*c, zenoh, cancel)),
             Role::Mission(c) => boxed(roam_mission::service::run(*c, zenoh, cancel)),
+            Role::Ros2(c) => boxed(roam_ros2::node::run(*c, zenoh, cancel)),
         }
     }
 }
@@ -177,7 +185,8 @@ role_from!(
     Localization(LocalizationConfig),
     Controller(ControllerConfig),
     Mapper(MapperConfig),
-    Mission(MissionConfig)
+    Mission(MissionConfig),
+    Ros2(Ros2Config)
 );
 
 #[cfg(test)]

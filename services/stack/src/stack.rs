@@ -44,12 +44,16 @@ pub struct StackOptions {
     pub sim_rate: Option<f64>,
     /// The controller's parameters (default: paper 002's).
     pub apf: Option<roam_controller::params::ApfParams>,
+    /// Run the ROS 2 node too (`roam ros2`: roam's topics and services on rmw_zenoh's
+    /// keys, through the stack's router); its `root` is the stack's.
+    pub ros2: Option<roam_ros2::node::Ros2Config>,
 }
 
 impl StackOptions {
     /// The roles the stack runs on a world with a sim world, in start order: the map
     /// server, the planners (on the change coupling: the stack runs the mapper), the
-    /// sim (free-running), localization, the controller and the mapper.
+    /// sim (free-running), localization, the controller, the mapper, and the ROS 2 node
+    /// when asked for.
     pub fn roles(&self, root: &str) -> Vec<Role> {
         let mut roles = vec![Role::from(MapServerConfig {
             root: root.to_owned(),
@@ -89,6 +93,12 @@ impl StackOptions {
             scenario: self.map.clone(),
             ..MapperConfig::default()
         }));
+        if let Some(ros2) = &self.ros2 {
+            roles.push(Role::from(roam_ros2::node::Ros2Config {
+                root: root.to_owned(),
+                ..ros2.clone()
+            }));
+        }
         roles
     }
 }

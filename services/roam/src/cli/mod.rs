@@ -4,6 +4,7 @@
 mod map;
 mod plan;
 mod roles;
+mod ros2;
 mod sim;
 mod tools;
 mod view;
@@ -52,6 +53,9 @@ ROLES
                ranges, moving blocks (paper 004), line-of-sight observations, a clock;
                free-running or in lock-step. `roam sim render` draws a scenario.
   router       A Zenoh router: run one per site or fleet; services connect to it.
+  ros2         roam in a ROS 2 system over rmw_zenoh (no bridge): /map and the layers,
+               each robot's plan, pose and driven path, the planner as ROS 2 services,
+               optionally the occupancy map from a ROS 2 topic and a rosbag2 recording.
   stack        Every landed service in one process around an in-process router on
                loopback, multicast off. The embedded default world needs no files.
 
@@ -120,6 +124,8 @@ enum Command {
     Router(RouterArgs),
     /// Run every landed service in one process around an in-process router.
     Stack(StackArgs),
+    /// roam in a ROS 2 system over rmw_zenoh: topics, services, the map from ROS 2.
+    Ros2(ros2::Ros2Args),
     /// The live view of a running stack in the Foxglove app, and MCAP recording.
     View(view::ViewArgs),
     /// Map files and the map server's layers.
@@ -198,6 +204,7 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Plan(args) => plan::plan(args).await,
         Command::Router(args) => roles::router(args).await,
         Command::Stack(args) => roles::stack(args).await,
+        Command::Ros2(args) => ros2::ros2(args).await,
         Command::View(args) => view::view(args).await,
         Command::Map(command) => map::map(command).await,
         Command::Bench(command) => tools::bench(command).await,

@@ -75,6 +75,12 @@ pub(crate) struct StackArgs {
     /// Where --once writes its report.
     #[arg(long, value_name = "DIR", default_value = "roam-report")]
     out: PathBuf,
+    /// Offer the stack to ROS 2 over rmw_zenoh (`roam ros2` in the stack; ROS 2 nodes
+    /// connect to this stack's router).
+    #[arg(long)]
+    ros2: bool,
+    #[command(flatten)]
+    ros: super::ros2::RosFlags,
 }
 
 pub(crate) async fn map_server(args: MapServerArgs) -> anyhow::Result<()> {
@@ -152,6 +158,7 @@ pub(crate) async fn stack(args: StackArgs) -> anyhow::Result<()> {
         load_dirs: args.load_dirs,
         listen: args.listen,
         planners: args.planners,
+        ros2: args.ros2.then(|| args.ros.config()),
         ..StackOptions::default()
     };
     let mut stack = Stack::start(options, Duration::from_secs(30)).await?;
@@ -329,6 +336,12 @@ pub(crate) struct DemoArgs {
     /// Who may connect to the live view (--view).
     #[command(flatten)]
     view_access: super::view::AccessArgs,
+    /// Offer the demo to ROS 2 over rmw_zenoh (roam's topics and services; see
+    /// services/ros2/README.md).
+    #[arg(long)]
+    ros2: bool,
+    #[command(flatten)]
+    ros: super::ros2::RosFlags,
 }
 
 pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
@@ -352,6 +365,7 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
             }
             None => roam_view::Access::default(),
         },
+        ros2: args.ros2.then(|| args.ros.config()),
     };
     let say = |line: &str| eprintln!("roam demo: {line}");
     let report = roam::demo::run(&options, &say).await?;
