@@ -162,7 +162,7 @@ impl Controller {
     }
 
     /// Ends the mission as if emptied: zero commands, status Idle.
-    pub fn clear(&mut self) {
+    pub fn end_mission(&mut self) {
         self.set_mission(Vec::new());
     }
 
@@ -321,7 +321,7 @@ impl Controller {
                 Ok(path) => self.path = Some(path),
                 Err(e) => {
                     tracing::warn!("the mission's path cannot be followed: {e}");
-                    self.clear();
+                    self.end_mission();
                     return self.decision(position, None);
                 }
             }
@@ -435,7 +435,7 @@ mod tests {
         assert_eq!((d.u, d.steps, d.waypoint), ([0.0, 0.0], 0, None));
         c.set_mission(vec![[25.0, 20.0]]);
         assert!(c.is_active());
-        c.clear();
+        c.end_mission();
         assert_eq!(c.update([20.0, 20.0], GOOD).status, MissionStatus::Idle);
     }
 

@@ -94,7 +94,9 @@ pub enum LocalizationServiceError {
     World(#[from] WorldMismatch),
 }
 
-struct State {
+/// What the localization service's subscribers and queryables share: the session,
+/// the sensing model and constellation, and every robot's tracker.
+struct LocalizationShared {
     root: String,
     session: zenoh::Session,
     sensing: SensingSpec,
@@ -166,7 +168,7 @@ pub async fn run(
         variance_derivative: config.variance_derivative,
         ..FimOptions::default()
     };
-    let state = Arc::new(State {
+    let state = Arc::new(LocalizationShared {
         world: world.clone(),
         root: config.root.clone(),
         session: service.session().clone(),
@@ -182,7 +184,7 @@ pub async fn run(
             &keys::robot_ranges_any(&config.root),
             MAX_SCAN_BYTES,
             state.clone(),
-            |state: &Arc<State>, key: &str, scan: RangeScan| on_scan(state, key, scan),
+            |state: &Arc<LocalizationShared>, key: &str, scan: RangeScan| on_scan(state, key, scan),
         )
         .await?;
     let peb = service
@@ -205,7 +207,7 @@ pub async fn run(
 
 /// Estimates a robot's position from one scan ([`Tracker::on_scan`]) and publishes it on
 /// the robot's key: the robot is the one the scan's key names ([`routing`]).
-fn on_scan(state: &State, key: &str, scan: RangeScan) {
+fn on_scan(state: &LocalizationShared, key: &str, scan: RangeScan) {
     let robot = match routing::robot_for(&state.root, key, &scan.robot) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "ignoring a scan: {e}"),
@@ -219,7 +221,7 @@ fn on_scan(state: &State, key: &str, scan: RangeScan) {
     roam_runtime::publish_wait(&state.session, &key, &message, Delivery::Latest);
 }
 
-async fn answer_peb(state: Arc<State>, query: Query) {
+async fn answer_peb(state: Arc<LocalizationShared>, query: Query) {
     let request = match reply::decode_request::<PebQuery>(&query, MAX_REQUEST_BYTES) {
         Ok(r) => r,
         Err(e) => return reply::send_error(&query, &e).await,
@@ -235,7 +237,7 @@ async fn answer_peb(state: Arc<State>, query: Query) {
     reply::send_result(&query, result).await;
 }
 
-fn peb_reply(state: &State, request: &PebQuery) -> Result<PebReply, ErrorReply> {
+fn peb_reply(state: &LocalizationShared, request: &PebQuery) -> Result<PebReply, ErrorReply> {
     let anchors: Vec<[f64; 2]> = request
         .anchors
         .as_ref()
@@ -341,7 +343,7 @@ fn region_of(meta: &GridMeta) -> GridRegion {
 
 /// Sends the PEB field over the scenario's map to the map server as layer `peb`,
 /// retrying until a map server answers (or the service stops).
-async fn publish_peb_layer(state: Arc<State>, cancel: CancellationToken) {
+async fn publish_peb_layer(state: Arc<LocalizationShared>, cancel: CancellationToken) {
     let anchors: Vec<[f64; 2]> = state.anchors.iter().map(|a| a.at).collect();
     let field = match model_of(&anchors, &state.sensing)
         .and_then(|m| peb_field(&m, &region_of(&state.map), &state.fim))

@@ -124,7 +124,8 @@ struct Control {
     free_steps: u64,
 }
 
-struct State {
+/// What the sim's control queryable, command subscriber and free run share.
+struct SimShared {
     root: String,
     session: zenoh::Session,
     control: Mutex<Control>,
@@ -139,7 +140,7 @@ struct State {
     warnings: WarnLimiter,
 }
 
-impl State {
+impl SimShared {
     fn control(&self) -> MutexGuard<'_, Control> {
         roam_runtime::lock(&self.control)
     }
@@ -210,7 +211,7 @@ pub async fn run(
     )
     .await?;
     let world_guard = world_check::guard(&service, roam_world::world_id::of_scenario(&scenario));
-    let state = Arc::new(State {
+    let state = Arc::new(SimShared {
         root: config.root.clone(),
         session: service.session().clone(),
         control: Mutex::new(Control {
@@ -300,7 +301,7 @@ fn resume_from(sim: &mut Sim, name: &str, seed: u64, path: &Path) -> Result<(), 
 
 /// Writes the snapshot every [`SNAPSHOT_PERIOD`] while the step count changes, and once
 /// more at shutdown.
-async fn keep_snapshots(state: Arc<State>, path: PathBuf, cancel: CancellationToken) {
+async fn keep_snapshots(state: Arc<SimShared>, path: PathBuf, cancel: CancellationToken) {
     let mut saved_step = None;
     loop {
         let stopping = tokio::select! {
@@ -328,7 +329,7 @@ async fn keep_snapshots(state: Arc<State>, path: PathBuf, cancel: CancellationTo
 
 /// Stores a command for the next step; commands for unknown robots or with non-finite
 /// values are dropped (logged), so the pending map never outgrows the robots.
-fn take_command(state: &State, key: &str, payload: &[u8]) {
+fn take_command(state: &SimShared, key: &str, payload: &[u8]) {
     let Some(robot) = keys::robot_of(&state.root, key) else {
         return;
     };
@@ -360,7 +361,7 @@ fn take_command(state: &State, key: &str, payload: &[u8]) {
 }
 
 /// One step under the lock; returns the messages to publish after it is released.
-fn step_once(state: &State) -> Result<(SimClock, Vec<RobotMessages>), ErrorReply> {
+fn step_once(state: &SimShared) -> Result<(SimClock, Vec<RobotMessages>), ErrorReply> {
     let mut control = state.control();
     let commands: Vec<Command> = std::mem::take(&mut control.pending)
         .into_iter()
@@ -381,11 +382,11 @@ fn step_once(state: &State) -> Result<(SimClock, Vec<RobotMessages>), ErrorReply
 
 /// Every reading of a step is delivered: a robot's localization and controller run in
 /// lock-step on them.
-async fn put<T: Message>(state: &State, key: &str, message: &T) {
+async fn put<T: Message>(state: &SimShared, key: &str, message: &T) {
     roam_runtime::publish(&state.session, key, message, Delivery::Reliable).await;
 }
 
-async fn publish(state: &State, clock: SimClock, robots: Vec<RobotMessages>) {
+async fn publish(state: &SimShared, clock: SimClock, robots: Vec<RobotMessages>) {
     let root = &state.root;
     for m in robots {
         let robot = m.truth.robot.clone();
@@ -403,9 +404,9 @@ async fn publish(state: &State, clock: SimClock, robots: Vec<RobotMessages>) {
 
 /// Steps while running: every `step_s / rate` seconds of wall time, or back to back at
 /// rate 0. A step whose messages are not out before the next one is due counts as late.
-/// Every control request wakes it ([`State::wake`]), so a pause, a reset or a new rate
+/// Every control request wakes it ([`SimShared::wake`]), so a pause, a reset or a new rate
 /// takes effect at once, whatever the period was.
-async fn free_run(state: Arc<State>, cancel: CancellationToken) {
+async fn free_run(state: Arc<SimShared>, cancel: CancellationToken) {
     let mut next = Instant::now();
     loop {
         let (running, period) = {
@@ -479,7 +480,7 @@ fn scenario_error(e: &ScenarioError) -> ErrorReply {
     }
 }
 
-async fn answer_control(state: Arc<State>, query: Query) {
+async fn answer_control(state: Arc<SimShared>, query: Query) {
     let request = match reply::decode_request::<SimControl>(&query, MAX_REQUEST_BYTES) {
         Ok(r) => r,
         Err(e) => return reply::send_error(&query, &e).await,
@@ -493,7 +494,7 @@ async fn answer_control(state: Arc<State>, query: Query) {
     reply::send_result(&query, outcome.map(|()| state.status())).await;
 }
 
-async fn control(state: &Arc<State>, request: SimControl) -> Result<(), ErrorReply> {
+async fn control(state: &Arc<SimShared>, request: SimControl) -> Result<(), ErrorReply> {
     match request {
         SimControl::Load { path, seed } => {
             let dirs = state.load_dirs.clone();

@@ -159,7 +159,7 @@ impl Episode {
     }
 }
 
-struct Driven {
+struct EpisodeRobot {
     index: usize,
     controller: Controller,
     track: RobotTrack,
@@ -177,7 +177,7 @@ pub fn run_episode(
     params.check()?;
     let mut sim = Sim::with_params(&setup.scenario, setup.sim_params, seed)?;
     let mut tracker = Tracker::new(setup.scenario.file.sensing, FimOptions::default());
-    let mut driven: BTreeMap<&str, Driven> = BTreeMap::new();
+    let mut driven: BTreeMap<&str, EpisodeRobot> = BTreeMap::new();
     for (index, m) in missions.iter().enumerate() {
         if sim.robot(&m.robot).is_none() {
             return Err(EpisodeError::UnknownRobot(m.robot.clone()));
@@ -188,7 +188,7 @@ pub fn run_episode(
             setup.information.clone(),
         );
         controller.set_mission(m.waypoints.clone());
-        let d = Driven {
+        let d = EpisodeRobot {
             index,
             done: !controller.is_active(),
             controller,

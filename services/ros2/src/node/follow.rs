@@ -16,11 +16,9 @@ use roam_proto::localization::PositionEstimate;
 use roam_proto::map::{Layer, LayerList};
 use roam_proto::sim::GroundTruth;
 use roam_proto::{decode, keys, Message};
-use roam_runtime::Requester;
+use roam_runtime::{subscribe_latest, LatestSamples, Requester};
 use tokio::time::MissedTickBehavior;
 use tokio_util::sync::CancellationToken;
-use zenoh::handlers::{RingChannel, RingChannelHandler};
-use zenoh::pubsub::Subscriber;
 use zenoh::sample::Sample;
 use zenoh::Session;
 
@@ -47,7 +45,7 @@ pub const MAX_LAYER_BYTES: usize = roam_runtime::service::DEFAULT_MAX_SAMPLE_BYT
 const MAX_ESTIMATE_BYTES: usize = 64 * 1024;
 const MAX_TRUTH_BYTES: usize = 4 * 1024;
 
-type Ring = Subscriber<RingChannelHandler<Sample>>;
+type Ring = LatestSamples;
 
 pub(super) struct Subscriptions {
     layers: Ring,
@@ -58,19 +56,14 @@ pub(super) struct Subscriptions {
 
 impl Subscriptions {
     pub(super) async fn declare(session: &Session, root: &str) -> Result<Self, Ros2Error> {
-        let ring = |key: String, capacity: usize| {
-            let session = session.clone();
-            async move {
-                session
-                    .declare_subscriber(key.clone())
-                    .with(RingChannel::new(capacity))
-                    .await
-                    .map_err(|e| Ros2Error::Declare {
-                        what: "subscriber",
-                        key,
-                        reason: e.to_string(),
-                    })
-            }
+        let ring = |key: String, capacity: usize| async move {
+            subscribe_latest(session, &key, capacity)
+                .await
+                .map_err(|e| Ros2Error::Declare {
+                    what: "subscriber",
+                    key,
+                    reason: e.to_string(),
+                })
         };
         Ok(Subscriptions {
             layers: ring(keys::map_layer_any(root), 8).await?,

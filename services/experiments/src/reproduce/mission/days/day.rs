@@ -177,7 +177,7 @@ impl DayRun<'_> {
             Follow::Path => mission_waypoints(&plan.points, self.executive.waypoint_spacing_m),
             Follow::Waypoints => {
                 super::thin::thin(&plan.points, self.executive.waypoint_spacing_m, |a, b| {
-                    super::thin::clear(&self.world.planning, a, b)
+                    super::thin::line_of_sight(&self.world.planning, a, b)
                 })
             }
         }

@@ -9,12 +9,12 @@ use roam_mission::path::distance;
 
 /// Thins a planned path (cell centres, 8-connected) into waypoints: from each kept
 /// point, the farthest later point that is at most `max_spacing_m` away and in a
-/// straight line of free space (`clear(a, b)`), always keeping the last. A corner is
-/// kept because its diagonal is not clear.
+/// straight line of free space (`in_sight(a, b)`, e.g. [`line_of_sight`]), always keeping
+/// the last. A corner is kept because its diagonal is not in sight.
 pub fn thin(
     points: &[[f64; 2]],
     max_spacing_m: f64,
-    clear: impl Fn([f64; 2], [f64; 2]) -> bool,
+    in_sight: impl Fn([f64; 2], [f64; 2]) -> bool,
 ) -> Vec<[f64; 2]> {
     let mut out = Vec::new();
     let Some(&first) = points.first() else {
@@ -25,7 +25,7 @@ pub fn thin(
     while from + 1 < points.len() {
         let mut next = from + 1;
         for (j, &p) in points.iter().enumerate().skip(from + 2) {
-            if distance(anchor, p) > max_spacing_m || !clear(anchor, p) {
+            if distance(anchor, p) > max_spacing_m || !in_sight(anchor, p) {
                 break;
             }
             next = j;
@@ -42,7 +42,7 @@ pub fn thin(
 
 /// Whether the straight segment a → b stays on traversable cells of the planning grid
 /// (sampled every half cell).
-pub fn clear(world: &World, a: [f64; 2], b: [f64; 2]) -> bool {
+pub fn line_of_sight(world: &World, a: [f64; 2], b: [f64; 2]) -> bool {
     let step = world.meta.resolution / 2.0;
     let n = (distance(a, b) / step).ceil().max(1.0) as usize;
     (0..=n).all(|i| {
