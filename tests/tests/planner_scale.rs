@@ -7,8 +7,6 @@
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use roam_map_server::layers::inflate;
-use roam_map_server::store::DEFAULT_LIMITS;
 use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
@@ -19,6 +17,8 @@ use roam_proto::planner::{
 use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::{ClientError, Requester};
 use roam_tests::{repo_path, within, Harness, RunningService};
+use roam_world::layers::inflate;
+use roam_world::DEFAULT_MAX_CELLS;
 
 const DEPOT: &str = "config/scenarios/depot.yaml";
 
@@ -51,7 +51,7 @@ struct Running {
 async fn boot(map: Option<&str>, planners: Vec<PlannerConfig>) -> Running {
     let harness = Harness::start().await;
     let map_server = harness
-        .start_map_server(roam_map_server::MapServerConfig {
+        .start_role(roam_map_server::MapServerConfig {
             map: map.map(repo_path),
             ..harness.map_server_config()
         })
@@ -62,7 +62,7 @@ async fn boot(map: Option<&str>, planners: Vec<PlannerConfig>) -> Running {
             root: harness.root.clone(),
             ..config
         };
-        started.push(harness.start_planner(config).await);
+        started.push(harness.start_role(config).await);
     }
     Running {
         harness,
@@ -109,8 +109,7 @@ async fn a_coarse_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
     assert_eq!(remote.planning_resolution_m, Some(0.2));
 
     let scenario =
-        roam_map_server::scenario::load(&repo_path(DEPOT), DEFAULT_LIMITS.max_layer_cells)
-            .expect("scenario");
+        roam_world::scenario::load(&repo_path(DEPOT), DEFAULT_MAX_CELLS).expect("scenario");
     let inflated = inflate(
         &scenario.occupancy,
         scenario.file.robot_radius_m.unwrap_or(0.2),
@@ -403,7 +402,7 @@ async fn bad_queue_lengths_and_planning_resolutions_are_refused_naming_the_limit
 async fn a_planning_resolution_finer_than_the_map_is_refused_in_every_reply() {
     let harness = Harness::start().await;
     let map_server = harness
-        .start_map_server(roam_map_server::MapServerConfig {
+        .start_role(roam_map_server::MapServerConfig {
             map: Some(repo_path(DEPOT)),
             ..harness.map_server_config()
         })

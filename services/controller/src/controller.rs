@@ -162,7 +162,7 @@ impl Controller {
     }
 
     /// Ends the mission as if emptied: zero commands, status Idle.
-    pub fn clear(&mut self) {
+    pub fn end_mission(&mut self) {
         self.set_mission(Vec::new());
     }
 
@@ -321,7 +321,7 @@ impl Controller {
                 Ok(path) => self.path = Some(path),
                 Err(e) => {
                     tracing::warn!("the mission's path cannot be followed: {e}");
-                    self.clear();
+                    self.end_mission();
                     return self.decision(position, None);
                 }
             }
@@ -387,8 +387,8 @@ mod tests {
     use roam_localization::fim::FimOptions;
     use roam_localization::model::RangingModel;
     use roam_localization::ToaNoise;
-    use roam_map_server::grid::{occupancy, Grid};
     use roam_proto::map::{GridMeta, Origin};
+    use roam_world::grid::{occupancy, Grid};
 
     /// An empty 40 × 40 m map (0.5 m cells, origin 0) with four anchors around the
     /// middle: covered everywhere near it.
@@ -435,7 +435,7 @@ mod tests {
         assert_eq!((d.u, d.steps, d.waypoint), ([0.0, 0.0], 0, None));
         c.set_mission(vec![[25.0, 20.0]]);
         assert!(c.is_active());
-        c.clear();
+        c.end_mission();
         assert_eq!(c.update([20.0, 20.0], GOOD).status, MissionStatus::Idle);
     }
 

@@ -33,7 +33,6 @@ use std::time::{Duration, Instant};
 
 use roam_localization::fim::FimOptions;
 use roam_localization::model::RangingModel;
-use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::controller::{
     ControllerStatus, Mission, MissionState, MAX_MISSION_BYTES, MAX_MISSION_ID_BYTES, MAX_WAYPOINTS,
 };
@@ -41,8 +40,9 @@ use roam_proto::localization::PositionEstimate;
 use roam_proto::sim::RobotCommand;
 use roam_proto::{excerpt, keys, Message};
 use roam_runtime::warn_limit::WarnLimiter;
+use roam_runtime::world_check::{self, WorldMismatch};
 use roam_runtime::{limited_warn, routing, Service, ServiceError};
-use roam_sim::service::load_scenario;
+use roam_world::scenario::load_or_builtin;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
 
@@ -54,7 +54,7 @@ use crate::params::ApfParams;
 pub const SERVICE_NAME: &str = "controller";
 /// Robots one controller instance drives at most.
 pub const MAX_ROBOTS: usize = 1000;
-/// Missions held for robots not yet heard of (see `State::hold`).
+/// Missions held for robots not yet heard of (see `ControllerShared::hold`).
 pub const MAX_HELD_MISSIONS: usize = 64;
 /// Largest estimate decoded, bytes (one is a few hundred).
 pub const MAX_ESTIMATE_BYTES: usize = 64 * 1024;
@@ -113,7 +113,7 @@ pub enum ControllerServiceError {
     #[error(transparent)]
     Service(#[from] ServiceError),
     #[error(transparent)]
-    Scenario(#[from] roam_map_server::scenario::ScenarioError),
+    Scenario(#[from] roam_world::scenario::ScenarioError),
     #[error("invalid config: {0}")]
     Config(String),
     #[error(transparent)]
@@ -121,7 +121,7 @@ pub enum ControllerServiceError {
 }
 
 /// One robot under control.
-struct Driven {
+struct ControlledRobot {
     controller: Controller,
     mission: String,
     waypoints: usize,
@@ -130,7 +130,9 @@ struct Driven {
     last: Option<ControllerStatus>,
 }
 
-struct State {
+/// What the controller's subscribers share: the session, the fields the controllers
+/// steer by, and the robots under control.
+struct ControllerShared {
     root: String,
     session: zenoh::Session,
     params: ApfParams,
@@ -140,7 +142,7 @@ struct State {
     release_after: Duration,
     /// The robots this instance may drive; empty: any.
     allowed: Vec<String>,
-    robots: Mutex<HashMap<String, Driven>>,
+    robots: Mutex<HashMap<String, ControlledRobot>>,
     /// The robots the scenario has: a mission for one is taken at once.
     scenario_robots: Vec<String>,
     /// When each robot's last estimate came (robots without a mission too), at most
@@ -154,8 +156,8 @@ struct State {
     warnings: WarnLimiter,
 }
 
-impl State {
-    fn robots(&self) -> MutexGuard<'_, HashMap<String, Driven>> {
+impl ControllerShared {
+    fn robots(&self) -> MutexGuard<'_, HashMap<String, ControlledRobot>> {
         roam_runtime::lock(&self.robots)
     }
 
@@ -233,7 +235,7 @@ fn state_of(status: MissionStatus) -> MissionState {
 
 fn status_of(
     robot: &str,
-    driven: &Driven,
+    driven: &ControlledRobot,
     decision: &Decision,
     estimate: Option<&PositionEstimate>,
 ) -> ControllerStatus {
@@ -278,7 +280,7 @@ fn check_mission(mission: &Mission) -> Result<(), String> {
     Ok(())
 }
 
-fn on_mission(state: &State, key: &str, mission: Mission) {
+fn on_mission(state: &ControllerShared, key: &str, mission: Mission) {
     let robot = match routing::robot_for(&state.root, key, &mission.robot) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "mission refused: {e}"),
@@ -305,7 +307,7 @@ fn on_mission(state: &State, key: &str, mission: Mission) {
 }
 
 /// Makes `mission` the robot's current one and publishes its first status.
-fn install_mission(state: &State, robot: &str, mission: &Mission) {
+fn install_mission(state: &ControllerShared, robot: &str, mission: &Mission) {
     let mut robots = state.robots();
     if robots.len() >= MAX_ROBOTS && !robots.contains_key(robot) {
         return limited_warn!(
@@ -313,18 +315,20 @@ fn install_mission(state: &State, robot: &str, mission: &Mission) {
             "mission refused: this controller already drives {MAX_ROBOTS} robots (max_robots)"
         );
     }
-    let driven = robots.entry(robot.to_owned()).or_insert_with(|| Driven {
-        controller: Controller::new(
-            state.params.clone(),
-            state.obstacles.clone(),
-            state.information.clone(),
-        ),
-        mission: String::new(),
-        waypoints: 0,
-        last_estimate: Instant::now(),
-        stale: false,
-        last: None,
-    });
+    let driven = robots
+        .entry(robot.to_owned())
+        .or_insert_with(|| ControlledRobot {
+            controller: Controller::new(
+                state.params.clone(),
+                state.obstacles.clone(),
+                state.information.clone(),
+            ),
+            mission: String::new(),
+            waypoints: 0,
+            last_estimate: Instant::now(),
+            stale: false,
+            last: None,
+        });
     driven.controller.set_mission(mission.waypoints.clone());
     driven.mission = mission.id.clone();
     driven.waypoints = mission.waypoints.len();
@@ -359,7 +363,7 @@ fn install_mission(state: &State, robot: &str, mission: &Mission) {
     state.put(&keys::robot_controller(&state.root, robot), &status);
 }
 
-fn on_estimate(state: &State, key: &str, estimate: PositionEstimate) {
+fn on_estimate(state: &ControllerShared, key: &str, estimate: PositionEstimate) {
     let robot = match routing::robot_for(&state.root, key, &estimate.robot) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "ignoring an estimate: {e}"),
@@ -392,7 +396,7 @@ fn on_estimate(state: &State, key: &str, estimate: PositionEstimate) {
 
 /// Holds every robot whose estimates have stopped: a zero command and `halted_stale`;
 /// forgets a robot whose estimates have stopped for `release_after_s` (it is gone).
-async fn watchdog(state: Arc<State>, cancel: CancellationToken) {
+async fn watchdog(state: Arc<ControllerShared>, cancel: CancellationToken) {
     let tick = (state.stale_after / 4).max(Duration::from_millis(5));
     loop {
         tokio::select! {
@@ -429,7 +433,7 @@ async fn watchdog(state: Arc<State>, cancel: CancellationToken) {
 
 /// Releases the slots of robots not heard from for `release_after`: a robot removed from
 /// the world, or one that never was, stops costing a slot, commands and statuses.
-fn release_gone(state: &State) {
+fn release_gone(state: &ControllerShared) {
     let release_after = state.release_after;
     state.seen().retain(|_, t| t.elapsed() < release_after);
     roam_runtime::lock(&state.held).retain(|_, (t, _)| t.elapsed() < release_after);
@@ -468,7 +472,7 @@ pub async fn run(
         keys::check_name("robot", robot)
             .map_err(|e| ControllerServiceError::Config(format!("robots: {e}")))?;
     }
-    let (_, scenario) = load_scenario(config.scenario.as_deref())?;
+    let (_, scenario) = load_or_builtin(config.scenario.as_deref())?;
     let anchors: Vec<[f64; 2]> = scenario.file.anchors.iter().map(|a| a.at).collect();
     let model = RangingModel::from_spec(&anchors, &scenario.file.sensing)
         .map_err(|e| ControllerServiceError::Config(format!("the scenario's sensing: {e}")))?;
@@ -482,8 +486,8 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world_guard = world_check::guard(&service, roam_map_server::world::of_scenario(&scenario));
-    let state = Arc::new(State {
+    let world_guard = world_check::guard(&service, roam_world::world_id::of_scenario(&scenario));
+    let state = Arc::new(ControllerShared {
         root: config.root.clone(),
         session: service.session().clone(),
         params: config.apf.clone(),
@@ -529,7 +533,9 @@ pub async fn run(
                 key,
                 MAX_MISSION_BYTES,
                 state.clone(),
-                |state: &Arc<State>, key: &str, mission: Mission| on_mission(state, key, mission),
+                |state: &Arc<ControllerShared>, key: &str, mission: Mission| {
+                    on_mission(state, key, mission)
+                },
             )
             .await?;
     }
@@ -539,7 +545,7 @@ pub async fn run(
                 key,
                 MAX_ESTIMATE_BYTES,
                 state.clone(),
-                |state: &Arc<State>, key: &str, estimate: PositionEstimate| {
+                |state: &Arc<ControllerShared>, key: &str, estimate: PositionEstimate| {
                     on_estimate(state, key, estimate)
                 },
             )

@@ -17,16 +17,16 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use roam_map_server::scenario::SensingSpec;
-use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::cells::Cells;
 use roam_proto::localization::{CrbCells, PebAt, PebQuery, PebReply, PebWhere};
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
 use roam_proto::sim::{NamedPoint, RangeScan};
 use roam_proto::{keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
+use roam_runtime::world_check::{self, WorldMismatch};
 use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
-use roam_sim::service::load_scenario;
+use roam_world::scenario::load_or_builtin;
+use roam_world::scenario::SensingSpec;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
@@ -87,14 +87,16 @@ pub enum LocalizationServiceError {
     #[error(transparent)]
     Service(#[from] ServiceError),
     #[error(transparent)]
-    Scenario(#[from] roam_map_server::scenario::ScenarioError),
+    Scenario(#[from] roam_world::scenario::ScenarioError),
     #[error("the scenario's sensing model is unusable: {0}")]
     Model(#[from] LocalizationError),
     #[error(transparent)]
     World(#[from] WorldMismatch),
 }
 
-struct State {
+/// What the localization service's subscribers and queryables share: the session,
+/// the sensing model and constellation, and every robot's tracker.
+struct LocalizationShared {
     root: String,
     session: zenoh::Session,
     sensing: SensingSpec,
@@ -139,7 +141,7 @@ pub async fn run(
     zenoh_config: zenoh::Config,
     cancel: CancellationToken,
 ) -> Result<(), LocalizationServiceError> {
-    let (_, scenario) = load_scenario(config.scenario.as_deref())?;
+    let (_, scenario) = load_or_builtin(config.scenario.as_deref())?;
     let sensing = scenario.file.sensing;
     let anchors: Vec<NamedPoint> = scenario
         .file
@@ -160,13 +162,13 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world = roam_map_server::world::of_scenario(&scenario);
+    let world = roam_world::world_id::of_scenario(&scenario);
     let world_guard = world_check::guard(&service, world.clone());
     let fim = FimOptions {
         variance_derivative: config.variance_derivative,
         ..FimOptions::default()
     };
-    let state = Arc::new(State {
+    let state = Arc::new(LocalizationShared {
         world: world.clone(),
         root: config.root.clone(),
         session: service.session().clone(),
@@ -182,7 +184,7 @@ pub async fn run(
             &keys::robot_ranges_any(&config.root),
             MAX_SCAN_BYTES,
             state.clone(),
-            |state: &Arc<State>, key: &str, scan: RangeScan| on_scan(state, key, scan),
+            |state: &Arc<LocalizationShared>, key: &str, scan: RangeScan| on_scan(state, key, scan),
         )
         .await?;
     let peb = service
@@ -205,7 +207,7 @@ pub async fn run(
 
 /// Estimates a robot's position from one scan ([`Tracker::on_scan`]) and publishes it on
 /// the robot's key: the robot is the one the scan's key names ([`routing`]).
-fn on_scan(state: &State, key: &str, scan: RangeScan) {
+fn on_scan(state: &LocalizationShared, key: &str, scan: RangeScan) {
     let robot = match routing::robot_for(&state.root, key, &scan.robot) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "ignoring a scan: {e}"),
@@ -219,7 +221,7 @@ fn on_scan(state: &State, key: &str, scan: RangeScan) {
     roam_runtime::publish_wait(&state.session, &key, &message, Delivery::Latest);
 }
 
-async fn answer_peb(state: Arc<State>, query: Query) {
+async fn answer_peb(state: Arc<LocalizationShared>, query: Query) {
     let request = match reply::decode_request::<PebQuery>(&query, MAX_REQUEST_BYTES) {
         Ok(r) => r,
         Err(e) => return reply::send_error(&query, &e).await,
@@ -235,7 +237,7 @@ async fn answer_peb(state: Arc<State>, query: Query) {
     reply::send_result(&query, result).await;
 }
 
-fn peb_reply(state: &State, request: &PebQuery) -> Result<PebReply, ErrorReply> {
+fn peb_reply(state: &LocalizationShared, request: &PebQuery) -> Result<PebReply, ErrorReply> {
     let anchors: Vec<[f64; 2]> = request
         .anchors
         .as_ref()
@@ -341,7 +343,7 @@ fn region_of(meta: &GridMeta) -> GridRegion {
 
 /// Sends the PEB field over the scenario's map to the map server as layer `peb`,
 /// retrying until a map server answers (or the service stops).
-async fn publish_peb_layer(state: Arc<State>, cancel: CancellationToken) {
+async fn publish_peb_layer(state: Arc<LocalizationShared>, cancel: CancellationToken) {
     let anchors: Vec<[f64; 2]> = state.anchors.iter().map(|a| a.at).collect();
     let field = match model_of(&anchors, &state.sensing)
         .and_then(|m| peb_field(&m, &region_of(&state.map), &state.fim))

@@ -24,10 +24,10 @@ use zenoh::query::Query;
 use zenoh::Session;
 
 use crate::config::MapServerConfig;
-use crate::load_dirs::LoadDirs;
 use crate::map_file::{self, MapFileError};
 use crate::persist::{DataDir, PersistError};
 use crate::store::{DerivedParams, LayerStore, OCCUPANCY};
+use roam_world::load_dirs::LoadDirs;
 
 /// The service name in liveliness tokens and logs.
 pub const SERVICE_NAME: &str = "map-server";
@@ -51,7 +51,7 @@ pub enum MapServerError {
 pub const MAX_LOAD_REQUEST_BYTES: usize = 64 * 1024;
 
 /// What the query handlers share.
-struct State {
+struct MapServerShared {
     root: String,
     store: Mutex<LayerStore>,
     /// Each layer encoded once per version, shared by gets and publications.
@@ -63,7 +63,7 @@ struct State {
     session: Session,
 }
 
-impl State {
+impl MapServerShared {
     fn store(&self) -> MutexGuard<'_, LayerStore> {
         // A panic while holding the lock would be a bug; the store is still consistent
         // because changes are staged and installed at the end.
@@ -162,7 +162,7 @@ pub fn open_store(config: &MapServerConfig) -> Result<LayerStore, MapServerError
     }
     if restored.found {
         let map_name = config.map.as_ref().map_or_else(
-            || map_file::BUILTIN_NAME.to_owned(),
+            || roam_world::scenario::BUILTIN_NAME.to_owned(),
             |p| p.display().to_string(),
         );
         store
@@ -214,7 +214,7 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let state = Arc::new(State {
+    let state = Arc::new(MapServerShared {
         root: config.root.clone(),
         store: Mutex::new(store),
         encoded: Mutex::new(HashMap::new()),
@@ -267,7 +267,7 @@ pub async fn run(
 /// Answers a layer `get`: every layer whose key matches the query's key expression,
 /// all taken from the store at one moment, so a wildcard `get` never mixes a new
 /// `occupancy` with an old `inflated`.
-async fn answer_layer(state: &State, query: &Query) {
+async fn answer_layer(state: &MapServerShared, query: &Query) {
     let (names, matching): (Vec<String>, Vec<_>) = {
         let store = state.store();
         let names: Vec<String> = store.names().map(str::to_owned).collect();
@@ -316,7 +316,7 @@ fn layer_name_of(query: &Query) -> Result<String, ErrorReply> {
     Ok(name.to_owned())
 }
 
-async fn answer_update(state: Arc<State>, query: &Query) {
+async fn answer_update(state: Arc<MapServerShared>, query: &Query) {
     let max = state.store().limits().max_request_bytes as usize;
     let request = layer_name_of(query)
         .and_then(|name| Ok((name, reply::decode_request::<LayerUpdate>(query, max)?)));
@@ -348,7 +348,7 @@ async fn answer_update(state: Arc<State>, query: &Query) {
     }
 }
 
-async fn answer_delete(state: Arc<State>, query: &Query) {
+async fn answer_delete(state: Arc<MapServerShared>, query: &Query) {
     let max = state.store().limits().max_request_bytes as usize;
     let request = layer_name_of(query)
         .and_then(|name| Ok((name, reply::decode_request::<DeleteLayer>(query, max)?)));
@@ -378,7 +378,7 @@ async fn answer_delete(state: Arc<State>, query: &Query) {
     }
 }
 
-async fn answer_load(state: Arc<State>, query: &Query) {
+async fn answer_load(state: Arc<MapServerShared>, query: &Query) {
     let request = match reply::decode_request::<LoadMap>(query, MAX_LOAD_REQUEST_BYTES) {
         Ok(r) => r,
         Err(e) => return reply::send_error(query, &e).await,
@@ -404,7 +404,10 @@ async fn answer_load(state: Arc<State>, query: &Query) {
     }
 }
 
-fn load(state: &State, request: &LoadMap) -> Result<(LayerList, Vec<String>), ErrorReply> {
+fn load(
+    state: &MapServerShared,
+    request: &LoadMap,
+) -> Result<(LayerList, Vec<String>), ErrorReply> {
     let max_cells = state.store().limits().max_layer_cells;
     let content = map_file::read_requested(&request.path, &state.load_dirs, max_cells)
         .map_err(|e| e.to_reply())?;

@@ -26,7 +26,6 @@ use roam_proto::cells::Cells;
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
 
 type MapMeta = GridMeta;
-use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::mapper::{
     ExplorationGoal, ExplorerStatus, MapperStatus, CHANGE_INFORMATION_LAYER,
     CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER, RECENCY_LAYER,
@@ -34,8 +33,9 @@ use roam_proto::mapper::{
 use roam_proto::sim::{LocalObservation, RobotCommand, SimClock};
 use roam_proto::{keys, ErrorReply, Message};
 use roam_runtime::warn_limit::WarnLimiter;
+use roam_runtime::world_check::{self, WorldMismatch};
 use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
-use roam_sim::service::load_scenario;
+use roam_world::scenario::load_or_builtin;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
@@ -97,7 +97,7 @@ pub enum MapperServiceError {
     #[error(transparent)]
     Service(#[from] ServiceError),
     #[error(transparent)]
-    Scenario(#[from] roam_map_server::scenario::ScenarioError),
+    Scenario(#[from] roam_world::scenario::ScenarioError),
     #[error("invalid config: {0}")]
     Config(String),
     #[error(transparent)]
@@ -108,7 +108,8 @@ pub enum MapperServiceError {
 struct Mapping {
     map: ChangeMap,
     explorers: BTreeMap<String, Explorer>,
-    goals: BTreeMap<String, ([f64; 2], String, u64)>,
+    /// The exploration goal last published per robot: a goal is published when it changes.
+    published_goals: BTreeMap<String, ExplorationGoal>,
     observations: u64,
     map_changes: u64,
     features: (f64, f64),
@@ -121,7 +122,9 @@ struct Mapping {
     epochs: Epochs,
 }
 
-struct State {
+/// What the mapper's subscribers, publisher and queryable share: the session and the
+/// mapping under its lock.
+struct MapperShared {
     root: String,
     session: zenoh::Session,
     meta: MapMeta,
@@ -132,7 +135,7 @@ struct State {
     world: roam_proto::map::WorldId,
 }
 
-impl State {
+impl MapperShared {
     fn mapping(&self) -> MutexGuard<'_, Mapping> {
         roam_runtime::lock(&self.mapping)
     }
@@ -182,7 +185,7 @@ fn cell_centre(meta: &MapMeta, (x, y): (u32, u32)) -> [f64; 2] {
     ]
 }
 
-fn on_observation(state: &State, key: &str, o: LocalObservation) {
+fn on_observation(state: &MapperShared, key: &str, o: LocalObservation) {
     let robot = match routing::robot_for(&state.root, key, &o.robot) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "ignoring an observation: {e}"),
@@ -229,20 +232,22 @@ fn on_observation(state: &State, key: &str, o: LocalObservation) {
                         let at = cell_centre(&state.meta, step.episode_goal);
                         let strategy = step.strategy.as_str().to_owned();
                         let episodes = explorer.episodes_ended();
-                        let fresh = m.goals.get(robot).is_none_or(|(goal, s, e)| {
-                            *goal != at || *s != strategy || *e != episodes
+                        let fresh = m.published_goals.get(robot).is_none_or(|last| {
+                            last.goal != at
+                                || last.strategy != strategy
+                                || last.episodes != episodes
                         });
                         let goal = fresh.then(|| {
-                            m.goals
-                                .insert(robot.to_owned(), (at, strategy.clone(), episodes));
-                            ExplorationGoal {
+                            let goal = ExplorationGoal {
                                 robot: robot.to_owned(),
                                 step: o.step,
                                 time_s: o.time_s,
                                 goal: at,
                                 strategy,
                                 episodes,
-                            }
+                            };
+                            m.published_goals.insert(robot.to_owned(), goal.clone());
+                            goal
                         });
                         Some((step.u, goal))
                     }
@@ -269,7 +274,7 @@ fn on_observation(state: &State, key: &str, o: LocalObservation) {
     }
 }
 
-fn status(state: &State) -> MapperStatus {
+fn status(state: &MapperShared) -> MapperStatus {
     let m = state.mapping();
     MapperStatus {
         observations: m.observations,
@@ -281,11 +286,11 @@ fn status(state: &State) -> MapperStatus {
             .explorers
             .iter()
             .map(|(robot, e)| {
-                let goal = m.goals.get(robot);
+                let published = m.published_goals.get(robot);
                 ExplorerStatus {
                     robot: robot.clone(),
-                    strategy: goal.map(|g| g.1.clone()),
-                    goal: goal.map(|g| g.0),
+                    strategy: published.map(|g| g.strategy.clone()),
+                    goal: published.map(|g| g.goal),
                     episodes: e.episodes_ended(),
                 }
             })
@@ -293,14 +298,14 @@ fn status(state: &State) -> MapperStatus {
     }
 }
 
-async fn answer_status(state: Arc<State>, query: Query) {
+async fn answer_status(state: Arc<MapperShared>, query: Query) {
     let result: Result<MapperStatus, ErrorReply> = Ok(status(&state));
     reply::send_result(&query, result).await;
 }
 
 /// The three layers at the newest observation's time, if anything was observed since
 /// they were last sent.
-fn layers_to_send(state: &State) -> Option<[(&'static str, Cells); 4]> {
+fn layers_to_send(state: &MapperShared) -> Option<[(&'static str, Cells); 4]> {
     let mut m = state.mapping();
     if !m.dirty {
         return None;
@@ -332,7 +337,7 @@ fn f32_cells(cells: Vec<f64>) -> Vec<f32> {
 }
 
 /// Sends the layers to the map server at most once per period.
-async fn publish_layers(state: Arc<State>, period: Duration, cancel: CancellationToken) {
+async fn publish_layers(state: Arc<MapperShared>, period: Duration, cancel: CancellationToken) {
     let requester = Requester::new(state.session.clone(), Duration::from_secs(5));
     let meta = GridMeta {
         width: state.meta.width,
@@ -417,7 +422,7 @@ pub async fn run(
     for robot in &explore {
         keys::check_name("robot", robot).map_err(|e| MapperServiceError::Config(e.to_string()))?;
     }
-    let (_, scenario) = load_scenario(config.scenario.as_deref())?;
+    let (_, scenario) = load_or_builtin(config.scenario.as_deref())?;
     let meta = scenario.occupancy.meta;
     let observation_period_s = scenario.file.time.step_s;
     let map = ChangeMap::new(
@@ -447,9 +452,9 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world = roam_map_server::world::of_scenario(&scenario);
+    let world = roam_world::world_id::of_scenario(&scenario);
     let world_guard = world_check::guard(&service, world.clone());
-    let state = Arc::new(State {
+    let state = Arc::new(MapperShared {
         world: world.clone(),
         root: config.root.clone(),
         session: service.session().clone(),
@@ -457,7 +462,7 @@ pub async fn run(
         mapping: Mutex::new(Mapping {
             map,
             explorers,
-            goals: BTreeMap::new(),
+            published_goals: BTreeMap::new(),
             observations: 0,
             map_changes: 0,
             features: (0.0, 0.0),
@@ -475,7 +480,7 @@ pub async fn run(
             &keys::sim_clock(&config.root),
             MAX_CLOCK_BYTES,
             state.clone(),
-            |state: &Arc<State>, _key: &str, clock: SimClock| {
+            |state: &Arc<MapperShared>, _key: &str, clock: SimClock| {
                 state.mapping().epochs.on_clock(clock.time_s)
             },
         )
@@ -485,7 +490,9 @@ pub async fn run(
             &keys::robot_observation_any(&config.root),
             MAX_OBSERVATION_BYTES,
             state.clone(),
-            |state: &Arc<State>, key: &str, o: LocalObservation| on_observation(state, key, o),
+            |state: &Arc<MapperShared>, key: &str, o: LocalObservation| {
+                on_observation(state, key, o)
+            },
         )
         .await?;
     let status_queryable = service

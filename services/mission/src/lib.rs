@@ -16,8 +16,8 @@
 //! - [`watch`]: the replan policy of a window (arrived, given up, lost mission, blocked,
 //!   late, pushed off the path, slack), a plain state machine.
 //! - [`information`]: the information a path gathers, on the planner's own scale.
-//! - [`experiment`]: `roam reproduce mission`, the couplings compared in batch.
-//! - [`days`]: `roam reproduce mission --days N`, the executive's whole day in batch
+//! - `roam_experiments::reproduce::mission`: `roam reproduce mission`, the couplings
+//!   compared in batch, and with `--days N` the executive's whole day in batch
 //!   (today's, the new one, each coupling left out, the shortest path) against issue
 //!   14's goals.
 //! - [`executive`]: the executive on Zenoh (a client of the planner, the controller,
@@ -26,13 +26,14 @@
 //! - [`service`]: `roam mission`, the executive as a service that publishes its reports.
 
 pub mod calibration;
-pub mod days;
+#[cfg(feature = "zenoh")]
 pub mod executive;
-pub mod experiment;
 pub mod information;
+#[cfg(feature = "zenoh")]
 mod inputs;
 pub mod margin;
 pub mod path;
+#[cfg(feature = "zenoh")]
 pub mod service;
 pub mod tasks;
 pub mod watch;

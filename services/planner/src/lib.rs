@@ -28,27 +28,35 @@
 //! from `roam_runtime::warn_limit` and `roam_proto::excerpt`, shared by every service.
 
 pub mod best;
+#[cfg(feature = "zenoh")]
 pub mod budget;
+#[cfg(feature = "zenoh")]
 pub mod client;
+#[cfg(feature = "zenoh")]
 pub mod config;
 pub mod coupling;
 pub mod curiosity;
 pub mod eta;
 pub mod ga;
 pub mod greedy;
+#[cfg(feature = "zenoh")]
 pub mod inflight;
 pub mod limits;
 pub mod maps;
 pub mod metrics;
 pub mod params;
 pub mod plan;
+#[cfg(feature = "zenoh")]
 pub mod queue;
 pub mod resolution;
 pub mod search;
 pub mod seeds;
+#[cfg(feature = "zenoh")]
 pub mod service;
 pub mod token;
 pub mod world;
 
+#[cfg(feature = "zenoh")]
 pub use config::PlannerConfig;
+#[cfg(feature = "zenoh")]
 pub use service::{run, SERVICE_NAME};

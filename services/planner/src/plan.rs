@@ -117,6 +117,22 @@ pub struct PlanOutcome {
     pub source: PlanSource,
     /// The via-point seeds the first population held ([`crate::seeds`]).
     pub via_seeds: usize,
+    /// The fastest path (the floor the budget was checked against, what `model:
+    /// shortest` answers) as the robot would drive it: for a reply that carries it
+    /// beside the plan.
+    pub fastest: FastestPath,
+}
+
+/// The fastest path of a plan, measured as the plan is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FastestPath {
+    /// Map cells `[x, y]`, as [`PlanOutcome::cells`].
+    pub cells: Vec<[u32; 2]>,
+    pub points: Vec<[f64; 2]>,
+    /// Eq. 2 on `cells`.
+    pub t_eta_s: f64,
+    /// The information of the distinct planning cells seen along it.
+    pub distinct_information: f64,
 }
 
 /// Why a plan was refused. Each says what to change.
@@ -252,9 +268,10 @@ pub fn check_spec(spec: &PlanSpec) -> Result<(), PlanError> {
     Ok(())
 }
 
-/// The work of a plan for the queue ([`crate::queue::units`]): its GA's cost
-/// ([`crate::limits`], 0 for the baseline), or the limit it exceeds.
-pub fn work(world: &World, spec: &PlanSpec) -> Result<f64, PlanError> {
+/// The work of a plan, for the service's queue: its GA's cost ([`crate::limits`]; for
+/// `greedy` its evaluations of a longest path; 0 for the baseline), or the limit it
+/// exceeds.
+pub fn work(world: &World, spec: &PlanSpec) -> Result<u64, PlanError> {
     let cost = match Model::of(spec.model) {
         Some(_) => {
             let size = limits::check(
@@ -272,7 +289,7 @@ pub fn work(world: &World, spec: &PlanSpec) -> Result<f64, PlanError> {
         }
         None => 0,
     };
-    Ok(crate::queue::units(cost))
+    Ok(cost)
 }
 
 /// The parameters a plan is sized by ([`crate::limits`]): the request's, except that
@@ -563,6 +580,7 @@ pub fn plan(
             }
         };
     let driven = drive(world, spec, &checked, scoring, ranked);
+    let fastest = fastest_as_driven(world, params, &checked);
     Ok(PlanOutcome {
         t_eta_s: driven.t_eta_s,
         reaches_goal: driven.chosen.evaluation.reaches_goal,
@@ -580,7 +598,28 @@ pub fn plan(
         stop_reason,
         source: driven.chosen.source,
         via_seeds,
+        fastest,
     })
+}
+
+/// [`FastestPath`] of a checked request.
+fn fastest_as_driven(world: &World, params: &GaParams, checked: &Checked) -> FastestPath {
+    match (&world.fine, &checked.fastest_driven) {
+        (Some(fine), Some(driven)) => FastestPath {
+            cells: fine.grid_cells(driven),
+            points: fine.centers(driven),
+            t_eta_s: fine.eta(params, driven),
+            distinct_information: path_metrics(world, params, &fine.planning_cells(driven))
+                .distinct_information,
+        },
+        _ => FastestPath {
+            cells: world.grid_cells(&checked.fastest),
+            points: world.centers(&checked.fastest),
+            t_eta_s: path_eta(world, params, &checked.fastest),
+            distinct_information: path_metrics(world, params, &checked.fastest)
+                .distinct_information,
+        },
+    }
 }
 
 /// The plan as the robot drives it.

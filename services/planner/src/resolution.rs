@@ -50,8 +50,8 @@
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-use roam_map_server::grid::{cell_center, world_to_cell, Grid};
 use roam_proto::map::GridMeta;
+use roam_world::grid::{cell_center, world_to_cell, Grid};
 
 use crate::eta::step_time_at;
 use crate::params::GaParams;

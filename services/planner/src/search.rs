@@ -284,8 +284,8 @@ mod tests {
     use super::*;
     use crate::eta::path_eta;
     use crate::params::GaParams;
-    use roam_map_server::grid::Grid;
     use roam_proto::map::{GridMeta, Origin};
+    use roam_world::grid::Grid;
 
     fn world(w: u32, h: u32, blocked: &[(u32, u32)]) -> World {
         let meta = GridMeta {

@@ -522,7 +522,7 @@ fn prepare(state: &State, request: PlanRequest) -> Result<Prepared<'_>, ErrorRep
     // The numbers and the plan's size, before it is queued: what is refused for its
     // content is refused at once, not after a wait.
     check_spec(&spec).map_err(|e| e.to_reply())?;
-    let units = crate::plan::work(&world, &spec).map_err(|e| e.to_reply())?;
+    let units = crate::queue::units(crate::plan::work(&world, &spec).map_err(|e| e.to_reply())?);
     Ok(Prepared {
         request,
         request_id,

@@ -189,7 +189,7 @@ fn a_walled_in_goal_has_no_path() {
     let mut world = common::open_world(30, 30);
     // Rebuild with a ring of walls around the goal cell (15, 15).
     let meta = world.meta;
-    let mut occupancy = roam_map_server::grid::Grid::filled(meta, 0i8);
+    let mut occupancy = roam_world::grid::Grid::filled(meta, 0i8);
     for (x, y) in [
         (13, 13),
         (14, 13),
@@ -210,7 +210,7 @@ fn a_walled_in_goal_has_no_path() {
     ] {
         occupancy.cells[y * 30 + x] = 100;
     }
-    let information = roam_map_server::grid::Grid {
+    let information = roam_world::grid::Grid {
         meta,
         cells: world.information.clone(),
     };
@@ -328,6 +328,9 @@ fn the_fastest_path_floor_admits_a_budget_the_distance_shortest_path_would_refus
         if model == PlannerModel::Shortest {
             assert_eq!(outcome.t_eta_s.to_bits(), fastest.to_bits());
         }
+        // Every plan carries the floor it was checked against, as driven.
+        assert_eq!(outcome.fastest.t_eta_s.to_bits(), fastest.to_bits());
+        assert_eq!(outcome.fastest.cells.len(), outcome.fastest.points.len());
     }
     let refused = plan(
         &world,

@@ -6,13 +6,13 @@
 use std::sync::atomic::AtomicBool;
 
 use proptest::prelude::*;
-use roam_map_server::grid::Grid;
-use roam_map_server::layers::inflate;
 use roam_planner::plan::{plan, PlanError, PlanOutcome, PlanSpec};
 use roam_planner::resolution::{ResolutionError, MAX_PLANNING_RESOLUTION_M};
 use roam_planner::world::{World, WorldError};
 use roam_proto::map::{GridMeta, Origin};
 use roam_proto::planner::PlannerModel;
+use roam_world::grid::Grid;
+use roam_world::layers::inflate;
 
 const FINE: f64 = 0.05;
 const ROBOT_RADIUS: f64 = 0.2;

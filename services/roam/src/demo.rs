@@ -12,21 +12,23 @@ use std::time::{Duration, Instant};
 
 use image::{Rgb, RgbImage};
 use roam_controller::params::ApfParams;
-use roam_map_server::grid::Grid;
-use roam_map_server::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, PATH};
-use roam_map_server::store::{INFLATED, INFORMATION, OCCUPANCY};
 use roam_mission::executive::{self, ExecutiveConfig, Progress, WindowOutcome};
 use roam_proto::cells::Cells;
 use roam_proto::map::{GridMeta, Layer};
+use roam_proto::map::{
+    INFLATED_LAYER as INFLATED, INFORMATION_LAYER as INFORMATION, OCCUPANCY_LAYER as OCCUPANCY,
+};
 use roam_proto::mission::WindowReport;
 use roam_proto::sim::GroundTruth;
 use roam_proto::{decode, keys};
 use roam_runtime::Requester;
+use roam_world::grid::Grid;
+use roam_world::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, PATH};
 use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
-use crate::demo_today::{todays_plans, TodaysPlan};
-use crate::stack::{Stack, StackOptions};
+use roam_experiments::reproduce::mission::todays_plans::{todays_plans, TodaysPlan};
+use roam_stack::stack::{Stack, StackOptions};
 
 /// The colour of the path the robot drove (its true positions).
 pub const DRIVEN: Rgb<u8> = Rgb([220, 20, 20]);
@@ -48,6 +50,8 @@ pub struct DemoOptions {
     pub record: Option<PathBuf>,
     /// Who may connect to the live view.
     pub view_access: roam_view::Access,
+    /// Offer the demo to ROS 2 (`roam ros2` in the stack).
+    pub ros2: Option<roam_ros2::node::Ros2Config>,
 }
 
 impl Default for DemoOptions {
@@ -60,6 +64,7 @@ impl Default for DemoOptions {
             view: None,
             record: None,
             view_access: roam_view::Access::default(),
+            ros2: None,
         }
     }
 }
@@ -86,7 +91,7 @@ pub struct DemoReport {
     /// The same along the planned curious paths.
     pub information_planned: f64,
     /// What today's executive (static map, Table I, one plan per window, paper 000's
-    /// initialization) would have planned per window ([`crate::demo_today`]), and the
+    /// initialization) would have planned per window ([`roam_experiments::reproduce::mission::todays_plans`]), and the
     /// information those plans promised, summed.
     pub todays_plans: Vec<Option<TodaysPlan>>,
     pub information_todays_plans: f64,
@@ -104,7 +109,7 @@ pub struct DemoReport {
 #[derive(Debug, thiserror::Error)]
 pub enum DemoError {
     #[error(transparent)]
-    Stack(#[from] crate::stack::StackError),
+    Stack(#[from] roam_stack::stack::StackError),
     #[error(transparent)]
     Executive(#[from] roam_mission::executive::ExecutiveError),
     #[error(transparent)]
@@ -144,6 +149,7 @@ pub async fn run(
             planners: 1,
             sim_rate: Some(options.rate),
             apf: Some(indoor_apf()),
+            ros2: options.ros2.clone(),
             ..StackOptions::default()
         },
         Duration::from_secs(30),
@@ -282,7 +288,7 @@ async fn drive(
     let driven = roam_runtime::lock(&truth).clone();
 
     let picture = options.out_dir.join("world.png");
-    let anchors: Vec<[f64; 2]> = roam_sim::service::load_scenario(Some(world))
+    let anchors: Vec<[f64; 2]> = roam_world::scenario::load_or_builtin(Some(world))
         .map(|(_, s)| s.file.anchors.iter().map(|a| a.at).collect())
         .unwrap_or_default();
     let image = draw_world(

@@ -85,11 +85,11 @@ fn reproduce_planner_prints_every_row_and_draws_each_model() {
     for model in ["model0", "model1", "model2"] {
         let png = out.path().join(format!("{model}.png"));
         assert!(
-            count_colour(&png, roam_map_server::render::PATH.0) > 50,
+            count_colour(&png, roam_world::render::PATH.0) > 50,
             "{model}: the path is drawn"
         );
         assert!(
-            count_colour(&png, roam_map_server::render::MARKER.0) > 50,
+            count_colour(&png, roam_world::render::MARKER.0) > 50,
             "{model}: start and goal marked"
         );
     }
@@ -568,4 +568,31 @@ fn bench_load_answers_or_refuses_every_request_and_none_hangs() {
         "two planners answer at least one each: {value}"
     );
     assert!(value["peak_rss_mib"].as_f64().is_some());
+}
+
+#[test]
+fn bench_fleet_closes_the_loop_for_every_robot() {
+    let (value, _) = run_json(
+        &[
+            "bench",
+            "fleet",
+            "--json",
+            "--robots",
+            "4",
+            "--seconds",
+            "2",
+        ],
+        None,
+    );
+    let count = |field: &str| value[field].as_u64().expect(field);
+    assert!(count("steps") >= 10, "{value}");
+    // Every robot commanded at every step from its first command on, some on time.
+    assert!(count("commands_on_time") > 0, "{value}");
+    assert_eq!(
+        count("commands_on_time") + count("commands_late"),
+        count("commands_expected"),
+        "every expected command arrived: {value}"
+    );
+    assert!(value["cpu_share"].as_f64().is_some_and(|c| c > 0.0));
+    assert!(value["rss_per_robot_mib"].as_f64().is_some());
 }

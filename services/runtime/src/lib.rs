@@ -11,8 +11,11 @@
 //! - [`telemetry`]: tracing from `RUST_LOG`;
 //! - [`warn_limit`]: warnings about wire data, a few lines per source and a count;
 //! - [`publish`]: put with the congestion control named at each call, failures logged;
+//! - [`subscribe`]: a subscriber that keeps the newest samples (a ring, never blocking
+//!   the session);
 //! - [`lock`]: shared state under a mutex, usable after a panicked holder;
-//! - [`liveliness`]: waiting until a service's token is seen.
+//! - [`liveliness`]: waiting until a service's token is seen;
+//! - [`world_check`]: a service's check that its world is the map server's.
 
 pub mod client;
 pub mod config_file;
@@ -24,8 +27,10 @@ pub mod routing;
 pub mod service;
 pub mod session;
 pub mod signals;
+pub mod subscribe;
 pub mod telemetry;
 pub mod warn_limit;
+pub mod world_check;
 
 pub use client::{ClientError, Requester};
 pub use liveliness::{wait_for_liveliness, LivelinessWait};
@@ -33,3 +38,4 @@ pub use lock::lock;
 pub use publish::{publish, publish_bytes, publish_wait, Delivery};
 pub use service::{PayloadBudget, Service, ServiceError};
 pub use session::{SessionArgs, SessionError};
+pub use subscribe::{subscribe_latest, LatestSamples};

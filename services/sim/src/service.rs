@@ -19,15 +19,14 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
-use roam_map_server::load_dirs::{Access, LoadDirs};
-use roam_map_server::map_file::{BUILTIN_NAME, BUILTIN_SCENARIO};
-use roam_map_server::scenario::{self, Scenario, ScenarioError};
-use roam_map_server::store::DEFAULT_LIMITS;
-use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::sim::{RobotCommand, SimClock, SimControl, SimStatus};
 use roam_proto::{decode, keys, ErrorCode, ErrorReply, Message};
 use roam_runtime::warn_limit::WarnLimiter;
+use roam_runtime::world_check::{self, WorldMismatch};
 use roam_runtime::{reply, Service, ServiceError};
+use roam_world::load_dirs::{Access, LoadDirs};
+use roam_world::scenario::{self, ScenarioError};
+use roam_world::DEFAULT_MAX_CELLS;
 use serde::Deserialize;
 use tokio::time::Instant;
 use tokio_util::sync::CancellationToken;
@@ -77,7 +76,7 @@ pub struct SimConfig {
     /// it is of the same scenario and seed. Absent: a restart begins at step 0.
     pub state_file: Option<PathBuf>,
     /// The directories a control `load` may read scenarios from (names relative to
-    /// them; see `roam_map_server::load_dirs`). Empty: loads from the wire are off.
+    /// them; see `roam_world::load_dirs`). Empty: loads from the wire are off.
     pub load_dirs: Vec<PathBuf>,
     pub zenoh: Option<serde_json::Value>,
 }
@@ -125,7 +124,8 @@ struct Control {
     free_steps: u64,
 }
 
-struct State {
+/// What the sim's control queryable, command subscriber and free run share.
+struct SimShared {
     root: String,
     session: zenoh::Session,
     control: Mutex<Control>,
@@ -140,7 +140,7 @@ struct State {
     warnings: WarnLimiter,
 }
 
-impl State {
+impl SimShared {
     fn control(&self) -> MutexGuard<'_, Control> {
         roam_runtime::lock(&self.control)
     }
@@ -161,19 +161,6 @@ impl State {
             robots,
             anchors,
         }
-    }
-}
-
-/// Reads a scenario file (or a ROS map as a scenario of the map alone), or the built-in
-/// world.
-pub fn load_scenario(path: Option<&Path>) -> Result<(String, Scenario), ScenarioError> {
-    let max = DEFAULT_LIMITS.max_layer_cells;
-    match path {
-        Some(p) => Ok((p.display().to_string(), scenario::load_any(p, max)?)),
-        None => Ok((
-            BUILTIN_NAME.to_owned(),
-            scenario::parse(Path::new(BUILTIN_NAME), BUILTIN_SCENARIO, max)?,
-        )),
     }
 }
 
@@ -210,7 +197,7 @@ pub async fn run(
     }
     let load_dirs =
         LoadDirs::new(&config.load_dirs).map_err(|e| SimServiceError::Config(e.to_string()))?;
-    let (name, scenario) = load_scenario(config.scenario.as_deref())?;
+    let (name, scenario) = scenario::load_or_builtin(config.scenario.as_deref())?;
     let mut sim = Sim::new(&scenario, config.seed)?;
     if let Some(path) = &config.state_file {
         resume_from(&mut sim, &name, config.seed, path)?;
@@ -223,8 +210,8 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world_guard = world_check::guard(&service, roam_map_server::world::of_scenario(&scenario));
-    let state = Arc::new(State {
+    let world_guard = world_check::guard(&service, roam_world::world_id::of_scenario(&scenario));
+    let state = Arc::new(SimShared {
         root: config.root.clone(),
         session: service.session().clone(),
         control: Mutex::new(Control {
@@ -314,7 +301,7 @@ fn resume_from(sim: &mut Sim, name: &str, seed: u64, path: &Path) -> Result<(), 
 
 /// Writes the snapshot every [`SNAPSHOT_PERIOD`] while the step count changes, and once
 /// more at shutdown.
-async fn keep_snapshots(state: Arc<State>, path: PathBuf, cancel: CancellationToken) {
+async fn keep_snapshots(state: Arc<SimShared>, path: PathBuf, cancel: CancellationToken) {
     let mut saved_step = None;
     loop {
         let stopping = tokio::select! {
@@ -342,7 +329,7 @@ async fn keep_snapshots(state: Arc<State>, path: PathBuf, cancel: CancellationTo
 
 /// Stores a command for the next step; commands for unknown robots or with non-finite
 /// values are dropped (logged), so the pending map never outgrows the robots.
-fn take_command(state: &State, key: &str, payload: &[u8]) {
+fn take_command(state: &SimShared, key: &str, payload: &[u8]) {
     let Some(robot) = keys::robot_of(&state.root, key) else {
         return;
     };
@@ -374,7 +361,7 @@ fn take_command(state: &State, key: &str, payload: &[u8]) {
 }
 
 /// One step under the lock; returns the messages to publish after it is released.
-fn step_once(state: &State) -> Result<(SimClock, Vec<RobotMessages>), ErrorReply> {
+fn step_once(state: &SimShared) -> Result<(SimClock, Vec<RobotMessages>), ErrorReply> {
     let mut control = state.control();
     let commands: Vec<Command> = std::mem::take(&mut control.pending)
         .into_iter()
@@ -395,11 +382,11 @@ fn step_once(state: &State) -> Result<(SimClock, Vec<RobotMessages>), ErrorReply
 
 /// Every reading of a step is delivered: a robot's localization and controller run in
 /// lock-step on them.
-async fn put<T: Message>(state: &State, key: &str, message: &T) {
+async fn put<T: Message>(state: &SimShared, key: &str, message: &T) {
     roam_runtime::publish(&state.session, key, message, Delivery::Reliable).await;
 }
 
-async fn publish(state: &State, clock: SimClock, robots: Vec<RobotMessages>) {
+async fn publish(state: &SimShared, clock: SimClock, robots: Vec<RobotMessages>) {
     let root = &state.root;
     for m in robots {
         let robot = m.truth.robot.clone();
@@ -417,9 +404,9 @@ async fn publish(state: &State, clock: SimClock, robots: Vec<RobotMessages>) {
 
 /// Steps while running: every `step_s / rate` seconds of wall time, or back to back at
 /// rate 0. A step whose messages are not out before the next one is due counts as late.
-/// Every control request wakes it ([`State::wake`]), so a pause, a reset or a new rate
+/// Every control request wakes it ([`SimShared::wake`]), so a pause, a reset or a new rate
 /// takes effect at once, whatever the period was.
-async fn free_run(state: Arc<State>, cancel: CancellationToken) {
+async fn free_run(state: Arc<SimShared>, cancel: CancellationToken) {
     let mut next = Instant::now();
     loop {
         let (running, period) = {
@@ -483,7 +470,7 @@ fn scenario_error(e: &ScenarioError) -> ErrorReply {
     match e {
         ScenarioError::Refused(refused)
         | ScenarioError::Map {
-            source: roam_map_server::ros_map::RosMapError::Refused(refused),
+            source: roam_world::ros_map::RosMapError::Refused(refused),
             ..
         } => refused.to_reply(),
         ScenarioError::Missing { .. } => ErrorReply::new(ErrorCode::NotFound, message),
@@ -493,7 +480,7 @@ fn scenario_error(e: &ScenarioError) -> ErrorReply {
     }
 }
 
-async fn answer_control(state: Arc<State>, query: Query) {
+async fn answer_control(state: Arc<SimShared>, query: Query) {
     let request = match reply::decode_request::<SimControl>(&query, MAX_REQUEST_BYTES) {
         Ok(r) => r,
         Err(e) => return reply::send_error(&query, &e).await,
@@ -507,18 +494,14 @@ async fn answer_control(state: Arc<State>, query: Query) {
     reply::send_result(&query, outcome.map(|()| state.status())).await;
 }
 
-async fn control(state: &Arc<State>, request: SimControl) -> Result<(), ErrorReply> {
+async fn control(state: &Arc<SimShared>, request: SimControl) -> Result<(), ErrorReply> {
     match request {
         SimControl::Load { path, seed } => {
             let dirs = state.load_dirs.clone();
             let loaded = tokio::task::spawn_blocking(move || {
                 let file = dirs.resolve(&path).map_err(|e| e.to_reply())?;
-                let scenario = scenario::load_with(
-                    &file,
-                    DEFAULT_LIMITS.max_layer_cells,
-                    Access::Within(&dirs),
-                )
-                .map_err(|e| scenario_error(&e))?;
+                let scenario = scenario::load_with(&file, DEFAULT_MAX_CELLS, Access::Within(&dirs))
+                    .map_err(|e| scenario_error(&e))?;
                 let name = file.display().to_string();
                 let sim = Sim::new(&scenario, seed).map_err(|e| sim_error(&e))?;
                 Ok::<_, ErrorReply>((name, sim))

@@ -27,11 +27,10 @@ use roam_proto::localization::PositionEstimate;
 use roam_proto::map::{Layer, LayerList};
 use roam_proto::sim::{GroundTruth, NamedPoint, SimControl, SimStatus};
 use roam_proto::{keys, Message};
+use roam_runtime::{subscribe_latest, LatestSamples};
 use tokio::sync::watch;
 use tokio::time::{Instant, MissedTickBehavior};
 use tokio_util::sync::CancellationToken;
-use zenoh::handlers::{RingChannel, RingChannelHandler};
-use zenoh::pubsub::Subscriber;
 use zenoh::sample::Sample;
 use zenoh::Session;
 
@@ -72,7 +71,7 @@ pub const MISSION_TOPIC: &str = "/robots/mission";
 pub const DRIVEN_TOPIC: &str = "/robots/driven";
 pub const ANCHORS_TOPIC: &str = "/anchors";
 
-type Ring = Subscriber<RingChannelHandler<Sample>>;
+type Ring = LatestSamples;
 
 /// The names of the robots in the sim's last status.
 type SimRobots = Arc<BTreeSet<String>>;
@@ -87,15 +86,10 @@ pub(crate) struct Subscriptions {
 
 impl Subscriptions {
     pub(crate) async fn declare(session: &Session, root: &str) -> Result<Self, ViewError> {
-        let ring = |key: String, capacity: usize| {
-            let session = session.clone();
-            async move {
-                session
-                    .declare_subscriber(key.clone())
-                    .with(RingChannel::new(capacity))
-                    .await
-                    .map_err(|e| ViewError::Zenoh(format!("subscribing to '{key}': {e}")))
-            }
+        let ring = |key: String, capacity: usize| async move {
+            subscribe_latest(session, &key, capacity)
+                .await
+                .map_err(|e| ViewError::Zenoh(format!("subscribing to '{key}': {e}")))
         };
         Ok(Subscriptions {
             layers: ring(keys::map_layer_any(root), LAYER_QUEUE).await?,
@@ -421,7 +415,7 @@ impl World {
 }
 
 /// One robot's driven path and whether it changed since it was last logged.
-struct Driven {
+struct LoggedPath {
     path: DrivenPath,
     dirty: bool,
 }
@@ -433,7 +427,7 @@ struct Robots {
     topics: RobotTopics,
     /// The robots whose missions are drawn (the drawings are kept in the latch).
     missions: Roster<()>,
-    driven: Roster<Driven>,
+    driven: Roster<LoggedPath>,
     driven_dirty: bool,
     sim: watch::Receiver<SimRobots>,
 }
@@ -510,7 +504,7 @@ impl Robots {
         let touched = self.driven.touch(
             &t.robot,
             |r| sim.contains(r),
-            || Driven {
+            || LoggedPath {
                 path: DrivenPath::new(DRIVEN_POINTS, DRIVEN_STEP_M),
                 dirty: false,
             },

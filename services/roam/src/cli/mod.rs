@@ -4,6 +4,7 @@
 mod map;
 mod plan;
 mod roles;
+mod ros2;
 mod sim;
 mod tools;
 mod view;
@@ -15,6 +16,7 @@ use anyhow::bail;
 use clap::{Args, Parser, Subcommand};
 use roam_proto::keys;
 use roam_runtime::{Requester, SessionArgs};
+use roam_stack::{Role, RoleConfig};
 
 use map::MapCommand;
 use plan::PlanArgs;
@@ -51,6 +53,9 @@ ROLES
                ranges, moving blocks (paper 004), line-of-sight observations, a clock;
                free-running or in lock-step. `roam sim render` draws a scenario.
   router       A Zenoh router: run one per site or fleet; services connect to it.
+  ros2         roam in a ROS 2 system over rmw_zenoh (no bridge): /map and the layers,
+               each robot's plan, pose and driven path, the planner as ROS 2 services,
+               optionally the occupancy map from a ROS 2 topic and a rosbag2 recording.
   stack        Every landed service in one process around an in-process router on
                loopback, multicast off. The embedded default world needs no files.
 
@@ -119,6 +124,8 @@ enum Command {
     Router(RouterArgs),
     /// Run every landed service in one process around an in-process router.
     Stack(StackArgs),
+    /// roam in a ROS 2 system over rmw_zenoh: topics, services, the map from ROS 2.
+    Ros2(ros2::Ros2Args),
     /// The live view of a running stack in the Foxglove app, and MCAP recording.
     View(view::ViewArgs),
     /// Map files and the map server's layers.
@@ -147,39 +154,6 @@ pub(crate) struct ServiceArgs {
     pub(crate) session: SessionArgs,
 }
 
-/// What every role's config file has: a key root, an instance name, a Zenoh section.
-pub(crate) trait RoleConfig: serde::de::DeserializeOwned + Default {
-    fn root_mut(&mut self) -> &mut String;
-    fn instance_mut(&mut self) -> &mut Option<String>;
-    fn zenoh(&self) -> Option<&serde_json::Value>;
-}
-
-macro_rules! role_config {
-    ($($config:ty),*) => {$(
-        impl RoleConfig for $config {
-            fn root_mut(&mut self) -> &mut String {
-                &mut self.root
-            }
-            fn instance_mut(&mut self) -> &mut Option<String> {
-                &mut self.instance
-            }
-            fn zenoh(&self) -> Option<&serde_json::Value> {
-                self.zenoh.as_ref()
-            }
-        }
-    )*};
-}
-
-role_config!(
-    roam_map_server::MapServerConfig,
-    roam_planner::PlannerConfig,
-    roam_sim::service::SimConfig,
-    roam_localization::service::LocalizationConfig,
-    roam_controller::service::ControllerConfig,
-    roam_mapper::service::MapperConfig,
-    roam_mission::service::MissionConfig
-);
-
 impl ServiceArgs {
     /// The role's config: its file (or the defaults), then `--root` and `--instance`.
     pub(crate) fn load_config<T: RoleConfig>(&self) -> anyhow::Result<T> {
@@ -196,9 +170,13 @@ impl ServiceArgs {
         Ok(config)
     }
 
-    /// The Zenoh config: the role's file section, `ZENOH_CONFIG`, then the flags.
-    pub(crate) fn zenoh_config<T: RoleConfig>(&self, config: &T) -> anyhow::Result<zenoh::Config> {
-        Ok(self.session.zenoh_config(config.zenoh())?)
+    /// Runs `role` until SIGINT or SIGTERM, on the Zenoh config of its file section,
+    /// `ZENOH_CONFIG`, then the flags.
+    pub(crate) async fn run(&self, role: Role) -> anyhow::Result<()> {
+        let zenoh = self.session.zenoh_config(role.zenoh())?;
+        role.run(zenoh, roam_runtime::signals::cancel_on_signal())
+            .await
+            .map_err(anyhow::Error::msg)
     }
 }
 
@@ -226,6 +204,7 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Plan(args) => plan::plan(args).await,
         Command::Router(args) => roles::router(args).await,
         Command::Stack(args) => roles::stack(args).await,
+        Command::Ros2(args) => ros2::ros2(args).await,
         Command::View(args) => view::view(args).await,
         Command::Map(command) => map::map(command).await,
         Command::Bench(command) => tools::bench(command).await,

@@ -6,11 +6,13 @@ use std::time::Duration;
 use anyhow::{bail, Context};
 use clap::Args;
 use roam::report::{self, Mission};
-use roam::router::Router;
-use roam::stack::{Stack, StackOptions};
-use roam_map_server::{map_file, MapServerConfig};
+use roam_map_server::MapServerConfig;
 use roam_planner::PlannerConfig;
 use roam_runtime::{signals, Requester, SessionArgs};
+use roam_stack::router::Router;
+use roam_stack::stack::{Stack, StackOptions};
+
+use roam_stack::Role;
 
 use super::ServiceArgs;
 
@@ -73,6 +75,12 @@ pub(crate) struct StackArgs {
     /// Where --once writes its report.
     #[arg(long, value_name = "DIR", default_value = "roam-report")]
     out: PathBuf,
+    /// Offer the stack to ROS 2 over rmw_zenoh (`roam ros2` in the stack; ROS 2 nodes
+    /// connect to this stack's router).
+    #[arg(long)]
+    ros2: bool,
+    #[command(flatten)]
+    ros: super::ros2::RosFlags,
 }
 
 pub(crate) async fn map_server(args: MapServerArgs) -> anyhow::Result<()> {
@@ -86,10 +94,7 @@ pub(crate) async fn map_server(args: MapServerArgs) -> anyhow::Result<()> {
     if !args.load_dirs.is_empty() {
         config.load_dirs = args.load_dirs;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    let cancel = signals::cancel_on_signal();
-    roam_map_server::run(config, zenoh, cancel).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }
 
 pub(crate) async fn planner(args: PlannerArgs) -> anyhow::Result<()> {
@@ -97,24 +102,16 @@ pub(crate) async fn planner(args: PlannerArgs) -> anyhow::Result<()> {
     if let Some(n) = args.max_concurrent_plans {
         config.max_concurrent_plans = n;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    roam_planner::run(config, zenoh, signals::cancel_on_signal()).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }
 
 /// The missions of a scenario: from its `start` place to each other place.
 pub(crate) fn scenario_missions(map: Option<&std::path::Path>) -> Vec<Mission> {
-    let max = roam_map_server::store::DEFAULT_LIMITS.max_layer_cells;
     let parsed = match map {
-        None => roam_map_server::scenario::parse(
-            std::path::Path::new(map_file::BUILTIN_NAME),
-            map_file::BUILTIN_SCENARIO,
-            max,
-        )
-        .ok(),
-        Some(path) => roam_map_server::scenario::load(path, max).ok(),
+        None => roam_world::scenario::builtin(),
+        Some(path) => roam_world::scenario::load(path, roam_world::DEFAULT_MAX_CELLS),
     };
-    let Some(scenario) = parsed else {
+    let Ok(scenario) = parsed else {
         return Vec::new();
     };
     let places = &scenario.file.places;
@@ -161,6 +158,7 @@ pub(crate) async fn stack(args: StackArgs) -> anyhow::Result<()> {
         load_dirs: args.load_dirs,
         listen: args.listen,
         planners: args.planners,
+        ros2: args.ros2.then(|| args.ros.config()),
         ..StackOptions::default()
     };
     let mut stack = Stack::start(options, Duration::from_secs(30)).await?;
@@ -273,9 +271,7 @@ pub(crate) async fn controller(args: ControllerArgs) -> anyhow::Result<()> {
     if !args.robots.is_empty() {
         config.robots = args.robots;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    roam_controller::service::run(config, zenoh, signals::cancel_on_signal()).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }
 
 #[derive(Debug, Args)]
@@ -298,9 +294,7 @@ pub(crate) async fn mapper(args: MapperArgs) -> anyhow::Result<()> {
     if !args.explore.is_empty() {
         config.explore = args.explore;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    roam_mapper::service::run(config, zenoh, signals::cancel_on_signal()).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }
 
 #[derive(Debug, Args)]
@@ -317,9 +311,7 @@ pub(crate) async fn mission(args: MissionArgs) -> anyhow::Result<()> {
     if let Some(robot) = args.robot {
         config.executive.robot = robot;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    roam_mission::service::run(config, zenoh, signals::cancel_on_signal()).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }
 
 #[derive(Debug, Args)]
@@ -344,6 +336,12 @@ pub(crate) struct DemoArgs {
     /// Who may connect to the live view (--view).
     #[command(flatten)]
     view_access: super::view::AccessArgs,
+    /// Offer the demo to ROS 2 over rmw_zenoh (roam's topics and services; see
+    /// services/ros2/README.md).
+    #[arg(long)]
+    ros2: bool,
+    #[command(flatten)]
+    ros: super::ros2::RosFlags,
 }
 
 pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
@@ -367,6 +365,7 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
             }
             None => roam_view::Access::default(),
         },
+        ros2: args.ros2.then(|| args.ros.config()),
     };
     let say = |line: &str| eprintln!("roam demo: {line}");
     let report = roam::demo::run(&options, &say).await?;
@@ -402,7 +401,5 @@ pub(crate) async fn localization(args: LocalizationArgs) -> anyhow::Result<()> {
     if args.scenario.is_some() {
         config.scenario = args.scenario;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    roam_localization::service::run(config, zenoh, signals::cancel_on_signal()).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }

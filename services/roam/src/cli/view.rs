@@ -69,11 +69,16 @@ pub(crate) struct ViewArgs {
     mcap: Option<PathBuf>,
     #[command(flatten)]
     access: AccessArgs,
+    /// Also record the ROS 2 topics (`roam ros2`'s: /map, the layers, each robot's plan,
+    /// pose and driven path) as a rosbag2 (MCAP, profile ros2) in this new directory,
+    /// for `ros2 bag play`; complete once the view stops.
+    #[arg(long, value_name = "DIR")]
+    rosbag: Option<PathBuf>,
 }
 
 pub(crate) async fn view(args: ViewArgs) -> anyhow::Result<()> {
-    if args.no_ws && args.mcap.is_none() {
-        bail!("--no-ws leaves the view nothing to do: add --mcap FILE");
+    if args.no_ws && args.mcap.is_none() && args.rosbag.is_none() {
+        bail!("--no-ws leaves the view nothing to do: add --mcap FILE or --rosbag DIR");
     }
     let access = args.access.access()?;
     let (_, session) = connect(&args.client).await?;
@@ -84,6 +89,31 @@ pub(crate) async fn view(args: ViewArgs) -> anyhow::Result<()> {
         mcap: args.mcap,
         access,
     };
+    // The rosbag2 recorder is roam ros2's node without its ROS 2 endpoints: the same
+    // conversions and CDR bytes, written to the bag instead of offered.
+    let recorder = match &args.rosbag {
+        Some(dir) => {
+            let ros2 = roam_ros2::node::Ros2Config {
+                root: args.client.root.clone(),
+                offer: false,
+                rosbag: Some(dir.clone()),
+                ..roam_ros2::node::Ros2Config::default()
+            };
+            let zenoh = args.client.session.zenoh_config(None)?;
+            let stop = cancel.clone();
+            eprintln!("roam view: recording the ROS 2 topics to {}", dir.display());
+            Some(tokio::spawn(roam_ros2::node::run(ros2, zenoh, stop)))
+        }
+        None => None,
+    };
+    if config.listen.is_none() && config.mcap.is_none() {
+        cancel.cancelled().await;
+        if let Some(recorder) = recorder {
+            recorder.await??;
+        }
+        let _ = session.close().await;
+        return Ok(());
+    }
     let view = roam_view::run(session.clone(), config, cancel).await?;
     if let Some(url) = view.websocket_url() {
         eprintln!("roam view: in the Foxglove app, Open connection -> Foxglove WebSocket -> {url}");
@@ -93,6 +123,9 @@ pub(crate) async fn view(args: ViewArgs) -> anyhow::Result<()> {
     }
     eprintln!("roam view: stop with Ctrl-C or SIGTERM");
     let outcome = view.join().await;
+    if let Some(recorder) = recorder {
+        recorder.await??;
+    }
     let _ = session.close().await;
     let stats = outcome?;
     eprintln!(

@@ -1,0 +1,594 @@
+//! roam's layers, plans, estimates and paths as ROS 2 messages, and back: a ROS map as a
+//! roam occupancy layer, a ROS plan request as a roam plan request.
+//!
+//! Everything is in one frame, `map`: roam's world metres, z up, the frame the layers'
+//! origins are given in.
+
+use roam_proto::cells::Cells;
+use roam_proto::localization::PositionEstimate;
+use roam_proto::map::{GridMeta, Layer, Origin};
+use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
+use roam_proto::{ErrorCode, ErrorReply};
+
+use crate::msg::{
+    Covariance, Header, MapMetaData, OccupancyGrid, Path, PlanDowntimeRequest,
+    PlanDowntimeResponse, Point, Pose, PoseStamped, PoseWithCovariance, PoseWithCovarianceStamped,
+    Quaternion, Time,
+};
+
+/// The one frame roam publishes in.
+pub const FRAME: &str = "map";
+
+/// How a layer's values become an OccupancyGrid's 0..100 (and -1 for no value).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Scale {
+    /// Already ROS occupancy (i8 -1, 0..=100): copied.
+    Occupancy,
+    /// Scores 0..=100 (u8): copied, above 100 as 100.
+    Score,
+    /// Probabilities 0..=1: × 100, rounded.
+    Probability,
+    /// Metres from 0 to `full_m`: 0..100, at or beyond `full_m` (∞ included) 100.
+    Metres { full_m: f64 },
+}
+
+/// The PEB at which `/roam/peb` shows 100: a metre of position error bound is already
+/// far worse than the controller's goals (paper 002's PEB stays in centimetres where the
+/// anchors cover).
+pub const PEB_FULL_SCALE_M: f64 = 1.0;
+
+/// The layers roam publishes and how: (layer, relative topic name, scale).
+pub const LAYER_TOPICS: [(&str, &str, Scale); 5] = [
+    ("occupancy", "map", Scale::Occupancy),
+    ("inflated", "roam/inflated", Scale::Occupancy),
+    ("information", "roam/information", Scale::Score),
+    (
+        "peb",
+        "roam/peb",
+        Scale::Metres {
+            full_m: PEB_FULL_SCALE_M,
+        },
+    ),
+    (
+        roam_proto::mapper::CHANGE_PROBABILITY_LAYER,
+        "roam/change_probability",
+        Scale::Probability,
+    ),
+];
+
+/// Why a conversion was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConvertError {
+    #[error("the layer has {cells} cells for a {width}x{height} grid")]
+    CellCount {
+        cells: usize,
+        width: u32,
+        height: u32,
+    },
+    #[error("a {width}x{height} map is {cells} cells; roam takes at most {max} (max_layer_cells)")]
+    TooManyCells {
+        width: u32,
+        height: u32,
+        cells: u64,
+        max: u64,
+    },
+    #[error("{0}")]
+    Invalid(String),
+}
+
+fn clamp_score(v: f64) -> i8 {
+    if v.is_nan() {
+        -1
+    } else {
+        v.round().clamp(0.0, 100.0) as i8
+    }
+}
+
+/// A layer as an OccupancyGrid in frame `map`, stamped `stamp`.
+pub fn layer_to_grid(
+    layer: &Layer,
+    scale: Scale,
+    stamp: Time,
+) -> Result<OccupancyGrid, ConvertError> {
+    let meta = layer.meta;
+    if layer.cells.len() as u64 != meta.cell_count() {
+        return Err(ConvertError::CellCount {
+            cells: layer.cells.len(),
+            width: meta.width,
+            height: meta.height,
+        });
+    }
+    let data: Vec<i8> = match (&layer.cells, scale) {
+        (Cells::I8(v), _) => v
+            .iter()
+            .map(|&c| if c < 0 { -1 } else { c.min(100) })
+            .collect(),
+        (Cells::U8(v), _) => v.iter().map(|&c| c.min(100) as i8).collect(),
+        (Cells::F32(v), Scale::Probability) => v
+            .iter()
+            .map(|&c| clamp_score(f64::from(c) * 100.0))
+            .collect(),
+        (Cells::F32(v), Scale::Metres { full_m }) => v
+            .iter()
+            .map(|&c| {
+                let c = f64::from(c);
+                if c.is_nan() {
+                    -1
+                } else {
+                    clamp_score(c / full_m * 100.0)
+                }
+            })
+            .collect(),
+        (Cells::F32(v), Scale::Occupancy | Scale::Score) => {
+            v.iter().map(|&c| clamp_score(f64::from(c))).collect()
+        }
+    };
+    Ok(OccupancyGrid {
+        header: Header {
+            stamp,
+            frame_id: FRAME.to_owned(),
+        },
+        info: MapMetaData {
+            map_load_time: stamp,
+            resolution: meta.resolution as f32,
+            width: meta.width,
+            height: meta.height,
+            origin: Pose {
+                position: Point {
+                    x: meta.origin.x,
+                    y: meta.origin.y,
+                    z: 0.0,
+                },
+                orientation: Quaternion::from_yaw(meta.origin.yaw),
+            },
+        },
+        data,
+    })
+}
+
+/// Checks a received grid's size against `max_cells` from its header alone, before its
+/// cells are read or kept: a 10⁹-cell map is refused here, naming the limit.
+pub fn check_grid_size(info: &MapMetaData, max_cells: u64) -> Result<(), ConvertError> {
+    let cells = u64::from(info.width) * u64::from(info.height);
+    if cells > max_cells {
+        return Err(ConvertError::TooManyCells {
+            width: info.width,
+            height: info.height,
+            cells,
+            max: max_cells,
+        });
+    }
+    Ok(())
+}
+
+/// A ROS map as roam's occupancy grid: its placement and its cells (-1 unknown, 0..=100;
+/// any other value is refused, as the map server refuses it).
+pub fn grid_to_occupancy(
+    grid: &OccupancyGrid,
+    max_cells: u64,
+) -> Result<(GridMeta, Cells), ConvertError> {
+    let info = &grid.info;
+    check_grid_size(info, max_cells)?;
+    let cells = u64::from(info.width) * u64::from(info.height);
+    if cells == 0 || grid.data.len() as u64 != cells {
+        return Err(ConvertError::CellCount {
+            cells: grid.data.len(),
+            width: info.width,
+            height: info.height,
+        });
+    }
+    let resolution = f64::from(info.resolution);
+    if !(resolution.is_finite() && resolution > 0.0) {
+        return Err(ConvertError::Invalid(format!(
+            "the map's resolution must be a positive number of metres, got {resolution}"
+        )));
+    }
+    let p = info.origin.position;
+    let q = info.origin.orientation;
+    if ![p.x, p.y, p.z, q.x, q.y, q.z, q.w]
+        .iter()
+        .all(|v| v.is_finite())
+    {
+        return Err(ConvertError::Invalid(
+            "the map's origin must be finite numbers".into(),
+        ));
+    }
+    if let Some((i, bad)) = grid
+        .data
+        .iter()
+        .enumerate()
+        .find(|(_, &v)| !(-1..=100).contains(&v))
+    {
+        return Err(ConvertError::Invalid(format!(
+            "occupancy values are -1 (unknown) or 0..=100; cell {i} is {bad}"
+        )));
+    }
+    let meta = GridMeta {
+        width: info.width,
+        height: info.height,
+        resolution,
+        origin: Origin {
+            x: p.x,
+            y: p.y,
+            yaw: q.yaw(),
+        },
+    };
+    Ok((meta, Cells::I8(grid.data.clone())))
+}
+
+fn header(stamp: Time) -> Header {
+    Header {
+        stamp,
+        frame_id: FRAME.to_owned(),
+    }
+}
+
+/// Points as a Path, each pose facing the next point (the last one keeps the heading
+/// before it).
+pub fn path(points: &[[f64; 2]], stamp: Time) -> Path {
+    let mut heading = 0.0;
+    let poses = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            if let Some(next) = points.get(i + 1) {
+                let (dx, dy) = (next[0] - p[0], next[1] - p[1]);
+                if dx != 0.0 || dy != 0.0 {
+                    heading = dy.atan2(dx);
+                }
+            }
+            PoseStamped {
+                header: header(stamp),
+                pose: Pose {
+                    position: Point {
+                        x: p[0],
+                        y: p[1],
+                        z: 0.0,
+                    },
+                    orientation: Quaternion::from_yaw(heading),
+                },
+            }
+        })
+        .collect();
+    Path {
+        header: header(stamp),
+        poses,
+    }
+}
+
+/// The variance put where roam knows nothing: the heading (roam's estimates are
+/// positions), and x and y when the CRB is singular (fewer than three anchors).
+pub const UNKNOWN_VARIANCE: f64 = 1e9;
+
+/// An estimate as a PoseWithCovarianceStamped: the position, and its CRB (paper 002
+/// Eq. 5, which WLS attains) as the x-y block of the covariance; z, roll and pitch are
+/// 0 (a planar robot), the heading's variance [`UNKNOWN_VARIANCE`].
+pub fn estimate_pose(estimate: &PositionEstimate, stamp: Time) -> PoseWithCovarianceStamped {
+    let mut covariance = [0.0; 36];
+    match estimate.crb {
+        Some(crb) if crb.iter().flatten().all(|v| v.is_finite()) => {
+            covariance[0] = crb[0][0];
+            covariance[1] = crb[0][1];
+            covariance[6] = crb[1][0];
+            covariance[7] = crb[1][1];
+        }
+        _ => {
+            covariance[0] = UNKNOWN_VARIANCE;
+            covariance[7] = UNKNOWN_VARIANCE;
+        }
+    }
+    covariance[35] = UNKNOWN_VARIANCE;
+    PoseWithCovarianceStamped {
+        header: header(stamp),
+        pose: PoseWithCovariance {
+            pose: Pose {
+                position: Point {
+                    x: estimate.position[0],
+                    y: estimate.position[1],
+                    z: 0.0,
+                },
+                orientation: Quaternion::default(),
+            },
+            covariance: Covariance(covariance),
+        },
+    }
+}
+
+/// A pose's position, checked: finite, and in frame `map` (or no frame).
+fn position(what: &str, pose: &PoseStamped) -> Result<[f64; 2], ErrorReply> {
+    let frame = pose.header.frame_id.as_str();
+    if !(frame.is_empty() || frame == FRAME || frame == "/map") {
+        return Err(ErrorReply::new(
+            ErrorCode::InvalidRequest,
+            format!(
+                "{what} is in frame '{}'; roam plans in frame 'map' (give poses in 'map')",
+                roam_proto::excerpt::excerpt_n(frame, 64)
+            ),
+        ));
+    }
+    let p = pose.pose.position;
+    if !(p.x.is_finite() && p.y.is_finite()) {
+        return Err(ErrorReply::new(
+            ErrorCode::InvalidRequest,
+            format!(
+                "{what} must be finite coordinates in metres, got ({}, {})",
+                p.x, p.y
+            ),
+        ));
+    }
+    Ok([p.x, p.y])
+}
+
+/// The deadline a PlanDowntime request without one (0) gets, seconds.
+pub const DEFAULT_DEADLINE_S: f64 = 5.0;
+
+/// A PlanDowntime request as roam's plan request, or the refusal that goes back in the
+/// response's error fields.
+pub fn plan_downtime_request(request: &PlanDowntimeRequest) -> Result<PlanRequest, ErrorReply> {
+    let start = position("start", &request.start)?;
+    let goal = position("goal", &request.goal)?;
+    if !(request.budget_s.is_finite() && request.budget_s > 0.0) {
+        return Err(ErrorReply::new(
+            ErrorCode::InvalidRequest,
+            format!(
+                "budget_s must be a positive number of seconds, got {}",
+                request.budget_s
+            ),
+        ));
+    }
+    if !(request.deadline_s.is_finite() && request.deadline_s >= 0.0) {
+        return Err(ErrorReply::new(
+            ErrorCode::InvalidRequest,
+            format!(
+                "deadline_s must be 0 (the default, {DEFAULT_DEADLINE_S} s) or a positive number of seconds, got {}",
+                request.deadline_s
+            ),
+        ));
+    }
+    let model = match request.model.as_str() {
+        "" | "model1" => PlannerModel::Model1,
+        "model0" => PlannerModel::Model0,
+        "model2" => PlannerModel::Model2,
+        "shortest" => PlannerModel::Shortest,
+        other => {
+            return Err(ErrorReply::new(
+                ErrorCode::InvalidRequest,
+                format!(
+                    "model '{}' is not one of shortest, model0, model1, model2 (empty: model1)",
+                    roam_proto::excerpt::excerpt_n(other, 64)
+                ),
+            ))
+        }
+    };
+    Ok(PlanRequest {
+        request_id: None,
+        cancel_token: None,
+        start,
+        goal,
+        t_exec_s: request.budget_s,
+        deadline_s: if request.deadline_s == 0.0 {
+            DEFAULT_DEADLINE_S
+        } else {
+            request.deadline_s
+        },
+        model,
+        params: GaOverrides::default(),
+        seed: request.seed,
+        map_version: None,
+    })
+}
+
+/// A GetPlan request's start and goal, checked like PlanDowntime's.
+pub fn get_plan_ends(
+    request: &crate::msg::GetPlanRequest,
+) -> Result<([f64; 2], [f64; 2]), ErrorReply> {
+    Ok((
+        position("start", &request.start)?,
+        position("goal", &request.goal)?,
+    ))
+}
+
+/// A plan as PlanDowntime's response.
+pub fn plan_downtime_response(plan: &Plan, stamp: Time) -> PlanDowntimeResponse {
+    PlanDowntimeResponse {
+        path: path(&plan.points, stamp),
+        eta_s: plan.t_eta_s,
+        information: plan.distinct_information,
+        within_budget: plan.within_budget,
+        reaches_goal: plan.reaches_goal,
+        error_code: String::new(),
+        error_message: String::new(),
+    }
+}
+
+/// A refusal as PlanDowntime's response: an empty path in frame `map`, the code and the
+/// message (with the limit, where one was hit).
+pub fn plan_downtime_refusal(error: &ErrorReply, stamp: Time) -> PlanDowntimeResponse {
+    PlanDowntimeResponse {
+        path: path(&[], stamp),
+        error_code: error.code.as_str().to_owned(),
+        error_message: match &error.limit {
+            Some(limit) => format!(
+                "{} (limit {}: at most {}, got {})",
+                error.message, limit.name, limit.max, limit.actual
+            ),
+            None => error.message.clone(),
+        },
+        ..PlanDowntimeResponse::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn layer(cells: Cells, width: u32, height: u32) -> Layer {
+        Layer {
+            name: "x".into(),
+            version: 1,
+            meta: GridMeta {
+                width,
+                height,
+                resolution: 0.2,
+                origin: Origin {
+                    x: -10.0,
+                    y: -5.0,
+                    yaw: 0.0,
+                },
+            },
+            derived_from: None,
+            cells,
+        }
+    }
+
+    #[test]
+    fn layers_become_grids_cell_for_cell() {
+        let occupancy = layer(Cells::I8(vec![-1, 0, 100, 50, 0, 0]), 3, 2);
+        let grid = layer_to_grid(&occupancy, Scale::Occupancy, Time::default()).expect("grid");
+        assert_eq!(grid.data, [-1, 0, 100, 50, 0, 0]);
+        assert_eq!((grid.info.width, grid.info.height), (3, 2));
+        assert_eq!(grid.info.resolution, 0.2);
+        assert_eq!(grid.info.origin.position.x, -10.0);
+        assert_eq!(grid.header.frame_id, "map");
+        let info = layer(Cells::U8(vec![0, 5, 100, 255]), 2, 2);
+        assert_eq!(
+            layer_to_grid(&info, Scale::Score, Time::default())
+                .expect("grid")
+                .data,
+            [0, 5, 100, 100]
+        );
+        let p = layer(Cells::F32(vec![0.0, 0.254, 1.0, f32::NAN]), 2, 2);
+        assert_eq!(
+            layer_to_grid(&p, Scale::Probability, Time::default())
+                .expect("grid")
+                .data,
+            [0, 25, 100, -1]
+        );
+        let peb = layer(Cells::F32(vec![0.05, 0.5, 2.0, f32::INFINITY]), 2, 2);
+        let scale = Scale::Metres { full_m: 1.0 };
+        assert_eq!(
+            layer_to_grid(&peb, scale, Time::default())
+                .expect("grid")
+                .data,
+            [5, 50, 100, 100]
+        );
+        let short = layer(Cells::I8(vec![0; 5]), 3, 2);
+        assert!(layer_to_grid(&short, Scale::Occupancy, Time::default()).is_err());
+    }
+
+    #[test]
+    fn a_ros_map_becomes_occupancy_and_bad_ones_are_refused() {
+        let occupancy = layer(Cells::I8(vec![-1, 0, 100, 50, 0, 0]), 3, 2);
+        let grid = layer_to_grid(&occupancy, Scale::Occupancy, Time::default()).expect("grid");
+        let (meta, cells) = grid_to_occupancy(&grid, 100).expect("back");
+        assert_eq!(cells, occupancy.cells);
+        assert_eq!(meta.width, 3);
+        assert!((meta.resolution - 0.2).abs() < 1e-6);
+        // 10⁹ cells, refused from the header alone, naming the limit.
+        let mut huge = grid.clone();
+        huge.info.width = 40_000;
+        huge.info.height = 25_000;
+        let refused = grid_to_occupancy(&huge, 16_777_216).expect_err("huge");
+        assert!(refused.to_string().contains("max_layer_cells"), "{refused}");
+        assert!(refused.to_string().contains("1000000000"), "{refused}");
+        let mut nan = grid.clone();
+        nan.info.resolution = f32::NAN;
+        assert!(grid_to_occupancy(&nan, 100).is_err());
+        let mut odd = grid.clone();
+        odd.data[0] = 101;
+        assert!(grid_to_occupancy(&odd, 100).is_err());
+        let mut short = grid;
+        short.data.pop();
+        assert!(grid_to_occupancy(&short, 100).is_err());
+    }
+
+    #[test]
+    fn paths_face_their_next_point() {
+        let p = path(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]], Time::default());
+        assert_eq!(p.poses.len(), 3);
+        assert!(p.poses[0].pose.orientation.yaw().abs() < 1e-12);
+        let up = std::f64::consts::FRAC_PI_2;
+        assert!((p.poses[1].pose.orientation.yaw() - up).abs() < 1e-12);
+        assert!((p.poses[2].pose.orientation.yaw() - up).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_crb_is_the_covariance() {
+        let estimate = PositionEstimate {
+            robot: "r1".into(),
+            step: 1,
+            time_s: 0.4,
+            position: [1.0, 2.0],
+            crb: Some([[0.01, 0.002], [0.002, 0.03]]),
+            peb_m: Some(0.2),
+            anchors_used: vec![],
+            degraded: false,
+        };
+        let pose = estimate_pose(&estimate, Time::default());
+        let c = pose.pose.covariance.0;
+        assert_eq!((c[0], c[1], c[6], c[7]), (0.01, 0.002, 0.002, 0.03));
+        assert_eq!(c[35], UNKNOWN_VARIANCE);
+        let singular = PositionEstimate {
+            crb: None,
+            ..estimate
+        };
+        assert_eq!(
+            estimate_pose(&singular, Time::default()).pose.covariance.0[0],
+            UNKNOWN_VARIANCE
+        );
+    }
+
+    #[test]
+    fn plan_requests_are_checked() {
+        let mut request = PlanDowntimeRequest {
+            budget_s: 60.0,
+            ..PlanDowntimeRequest::default()
+        };
+        request.goal.pose.position.x = 6.0;
+        let ok = plan_downtime_request(&request).expect("ok");
+        assert_eq!(
+            (ok.model, ok.deadline_s, ok.goal),
+            (PlannerModel::Model1, 5.0, [6.0, 0.0])
+        );
+        let mut nan = request.clone();
+        nan.start.pose.position.x = f64::NAN;
+        let refused = plan_downtime_request(&nan).expect_err("nan");
+        assert_eq!(refused.code, ErrorCode::InvalidRequest);
+        assert!(refused.message.contains("start"), "{refused}");
+        for bad in [
+            PlanDowntimeRequest {
+                budget_s: f64::NAN,
+                ..request.clone()
+            },
+            PlanDowntimeRequest {
+                budget_s: 0.0,
+                ..request.clone()
+            },
+            PlanDowntimeRequest {
+                deadline_s: -1.0,
+                ..request.clone()
+            },
+            PlanDowntimeRequest {
+                model: "model9".into(),
+                ..request.clone()
+            },
+        ] {
+            assert!(plan_downtime_request(&bad).is_err(), "{bad:?}");
+        }
+        let mut frame = request;
+        frame.goal.header.frame_id = "odom".into();
+        assert!(plan_downtime_request(&frame)
+            .expect_err("frame")
+            .message
+            .contains("odom"));
+    }
+
+    #[test]
+    fn refusals_fill_the_error_fields() {
+        let error = ErrorReply::limit("max_plan_cost", 10, 20, "too big");
+        let response = plan_downtime_refusal(&error, Time::default());
+        assert_eq!(response.error_code, "limit_exceeded");
+        assert!(response.error_message.contains("max_plan_cost"));
+        assert!(response.path.poses.is_empty());
+    }
+}

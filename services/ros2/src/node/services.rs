@@ -1,0 +1,250 @@
+//! The planner as two ROS 2 services, with rmw_zenoh's conventions: a queryable declared
+//! `complete` on the service's key, the request's CDR as the query's payload and its
+//! attachment (sequence number, timestamp, client GID) echoed in the reply's, with the
+//! reply's own timestamp.
+//!
+//! - `/roam/plan_downtime` (`roam_interfaces/srv/PlanDowntime`): roam's plan request
+//!   and plan; every refusal comes back in `error_code` and `error_message`.
+//! - `/roam/get_plan` (`nav_msgs/srv/GetPlan`), for tools that know only that type. Its
+//!   budget rule: the shortest path's ETA (Eq. 2, from the planner's `shortest` model)
+//!   times [`GET_PLAN_BUDGET_FACTOR`], planned with Model I, seed 0, in at most
+//!   [`crate::convert::DEFAULT_DEADLINE_S`] s. GetPlan has no error field: a refusal is
+//!   an empty path (nav_msgs' own convention for "no plan") and a logged line with the
+//!   reason; `tolerance` is ignored (roam plans to the goal cell).
+//!
+//! Both call roam's planner through Zenoh ([`roam_planner::client::PlannerClient`]), as
+//! any client would. A request that is not valid CDR gets `malformed` (PlanDowntime) or an
+//! empty path (GetPlan), a NaN or a frame other than `map` `invalid_request`; a query
+//! without rmw_zenoh's attachment cannot be answered as ROS 2 (no sequence number to
+//! echo), so it gets a Zenoh error reply saying so.
+
+use std::sync::Arc;
+
+use roam_planner::client::PlannerClient;
+use roam_proto::planner::{PlanRequest, PlannerModel};
+use roam_proto::{ErrorCode, ErrorReply};
+use roam_runtime::{ClientError, Service};
+use serde::Serialize;
+use zenoh::query::Query;
+
+use super::{Output, Ros2Error};
+use crate::attachment::{self, Attachment};
+use crate::convert;
+use crate::msg::{GetPlanRequest, GetPlanResponse, PlanDowntimeRequest, Time};
+use crate::names::{EntityKind, Qos};
+use crate::types;
+
+/// `/roam/get_plan`'s budget: this many times the shortest path's ETA.
+pub const GET_PLAN_BUDGET_FACTOR: f64 = 1.5;
+/// The budget of the shortest-path probe behind `/roam/get_plan`, seconds.
+pub const GET_PLAN_PROBE_BUDGET_S: f64 = 3600.0;
+/// The largest request read: two poses, a few numbers and a model name.
+pub const MAX_REQUEST_BYTES: usize = 16 * 1024;
+
+pub const PLAN_DOWNTIME: &str = "roam/plan_downtime";
+pub const GET_PLAN: &str = "roam/get_plan";
+
+#[derive(Clone)]
+struct State {
+    out: Arc<Output>,
+    planner: Arc<PlannerClient>,
+}
+
+pub(super) async fn declare(
+    service: &Service,
+    out: Arc<Output>,
+    root: &str,
+) -> Result<(), Ros2Error> {
+    let state = State {
+        planner: Arc::new(PlannerClient::new(out.session().clone(), root)),
+        out: out.clone(),
+    };
+    let mut tokens = Vec::new();
+    for (name, ros_type) in [
+        (PLAN_DOWNTIME, types::PLAN_DOWNTIME),
+        (GET_PLAN, types::GET_PLAN),
+    ] {
+        let endpoint = out
+            .endpoint(EntityKind::Service, name, ros_type, Qos::SERVICE)
+            .map_err(|e| Ros2Error::Declare {
+                what: "service",
+                key: name.to_owned(),
+                reason: e.to_string(),
+            })?;
+        let queryable = service.declare_queryable(&endpoint.key).await?;
+        tokens.push(out.token(&endpoint.token).await?);
+        let key = endpoint.key.clone();
+        if name == PLAN_DOWNTIME {
+            service.serve(queryable, state.clone(), move |s, q| {
+                let key = key.clone();
+                async move { plan_downtime(s, q, key).await }
+            });
+        } else {
+            service.serve(queryable, state.clone(), move |s, q| {
+                let key = key.clone();
+                async move { get_plan(s, q, key).await }
+            });
+        }
+    }
+    // The tokens live as long as the service.
+    let cancel = service.cancel_token();
+    service.spawn(async move {
+        cancel.cancelled().await;
+        drop(tokens);
+    });
+    Ok(())
+}
+
+/// The request's attachment, or a Zenoh error reply saying why it cannot be answered.
+async fn request_attachment(out: &Output, query: &Query, key: &str) -> Option<Attachment> {
+    let parsed = match query.attachment() {
+        Some(bytes) => Attachment::parse(&bytes.to_bytes()).map_err(|e| e.to_string()),
+        None => Err("no attachment".to_owned()),
+    };
+    match parsed {
+        Ok(a) => Some(a),
+        Err(why) => {
+            let reason = format!("not an rmw_zenoh request ({why}): a ROS 2 service call carries the 33-byte attachment (sequence number, timestamp, client GID)");
+            out.refuse(key, &reason);
+            let _ = query.reply_err(reason).await;
+            None
+        }
+    }
+}
+
+/// Replies with `response` on the service's key, the request's sequence number and GID.
+async fn reply<T: Serialize>(
+    out: &Output,
+    query: &Query,
+    key: &str,
+    request: &Attachment,
+    response: &T,
+) {
+    let bytes = match crate::cdr::encode(response) {
+        Ok(bytes) => bytes,
+        Err(e) => return tracing::warn!(%key, "roam ros2: no reply: {e}"),
+    };
+    let attachment = Attachment {
+        sequence_number: request.sequence_number,
+        source_timestamp_ns: attachment::now_ns(),
+        gid: request.gid,
+    };
+    if let Err(e) = query
+        .reply(key.to_owned(), bytes)
+        .attachment(attachment.to_bytes().to_vec())
+        .await
+    {
+        out.refuse(key, &format!("reply failed: {e}"));
+    }
+}
+
+fn payload(query: &Query) -> Vec<u8> {
+    query
+        .payload()
+        .map(|p| p.to_bytes().to_vec())
+        .unwrap_or_default()
+}
+
+fn now() -> Time {
+    Time::from_nanos(attachment::now_ns())
+}
+
+fn client_error(e: ClientError) -> ErrorReply {
+    match e {
+        ClientError::Refused(reply) => reply,
+        other => ErrorReply::new(
+            ErrorCode::Unavailable,
+            format!("roam's planner did not answer: {other}"),
+        ),
+    }
+}
+
+async fn plan_downtime(state: State, query: Query, key: String) {
+    let out = &state.out;
+    let Some(att) = request_attachment(out, &query, &key).await else {
+        return;
+    };
+    let outcome = match crate::cdr::decode::<PlanDowntimeRequest>(
+        &payload(&query),
+        "PlanDowntime request",
+        MAX_REQUEST_BYTES,
+    ) {
+        Err(e) => Err(ErrorReply::new(ErrorCode::Malformed, e.to_string())),
+        Ok(request) => match convert::plan_downtime_request(&request) {
+            Err(refusal) => Err(refusal),
+            Ok(plan_request) => state
+                .planner
+                .plan(&plan_request)
+                .await
+                .map_err(client_error),
+        },
+    };
+    let response = match outcome {
+        Ok(plan) => convert::plan_downtime_response(&plan, now()),
+        Err(refusal) => {
+            out.refuse(&key, &refusal.to_string());
+            convert::plan_downtime_refusal(&refusal, now())
+        }
+    };
+    reply(out, &query, &key, &att, &response).await;
+}
+
+/// GetPlan's plan: the shortest path's ETA sets the budget of a Model I plan.
+async fn get_plan_path(
+    state: &State,
+    request: &GetPlanRequest,
+) -> Result<Vec<[f64; 2]>, ErrorReply> {
+    let (start, goal) = convert::get_plan_ends(request)?;
+    let probe = PlanRequest {
+        request_id: None,
+        cancel_token: None,
+        start,
+        goal,
+        t_exec_s: GET_PLAN_PROBE_BUDGET_S,
+        deadline_s: convert::DEFAULT_DEADLINE_S,
+        model: PlannerModel::Shortest,
+        params: Default::default(),
+        seed: 0,
+        map_version: None,
+    };
+    let shortest = state.planner.plan(&probe).await.map_err(client_error)?;
+    if !shortest.reaches_goal {
+        return Err(ErrorReply::new(
+            ErrorCode::NotFound,
+            "no path reaches the goal",
+        ));
+    }
+    let curious = PlanRequest {
+        t_exec_s: (shortest.t_eta_s * GET_PLAN_BUDGET_FACTOR).max(shortest.t_eta_s + 1.0),
+        model: PlannerModel::Model1,
+        ..probe
+    };
+    let plan = state.planner.plan(&curious).await.map_err(client_error)?;
+    Ok(plan.points)
+}
+
+async fn get_plan(state: State, query: Query, key: String) {
+    let out = &state.out;
+    let Some(att) = request_attachment(out, &query, &key).await else {
+        return;
+    };
+    let points = match crate::cdr::decode::<GetPlanRequest>(
+        &payload(&query),
+        "GetPlan request",
+        MAX_REQUEST_BYTES,
+    ) {
+        Err(e) => Err(ErrorReply::new(ErrorCode::Malformed, e.to_string())),
+        Ok(request) => get_plan_path(&state, &request).await,
+    };
+    let points = points.unwrap_or_else(|refusal| {
+        out.refuse(
+            &key,
+            &format!("GetPlan answered with an empty path: {refusal}"),
+        );
+        Vec::new()
+    });
+    let response = GetPlanResponse {
+        plan: convert::path(&points, now()),
+    };
+    reply(out, &query, &key, &att, &response).await;
+}

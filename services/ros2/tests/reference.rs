@@ -1,0 +1,118 @@
+//! roam's CDR and hashes against PyPI's `rosbags` 0.11.9, an independent implementation
+//! of ROS 2 messages: the bytes and hashes below are what
+//! `tests/reference/rosbags_reference.py` prints.
+
+use roam_ros2::msg::*;
+use roam_ros2::{cdr, hash, types};
+
+fn hex(text: &str) -> Vec<u8> {
+    (0..text.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&text[i..i + 2], 16).expect("hex"))
+        .collect()
+}
+
+fn header() -> Header {
+    Header {
+        stamp: Time {
+            sec: 1_700_000_000,
+            nanosec: 5,
+        },
+        frame_id: "map".into(),
+    }
+}
+
+fn pose(x: f64, y: f64, z: f64, w: f64) -> Pose {
+    Pose {
+        position: Point { x, y, z: 0.0 },
+        orientation: Quaternion {
+            x: 0.0,
+            y: 0.0,
+            z,
+            w,
+        },
+    }
+}
+
+const OCCUPANCY_GRID: &str = "0001000000f1536505000000040000006d6170000100000002000000cdcc4c3e03000000020000000000000000000000000024c000000000000014c00000000000000000000000000000000000000000000000000000000000000000000000000000f03f06000000ff0064320000";
+const PATH: &str = "0001000000f1536505000000040000006d6170000200000000f1536505000000040000006d61700000000000000000000000f83f00000000000000c00000000000000000000000000000000000000000000000000000000000000000000000000000f03f00f1536505000000040000006d617000000000000000004000000000000000c0000000000000000000000000000000000000000000000000000000000000e03f000000000000e83f";
+const POSE_WITH_COVARIANCE_STAMPED: &str = "0001000000f1536505000000040000006d617000000000000000f03f00000000000000400000000000000000000000000000000000000000000000000000000000000000000000000000f03f0000000000000000000000000000f03f000000000000004000000000000008400000000000001040000000000000144000000000000018400000000000001c40000000000000204000000000000022400000000000002440000000000000264000000000000028400000000000002a400000000000002c400000000000002e4000000000000030400000000000003140000000000000324000000000000033400000000000003440000000000000354000000000000036400000000000003740000000000000384000000000000039400000000000003a400000000000003b400000000000003c400000000000003d400000000000003e400000000000003f400000000000004040000000000080404000000000000041400000000000804140";
+
+#[test]
+fn an_occupancy_grid_is_byte_for_byte_rosbags_s() {
+    let grid = OccupancyGrid {
+        header: header(),
+        info: MapMetaData {
+            map_load_time: Time { sec: 1, nanosec: 2 },
+            resolution: 0.2,
+            width: 3,
+            height: 2,
+            origin: Pose {
+                position: Point {
+                    x: -10.0,
+                    y: -5.0,
+                    z: 0.0,
+                },
+                orientation: Quaternion::default(),
+            },
+        },
+        data: vec![-1, 0, 100, 50, 0, 0],
+    };
+    let bytes = hex(OCCUPANCY_GRID);
+    assert_eq!(cdr::encode(&grid).expect("encode"), bytes);
+    assert_eq!(
+        cdr::decode::<OccupancyGrid>(&bytes, "map", 1 << 20),
+        Ok(grid)
+    );
+}
+
+#[test]
+fn a_path_is_byte_for_byte_rosbags_s() {
+    let stamped = |pose| PoseStamped {
+        header: header(),
+        pose,
+    };
+    let path = Path {
+        header: header(),
+        poses: vec![
+            stamped(pose(1.5, -2.0, 0.0, 1.0)),
+            stamped(pose(2.0, -2.0, 0.5, 0.75)),
+        ],
+    };
+    let bytes = hex(PATH);
+    assert_eq!(cdr::encode(&path).expect("encode"), bytes);
+    assert_eq!(cdr::decode::<Path>(&bytes, "path", 1 << 20), Ok(path));
+}
+
+#[test]
+fn a_pose_with_covariance_is_byte_for_byte_rosbags_s() {
+    let mut covariance = [0.0; 36];
+    for (i, c) in covariance.iter_mut().enumerate() {
+        *c = i as f64;
+    }
+    let message = PoseWithCovarianceStamped {
+        header: header(),
+        pose: PoseWithCovariance {
+            pose: pose(1.0, 2.0, 0.0, 1.0),
+            covariance: Covariance(covariance),
+        },
+    };
+    let bytes = hex(POSE_WITH_COVARIANCE_STAMPED);
+    assert_eq!(cdr::encode(&message).expect("encode"), bytes);
+    assert_eq!(
+        cdr::decode::<PoseWithCovarianceStamped>(&bytes, "pose", 1 << 20),
+        Ok(message)
+    );
+}
+
+#[test]
+fn the_service_hashes_are_rosbags_s() {
+    assert_eq!(
+        hash::service_type_hash(types::PLAN_DOWNTIME).as_deref(),
+        Ok("RIHS01_d5e249ca4b3504320f17348ec589584120a6a8f3c771adfe56a3f951f221bba6")
+    );
+    assert_eq!(
+        hash::service_type_hash(types::GET_PLAN).as_deref(),
+        Ok("RIHS01_234f7aff100f5edb8150366601687b027bcdc253db47decb88fff846193fe5e8")
+    );
+}

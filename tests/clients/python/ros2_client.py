@@ -1,0 +1,286 @@
+"""A ROS 2 client of roam that shares no code with it: rmw_zenoh's wire built from its
+spec with PyPI's `eclipse-zenoh` (1.10.2) and `rosbags` (0.11.9, an independent ROS 2
+message implementation: CDR, RIHS01 hashes, rosbag2 reading).
+
+    python3 ros2_client.py live --connect tcp/127.0.0.1:7447 --robot r1 --waypoints '[[..]]'
+    python3 ros2_client.py bag DIR
+
+`live` finds roam's liveliness tokens, subscribes to /map and /<robot>/plan as
+rmw_zenoh's transient-local subscriber does (an AdvancedSubscriber asking the
+publishers' caches), checks the attachments, calls /roam/plan_downtime and
+/roam/get_plan with rmw_zenoh's query conventions (good and bad requests), and prints
+one JSON object (the map's cells in hex, for the caller to compare with the map
+server's layer). `bag` reads a rosbag2 directory and prints its topics and counts.
+Exit code 0 when every check passed; 1 with the failed check on stderr otherwise.
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+import zenoh
+import zenoh.ext
+from rosbags.typesys import Stores, get_typestore, get_types_from_msg
+
+STORE = get_typestore(Stores.ROS2_JAZZY)
+SRV_DIR = os.path.join(os.path.dirname(__file__), '../../../services/ros2/roam_interfaces/srv')
+
+
+def fail(what):
+    print(f'FAILED: {what}', file=sys.stderr)
+    sys.exit(1)
+
+
+def check(cond, what):
+    if not cond:
+        fail(what)
+
+
+def register_services():
+    """PlanDowntime from the shipped .srv file, GetPlan from nav_msgs' definition."""
+    text = open(os.path.join(SRV_DIR, 'PlanDowntime.srv')).read()
+    request, response = text.split('\n---\n')
+    types = {}
+    types.update(get_types_from_msg(request, 'roam_interfaces/msg/PlanDowntime_Request'))
+    types.update(get_types_from_msg(response, 'roam_interfaces/msg/PlanDowntime_Response'))
+    types.update(get_types_from_msg(
+        'geometry_msgs/PoseStamped start\ngeometry_msgs/PoseStamped goal\nfloat32 tolerance',
+        'nav_msgs/msg/GetPlan_Request'))
+    types.update(get_types_from_msg('nav_msgs/Path plan', 'nav_msgs/msg/GetPlan_Response'))
+    STORE.register(types)
+
+
+def dds(ros_type):
+    pkg, kind, name = ros_type.split('/')
+    return f'{pkg}::{kind}::dds_::{name}_'
+
+
+def topic_key(domain, name, ros_type, digest):
+    return f'{domain}/{name.strip("/")}/{dds(ros_type)}/{digest}'
+
+
+def attachment(seq, gid):
+    return seq.to_bytes(8, 'little', signed=True) + time.time_ns().to_bytes(8, 'little', signed=True) \
+        + bytes([16]) + gid
+
+
+def parse_attachment(raw):
+    check(raw is not None, 'a sample or reply has rmw_zenoh\'s attachment')
+    data = raw.to_bytes()
+    check(len(data) == 33, f'the attachment is 33 bytes (got {len(data)})')
+    check(data[16] == 16, 'the GID length byte is 16')
+    seq = int.from_bytes(data[0:8], 'little', signed=True)
+    stamp = int.from_bytes(data[8:16], 'little', signed=True)
+    check(abs(stamp - time.time_ns()) < 600e9, 'the source timestamp is now, in ns since the epoch')
+    return seq, data[17:]
+
+
+def pose(x, y):
+    T = STORE.types
+    return T['geometry_msgs/msg/PoseStamped'](
+        header=T['std_msgs/msg/Header'](stamp=T['builtin_interfaces/msg/Time'](sec=0, nanosec=0),
+                                        frame_id='map'),
+        pose=T['geometry_msgs/msg/Pose'](
+            position=T['geometry_msgs/msg/Point'](x=x, y=y, z=0.0),
+            orientation=T['geometry_msgs/msg/Quaternion'](x=0.0, y=0.0, z=0.0, w=1.0)))
+
+
+def latest(session, key, timeout):
+    """The last sample on `key`, as an rmw_zenoh transient-local subscription gets it:
+    an AdvancedSubscriber that detects late publishers and queries their cache."""
+    got = []
+    sub = zenoh.ext.declare_advanced_subscriber(
+        session, key, lambda s: got.append(s),
+        history=zenoh.ext.HistoryConfig(detect_late_publishers=True, max_samples=1),
+        subscriber_detection=True)
+    deadline = time.time() + timeout
+    while not got and time.time() < deadline:
+        time.sleep(0.05)
+    sub.undeclare()
+    check(got, f'a sample on {key} within {timeout} s (transient local)')
+    return got[-1]
+
+
+class Caller:
+    """A ROS 2 service client the rmw_zenoh way: get on the service key, target
+    ALL_COMPLETE, no consolidation, the request's CDR as payload, the attachment with
+    a sequence number from 1 and the client's GID."""
+
+    def __init__(self, session, key, gid):
+        self.session, self.key, self.gid, self.seq = session, key, gid, 0
+
+    def call_raw(self, payload):
+        self.seq += 1
+        replies = self.session.get(
+            self.key, payload=bytes(payload), attachment=attachment(self.seq, self.gid),
+            target=zenoh.QueryTarget.ALL_COMPLETE,
+            consolidation=zenoh.ConsolidationMode.NONE, timeout=60.0)
+        for reply in replies:
+            check(reply.ok is not None, f'{self.key} replied with an error: {reply.err}')
+            seq, gid = parse_attachment(reply.ok.attachment)
+            check(seq == self.seq, f'the reply echoes sequence number {self.seq} (got {seq})')
+            check(gid == self.gid, 'the reply echoes the client GID')
+            check(str(reply.ok.key_expr) == self.key, 'the reply is on the service key')
+            return reply.ok.payload.to_bytes()
+        fail(f'no reply on {self.key}')
+
+    def call(self, msg, req_type, resp_type):
+        data = self.call_raw(STORE.serialize_cdr(msg, req_type))
+        return STORE.deserialize_cdr(data, resp_type)
+
+
+def live(args):
+    register_services()
+    domain = args.domain
+    conf = zenoh.Config()
+    conf.insert_json5('mode', '"client"')
+    conf.insert_json5('connect/endpoints', json.dumps([args.connect]))
+    conf.insert_json5('scouting/multicast/enabled', 'false')
+    session = zenoh.open(conf)
+    out = {}
+
+    h_grid = STORE.hash_rihs01('nav_msgs/msg/OccupancyGrid')
+    h_path = STORE.hash_rihs01('nav_msgs/msg/Path')
+    map_key = topic_key(domain, '/map', 'nav_msgs/msg/OccupancyGrid', h_grid)
+    plan_key = topic_key(domain, f'/{args.robot}/plan', 'nav_msgs/msg/Path', h_path)
+
+    # The graph: roam's node and its endpoints, as rmw_zenoh's graph cache reads them.
+    tokens = []
+    deadline = time.time() + 30
+    while time.time() < deadline:
+        tokens = [str(r.ok.key_expr) for r in session.liveliness().get(f'@ros2_lv/{domain}/**')
+                  if r.ok is not None]
+        if any('/MP/' in t and '/%map/' in t for t in tokens) and any('/SS/' in t for t in tokens):
+            break
+        time.sleep(0.2)
+    parts = [t.split('/') for t in tokens]
+    nodes = [p for p in parts if len(p) == 9 and p[5] == 'NN' and p[8] == 'roam']
+    check(nodes, f'a node token for /roam among {tokens}')
+    check(nodes[0][6] == '%' and nodes[0][7] == '%', 'empty enclave and root namespace as %')
+    zid = nodes[0][2]
+    mine = [p for p in parts if p[2] == zid and len(p) == 13]
+    want = {
+        ('MP', '%map', dds('nav_msgs/msg/OccupancyGrid'), h_grid, ':1:,1:,:,:,,'),
+        ('MP', f'%{args.robot}%plan', dds('nav_msgs/msg/Path'), h_path, ':1:,1:,:,:,,'),
+        ('SS', '%roam%get_plan', 'nav_msgs::srv::dds_::GetPlan_', None, '::,10:,:,:,,'),
+        ('SS', '%roam%plan_downtime', 'roam_interfaces::srv::dds_::PlanDowntime_', None, '::,10:,:,:,,'),
+    }
+    for kind, name, ty, digest, qos in want:
+        found = [p for p in mine if p[5] == kind and p[9] == name and p[10] == ty and p[12] == qos
+                 and (digest is None or p[11] == digest) and p[3] == nodes[0][3]]
+        check(found, f'an endpoint token {kind} {name} {ty} {qos}')
+    service_hash = {p[9]: p[11] for p in mine if p[5] == 'SS'}
+    out['tokens'] = len(mine) + 1
+
+    # /map, decoded by rosbags, its attachment checked.
+    sample = latest(session, map_key, 30)
+    seq, gid = parse_attachment(sample.attachment)
+    check(seq >= 1, 'sequence numbers start at 1')
+    raw = sample.payload.to_bytes()
+    check(raw[:4] == b'\x00\x01\x00\x00', 'CDR little-endian encapsulation')
+    grid = STORE.deserialize_cdr(raw, 'nav_msgs/msg/OccupancyGrid')
+    check(grid.header.frame_id == 'map', 'the map is in frame map')
+    out['map'] = {
+        'width': int(grid.info.width), 'height': int(grid.info.height),
+        'resolution': float(grid.info.resolution),
+        'origin': [grid.info.origin.position.x, grid.info.origin.position.y],
+        'data_hex': np.asarray(grid.data, dtype=np.int8).tobytes().hex(),
+        'gid_hex': gid.hex(),
+    }
+
+    # /<robot>/plan.
+    sample = latest(session, plan_key, 30)
+    parse_attachment(sample.attachment)
+    path = STORE.deserialize_cdr(sample.payload.to_bytes(), 'nav_msgs/msg/Path')
+    got = [[p.pose.position.x, p.pose.position.y] for p in path.poses]
+    check(got == json.loads(args.waypoints), f'/{args.robot}/plan holds the mission ({got})')
+    out['plan_poses'] = len(got)
+
+    gid = os.urandom(16)
+    T = STORE.types
+    Req = T['roam_interfaces/msg/PlanDowntime_Request']
+    pd = Caller(session, topic_key(domain, '/roam/plan_downtime', 'roam_interfaces/srv/PlanDowntime',
+                                   service_hash['%roam%plan_downtime']), gid)
+    rt, st = 'roam_interfaces/msg/PlanDowntime_Request', 'roam_interfaces/msg/PlanDowntime_Response'
+    good = Req(start=pose(-8.0, -8.0), goal=pose(6.0, -7.0), budget_s=80.0, model='model1', seed=7,
+               deadline_s=3.0)
+    r = pd.call(good, rt, st)
+    check(r.error_code == '', f'plan_downtime succeeds ({r.error_code}: {r.error_message})')
+    check(r.reaches_goal and r.within_budget and r.eta_s <= 80.0, 'the plan reaches the goal in budget')
+    last = r.path.poses[-1].pose.position
+    check(math.hypot(last.x - 6.0, last.y + 7.0) < 0.5, 'the path ends at the goal')
+    out['plan_downtime'] = {'poses': len(r.path.poses), 'eta_s': r.eta_s, 'information': r.information}
+
+    bad = {
+        'nan': (Req(start=pose(float('nan'), -8.0), goal=pose(6.0, -7.0), budget_s=80.0, model='',
+                    seed=0, deadline_s=0.0), 'invalid_request'),
+        'short_budget': (Req(start=pose(-8.0, -8.0), goal=pose(6.0, -7.0), budget_s=1.0, model='',
+                             seed=0, deadline_s=0.0), 'invalid_request'),
+        'model': (Req(start=pose(-8.0, -8.0), goal=pose(6.0, -7.0), budget_s=80.0, model='model9',
+                      seed=0, deadline_s=0.0), 'invalid_request'),
+    }
+    out['refusals'] = {}
+    for name, (msg, code) in bad.items():
+        r = pd.call(msg, rt, st)
+        check(r.error_code == code and r.error_message, f'{name}: error {code} (got {r.error_code!r})')
+        check(len(r.path.poses) == 0, f'{name}: an empty path')
+        out['refusals'][name] = r.error_message
+    truncated = bytes(STORE.serialize_cdr(good, rt))[:20]
+    r = STORE.deserialize_cdr(pd.call_raw(truncated), st)
+    check(r.error_code == 'malformed', f'a truncated request is malformed (got {r.error_code!r})')
+    out['refusals']['truncated'] = r.error_message
+
+    gp = Caller(session, topic_key(domain, '/roam/get_plan', 'nav_msgs/srv/GetPlan',
+                                   service_hash['%roam%get_plan']), gid)
+    GReq = T['nav_msgs/msg/GetPlan_Request']
+    r = gp.call(GReq(start=pose(-8.0, -8.0), goal=pose(6.0, -7.0), tolerance=0.0),
+                'nav_msgs/msg/GetPlan_Request', 'nav_msgs/msg/GetPlan_Response')
+    check(len(r.plan.poses) > 1, 'get_plan returns a path')
+    last = r.plan.poses[-1].pose.position
+    check(math.hypot(last.x - 6.0, last.y + 7.0) < 0.5, 'the get_plan path ends at the goal')
+    r = gp.call(GReq(start=pose(-8.0, -8.0), goal=pose(float('inf'), -7.0), tolerance=0.0),
+                'nav_msgs/msg/GetPlan_Request', 'nav_msgs/msg/GetPlan_Response')
+    check(len(r.plan.poses) == 0, 'a get_plan to an infinite goal is an empty path')
+    out['get_plan_poses'] = True
+    session.close()
+    print(json.dumps(out))
+
+
+def bag(args):
+    from rosbags.rosbag2 import Reader
+    out = {'topics': {}}
+    with Reader(args.dir) as reader:
+        check(reader.message_count > 0, 'the bag holds messages')
+        for conn in reader.connections:
+            out['topics'][conn.topic] = {'type': conn.msgtype, 'count': conn.msgcount,
+                                         'hash': conn.digest}
+        for conn, stamp, raw in reader.messages():
+            if conn.topic == '/map':
+                grid = STORE.deserialize_cdr(raw, conn.msgtype)
+                out['map'] = {'width': int(grid.info.width), 'height': int(grid.info.height)}
+            elif conn.msgtype == 'nav_msgs/msg/Path':
+                STORE.deserialize_cdr(raw, conn.msgtype)
+    check('map' in out, 'the bag holds /map')
+    print(json.dumps(out))
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    sub = parser.add_subparsers(dest='command', required=True)
+    p = sub.add_parser('live')
+    p.add_argument('--connect', required=True)
+    p.add_argument('--domain', type=int, default=0)
+    p.add_argument('--robot', default='r1')
+    p.add_argument('--waypoints', required=True)
+    p = sub.add_parser('bag')
+    p.add_argument('dir')
+    args = parser.parse_args()
+    {'live': live, 'bag': bag}[args.command](args)
+
+
+if __name__ == '__main__':
+    main()
