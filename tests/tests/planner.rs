@@ -415,7 +415,7 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
         quoted.message.len()
     );
     assert!(
-        quoted.message.contains("(50076 bytes)"),
+        quoted.message.contains("(50086 bytes)"),
         "{}",
         quoted.message
     );
