@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 
 use roam_proto::excerpt;
 use roam_proto::map::Layer;
-use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, StopReason};
+use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, ShortestPath, StopReason};
 use roam_proto::{keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, Requester, Service, ServiceError};
@@ -415,6 +415,7 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
         seed: request.seed,
         threads: crate::ga::default_threads(),
         limits: state.limits,
+        shortest: request.shortest,
     };
     // The deadline is checked before the budget takes it as the grant it asks for.
     check_spec(&spec).map_err(|e| e.to_reply())?;
@@ -475,9 +476,17 @@ pub fn to_message(
 ) -> Plan {
     let cells = world.grid_cells(&outcome.path);
     let points = world.centers(&outcome.path);
+    // Only when the request asked ([`plan`] measures it only then): a client from
+    // before the field never sees it.
+    let shortest = outcome.shortest.as_ref().map(|s| ShortestPath {
+        cells: world.grid_cells(&s.path),
+        points: world.centers(&s.path),
+        t_eta_s: s.t_eta_s,
+        distinct_information: s.metrics.distinct_information,
+    });
     Plan {
         request_id,
-        model: request.model,
+        model: outcome.model,
         cells,
         points,
         t_eta_s: outcome.t_eta_s,
@@ -494,5 +503,6 @@ pub fn to_message(
         seed: request.seed,
         map_version,
         instance: instance.to_owned(),
+        shortest,
     }
 }
