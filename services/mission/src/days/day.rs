@@ -19,7 +19,7 @@ use crate::tasks::Task;
 use crate::watch::WatchParams;
 
 /// How often the executive asks again for a window's first plans when none came
-/// (its `PLAN_RETRY`), mission seconds.
+/// ([`crate::window::PLAN_RETRY_S`], wall seconds there), mission seconds.
 const PLAN_RETRY_S: f64 = 1.0;
 
 /// The steps the day may take to get the robot's first fix.
@@ -202,7 +202,7 @@ impl DayRun<'_> {
     }
 
     /// The curious plan for the budget, or the shortest when curiosity does not fit
-    /// (the executive's `plan_window`), with the budget. A curious plan costs
+    /// (the executive's rule, [`crate::window`]), with the budget. A curious plan costs
     /// `plan_cost_s` of mission time, through which the robot goes on as it was (its
     /// mission, a hold, or standing at its task). `leave_at_s`: the robot cannot set
     /// off before (a window planned during the previous task). `rank` counts the
@@ -240,7 +240,7 @@ impl DayRun<'_> {
         }
     }
 
-    /// A window's shortest and curious plans (the executive's `first_plans`): asked
+    /// A window's shortest and curious plans (the executive's first plan): asked
     /// again every [`PLAN_RETRY_S`] while the planner refuses (the estimate in an
     /// inflated cell), `None` once the window is given up.
     #[allow(clippy::too_many_arguments)]

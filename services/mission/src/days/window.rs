@@ -1,12 +1,17 @@
-//! One downtime window, as the executive's window loop runs it (`executive.rs`), on the
-//! mission clock of the sim: the plans (made ahead during the last task, or now), the
+//! One downtime window, as the executive's window machine runs it ([`crate::window`]), on
+//! the mission clock of the sim: the plans (made ahead during the last task, or now), the
 //! mission, the [`Watch`]'s decisions on every step's estimate and controller status,
 //! the replans they ask for, the arrival, the time model learning from the arrived
 //! mission, the next window planned during the task, and the wait at the task.
 //!
 //! Every step is an estimate and a controller status, in that order, then a tick (the
-//! executive's 100 ms timer is finer than the sim's 0.4 s step). Wall time is mission
+//! executive's 20 ms tick is finer than the sim's 0.4 s step). Wall time is mission
 //! time: statuses come every step, so the lost-mission rule never fires here.
+//!
+//! The planner is asked in process here, for the shortest path and then (when
+//! curiosity fits the budget) the curious one, as the executive did before its plan
+//! reply carried the shortest path: the same paths and the same GA seeds, and no
+//! request to save.
 
 use super::day::{DayRun, Preplanned};
 use super::measure::{planned_path, Leg, TimeModelUse, Track, WindowResult};
@@ -15,10 +20,7 @@ use crate::calibration::path_measure;
 use crate::path::distance;
 use crate::tasks::Task;
 use crate::watch::{Decision, Reason, Status, Watch};
-
-/// A preplanned window is used when the robot sets off at most this far from where the
-/// plans start (the executive's `PREPLAN_FROM_M`), metres.
-const PREPLAN_FROM_M: f64 = 0.5;
+use crate::window::PREPLAN_FROM_M;
 
 /// A replan's reason as the report names it.
 pub fn reason_name(reason: Reason) -> &'static str {
