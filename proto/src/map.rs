@@ -34,6 +34,14 @@ impl GridMeta {
     }
 }
 
+/// The map server's base layers, by name (`<root>/map/layer/<name>`): the occupancy
+/// grid (i8, -1 unknown, 0..=100), its inflation by the robot radius (i8), the
+/// information map (u8, paper 000's 0..=100 scores) and paper 000's heuristic map (u8).
+pub const OCCUPANCY_LAYER: &str = "occupancy";
+pub const INFLATED_LAYER: &str = "inflated";
+pub const INFORMATION_LAYER: &str = "information";
+pub const HEURISTIC_LAYER: &str = "heuristic";
+
 /// One layer as the map server holds it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

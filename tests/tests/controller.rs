@@ -320,7 +320,7 @@ async fn a_detour_is_driven_as_planned_under_follow_path() {
     let planned: Vec<[f64; 2]> = std::iter::once(start).chain(corners.clone()).collect();
     let params = ApfParams::indoor();
     assert_eq!(params.follow, Follow::Path);
-    let scenario = roam_sim::service::load_scenario(None)
+    let scenario = roam_world::scenario::load_or_builtin(None)
         .expect("built-in world")
         .1;
     let setup = Setup::new(&scenario).expect("setup");

@@ -616,12 +616,12 @@ async fn inflated_always_matches_occupancy_after_a_kill_between_saves() {
     assert!(warnings.contains("'inflated' computed again"), "{warnings}");
     assert!(warnings.contains("incomplete last record"), "{warnings}");
     // Exactly what inflating this occupancy gives, with the built-in world's radius.
-    let radius = roam_map_server::map_file::builtin(DEFAULT_LIMITS.max_layer_cells)
+    let radius = roam_map_server::map_file::builtin(roam_world::DEFAULT_MAX_CELLS)
         .expect("built-in world")
         .robot_radius_m
         .unwrap_or(0.2);
-    let expected = roam_map_server::layers::inflate(
-        &roam_map_server::grid::Grid {
+    let expected = roam_world::layers::inflate(
+        &roam_world::grid::Grid {
             meta: occupancy.meta,
             cells: cells.clone(),
         },

@@ -6,9 +6,7 @@
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
-use roam_map_server::layers::inflate;
 use roam_map_server::map_file;
-use roam_map_server::store::DEFAULT_LIMITS;
 use roam_planner::client::PlannerClient;
 use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanSpec};
@@ -20,6 +18,8 @@ use roam_proto::planner::{
 use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::{ClientError, Requester};
 use roam_tests::{within, Harness, RunningService};
+use roam_world::layers::inflate;
+use roam_world::DEFAULT_MAX_CELLS;
 
 fn request(start: [f64; 2], goal: [f64; 2], t_exec_s: f64, generations: u32) -> PlanRequest {
     PlanRequest {
@@ -221,7 +221,7 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
     assert_eq!(remote.points.len(), remote.cells.len());
 
     // The same request in process, on the same world built from the same scenario.
-    let content = map_file::builtin(DEFAULT_LIMITS.max_layer_cells).expect("builtin");
+    let content = map_file::builtin(DEFAULT_MAX_CELLS).expect("builtin");
     let inflated = inflate(
         &content.occupancy,
         content.robot_radius_m.unwrap_or(0.2),
@@ -613,7 +613,7 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
 async fn a_round_trip_through_zenoh_uses_the_budget() {
     let running = boot(&[("solo", 2)]).await;
     let client = running.harness.client().await;
-    let content = map_file::builtin(DEFAULT_LIMITS.max_layer_cells).expect("builtin");
+    let content = map_file::builtin(DEFAULT_MAX_CELLS).expect("builtin");
     let inflated = inflate(
         &content.occupancy,
         content.robot_radius_m.unwrap_or(0.2),

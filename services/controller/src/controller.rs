@@ -387,8 +387,8 @@ mod tests {
     use roam_localization::fim::FimOptions;
     use roam_localization::model::RangingModel;
     use roam_localization::ToaNoise;
-    use roam_map_server::grid::{occupancy, Grid};
     use roam_proto::map::{GridMeta, Origin};
+    use roam_world::grid::{occupancy, Grid};
 
     /// An empty 40 × 40 m map (0.5 m cells, origin 0) with four anchors around the
     /// middle: covered everywhere near it.

@@ -30,9 +30,9 @@ use std::sync::Arc;
 use roam_localization::fim::FimOptions;
 use roam_localization::model::RangingModel;
 use roam_localization::{LocalizationError, Tracker};
-use roam_map_server::scenario::Scenario;
 use roam_sim::messages::robot_messages;
 use roam_sim::{Command, Sim, SimError, SimParams};
+use roam_world::scenario::Scenario;
 use serde::Serialize;
 
 use crate::controller::{Controller, MissionStatus};
@@ -71,7 +71,7 @@ pub enum EpisodeError {
     #[error("robot '{0}' has two missions")]
     DuplicateMission(String),
     #[error(transparent)]
-    Scenario(#[from] roam_map_server::scenario::ScenarioError),
+    Scenario(#[from] roam_world::scenario::ScenarioError),
     #[error("scenario {0} has no robot")]
     NoRobot(String),
 }
@@ -299,9 +299,9 @@ pub fn mission_from_waypoints(
     })
 }
 
-/// Loads a scenario file as the services do (`roam_sim::service::load_scenario`).
+/// Loads a scenario file as the services do (`roam_world::scenario::load_or_builtin`).
 pub fn load_scenario(path: &Path) -> Result<Scenario, EpisodeError> {
-    Ok(roam_sim::service::load_scenario(Some(path))?.1)
+    Ok(roam_world::scenario::load_or_builtin(Some(path))?.1)
 }
 
 /// One ES1 mission in batch (paper 002 §4): the scenario at `path`'s first robot from its

@@ -2,11 +2,11 @@
 //! force of paper 002 Eq. 3 (Khatib's potential [10]).
 //!
 //! Built once per map with the exact Euclidean distance transform of
-//! [`roam_map_server::distance`] (O(cells)); each query is then a constant-time lookup, not
+//! [`roam_world::distance`] (O(cells)); each query is then a constant-time lookup, not
 //! a scan of the map.
 //!
 //! **What η is.** Obstacles are the cells the sim world treats as blocked
-//! ([`roam_map_server::scenario::is_blocked`]: occupied or unknown), and everything off
+//! ([`roam_world::scenario::is_blocked`]: occupied or unknown), and everything off
 //! the map (the grid is padded with one ring of obstacle cells before the transform, so
 //! the map's edge repels like a wall). The transform gives the distance between cell
 //! centres; η at a world point is that field interpolated bilinearly at the point, less
@@ -21,9 +21,9 @@
 //! is zero, which is also where the repulsions from both sides cancel. Off the map the
 //! direction points straight back onto it.
 
-use roam_map_server::distance::squared_distance;
-use roam_map_server::grid::Grid;
-use roam_map_server::scenario::is_blocked;
+use roam_world::distance::squared_distance;
+use roam_world::grid::Grid;
+use roam_world::scenario::is_blocked;
 
 /// The distance field of one map.
 #[derive(Debug, Clone)]
@@ -158,8 +158,8 @@ pub(crate) fn unit(v: [f64; 2]) -> [f64; 2] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use roam_map_server::grid::occupancy::{FREE, OCCUPIED};
     use roam_proto::map::{GridMeta, Origin};
+    use roam_world::grid::occupancy::{FREE, OCCUPIED};
 
     /// A `w × h` grid of 0.5 m cells with its origin at (0, 0), cells set by `occupied`.
     fn grid(w: u32, h: u32, occupied: impl Fn(usize, usize) -> bool) -> Grid<i8> {

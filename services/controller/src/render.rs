@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use image::{Rgb, RgbImage};
-use roam_map_server::scenario::is_blocked;
+use roam_world::scenario::is_blocked;
 
 use crate::episode::Setup;
 use crate::experiments::{Es2Row, Reproduction, Trajectory};
@@ -124,7 +124,7 @@ pub fn render_map(setup: &Setup, scale: u32) -> RgbImage {
             let colour = if grid.cells.get(i).is_none_or(|&v| is_blocked(v)) {
                 WALL
             } else {
-                let (cx, cy) = roam_map_server::grid::cell_center(&meta, x as usize, y as usize);
+                let (cx, cy) = roam_world::grid::cell_center(&meta, x as usize, y as usize);
                 let n = setup.information.coverage([cx, cy]);
                 COVERAGE[n.min(COVERAGE.len() - 1)]
             };
@@ -302,7 +302,7 @@ pub fn write_figures(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use roam_map_server::scenario::parse;
+    use roam_world::scenario::parse;
 
     const ROOM: &str = "
 name: room

@@ -33,7 +33,6 @@ use std::time::{Duration, Instant};
 
 use roam_localization::fim::FimOptions;
 use roam_localization::model::RangingModel;
-use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::controller::{
     ControllerStatus, Mission, MissionState, MAX_MISSION_BYTES, MAX_MISSION_ID_BYTES, MAX_WAYPOINTS,
 };
@@ -41,8 +40,9 @@ use roam_proto::localization::PositionEstimate;
 use roam_proto::sim::RobotCommand;
 use roam_proto::{excerpt, keys, Message};
 use roam_runtime::warn_limit::WarnLimiter;
+use roam_runtime::world_check::{self, WorldMismatch};
 use roam_runtime::{limited_warn, routing, Service, ServiceError};
-use roam_sim::service::load_scenario;
+use roam_world::scenario::load_or_builtin;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
 
@@ -113,7 +113,7 @@ pub enum ControllerServiceError {
     #[error(transparent)]
     Service(#[from] ServiceError),
     #[error(transparent)]
-    Scenario(#[from] roam_map_server::scenario::ScenarioError),
+    Scenario(#[from] roam_world::scenario::ScenarioError),
     #[error("invalid config: {0}")]
     Config(String),
     #[error(transparent)]
@@ -468,7 +468,7 @@ pub async fn run(
         keys::check_name("robot", robot)
             .map_err(|e| ControllerServiceError::Config(format!("robots: {e}")))?;
     }
-    let (_, scenario) = load_scenario(config.scenario.as_deref())?;
+    let (_, scenario) = load_or_builtin(config.scenario.as_deref())?;
     let anchors: Vec<[f64; 2]> = scenario.file.anchors.iter().map(|a| a.at).collect();
     let model = RangingModel::from_spec(&anchors, &scenario.file.sensing)
         .map_err(|e| ControllerServiceError::Config(format!("the scenario's sensing: {e}")))?;
@@ -482,7 +482,7 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world_guard = world_check::guard(&service, roam_map_server::world::of_scenario(&scenario));
+    let world_guard = world_check::guard(&service, roam_world::world_id::of_scenario(&scenario));
     let state = Arc::new(State {
         root: config.root.clone(),
         session: service.session().clone(),

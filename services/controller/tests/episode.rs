@@ -182,7 +182,9 @@ fn off_polyline(p: [f64; 2], path: &[[f64; 2]]) -> f64 {
 fn under_follow_path_a_u_detour_is_driven_within_0_3_m_whatever_the_seed() {
     // The built-in world (indoor parameters, on estimates): from the robot's start at
     // (-8, -8), east, 2.5 m up a U in open floor, 1 m across, down, and east.
-    let scenario = roam_sim::service::load_scenario(None).expect("built-in").1;
+    let scenario = roam_world::scenario::load_or_builtin(None)
+        .expect("built-in")
+        .1;
     let setup = Setup::new(&scenario).expect("setup");
     let corners = vec![
         [-6.0, -8.0],

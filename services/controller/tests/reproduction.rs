@@ -20,7 +20,7 @@ use roam_controller::experiments::{
     es1, es2, es3, reproduce, Es1Row, ReproduceOptions, Reproduction, RunOptions,
 };
 use roam_controller::{ApfParams, Scheme};
-use roam_map_server::scenario::Scenario;
+use roam_world::scenario::Scenario;
 
 fn scenario(file: &str) -> Scenario {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -24,6 +24,6 @@ pub use field::{
 pub use fim::{bound, bound_from_fim, fim, Bound, FimOptions, MIN_FIX_ANCHORS};
 pub use model::RangingModel;
 pub use nalgebra;
-pub use roam_sim::noise::ToaNoise;
+pub use roam_world::noise::ToaNoise;
 pub use tracker::Tracker;
 pub use wls::{estimate, Degraded, Estimate, Range, WlsOptions};

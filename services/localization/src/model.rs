@@ -7,8 +7,8 @@
 //! one place.
 
 use nalgebra::Vector2;
-use roam_map_server::scenario::SensingSpec;
-use roam_sim::noise::ToaNoise;
+use roam_world::noise::ToaNoise;
+use roam_world::scenario::SensingSpec;
 
 use crate::error::LocalizationError;
 

@@ -17,16 +17,16 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use roam_map_server::scenario::SensingSpec;
-use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::cells::Cells;
 use roam_proto::localization::{CrbCells, PebAt, PebQuery, PebReply, PebWhere};
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
 use roam_proto::sim::{NamedPoint, RangeScan};
 use roam_proto::{keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
+use roam_runtime::world_check::{self, WorldMismatch};
 use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
-use roam_sim::service::load_scenario;
+use roam_world::scenario::load_or_builtin;
+use roam_world::scenario::SensingSpec;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
@@ -87,7 +87,7 @@ pub enum LocalizationServiceError {
     #[error(transparent)]
     Service(#[from] ServiceError),
     #[error(transparent)]
-    Scenario(#[from] roam_map_server::scenario::ScenarioError),
+    Scenario(#[from] roam_world::scenario::ScenarioError),
     #[error("the scenario's sensing model is unusable: {0}")]
     Model(#[from] LocalizationError),
     #[error(transparent)]
@@ -139,7 +139,7 @@ pub async fn run(
     zenoh_config: zenoh::Config,
     cancel: CancellationToken,
 ) -> Result<(), LocalizationServiceError> {
-    let (_, scenario) = load_scenario(config.scenario.as_deref())?;
+    let (_, scenario) = load_or_builtin(config.scenario.as_deref())?;
     let sensing = scenario.file.sensing;
     let anchors: Vec<NamedPoint> = scenario
         .file
@@ -160,7 +160,7 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world = roam_map_server::world::of_scenario(&scenario);
+    let world = roam_world::world_id::of_scenario(&scenario);
     let world_guard = world_check::guard(&service, world.clone());
     let fim = FimOptions {
         variance_derivative: config.variance_derivative,

@@ -7,9 +7,9 @@
 
 use std::collections::HashMap;
 
-use roam_map_server::scenario::SensingSpec;
 use roam_proto::localization::PositionEstimate;
 use roam_proto::sim::RangeScan;
+use roam_world::scenario::SensingSpec;
 
 use crate::fim::FimOptions;
 use crate::model::RangingModel;

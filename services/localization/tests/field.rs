@@ -10,7 +10,7 @@ use roam_localization::{
 
 fn es1() -> (RangingModel, GridRegion) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenarios/es1.yaml");
-    let s = roam_map_server::scenario::load(&path, 10_000_000).expect("es1 loads");
+    let s = roam_world::scenario::load(&path, 10_000_000).expect("es1 loads");
     let anchors: Vec<[f64; 2]> = s.file.anchors.iter().map(|a| a.at).collect();
     let model = RangingModel::from_spec(&anchors, &s.file.sensing).expect("es1 is valid");
     let m = &s.occupancy.meta;

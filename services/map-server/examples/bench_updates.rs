@@ -14,11 +14,11 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use roam_map_server::grid::{occupancy, Grid};
 use roam_map_server::persist::DataDir;
 use roam_map_server::store::{DerivedParams, LayerStore, DEFAULT_LIMITS};
 use roam_proto::cells::Cells;
 use roam_proto::map::{CellWrite, GridMeta, LayerChange, LayerUpdate, Origin};
+use roam_world::grid::{occupancy, Grid};
 
 const SIDE: u32 = 4096;
 

@@ -28,7 +28,7 @@ pub struct MapServerConfig {
     pub map: Option<PathBuf>,
     pub data_dir: Option<PathBuf>,
     /// The directories a `<root>/map/load` request may read from (names relative to
-    /// them; see [`crate::load_dirs`]). Empty: loads from the wire are off.
+    /// them; see [`roam_world::load_dirs`]). Empty: loads from the wire are off.
     pub load_dirs: Vec<PathBuf>,
     pub robot_radius_m: Option<f64>,
     pub heuristic_compression: f64,

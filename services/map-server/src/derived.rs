@@ -14,8 +14,8 @@ use roam_proto::map::GridMeta;
 use serde::{Deserialize, Serialize};
 
 use crate::edits::CellEdits;
-use crate::grid::Grid;
-use crate::layers;
+use roam_world::grid::Grid;
+use roam_world::layers;
 
 /// How a derived layer is computed from its source.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -179,9 +179,9 @@ pub fn heuristic_changes(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::occupancy;
     use proptest::prelude::*;
     use roam_proto::map::Origin;
+    use roam_world::grid::occupancy;
 
     fn meta(w: u32, h: u32) -> GridMeta {
         GridMeta {

@@ -5,7 +5,7 @@
 use roam_proto::cells::{Cells, Dtype};
 use roam_proto::map::{CellWrite, GridMeta, Layer};
 
-use crate::grid::occupancy;
+use roam_world::grid::occupancy;
 
 /// Cell positions and their new values, in the order they are applied (a later write to
 /// the same cell wins). `values` has the layer's element type and one value per

@@ -7,23 +7,16 @@ use roam_proto::{ErrorCode, ErrorReply};
 
 use roam_proto::map::WorldId;
 
-use crate::grid::Grid;
-use crate::load_dirs::{Access, LoadDirs, LoadRefused};
-use crate::ros_map::{self, RosMapError};
-use crate::scenario::{self, ScenarioError};
-use crate::world::world_id;
-
-/// The embedded default world: a paper-000-like 20 × 20 m downtime world (see
-/// `config/scenarios/downtime.yaml`), used when no map is configured.
-pub const BUILTIN_SCENARIO: &str = include_str!("../../../config/scenarios/downtime.yaml");
-
-/// The name the built-in scenario goes by in messages.
-pub const BUILTIN_NAME: &str = "<built-in downtime world>";
+use roam_world::grid::Grid;
+use roam_world::load_dirs::{Access, LoadDirs, LoadRefused};
+use roam_world::ros_map::{self, RosMapError};
+use roam_world::scenario::{self, ScenarioError};
+use roam_world::world_id::world_id;
 
 /// What a map file gives the map server.
 #[derive(Debug, Clone)]
 pub struct MapContent {
-    /// Which world this map is ([`crate::world`]).
+    /// Which world this map is ([`roam_world::world_id`]).
     pub world: WorldId,
     pub occupancy: Grid<i8>,
     pub information: Option<Grid<u8>>,
@@ -116,7 +109,11 @@ fn read_with(path: &Path, max_cells: u64, access: Access<'_>) -> Result<MapConte
 
 /// The built-in world.
 pub fn builtin(max_cells: u64) -> Result<MapContent, MapFileError> {
-    let scenario = scenario::parse(&PathBuf::from(BUILTIN_NAME), BUILTIN_SCENARIO, max_cells)?;
+    let scenario = scenario::parse(
+        &PathBuf::from(scenario::BUILTIN_NAME),
+        scenario::BUILTIN,
+        max_cells,
+    )?;
     Ok(from_scenario(scenario))
 }
 

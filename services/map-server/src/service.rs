@@ -24,10 +24,10 @@ use zenoh::query::Query;
 use zenoh::Session;
 
 use crate::config::MapServerConfig;
-use crate::load_dirs::LoadDirs;
 use crate::map_file::{self, MapFileError};
 use crate::persist::{DataDir, PersistError};
 use crate::store::{DerivedParams, LayerStore, OCCUPANCY};
+use roam_world::load_dirs::LoadDirs;
 
 /// The service name in liveliness tokens and logs.
 pub const SERVICE_NAME: &str = "map-server";
@@ -162,7 +162,7 @@ pub fn open_store(config: &MapServerConfig) -> Result<LayerStore, MapServerError
     }
     if restored.found {
         let map_name = config.map.as_ref().map_or_else(
-            || map_file::BUILTIN_NAME.to_owned(),
+            || roam_world::scenario::BUILTIN_NAME.to_owned(),
             |p| p.display().to_string(),
         );
         store

@@ -6,8 +6,6 @@
 use std::fs;
 use std::path::Path;
 
-use roam_map_server::grid::{occupancy, Grid};
-use roam_map_server::layers;
 use roam_map_server::persist::{Compaction, DataDir, DEFAULT_COMPACTION};
 use roam_map_server::service::open_store;
 use roam_map_server::store::{
@@ -18,6 +16,8 @@ use roam_map_server::MapServerConfig;
 use roam_proto::cells::Cells;
 use roam_proto::map::{CellWrite, GridMeta, Layer, LayerChange, LayerUpdate, Origin};
 use roam_proto::ErrorCode;
+use roam_world::grid::{occupancy, Grid};
+use roam_world::layers;
 
 fn meta(w: u32, h: u32) -> GridMeta {
     GridMeta {

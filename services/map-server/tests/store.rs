@@ -1,6 +1,5 @@
 //! The layer store's rules: versions, stale refusals, derived layers, limits.
 
-use roam_map_server::grid::{occupancy, Grid};
 use roam_map_server::persist::DataDir;
 use roam_map_server::store::{
     DerivedParams, LayerStore, Limits, StoreError, DEFAULT_LIMITS, HEURISTIC, INFLATED,
@@ -9,6 +8,7 @@ use roam_map_server::store::{
 use roam_proto::cells::Cells;
 use roam_proto::map::{CellWrite, GridMeta, LayerChange, LayerUpdate, Origin};
 use roam_proto::ErrorCode;
+use roam_world::grid::{occupancy, Grid};
 
 fn meta(w: u32, h: u32) -> GridMeta {
     GridMeta {

@@ -183,7 +183,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 }
 
 /// 4. Curious against uniform for a range of τ, episode and feature variants.
-fn sweep(scenario: &roam_map_server::scenario::Scenario) -> Result<(), Box<dyn std::error::Error>> {
+fn sweep(scenario: &roam_world::scenario::Scenario) -> Result<(), Box<dyn std::error::Error>> {
     println!("sweep, {REPS} runs per mode: AUC curious vs uniform (recency, poisson)");
     let base = ExperimentOptions {
         repetitions: REPS,

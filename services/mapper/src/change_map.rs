@@ -16,9 +16,9 @@
 //! **Time.** Observations must come in time order (the same time again is fine: several
 //! robots' windows of one instant merge by observing each in turn).
 
-use roam_map_server::grid::{occupancy, world_to_cell, Grid};
 use roam_proto::map::GridMeta;
 use roam_sim::Observation;
+use roam_world::grid::{occupancy, world_to_cell, Grid};
 use serde::{Deserialize, Serialize};
 
 use crate::error::MapperError;

@@ -42,8 +42,8 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::OnceLock;
 
-use roam_map_server::scenario::{self, Scenario};
 use roam_sim::{Command, Sim, SimError};
+use roam_world::scenario::{self, Scenario};
 use serde::Serialize;
 
 use crate::change_map::{ChangeMap, MapParams, MAX_MAP_CELLS};

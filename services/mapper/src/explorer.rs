@@ -451,7 +451,7 @@ fn random_neighbour(
             let (x, y) = (i64::from(robot.0) + dx, i64::from(robot.1) + dy);
             let (x, y) = (u32::try_from(x).ok()?, u32::try_from(y).ok()?);
             let i = map.index(x, y)?;
-            (map.obstacles().get(i) != Some(&roam_map_server::grid::occupancy::OCCUPIED))
+            (map.obstacles().get(i) != Some(&roam_world::grid::occupancy::OCCUPIED))
                 .then_some((x, y))
         })
         .collect();

@@ -21,7 +21,7 @@
 //! Every draw comes from the caller's seeded stream.
 
 use rand::{Rng, RngCore};
-use roam_map_server::grid::occupancy;
+use roam_world::grid::occupancy;
 
 /// The default patch side, cells.
 pub const DEFAULT_PATCH_CELLS: u32 = 3;

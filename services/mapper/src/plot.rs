@@ -13,8 +13,8 @@
 use std::path::{Path, PathBuf};
 
 use image::{Rgb, RgbImage};
-use roam_map_server::scenario::{is_blocked, Scenario};
 use roam_sim::world::World;
+use roam_world::scenario::{is_blocked, Scenario};
 
 use crate::experiment::{ExperimentError, Reproduction};
 use crate::learner::Mode;
@@ -208,7 +208,7 @@ pub fn world_panel(scenario: &Scenario, size: u32) -> RgbImage {
         }
     }
     for robot in &scenario.file.robots {
-        let cell = roam_map_server::grid::world_to_cell(&grid.meta, robot.at[0], robot.at[1]);
+        let cell = roam_world::grid::world_to_cell(&grid.meta, robot.at[0], robot.at[1]);
         if let Some((x, y)) = cell {
             fill(&mut img, (x as i64, y as i64), START);
         }

@@ -26,7 +26,6 @@ use roam_proto::cells::Cells;
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
 
 type MapMeta = GridMeta;
-use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::mapper::{
     ExplorationGoal, ExplorerStatus, MapperStatus, CHANGE_INFORMATION_LAYER,
     CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER, RECENCY_LAYER,
@@ -34,8 +33,9 @@ use roam_proto::mapper::{
 use roam_proto::sim::{LocalObservation, RobotCommand, SimClock};
 use roam_proto::{keys, ErrorReply, Message};
 use roam_runtime::warn_limit::WarnLimiter;
+use roam_runtime::world_check::{self, WorldMismatch};
 use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
-use roam_sim::service::load_scenario;
+use roam_world::scenario::load_or_builtin;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
@@ -97,7 +97,7 @@ pub enum MapperServiceError {
     #[error(transparent)]
     Service(#[from] ServiceError),
     #[error(transparent)]
-    Scenario(#[from] roam_map_server::scenario::ScenarioError),
+    Scenario(#[from] roam_world::scenario::ScenarioError),
     #[error("invalid config: {0}")]
     Config(String),
     #[error(transparent)]
@@ -417,7 +417,7 @@ pub async fn run(
     for robot in &explore {
         keys::check_name("robot", robot).map_err(|e| MapperServiceError::Config(e.to_string()))?;
     }
-    let (_, scenario) = load_scenario(config.scenario.as_deref())?;
+    let (_, scenario) = load_or_builtin(config.scenario.as_deref())?;
     let meta = scenario.occupancy.meta;
     let observation_period_s = scenario.file.time.step_s;
     let map = ChangeMap::new(
@@ -447,7 +447,7 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world = roam_map_server::world::of_scenario(&scenario);
+    let world = roam_world::world_id::of_scenario(&scenario);
     let world_guard = world_check::guard(&service, world.clone());
     let state = Arc::new(State {
         world: world.clone(),

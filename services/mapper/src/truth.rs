@@ -13,8 +13,8 @@
 //!
 //! Random walkers have no script, so a world with walkers has no true rates here.
 
-use roam_map_server::scenario::{is_blocked, Scenario};
 use roam_sim::world::World;
+use roam_world::scenario::{is_blocked, Scenario};
 
 /// The longest world cycle scored (limit `max_cycle_steps`).
 pub const MAX_CYCLE_STEPS: u64 = 1_000_000;

@@ -21,7 +21,7 @@
 
 use std::collections::VecDeque;
 
-use roam_map_server::grid::occupancy;
+use roam_world::grid::occupancy;
 use serde::Serialize;
 
 /// The 4-neighbourhood in the order hill climbing and random steps use.

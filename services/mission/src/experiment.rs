@@ -21,7 +21,6 @@
 //! what the plan promised on the same measure, driven / planned information per mission
 //! and its median (how closely the plan was driven as planned).
 
-use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 use rand::{Rng, SeedableRng};
@@ -30,15 +29,13 @@ use roam_controller::episode::{run_episode, PositionSource, RobotMission, Setup}
 use roam_controller::params::ApfParams;
 use roam_localization::field::{peb_field, GridRegion};
 use roam_localization::{FimOptions, RangingModel};
-use roam_map_server::layers::inflate;
-use roam_map_server::map_file::{BUILTIN_NAME, BUILTIN_SCENARIO};
-use roam_map_server::scenario::{self, Scenario};
-use roam_map_server::store::DEFAULT_LIMITS;
 use roam_mapper::change_map::{ChangeMap, MapParams, ObservationWindow};
 use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
+use roam_world::layers::inflate;
+use roam_world::scenario::{self, Scenario};
 use serde::Serialize;
 
 use crate::information::gathered;
@@ -124,12 +121,7 @@ pub enum MissionExperimentError {
 }
 
 fn builtin() -> Result<Scenario, MissionExperimentError> {
-    scenario::parse(
-        Path::new(BUILTIN_NAME),
-        BUILTIN_SCENARIO,
-        DEFAULT_LIMITS.max_layer_cells,
-    )
-    .map_err(|e| MissionExperimentError::World(e.to_string()))
+    scenario::builtin().map_err(|e| MissionExperimentError::World(e.to_string()))
 }
 
 const VARIANTS: [&str; 4] = ["static", "peb_cost", "change", "shortest"];

@@ -7,18 +7,18 @@ use std::sync::{Arc, Mutex};
 use roam_runtime::lock;
 use std::time::{Duration, Instant};
 
-use roam_map_server::grid::Grid;
-use roam_map_server::store::{INFLATED, INFORMATION};
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
 use roam_proto::cells::Cells;
 use roam_proto::controller::ControllerStatus;
 use roam_proto::localization::PositionEstimate;
 use roam_proto::map::Layer;
+use roam_proto::map::{INFLATED_LAYER as INFLATED, INFORMATION_LAYER as INFORMATION};
 use roam_proto::sim::SimClock;
 use roam_proto::ErrorCode;
 use roam_proto::{decode, keys};
 use roam_runtime::{ClientError, Requester};
+use roam_world::grid::Grid;
 use tokio_util::sync::CancellationToken;
 use zenoh::sample::Sample;
 

@@ -34,10 +34,10 @@ time: {{ step_s: 0.4 }}
 robots: [ {{ name: r, at: [1.5, 6.0] }} ]
 "
     );
-    let scenario = roam_map_server::scenario::parse(
+    let scenario = roam_world::scenario::parse(
         std::path::Path::new("zigzag.yaml"),
         &text,
-        roam_map_server::store::DEFAULT_LIMITS.max_layer_cells,
+        roam_world::DEFAULT_MAX_CELLS,
     )
     .unwrap_or_else(|e| panic!("{e}"));
     Sim::new(&scenario, seed).expect("sim")
@@ -241,7 +241,7 @@ fn waits_anywhere_do_not_inflate_the_fit() {
 #[test]
 fn transition_noise_and_waits_together_stay_within_5_percent() {
     let stretches = drive(Drive {
-        sigma_tr_m: roam_map_server::scenario::DEFAULT_SIGMA_TR_M,
+        sigma_tr_m: roam_world::scenario::DEFAULT_SIGMA_TR_M,
         wait_every: Some(53),
         wait_steps: 20,
     });
@@ -295,7 +295,7 @@ fn transition_noise_and_waits_together_stay_within_5_percent() {
     for seed in 0..8 {
         let stretches = drive_seeded(
             Drive {
-                sigma_tr_m: roam_map_server::scenario::DEFAULT_SIGMA_TR_M,
+                sigma_tr_m: roam_world::scenario::DEFAULT_SIGMA_TR_M,
                 wait_every: Some(53),
                 wait_steps: 20,
             },
@@ -353,13 +353,13 @@ fn noisy_position_estimates_need_the_scaled_config() {
     // for that noise. Position-only measurement degrades with the noise: within 5% at
     // 0.02 m, within 10% at 0.05 m on this zig-zag (legs of 2.7 to 4.5 m).
     let stretches = drive(Drive {
-        sigma_tr_m: roam_map_server::scenario::DEFAULT_SIGMA_TR_M,
+        sigma_tr_m: roam_world::scenario::DEFAULT_SIGMA_TR_M,
         wait_every: Some(53),
         wait_steps: 20,
     });
     for (sigma, within) in [(0.02, 0.05), (0.05, 0.10)] {
-        let mut rng = roam_sim::noise::stream(3, "estimates");
-        let mut n = || sigma * roam_sim::noise::standard_normal(&mut rng);
+        let mut rng = roam_world::noise::stream(3, "estimates");
+        let mut n = || sigma * roam_world::noise::standard_normal(&mut rng);
         let estimates: Vec<Stretch> = stretches
             .iter()
             .map(|s| {

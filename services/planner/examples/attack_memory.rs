@@ -15,12 +15,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use roam_map_server::grid::{occupancy, Grid};
 use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::map::{GridMeta, Origin};
 use roam_proto::planner::{PlannerModel, ShortestPathUse};
+use roam_world::grid::{occupancy, Grid};
 
 fn status_kib(field: &str) -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;

@@ -66,8 +66,8 @@ mod tests {
     use crate::params::GaParams;
     use crate::search::shortest_path;
     use crate::world::World;
-    use roam_map_server::grid::Grid;
     use roam_proto::map::{GridMeta, Origin};
+    use roam_world::grid::Grid;
 
     fn world() -> World {
         let meta = GridMeta {

@@ -265,8 +265,8 @@ impl<'a> Evaluator<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use roam_map_server::grid::Grid;
     use roam_proto::map::{GridMeta, Origin};
+    use roam_world::grid::Grid;
 
     fn world_with_scores(scores: &[u8], width: u32) -> World {
         let meta = GridMeta {

@@ -557,8 +557,8 @@ fn bridge(world: &World, a: Cell, b: Cell) -> Option<Bridge> {
 mod tests {
     use super::*;
     use crate::search::distance_field;
-    use roam_map_server::grid::Grid;
     use roam_proto::map::{GridMeta, Origin};
+    use roam_world::grid::Grid;
 
     fn open_world(side: u32) -> World {
         let meta = GridMeta {

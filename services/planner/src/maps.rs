@@ -5,17 +5,16 @@
 use std::collections::VecDeque;
 use std::sync::Arc;
 
-use roam_map_server::grid::Grid;
 use roam_proto::cells::Cells;
 use roam_proto::map::Layer;
 use roam_proto::planner::MapVersion;
+use roam_world::grid::Grid;
 
 use crate::coupling;
 use crate::world::World;
 
 /// The layer names the planner reads.
-pub const INFLATED: &str = "inflated";
-pub const INFORMATION: &str = "information";
+pub use roam_proto::map::{INFLATED_LAYER as INFLATED, INFORMATION_LAYER as INFORMATION};
 /// Localization's PEB layer: the localizability cost's input (`w_loc`).
 pub const PEB: &str = "peb";
 

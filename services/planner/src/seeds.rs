@@ -385,8 +385,8 @@ fn one_seed(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use roam_map_server::grid::Grid;
     use roam_proto::map::{GridMeta, Origin};
+    use roam_world::grid::Grid;
 
     /// A 40 × 30 open world whose information is one 80-scored square in the top right.
     fn world() -> World {

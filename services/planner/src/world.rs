@@ -1,9 +1,9 @@
 //! The planning grid: which cells the robot may occupy, their information scores, and
 //! the heuristic blocks of Model II.
 
-use roam_map_server::grid::{cell_center, world_to_cell, Grid};
-use roam_map_server::layers::block_size;
 use roam_proto::map::GridMeta;
+use roam_world::grid::{cell_center, world_to_cell, Grid};
+use roam_world::layers::block_size;
 
 /// A cell index, `y * width + x`.
 pub type Cell = u32;
@@ -161,7 +161,7 @@ impl World {
     }
 
     /// Recomputes the heuristic blocks for compression `c_h` (see
-    /// [`roam_map_server::layers::heuristic`] for how blocks are cut).
+    /// [`roam_world::layers::heuristic`] for how blocks are cut).
     pub fn set_heuristic_compression(&mut self, compression: f64) {
         let (w, h) = (self.width, self.height);
         self.heuristic_compression = compression;

@@ -24,11 +24,11 @@
 //! (6 cells); gene 1 adds column x = 2, gene 2 column x = 3 (3 cells each); gene 3 at
 //! (3,1) adds nothing (x = 4 is off the grid). 12 cells, rows 0..=2.
 
-use roam_map_server::grid::Grid;
 use roam_planner::curiosity::{Evaluation, Evaluator, Model};
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
 use roam_proto::map::{GridMeta, Origin};
+use roam_world::grid::Grid;
 
 /// Row-major from y = 0.
 const SCORES: [u8; 16] = [

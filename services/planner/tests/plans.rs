@@ -248,7 +248,7 @@ fn a_walled_in_goal_has_no_path() {
     let mut world = common::open_world(30, 30);
     // Rebuild with a ring of walls around the goal cell (15, 15).
     let meta = world.meta;
-    let mut occupancy = roam_map_server::grid::Grid::filled(meta, 0i8);
+    let mut occupancy = roam_world::grid::Grid::filled(meta, 0i8);
     for (x, y) in [
         (13, 13),
         (14, 13),
@@ -269,7 +269,7 @@ fn a_walled_in_goal_has_no_path() {
     ] {
         occupancy.cells[y * 30 + x] = 100;
     }
-    let information = roam_map_server::grid::Grid {
+    let information = roam_world::grid::Grid {
         meta,
         cells: world.information.clone(),
     };

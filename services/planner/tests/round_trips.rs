@@ -8,7 +8,6 @@ mod common;
 use std::sync::atomic::AtomicBool;
 
 use common::check_geometry;
-use roam_map_server::grid::Grid;
 use roam_planner::best::PlanSource;
 use roam_planner::curiosity::{Evaluator, Model};
 use roam_planner::eta::path_eta;
@@ -16,6 +15,7 @@ use roam_planner::plan::{plan, via_seeds, PlanError, PlanOutcome, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
 use roam_proto::ErrorCode;
+use roam_world::grid::Grid;
 
 const MODELS: [PlannerModel; 3] = [
     PlannerModel::Model0,

@@ -10,7 +10,6 @@ mod common;
 use std::sync::atomic::AtomicBool;
 
 use common::check_geometry;
-use roam_map_server::grid::Grid;
 use roam_planner::eta::path_eta;
 use roam_planner::metrics::path_metrics;
 use roam_planner::params::GaParams;
@@ -18,6 +17,7 @@ use roam_planner::plan::{plan, PlanOutcome, PlanSpec};
 use roam_planner::world::{Cell, World};
 use roam_proto::map::{GridMeta, Origin};
 use roam_proto::planner::PlannerModel;
+use roam_world::grid::Grid;
 
 const W: usize = 70;
 const H: usize = 40;

@@ -12,12 +12,12 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use roam_map_server::grid::{occupancy, Grid};
-use roam_map_server::ros_map::{self, SaveParams};
 use roam_proto::cells::Cells;
 use roam_proto::map::{GridMeta, Layer, Origin};
 use roam_proto::{decode, encode, keys};
 use roam_runtime::{Requester, SessionArgs};
+use roam_world::grid::{occupancy, Grid};
+use roam_world::ros_map::{self, SaveParams};
 use serde::Serialize;
 use zenoh::qos::CongestionControl;
 

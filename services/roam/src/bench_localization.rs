@@ -25,7 +25,7 @@ pub fn localization(estimates: usize) -> Result<LocalizationBench, BenchError> {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenarios/es3.yaml");
     let (_, scenario) =
-        roam_sim::service::load_scenario(Some(&path)).map_err(|e| setup(e.to_string()))?;
+        roam_world::scenario::load_or_builtin(Some(&path)).map_err(|e| setup(e.to_string()))?;
     let anchors: Vec<[f64; 2]> = scenario.file.anchors.iter().map(|a| a.at).collect();
     let model = RangingModel::from_spec(&anchors, &scenario.file.sensing)
         .map_err(|e| setup(e.to_string()))?;

@@ -11,14 +11,14 @@ use std::collections::BTreeMap;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use roam_map_server::layers::inflate;
 use roam_map_server::map_file;
-use roam_map_server::store::DEFAULT_LIMITS;
 use roam_planner::client::PlannerClient;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::{GaOverrides, PlanRequest, PlannerModel, ShortestPathUse};
 use roam_runtime::SessionArgs;
+use roam_world::layers::inflate;
+use roam_world::DEFAULT_MAX_CELLS;
 use serde::Serialize;
 
 use crate::bench::BenchError;
@@ -53,8 +53,8 @@ pub const GOAL: [f64; 2] = [6.0, -7.0];
 
 /// The built-in world as the planner sees it.
 pub fn builtin_world() -> Result<World, BenchError> {
-    let content = map_file::builtin(DEFAULT_LIMITS.max_layer_cells)
-        .map_err(|e| BenchError::Setup(e.to_string()))?;
+    let content =
+        map_file::builtin(DEFAULT_MAX_CELLS).map_err(|e| BenchError::Setup(e.to_string()))?;
     let inflated = inflate(
         &content.occupancy,
         content.robot_radius_m.unwrap_or(0.2),

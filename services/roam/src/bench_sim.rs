@@ -11,11 +11,12 @@
 
 use std::time::{Duration, Instant};
 
-use roam_map_server::grid::cell_center;
 use roam_proto::keys;
 use roam_proto::sim::{SimControl, SimStatus};
 use roam_runtime::{Requester, SessionArgs};
-use roam_sim::service::{load_scenario, SimConfig};
+use roam_sim::service::SimConfig;
+use roam_world::grid::cell_center;
+use roam_world::scenario::load_or_builtin;
 use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
@@ -86,7 +87,7 @@ pub async fn sim(robots: usize, rate_hz: f64, seconds: f64) -> Result<SimBench, 
         let control_key = keys::sim_control(&root);
 
         // Robots on free cells, spread over the map.
-        let (_, scenario) = load_scenario(None).map_err(setup)?;
+        let (_, scenario) = load_or_builtin(None).map_err(setup)?;
         let free: Vec<usize> = scenario
             .occupancy
             .cells

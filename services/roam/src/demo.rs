@@ -12,16 +12,18 @@ use std::time::{Duration, Instant};
 
 use image::{Rgb, RgbImage};
 use roam_controller::params::ApfParams;
-use roam_map_server::grid::Grid;
-use roam_map_server::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, PATH};
-use roam_map_server::store::{INFLATED, INFORMATION, OCCUPANCY};
 use roam_mission::executive::{self, ExecutiveConfig, Progress, WindowOutcome};
 use roam_proto::cells::Cells;
 use roam_proto::map::{GridMeta, Layer};
+use roam_proto::map::{
+    INFLATED_LAYER as INFLATED, INFORMATION_LAYER as INFORMATION, OCCUPANCY_LAYER as OCCUPANCY,
+};
 use roam_proto::mission::WindowReport;
 use roam_proto::sim::GroundTruth;
 use roam_proto::{decode, keys};
 use roam_runtime::Requester;
+use roam_world::grid::Grid;
+use roam_world::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, PATH};
 use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
@@ -282,7 +284,7 @@ async fn drive(
     let driven = roam_runtime::lock(&truth).clone();
 
     let picture = options.out_dir.join("world.png");
-    let anchors: Vec<[f64; 2]> = roam_sim::service::load_scenario(Some(world))
+    let anchors: Vec<[f64; 2]> = roam_world::scenario::load_or_builtin(Some(world))
         .map(|(_, s)| s.file.anchors.iter().map(|a| a.at).collect())
         .unwrap_or_default();
     let image = draw_world(

@@ -11,11 +11,11 @@
 
 use std::sync::atomic::AtomicBool;
 
-use roam_map_server::grid::Grid;
 use roam_mission::executive::WindowOutcome;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
+use roam_world::grid::Grid;
 use serde::Serialize;
 
 /// Table I's heuristic compression (the planner service's cached worlds).

@@ -4,15 +4,15 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use roam_map_server::grid::Grid;
-use roam_map_server::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, PATH};
-use roam_map_server::store::{INFORMATION, OCCUPANCY};
 use roam_planner::client::PlannerClient;
 use roam_proto::cells::Cells;
 use roam_proto::keys;
 use roam_proto::map::{Layer, LayerList};
+use roam_proto::map::{INFORMATION_LAYER as INFORMATION, OCCUPANCY_LAYER as OCCUPANCY};
 use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel, ShortestPathUse};
 use roam_runtime::{ClientError, Requester};
+use roam_world::grid::Grid;
+use roam_world::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, PATH};
 use serde::Serialize;
 
 /// One layer as the report shows it.

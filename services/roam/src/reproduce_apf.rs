@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use roam_controller::episode::Setup;
 use roam_controller::experiments::{paper, reproduce, ReproduceOptions, Reproduction};
-use roam_map_server::scenario::{self, Scenario};
-use roam_map_server::store::DEFAULT_LIMITS;
+use roam_world::scenario::{self, Scenario};
+use roam_world::DEFAULT_MAX_CELLS;
 use serde::Serialize;
 
 use crate::verdict::Comparison;
@@ -31,11 +31,7 @@ pub struct Sizes {
 }
 
 fn shipped(name: &str, text: &str) -> anyhow::Result<Scenario> {
-    Ok(scenario::parse(
-        Path::new(name),
-        text,
-        DEFAULT_LIMITS.max_layer_cells,
-    )?)
+    Ok(scenario::parse(Path::new(name), text, DEFAULT_MAX_CELLS)?)
 }
 
 /// What `roam reproduce apf` prints: the reproduction (its keys at the top level of the

@@ -26,11 +26,11 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use roam_map_server::map_file;
-use roam_map_server::render::{draw_marker, draw_path, render_map, MARKER, PATH};
-use roam_map_server::store::DEFAULT_LIMITS;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
+use roam_world::render::{draw_marker, draw_path, render_map, MARKER, PATH};
+use roam_world::DEFAULT_MAX_CELLS;
 use serde::Serialize;
 
 use crate::bench::BenchError;
@@ -242,8 +242,8 @@ fn draw(
     out_dir: &Path,
     prefix: &str,
 ) -> Result<Vec<PathBuf>, BenchError> {
-    let content = map_file::builtin(DEFAULT_LIMITS.max_layer_cells)
-        .map_err(|e| BenchError::Setup(e.to_string()))?;
+    let content =
+        map_file::builtin(DEFAULT_MAX_CELLS).map_err(|e| BenchError::Setup(e.to_string()))?;
     let info = content.information.as_ref();
     std::fs::create_dir_all(out_dir)
         .map_err(|e| BenchError::Setup(format!("{}: {e}", out_dir.display())))?;

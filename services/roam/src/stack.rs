@@ -72,7 +72,7 @@ pub enum StackError {
     #[error("watching liveliness failed: {0}")]
     Liveliness(String),
     #[error("the stack's world cannot be read: {0}")]
-    World(#[from] roam_map_server::scenario::ScenarioError),
+    World(#[from] roam_world::scenario::ScenarioError),
 }
 
 type ServiceTasks = JoinSet<(&'static str, Result<(), String>)>;
@@ -116,7 +116,7 @@ impl Stack {
         let client = SessionArgs::client_of(&router.endpoint);
         let mut services = JoinSet::new();
 
-        let (_, world) = roam_sim::service::load_scenario(options.map.as_deref())?;
+        let (_, world) = roam_world::scenario::load_or_builtin(options.map.as_deref())?;
         let map_config = MapServerConfig {
             root: root.clone(),
             map: options.map.clone(),

@@ -121,10 +121,7 @@ fn stack_once_fetches_every_layer_and_draws_the_world() {
         );
     }
     assert!(
-        count_colour(
-            &out.path().join("world.png"),
-            roam_map_server::render::PATH.0
-        ) > 100,
+        count_colour(&out.path().join("world.png"), roam_world::render::PATH.0) > 100,
         "planned paths drawn"
     );
 
@@ -283,7 +280,7 @@ fn roam_plan_asks_a_running_stack_and_draws_the_path() {
     assert_eq!(plan["reaches_goal"], true);
     assert_eq!(plan["within_budget"], true);
     assert!(
-        count_colour(&png, roam_map_server::render::PATH.0) > 50,
+        count_colour(&png, roam_world::render::PATH.0) > 50,
         "the path is drawn"
     );
 
@@ -426,9 +423,5 @@ fn every_shipped_scenario_renders_and_es1_shows_anchor_wall_and_robot() {
     };
     assert_eq!(px(4.0, 44.0), roam_sim::render::ANCHOR, "anchor a1");
     assert_eq!(px(10.0, 16.0), roam_sim::render::ROBOT, "the robot at A");
-    assert_eq!(
-        px(0.1, 25.0),
-        roam_map_server::render::OCCUPIED,
-        "the west wall"
-    );
+    assert_eq!(px(0.1, 25.0), roam_world::render::OCCUPIED, "the west wall");
 }

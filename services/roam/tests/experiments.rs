@@ -85,11 +85,11 @@ fn reproduce_planner_prints_every_row_and_draws_each_model() {
     for model in ["model0", "model1", "model2"] {
         let png = out.path().join(format!("{model}.png"));
         assert!(
-            count_colour(&png, roam_map_server::render::PATH.0) > 50,
+            count_colour(&png, roam_world::render::PATH.0) > 50,
             "{model}: the path is drawn"
         );
         assert!(
-            count_colour(&png, roam_map_server::render::MARKER.0) > 50,
+            count_colour(&png, roam_world::render::MARKER.0) > 50,
             "{model}: start and goal marked"
         );
     }

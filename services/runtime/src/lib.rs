@@ -12,7 +12,8 @@
 //! - [`warn_limit`]: warnings about wire data, a few lines per source and a count;
 //! - [`publish`]: put with the congestion control named at each call, failures logged;
 //! - [`lock`]: shared state under a mutex, usable after a panicked holder;
-//! - [`liveliness`]: waiting until a service's token is seen.
+//! - [`liveliness`]: waiting until a service's token is seen;
+//! - [`world_check`]: a service's check that its world is the map server's.
 
 pub mod client;
 pub mod config_file;
@@ -26,6 +27,7 @@ pub mod session;
 pub mod signals;
 pub mod telemetry;
 pub mod warn_limit;
+pub mod world_check;
 
 pub use client::{ClientError, Requester};
 pub use liveliness::{wait_for_liveliness, LivelinessWait};

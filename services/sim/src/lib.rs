@@ -1,12 +1,13 @@
 //! roam's sim world: the world every other service is tested and demonstrated against.
 //!
 //! Plain Rust, no network and no async: a [`Sim`] is built from a scenario
-//! (`roam_map_server::scenario`) and a seed, and stepped explicitly with motion commands;
+//! (`roam_world::scenario`) and a seed, and stepped explicitly with motion commands;
 //! each [`Sim::step`] returns what every robot did and sensed. The Zenoh service, the
 //! CLI, the benchmark and the render are thin layers over this API.
 //!
-//! - [`noise`]: the seeded streams, a Gaussian sampler, paper 002's TOA noise
-//!   (σ² up to d0, σ²((d/d0)^K + 1) beyond) and transition noise.
+//! - `roam_world::noise` (shared with localization and the experiments): the seeded
+//!   streams, a Gaussian sampler, paper 002's TOA noise (σ² up to d0, σ²((d/d0)^K + 1)
+//!   beyond) and transition noise.
 //! - [`world`]: the static grid, anchors, scripted blocks (paper 004), random walkers,
 //!   the dynamic occupancy.
 //! - [`robot`]: a robot and paper 002's motion model (Eq. 1) with a top speed and
@@ -22,14 +23,13 @@
 //!
 //! Where papers 002 and 004 are ambiguous, the choice is written next to the code that
 //! makes it and is a parameter of the scenario file: the exponent K and the step at d0
-//! ([`noise::ToaNoise`]), the range gate ([`sensors::ranges`]), how blocks move
+//! (`roam_world::noise::ToaNoise`), the range gate ([`sensors::ranges`]), how blocks move
 //! ([`world::Block`]), the observation radius (`sensing.observation_radius_m`), the
 //! top speed and the sim time per step (`motion`, `time`).
 
 pub mod event;
 pub mod los;
 pub mod messages;
-pub mod noise;
 pub mod raster;
 pub mod render;
 pub mod robot;

@@ -3,7 +3,7 @@
 //! robots.
 
 use image::{Rgb, RgbImage};
-use roam_map_server::render::{render_map, OCCUPIED};
+use roam_world::render::{render_map, OCCUPIED};
 
 use crate::sim::Sim;
 

@@ -3,13 +3,13 @@
 //! unicycle's rule is in [`crate::unicycle`]; both end in the same collision walk.
 
 use rand_chacha::ChaCha8Rng;
-use roam_map_server::scenario::MotionSpec;
+use roam_world::scenario::MotionSpec;
 use serde::Serialize;
 
 use crate::event::Event;
-use crate::noise;
 use crate::raster;
 use crate::world::World;
+use roam_world::noise;
 
 /// How far (in cells) a clipped move stops short of the cell it would have entered:
 /// enough that rounding never puts the stopping point inside that cell.

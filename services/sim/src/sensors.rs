@@ -1,12 +1,12 @@
 //! A robot's TOA range sensor (paper 002 §2.1) and what its readings look like.
 
 use rand::RngCore;
-use roam_map_server::scenario::{RangeGate, SensingSpec};
+use roam_world::scenario::{RangeGate, SensingSpec};
 use serde::Serialize;
 
 use crate::los::Observation;
-use crate::noise::ToaNoise;
 use crate::world::Anchor;
+use roam_world::noise::ToaNoise;
 
 /// One TOA range: `d̂ = d + n` to one anchor.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -19,15 +19,14 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
-use roam_map_server::load_dirs::{Access, LoadDirs};
-use roam_map_server::map_file::{BUILTIN_NAME, BUILTIN_SCENARIO};
-use roam_map_server::scenario::{self, Scenario, ScenarioError};
-use roam_map_server::store::DEFAULT_LIMITS;
-use roam_map_server::world_check::{self, WorldMismatch};
 use roam_proto::sim::{RobotCommand, SimClock, SimControl, SimStatus};
 use roam_proto::{decode, keys, ErrorCode, ErrorReply, Message};
 use roam_runtime::warn_limit::WarnLimiter;
+use roam_runtime::world_check::{self, WorldMismatch};
 use roam_runtime::{reply, Service, ServiceError};
+use roam_world::load_dirs::{Access, LoadDirs};
+use roam_world::scenario::{self, ScenarioError};
+use roam_world::DEFAULT_MAX_CELLS;
 use serde::Deserialize;
 use tokio::time::Instant;
 use tokio_util::sync::CancellationToken;
@@ -77,7 +76,7 @@ pub struct SimConfig {
     /// it is of the same scenario and seed. Absent: a restart begins at step 0.
     pub state_file: Option<PathBuf>,
     /// The directories a control `load` may read scenarios from (names relative to
-    /// them; see `roam_map_server::load_dirs`). Empty: loads from the wire are off.
+    /// them; see `roam_world::load_dirs`). Empty: loads from the wire are off.
     pub load_dirs: Vec<PathBuf>,
     pub zenoh: Option<serde_json::Value>,
 }
@@ -164,19 +163,6 @@ impl State {
     }
 }
 
-/// Reads a scenario file (or a ROS map as a scenario of the map alone), or the built-in
-/// world.
-pub fn load_scenario(path: Option<&Path>) -> Result<(String, Scenario), ScenarioError> {
-    let max = DEFAULT_LIMITS.max_layer_cells;
-    match path {
-        Some(p) => Ok((p.display().to_string(), scenario::load_any(p, max)?)),
-        None => Ok((
-            BUILTIN_NAME.to_owned(),
-            scenario::parse(Path::new(BUILTIN_NAME), BUILTIN_SCENARIO, max)?,
-        )),
-    }
-}
-
 fn check_rate(rate: f64) -> Result<(), ErrorReply> {
     if rate == 0.0 || (rate.is_finite() && (MIN_RATE..=MAX_RATE).contains(&rate)) {
         Ok(())
@@ -210,7 +196,7 @@ pub async fn run(
     }
     let load_dirs =
         LoadDirs::new(&config.load_dirs).map_err(|e| SimServiceError::Config(e.to_string()))?;
-    let (name, scenario) = load_scenario(config.scenario.as_deref())?;
+    let (name, scenario) = scenario::load_or_builtin(config.scenario.as_deref())?;
     let mut sim = Sim::new(&scenario, config.seed)?;
     if let Some(path) = &config.state_file {
         resume_from(&mut sim, &name, config.seed, path)?;
@@ -223,7 +209,7 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world_guard = world_check::guard(&service, roam_map_server::world::of_scenario(&scenario));
+    let world_guard = world_check::guard(&service, roam_world::world_id::of_scenario(&scenario));
     let state = Arc::new(State {
         root: config.root.clone(),
         session: service.session().clone(),
@@ -483,7 +469,7 @@ fn scenario_error(e: &ScenarioError) -> ErrorReply {
     match e {
         ScenarioError::Refused(refused)
         | ScenarioError::Map {
-            source: roam_map_server::ros_map::RosMapError::Refused(refused),
+            source: roam_world::ros_map::RosMapError::Refused(refused),
             ..
         } => refused.to_reply(),
         ScenarioError::Missing { .. } => ErrorReply::new(ErrorCode::NotFound, message),
@@ -513,12 +499,8 @@ async fn control(state: &Arc<State>, request: SimControl) -> Result<(), ErrorRep
             let dirs = state.load_dirs.clone();
             let loaded = tokio::task::spawn_blocking(move || {
                 let file = dirs.resolve(&path).map_err(|e| e.to_reply())?;
-                let scenario = scenario::load_with(
-                    &file,
-                    DEFAULT_LIMITS.max_layer_cells,
-                    Access::Within(&dirs),
-                )
-                .map_err(|e| scenario_error(&e))?;
+                let scenario = scenario::load_with(&file, DEFAULT_MAX_CELLS, Access::Within(&dirs))
+                    .map_err(|e| scenario_error(&e))?;
                 let name = file.display().to_string();
                 let sim = Sim::new(&scenario, seed).map_err(|e| sim_error(&e))?;
                 Ok::<_, ErrorReply>((name, sim))

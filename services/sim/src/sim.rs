@@ -3,19 +3,19 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use roam_map_server::scenario::{
+use roam_world::scenario::{
     MotionModel, MotionSpec, Scenario, ScenarioFile, SensingSpec, TimeSpec,
 };
 use serde::Serialize;
 
 use crate::event::Event;
 use crate::los::LosTable;
-use crate::noise;
 use crate::robot::{step_motion, Resumed, Robot};
 use crate::sensors::{self, Readings};
 use crate::snapshot::{RobotState, SimSnapshot};
 use crate::unicycle::Unicycle;
 use crate::world::{Anchor, Obstacle, World, WorldError};
+use roam_world::noise;
 
 /// The most robots one sim holds (limit `max_robots`): each costs a stream, a report
 /// per step and its sensing, so a client cannot grow the sim without bound.
@@ -45,7 +45,7 @@ impl SimParams {
 
     /// Checks every field as a scenario file's are checked; `resolution` is the map's.
     pub fn check(&self, resolution: f64) -> Result<(), SimError> {
-        let param = |i: roam_map_server::scenario::FieldIssue| SimError::Param {
+        let param = |i: roam_world::scenario::FieldIssue| SimError::Param {
             field: i.field,
             reason: i.reason,
         };
@@ -426,7 +426,7 @@ impl Sim {
     }
 
     /// The occupancy now: the static map with every block and walker on it.
-    pub fn occupancy(&self) -> roam_map_server::grid::Grid<i8> {
+    pub fn occupancy(&self) -> roam_world::grid::Grid<i8> {
         self.world.occupancy(&self.scenario.occupancy)
     }
 

@@ -16,7 +16,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use roam_map_server::ros_map::read_bounded;
+use roam_world::ros_map::read_bounded;
 use serde::{Deserialize, Serialize};
 
 /// The latest step a snapshot may hold: a resume replays the world to it (blocks and

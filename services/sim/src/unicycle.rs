@@ -34,7 +34,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use roam_map_server::scenario::{MotionSpec, TimeSpec, UnicycleSpec};
+use roam_world::scenario::{MotionSpec, TimeSpec, UnicycleSpec};
 
 use crate::event::Event;
 use crate::robot::{translate, Moved};

@@ -2,13 +2,13 @@
 //! the random walkers, and the dynamic occupancy they make together at each step.
 
 use rand_chacha::ChaCha8Rng;
-use roam_map_server::grid::{cell_center, occupancy, world_to_cell, Grid};
-use roam_map_server::scenario::{is_blocked, BlockSpec, Place, Scenario, WalkerSpec};
 use roam_proto::map::GridMeta;
+use roam_world::grid::{cell_center, occupancy, world_to_cell, Grid};
+use roam_world::scenario::{is_blocked, BlockSpec, Place, Scenario, WalkerSpec};
 use serde::Serialize;
 
-use crate::noise;
 use crate::raster::CellXy;
+use roam_world::noise;
 
 /// An anchor (paper 002 §2): a beacon at a known position, world metres.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -3,9 +3,9 @@
 
 mod common;
 
-use roam_map_server::scenario::SensingSpec;
-use roam_sim::noise::{self, ToaNoise};
 use roam_sim::Sim;
+use roam_world::noise::{self, ToaNoise};
+use roam_world::scenario::SensingSpec;
 
 /// Sample mean and unbiased sample variance.
 fn mean_var(xs: &[f64]) -> (f64, f64) {

@@ -5,8 +5,8 @@ mod common;
 
 use std::collections::VecDeque;
 
-use roam_map_server::scenario::Place;
 use roam_sim::Sim;
+use roam_world::scenario::Place;
 
 /// How many anchors are within the sensing range of a point.
 fn coverage(sim: &Sim, [x, y]: [f64; 2]) -> usize {

@@ -5,10 +5,10 @@ mod common;
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use roam_map_server::scenario::{MotionModel, UnicycleSpec};
 use roam_sim::snapshot;
 use roam_sim::unicycle::wrap;
 use roam_sim::{Command, Event, Sim, SimError, SimParams};
+use roam_world::scenario::{MotionModel, UnicycleSpec};
 
 /// Every robot's position and heading after one step.
 type Track = (Vec<[f64; 2]>, Vec<Option<f64>>);

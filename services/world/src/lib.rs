@@ -1,8 +1,29 @@
-//! What every roam service and experiment shares about the world, and builds without
-//! Zenoh or tokio (an estimator on a robot, an experiment in batch):
+//! What every roam service and experiment shares about the world, built without Zenoh
+//! or tokio, so that an estimator on a robot or an experiment in batch pulls in no
+//! network stack:
 //!
-//! - [`seed`]: the seeded random streams behind every random choice, so that the same
-//!   seed gives the same answer bit for bit in the sim, the mapper's explorer and the
-//!   experiments.
+//! - [`grid`]: a grid with its placement in the world; [`distance`]: the exact
+//!   Euclidean distance transform; [`layers`]: the inflated and heuristic layers made
+//!   from an occupancy grid; [`render`]: grids and paths drawn to PNG.
+//! - [`scenario`]: roam's scenario file (the map, zones of interest, places and the sim
+//!   world's sections), its checks and loader, and the built-in world;
+//!   [`ros_map`]: ROS `map_server` maps as Nav2 reads and writes them;
+//!   [`load_dirs`]: which directories a load request from the wire may read.
+//! - [`world_id`]: which world a map is (one stack runs one world).
+//! - [`seed`]: the seeded random streams behind every random choice; [`noise`]: the
+//!   Gaussian sampler and paper 002's TOA and transition noise drawn from them.
 
+pub mod distance;
+pub mod grid;
+pub mod layers;
+pub mod load_dirs;
+pub mod noise;
+pub mod render;
+pub mod ros_map;
+pub mod scenario;
 pub mod seed;
+pub mod world_id;
+
+pub use grid::{Grid, DEFAULT_MAX_CELLS};
+pub use noise::ToaNoise;
+pub use scenario::{Scenario, ScenarioError};

@@ -37,7 +37,16 @@ pub fn labelled(base: u64, label: &str) -> u64 {
 
 /// 64-bit FNV-1a: a stable hash of bytes.
 pub fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+    fnv1a_extend(FNV1A_OFFSET, bytes)
+}
+
+/// FNV-1a's starting value: `fnv1a_extend(FNV1A_OFFSET, b)` is `fnv1a(b)`.
+pub const FNV1A_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+/// FNV-1a of what `hash` covered followed by `bytes`: hashes a concatenation piece by
+/// piece, without building it.
+pub fn fnv1a_extend(hash: u64, bytes: &[u8]) -> u64 {
+    bytes.iter().fold(hash, |h, &b| {
         (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
     })
 }

@@ -16,7 +16,7 @@
 //!
 //! ES1 runs twice, with roam's PEB guard on and off on the same seeds ([`super`]).
 
-use roam_map_server::scenario::Scenario;
+use roam_world::scenario::Scenario;
 use serde::Serialize;
 
 use super::{

@@ -11,7 +11,7 @@
 //! every point (common random numbers, see [`super`]), so a curve over z_is, and the gap
 //! between two schemes' curves, shows their effect rather than the noise's.
 
-use roam_map_server::scenario::Scenario;
+use roam_world::scenario::Scenario;
 use serde::Serialize;
 
 use super::{

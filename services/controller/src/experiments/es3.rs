@@ -25,8 +25,8 @@
 
 use rand_chacha::rand_core::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use roam_map_server::scenario::Scenario;
-use roam_sim::noise::uniform;
+use roam_world::noise::uniform;
+use roam_world::scenario::Scenario;
 use serde::Serialize;
 
 use super::{

@@ -48,7 +48,7 @@ pub mod paper;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-use roam_map_server::scenario::Scenario;
+use roam_world::scenario::Scenario;
 use serde::Serialize;
 
 use crate::episode::{Episode, EpisodeError, Setup};

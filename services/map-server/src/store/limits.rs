@@ -18,7 +18,7 @@ pub struct Limits {
 }
 
 pub const DEFAULT_LIMITS: Limits = Limits {
-    max_layer_cells: 16_777_216,
+    max_layer_cells: roam_world::DEFAULT_MAX_CELLS,
     max_cells_per_update: 100_000,
     max_request_bytes: 96 * 1024 * 1024,
     max_layers: 64,

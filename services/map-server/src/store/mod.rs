@@ -36,15 +36,15 @@ pub use limits::{DerivedParams, Limits, DEFAULT_LIMITS};
 
 use crate::derived::Derivation;
 use crate::edits::CellEdits;
-use crate::grid::Grid;
 use crate::persist::{DataDir, Tombstone, MAX_TOMBSTONES};
 use error::limit;
+use roam_world::grid::Grid;
 use stage::Pending;
 
-pub const OCCUPANCY: &str = "occupancy";
-pub const INFLATED: &str = "inflated";
-pub const INFORMATION: &str = "information";
-pub const HEURISTIC: &str = "heuristic";
+pub use roam_proto::map::{
+    HEURISTIC_LAYER as HEURISTIC, INFLATED_LAYER as INFLATED, INFORMATION_LAYER as INFORMATION,
+    OCCUPANCY_LAYER as OCCUPANCY,
+};
 
 /// The layers every stack needs, which cannot be deleted.
 pub const BASE_LAYERS: [&str; 4] = [OCCUPANCY, INFORMATION, INFLATED, HEURISTIC];

@@ -28,7 +28,7 @@ use super::{
     derived_source, remember, LayerStore, StoreError, HEURISTIC, INFLATED, INFORMATION, OCCUPANCY,
 };
 use crate::derived::{Derivation, Recipe};
-use crate::grid::Grid;
+use roam_world::grid::Grid;
 
 /// What a restore found.
 #[derive(Debug, Clone, Default, PartialEq)]

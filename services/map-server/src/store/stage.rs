@@ -13,9 +13,9 @@ use roam_proto::map::{GridMeta, Layer};
 use super::{LayerStore, StoreError, HEURISTIC, INFLATED, INFORMATION, OCCUPANCY};
 use crate::derived::{self, Derivation};
 use crate::edits::CellEdits;
-use crate::grid::{occupancy, Grid};
-use crate::layers;
 use crate::persist::log::record_bytes;
+use roam_world::grid::{occupancy, Grid};
+use roam_world::layers;
 
 /// What a change does to one layer.
 #[derive(Debug)]

@@ -9,12 +9,12 @@ use roam_controller::stepper::Stepper;
 use roam_controller::PositionSource;
 use roam_localization::field::{peb_field, GridRegion};
 use roam_localization::{FimOptions, RangingModel};
-use roam_map_server::grid::Grid;
-use roam_map_server::layers::inflate;
-use roam_map_server::scenario::{self, Scenario};
-use roam_map_server::store::DEFAULT_LIMITS;
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
+use roam_world::grid::Grid;
+use roam_world::layers::inflate;
+use roam_world::scenario::{self, Scenario};
+use roam_world::DEFAULT_MAX_CELLS;
 
 use super::DaysError;
 use crate::tasks::{self, Task, DAY_SCENARIO};
@@ -55,12 +55,9 @@ impl DayWorld {
     /// The day of [`tasks::day`] in [`DAY_SCENARIO`].
     pub fn new() -> Result<DayWorld, DaysError> {
         let world = |e: &dyn std::fmt::Display| DaysError::World(e.to_string());
-        let scenario: Scenario = scenario::parse(
-            Path::new("day.yaml"),
-            DAY_SCENARIO,
-            DEFAULT_LIMITS.max_layer_cells,
-        )
-        .map_err(|e| world(&e))?;
+        let scenario: Scenario =
+            scenario::parse(Path::new("day.yaml"), DAY_SCENARIO, DEFAULT_MAX_CELLS)
+                .map_err(|e| world(&e))?;
         let robot = scenario
             .file
             .robots

@@ -1,17 +1,17 @@
 //! Worlds for the planner's tests.
 
-use roam_map_server::grid::Grid;
-use roam_map_server::layers::inflate;
 use roam_map_server::map_file;
-use roam_map_server::store::DEFAULT_LIMITS;
 use roam_planner::params::GaParams;
 use roam_planner::plan::{PlanOutcome, PlanSpec};
 use roam_planner::world::World;
+use roam_world::grid::Grid;
+use roam_world::layers::inflate;
+use roam_world::DEFAULT_MAX_CELLS;
 
 /// The built-in 20 × 20 m downtime world, inflated by its robot radius.
 #[allow(dead_code)]
 pub fn builtin_world() -> World {
-    let content = map_file::builtin(DEFAULT_LIMITS.max_layer_cells).expect("builtin");
+    let content = map_file::builtin(DEFAULT_MAX_CELLS).expect("builtin");
     let inflated = inflate(
         &content.occupancy,
         content.robot_radius_m.unwrap_or(0.2),
@@ -28,8 +28,7 @@ pub fn scenario_world(file: &str) -> World {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../config/scenarios")
         .join(file);
-    let scenario =
-        roam_map_server::scenario::load(&path, DEFAULT_LIMITS.max_layer_cells).expect("scenario");
+    let scenario = roam_world::scenario::load(&path, DEFAULT_MAX_CELLS).expect("scenario");
     let inflated = inflate(
         &scenario.occupancy,
         scenario.file.robot_radius_m.unwrap_or(0.2),

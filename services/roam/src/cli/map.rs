@@ -3,9 +3,9 @@
 use std::path::PathBuf;
 
 use clap::Subcommand;
-use roam_map_server::ros_map;
 use roam_proto::keys;
 use roam_proto::map::{LayerList, LoadMap};
+use roam_world::ros_map;
 
 use super::{connect, ClientArgs};
 
@@ -31,8 +31,7 @@ pub(crate) enum MapCommand {
 pub(crate) async fn map(command: MapCommand) -> anyhow::Result<()> {
     match command {
         MapCommand::Inspect { map, json } => {
-            let loaded =
-                ros_map::load(&map, roam_map_server::store::DEFAULT_LIMITS.max_layer_cells)?;
+            let loaded = ros_map::load(&map, roam_world::DEFAULT_MAX_CELLS)?;
             let counts = ros_map::count_cells(&loaded.grid);
             let meta = loaded.grid.meta;
             let value = serde_json::json!({

@@ -8,7 +8,7 @@ use clap::Args;
 use roam::report::{self, Mission};
 use roam::router::Router;
 use roam::stack::{Stack, StackOptions};
-use roam_map_server::{map_file, MapServerConfig};
+use roam_map_server::MapServerConfig;
 use roam_planner::PlannerConfig;
 use roam_runtime::{signals, Requester, SessionArgs};
 
@@ -104,17 +104,11 @@ pub(crate) async fn planner(args: PlannerArgs) -> anyhow::Result<()> {
 
 /// The missions of a scenario: from its `start` place to each other place.
 pub(crate) fn scenario_missions(map: Option<&std::path::Path>) -> Vec<Mission> {
-    let max = roam_map_server::store::DEFAULT_LIMITS.max_layer_cells;
     let parsed = match map {
-        None => roam_map_server::scenario::parse(
-            std::path::Path::new(map_file::BUILTIN_NAME),
-            map_file::BUILTIN_SCENARIO,
-            max,
-        )
-        .ok(),
-        Some(path) => roam_map_server::scenario::load(path, max).ok(),
+        None => roam_world::scenario::builtin(),
+        Some(path) => roam_world::scenario::load(path, roam_world::DEFAULT_MAX_CELLS),
     };
-    let Some(scenario) = parsed else {
+    let Ok(scenario) = parsed else {
         return Vec::new();
     };
     let places = &scenario.file.places;

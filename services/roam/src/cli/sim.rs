@@ -5,8 +5,9 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use roam_runtime::signals;
-use roam_sim::service::{load_scenario, SimConfig};
+use roam_sim::service::SimConfig;
 use roam_sim::Sim;
+use roam_world::scenario::load_or_builtin;
 
 use super::ServiceArgs;
 
@@ -92,7 +93,7 @@ async fn run(args: SimRunArgs) -> anyhow::Result<()> {
 }
 
 fn render(scenario: PathBuf, png: PathBuf, scale: Option<u32>) -> anyhow::Result<()> {
-    let (_, loaded) = load_scenario(Some(&scenario))?;
+    let (_, loaded) = load_or_builtin(Some(&scenario))?;
     let sim = Sim::new(&loaded, 0)?;
     let scale = scale.unwrap_or_else(|| roam_sim::render::auto_scale(&sim));
     roam_sim::render::render(&sim, scale)

@@ -4,12 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
-use roam_map_server::scenario::{self, Scenario};
-use roam_map_server::store::DEFAULT_LIMITS;
+use roam_world::scenario::{self, Scenario};
+use roam_world::DEFAULT_MAX_CELLS;
 
 /// Parses a scenario written in a test.
 pub fn inline(text: &str) -> Scenario {
-    scenario::parse(Path::new("test.yaml"), text, DEFAULT_LIMITS.max_layer_cells)
+    scenario::parse(Path::new("test.yaml"), text, DEFAULT_MAX_CELLS)
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -20,8 +20,7 @@ pub fn scenarios_dir() -> PathBuf {
 
 /// Loads a shipped scenario by file name.
 pub fn shipped(file: &str) -> Scenario {
-    scenario::load(&scenarios_dir().join(file), DEFAULT_LIMITS.max_layer_cells)
-        .unwrap_or_else(|e| panic!("{e}"))
+    scenario::load(&scenarios_dir().join(file), DEFAULT_MAX_CELLS).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// A 10 x 10 m room of 0.5 m cells with border walls and a wall at x = 5..5.9 (cells

@@ -7,22 +7,12 @@
 //! and cells (FNV-1a 64), with the scenario's name (or the map file's stem) to show to a
 //! person. Two services agree on the world when their hashes agree; the map server
 //! publishes its world in `<root>/map/layers`, refuses updates made for another, and
-//! every other service compares its own at start ([`crate::world_check`]).
+//! every other service compares its own at start (`roam_runtime::world_check`).
 
 use roam_proto::map::{GridMeta, WorldId};
 
 use crate::grid::Grid;
-
-const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
-const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
-
-fn fnv(mut hash: u64, bytes: &[u8]) -> u64 {
-    for &b in bytes {
-        hash ^= u64::from(b);
-        hash = hash.wrapping_mul(FNV_PRIME);
-    }
-    hash
-}
+use crate::seed::{fnv1a_extend, FNV1A_OFFSET};
 
 fn meta_bytes(meta: &GridMeta) -> Vec<u8> {
     let mut out = Vec::with_capacity(48);
@@ -41,10 +31,10 @@ fn meta_bytes(meta: &GridMeta) -> Vec<u8> {
 
 /// The id of the world whose occupancy grid is `occupancy`, shown as `name`.
 pub fn world_id(name: &str, occupancy: &Grid<i8>) -> WorldId {
-    let mut hash = fnv(FNV_OFFSET, &meta_bytes(&occupancy.meta));
+    let mut hash = fnv1a_extend(FNV1A_OFFSET, &meta_bytes(&occupancy.meta));
     // i8 cells as their bytes: the grid's own representation, whatever the platform.
     let cells: Vec<u8> = occupancy.cells.iter().map(|&c| c as u8).collect();
-    hash = fnv(hash, &cells);
+    hash = fnv1a_extend(hash, &cells);
     WorldId {
         name: roam_proto::excerpt(name).to_string(),
         hash: format!("{hash:016x}"),

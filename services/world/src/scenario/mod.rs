@@ -50,7 +50,7 @@ use std::path::{Path, PathBuf};
 use roam_proto::excerpt::file_parse_reason;
 use serde::Deserialize;
 
-use crate::grid::Grid;
+use crate::grid::{Grid, DEFAULT_MAX_CELLS};
 use crate::load_dirs::{Access, LoadRefused};
 use crate::ros_map::{self, RosMapError};
 
@@ -231,6 +231,28 @@ pub enum ScenarioError {
     Map { path: PathBuf, source: RosMapError },
     #[error(transparent)]
     Refused(#[from] LoadRefused),
+}
+
+/// The embedded default world: a paper-000-like 20 × 20 m downtime world
+/// (`config/scenarios/downtime.yaml`), used wherever no map or scenario is given.
+pub const BUILTIN: &str = include_str!("../../../../config/scenarios/downtime.yaml");
+
+/// The name the built-in world goes by in messages.
+pub const BUILTIN_NAME: &str = "<built-in downtime world>";
+
+/// The built-in world, parsed.
+pub fn builtin() -> Result<Scenario, ScenarioError> {
+    parse(Path::new(BUILTIN_NAME), BUILTIN, DEFAULT_MAX_CELLS)
+}
+
+/// The world every service of a stack is given: the scenario at `path` (or a ROS map,
+/// as a scenario of the map alone), or the built-in world without one; with the name
+/// to show it by. Grids are bounded by [`DEFAULT_MAX_CELLS`], the map server's default.
+pub fn load_or_builtin(path: Option<&Path>) -> Result<(String, Scenario), ScenarioError> {
+    match path {
+        Some(p) => Ok((p.display().to_string(), load_any(p, DEFAULT_MAX_CELLS)?)),
+        None => Ok((BUILTIN_NAME.to_owned(), builtin()?)),
+    }
 }
 
 /// Reads a scenario file and builds its grids.

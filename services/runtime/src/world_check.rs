@@ -10,9 +10,9 @@
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+use crate::{Requester, Service};
 use roam_proto::keys;
 use roam_proto::map::{LayerList, WorldId};
-use roam_runtime::{Requester, Service};
 
 /// How long one ask waits for the map server, and how long between asks.
 const ASK_EVERY: Duration = Duration::from_secs(1);
@@ -35,7 +35,7 @@ pub struct WorldGuard {
 impl WorldGuard {
     /// `Err` when the map server's world turned out to be another.
     pub fn outcome(&self) -> Result<(), WorldMismatch> {
-        match roam_runtime::lock(&self.mismatch).clone() {
+        match crate::lock(&self.mismatch).clone() {
             Some(mismatch) => Err(mismatch),
             None => Ok(()),
         }
@@ -65,7 +65,7 @@ pub fn guard(service: &Service, mine: WorldId) -> WorldGuard {
                             map_server: theirs,
                         };
                         tracing::error!("{mismatch}");
-                        *roam_runtime::lock(&found) = Some(mismatch);
+                        *crate::lock(&found) = Some(mismatch);
                         cancel.cancel();
                     }
                     Some(_) => tracing::debug!(service = name, "on the map server's world"),

@@ -1,14 +1,14 @@
 //! Every random number the sim draws: the seeded streams, a Gaussian sampler, and paper
 //! 002's two noise models (TOA ranging, §2.1; transition noise, Eq. 1).
 
+use crate::scenario::SensingSpec;
 use rand::RngCore;
-use roam_map_server::scenario::SensingSpec;
 
 /// A ChaCha8 stream for one consumer (`"world"`, `"robot/<name>"`) of a sim seeded with
-/// `seed` ([`roam_world::seed::stream`]): each consumer draws only from its own stream,
+/// `seed` ([`crate::seed::stream`]): each consumer draws only from its own stream,
 /// so adding a robot, or a robot taking a different path, never changes what another
 /// robot or the world draws.
-pub use roam_world::seed::stream;
+pub use crate::seed::stream;
 
 /// A uniform number in [0, 1) with 53 random bits.
 pub fn uniform(rng: &mut impl RngCore) -> f64 {

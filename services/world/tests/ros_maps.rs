@@ -2,15 +2,15 @@
 
 use std::path::{Path, PathBuf};
 
-use roam_map_server::grid::occupancy;
-use roam_map_server::ros_map::{self, count_cells, CellCounts, MapMode, RosMapError, SaveParams};
-use roam_map_server::store::DEFAULT_LIMITS;
+use roam_world::grid::occupancy;
+use roam_world::grid::DEFAULT_MAX_CELLS;
+use roam_world::ros_map::{self, count_cells, CellCounts, MapMode, RosMapError, SaveParams};
 
 fn maps_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/maps")
 }
 
-const MAX: u64 = DEFAULT_LIMITS.max_layer_cells;
+const MAX: u64 = DEFAULT_MAX_CELLS;
 
 /// The expected counts were computed outside roam, by a short Python script that reads
 /// the PGM bytes, histograms the pixel values and applies Nav2's trinary rule
@@ -165,10 +165,10 @@ fn a_fifo_is_refused_not_read() {
         .expect("mkfifo");
     assert!(made.success());
     let started = std::time::Instant::now();
-    let err = roam_map_server::map_file::read(&fifo, 1 << 22).expect_err("refused");
+    let err = roam_world::scenario::load_any(&fifo, 1 << 22).expect_err("refused");
     assert!(started.elapsed() < std::time::Duration::from_secs(2));
     assert!(err.to_string().contains("not a regular file"), "{err}");
-    let err = roam_map_server::ros_map::read_bounded(std::path::Path::new("/dev/zero"))
-        .expect_err("a device");
+    let err =
+        roam_world::ros_map::read_bounded(std::path::Path::new("/dev/zero")).expect_err("a device");
     assert!(err.to_string().contains("not a regular file"), "{err}");
 }

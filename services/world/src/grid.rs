@@ -3,6 +3,11 @@
 
 use roam_proto::map::GridMeta;
 
+/// Cells in one grid unless a service is configured otherwise: 16,777,216 = 4096², a
+/// 1 km² site at 0.25 m (the map server's `max_layer_cells`). Every scenario or map a
+/// service reads is bounded by it before its cells are allocated.
+pub const DEFAULT_MAX_CELLS: u64 = 16_777_216;
+
 /// A grid of `T` with its placement in the world.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Grid<T> {
