@@ -43,7 +43,7 @@ pub struct DayResult {
 }
 
 /// A window's plans made ahead, while the robot did the previous task.
-pub(super) struct Preplanned {
+pub(super) struct PlannedAhead {
     pub window: usize,
     pub from: [f64; 2],
     pub shortest: Planned,
@@ -66,7 +66,7 @@ pub(super) struct DayRun<'a> {
     pub margin: ArrivalMargin,
     pub plan_cost_s: f64,
     pub day_seed: u64,
-    pub preplanned: Option<Preplanned>,
+    pub planned_ahead: Option<PlannedAhead>,
     /// The whole day's true path.
     pub truth: Vec<[f64; 2]>,
 }
@@ -109,7 +109,7 @@ pub fn run_day(
         executive,
         plan_cost_s: options.plan_cost_s,
         day_seed: seed,
-        preplanned: None,
+        planned_ahead: None,
         truth: Vec::new(),
     };
     run.first_fix()?;

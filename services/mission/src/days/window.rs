@@ -13,7 +13,7 @@
 //! reply carried the shortest path: the same paths and the same GA seeds, and no
 //! request to save.
 
-use super::day::{DayRun, Preplanned};
+use super::day::{DayRun, PlannedAhead};
 use super::measure::{planned_path, Leg, TimeModelUse, Track, WindowResult};
 use super::DaysError;
 use crate::calibration::path_measure;
@@ -52,11 +52,11 @@ impl DayRun<'_> {
             track.truth.push(at);
         }
         let mut rank = 0;
-        let preplanned = self
-            .preplanned
+        let planned_ahead = self
+            .planned_ahead
             .take()
             .filter(|p| p.window == w && distance(p.from, from) <= PREPLAN_FROM_M);
-        let planned = match preplanned {
+        let planned = match planned_ahead {
             Some(p) => {
                 rank = p.ranks;
                 Some((p.shortest, p.plan, p.budget_s))
@@ -226,7 +226,7 @@ impl DayRun<'_> {
                 self.first_plans(Some(task.at), next, w + 1, &mut ranks, Some(leave_at), None)?;
             if let Some((shortest, plan, budget_s)) = plans {
                 if self.robot.now_s() <= leave_at {
-                    self.preplanned = Some(Preplanned {
+                    self.planned_ahead = Some(PlannedAhead {
                         window: w + 1,
                         from: task.at,
                         shortest,
