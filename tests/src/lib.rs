@@ -9,7 +9,6 @@ use std::future::IntoFuture;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
-use roam::router::Router;
 use roam_controller::service::ControllerConfig;
 use roam_localization::service::LocalizationConfig;
 use roam_map_server::MapServerConfig;
@@ -19,6 +18,8 @@ use roam_proto::keys;
 use roam_runtime::wait_for_liveliness;
 use roam_runtime::{Requester, SessionArgs};
 use roam_sim::service::SimConfig;
+use roam_stack::router::Router;
+use roam_stack::Role;
 use tokio::task::JoinHandle;
 use tokio_util::sync::CancellationToken;
 
@@ -228,15 +229,6 @@ impl Harness {
         }
     }
 
-    /// Starts a map server and waits until its liveliness token is seen.
-    pub async fn start_map_server(&self, config: MapServerConfig) -> RunningService {
-        let key = keys::liveliness_of(&self.root, roam_map_server::SERVICE_NAME);
-        self.start_service_as(roam_map_server::SERVICE_NAME, key, |zenoh, cancel| {
-            roam_map_server::run(config, zenoh, cancel)
-        })
-        .await
-    }
-
     /// A planner config under this harness's root with the given instance name.
     pub fn planner_config(&self, instance: &str) -> PlannerConfig {
         PlannerConfig {
@@ -244,17 +236,6 @@ impl Harness {
             instance: Some(instance.to_owned()),
             ..PlannerConfig::default()
         }
-    }
-
-    /// Starts a planner and waits for its own liveliness token (it announces itself
-    /// once it has a map, so start the map server first).
-    pub async fn start_planner(&self, config: PlannerConfig) -> RunningService {
-        let instance = config.instance.clone().unwrap_or_default();
-        let key = keys::liveliness(&self.root, roam_planner::SERVICE_NAME, &instance);
-        self.start_service_as(roam_planner::SERVICE_NAME, key, |zenoh, cancel| {
-            roam_planner::run(config, zenoh, cancel)
-        })
-        .await
     }
 
     /// A sim config under this harness's root: `scenario` (the built-in world when
@@ -270,29 +251,26 @@ impl Harness {
         }
     }
 
-    /// Starts the sim world and waits for its liveliness token.
-    pub async fn start_sim(&self, config: SimConfig) -> RunningService {
-        let key = keys::liveliness_of(&self.root, roam_sim::service::SERVICE_NAME);
-        self.start_service_as(roam_sim::service::SERVICE_NAME, key, |zenoh, cancel| {
-            roam_sim::service::run(config, zenoh, cancel)
-        })
-        .await
-    }
-
-    /// Starts the localization service on a scenario's sensing model and constellation.
-    pub async fn start_localization(&self, scenario: Option<&str>) -> RunningService {
-        let config = LocalizationConfig {
+    /// A localization config under this harness's root on a scenario's sensing model and
+    /// constellation (`scenario` relative to the repository; the built-in world when
+    /// `None`).
+    pub fn localization_config(&self, scenario: Option<&str>) -> LocalizationConfig {
+        LocalizationConfig {
             root: self.root.clone(),
             scenario: scenario.map(repo_path),
             ..LocalizationConfig::default()
-        };
-        let key = keys::liveliness_of(&self.root, roam_localization::service::SERVICE_NAME);
-        self.start_service_as(
-            roam_localization::service::SERVICE_NAME,
-            key,
-            |zenoh, cancel| roam_localization::service::run(config, zenoh, cancel),
-        )
-        .await
+        }
+    }
+
+    /// Starts a service of roam's role table ([`Role`]: a config of any service
+    /// converts into one) as itself ([`Harness::role_config`]), and waits for its
+    /// liveliness token: its instance's own when the config names one (a planner
+    /// announces itself once it has a map, so start the map server first).
+    pub async fn start_role(&self, role: impl Into<Role>) -> RunningService {
+        let role = role.into();
+        let (name, key) = (role.name(), role.live_key());
+        self.start_service_as(name, key, |zenoh, cancel| role.run(zenoh, cancel))
+            .await
     }
 
     /// A controller config under this harness's root (built-in world, paper defaults).
@@ -303,32 +281,12 @@ impl Harness {
         }
     }
 
-    /// Starts the APF controller and waits for its liveliness token.
-    pub async fn start_controller(&self, config: ControllerConfig) -> RunningService {
-        let key = keys::liveliness_of(&self.root, roam_controller::service::SERVICE_NAME);
-        self.start_service_as(
-            roam_controller::service::SERVICE_NAME,
-            key,
-            |zenoh, cancel| roam_controller::service::run(config, zenoh, cancel),
-        )
-        .await
-    }
-
     /// A mapper config under this harness's root (built-in world, drives no robot).
     pub fn mapper_config(&self) -> MapperConfig {
         MapperConfig {
             root: self.root.clone(),
             ..MapperConfig::default()
         }
-    }
-
-    /// Starts the change-rate mapper and waits for its liveliness token.
-    pub async fn start_mapper(&self, config: MapperConfig) -> RunningService {
-        let key = keys::liveliness_of(&self.root, roam_mapper::service::SERVICE_NAME);
-        self.start_service_as(roam_mapper::service::SERVICE_NAME, key, |zenoh, cancel| {
-            roam_mapper::service::run(config, zenoh, cancel)
-        })
-        .await
     }
 
     /// Whether any instance of `service` currently holds a liveliness token.

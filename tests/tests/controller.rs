@@ -5,10 +5,10 @@
 
 use std::time::{Duration, Instant};
 
-use roam_controller::episode::{run_episode, PositionSource, RobotMission, Setup};
 use roam_controller::params::{ApfParams, Follow};
 use roam_controller::service::ControllerConfig;
 use roam_controller::weights::Scheme;
+use roam_experiments::closed_loop::episode::{run_episode, PositionSource, RobotMission, Setup};
 use roam_proto::controller::{ControllerStatus, Mission, MissionState};
 use roam_proto::localization::PositionEstimate;
 use roam_proto::sim::{GroundTruth, RobotCommand, SimControl, SimStatus};
@@ -98,18 +98,21 @@ async fn an_es1_mission_through_zenoh_drives_the_batch_trajectory() {
         scheme: Scheme::Linear,
         ..ApfParams::default()
     };
-    let batch = roam_controller::episode::es1_mission(&repo_path(scenario), &params, SEED)
-        .expect("batch episode");
+    let batch =
+        roam_experiments::closed_loop::episode::es1_mission(&repo_path(scenario), &params, SEED)
+            .expect("batch episode");
     let expected = &batch.robots[0];
     assert!(expected.success, "the linear scheme reaches B in batch");
 
     let harness = Harness::start().await;
     let mut sim_config = harness.sim_config(Some(scenario));
     sim_config.seed = SEED;
-    let _sim = harness.start_sim(sim_config).await;
-    let _localization = harness.start_localization(Some(scenario)).await;
+    let _sim = harness.start_role(sim_config).await;
+    let _localization = harness
+        .start_role(harness.localization_config(Some(scenario)))
+        .await;
     let _controller = harness
-        .start_controller(ControllerConfig {
+        .start_role(ControllerConfig {
             scenario: Some(repo_path(scenario)),
             // Lock-step waits on this test, not on the clock: no stale halts.
             stale_after_s: 60.0,
@@ -172,11 +175,13 @@ async fn stale_estimates_halt_the_robot_within_the_configured_time() {
     let harness = Harness::start().await;
     let mut sim_config = harness.sim_config(Some(scenario));
     sim_config.rate = Some(10.0); // 25 steps per second
-    let _sim = harness.start_sim(sim_config).await;
-    let localization = harness.start_localization(Some(scenario)).await;
+    let _sim = harness.start_role(sim_config).await;
+    let localization = harness
+        .start_role(harness.localization_config(Some(scenario)))
+        .await;
     let stale_after_s = 0.5;
     let _controller = harness
-        .start_controller(ControllerConfig {
+        .start_role(ControllerConfig {
             scenario: Some(repo_path(scenario)),
             stale_after_s,
             ..harness.controller_config()
@@ -219,10 +224,12 @@ async fn a_local_minimum_is_reported_as_stuck() {
     let harness = Harness::start().await;
     let mut sim_config = harness.sim_config(Some(scenario));
     sim_config.rate = Some(0.0); // as fast as the services keep up
-    let _sim = harness.start_sim(sim_config).await;
-    let _localization = harness.start_localization(Some(scenario)).await;
+    let _sim = harness.start_role(sim_config).await;
+    let _localization = harness
+        .start_role(harness.localization_config(Some(scenario)))
+        .await;
     let _controller = harness
-        .start_controller(ControllerConfig {
+        .start_role(ControllerConfig {
             scenario: Some(repo_path(scenario)),
             stale_after_s: 5.0,
             apf: ApfParams {
@@ -265,15 +272,17 @@ async fn a_controller_on_board_one_robot_leaves_the_others_alone() {
     let harness = Harness::start().await;
     let mut sim_config = harness.sim_config(Some(scenario));
     sim_config.rate = Some(10.0);
-    let _sim = harness.start_sim(sim_config).await;
-    let _localization = harness.start_localization(Some(scenario)).await;
+    let _sim = harness.start_role(sim_config).await;
+    let _localization = harness
+        .start_role(harness.localization_config(Some(scenario)))
+        .await;
     let on_board = |robot: &str| ControllerConfig {
         scenario: Some(repo_path(scenario)),
         robots: vec![robot.to_owned()],
         instance: Some(format!("on-{robot}")),
         ..harness.controller_config()
     };
-    let other = harness.start_controller(on_board("other")).await;
+    let other = harness.start_role(on_board("other")).await;
     let client = harness.client().await;
     let root = harness.root.clone();
     let statuses = subscribe(&client, keys::robot_controller(&root, "robot")).await;
@@ -292,7 +301,7 @@ async fn a_controller_on_board_one_robot_leaves_the_others_alone() {
     );
     other.stop().await.1.expect("clean stop");
 
-    let _mine = harness.start_controller(on_board("robot")).await;
+    let _mine = harness.start_role(on_board("robot")).await;
     give_mission(&client, &root, "yours", [45.0, 45.0]).await;
     let status = status_until(&statuses, Duration::from_secs(10), |s| {
         s.state == MissionState::Active && s.steps >= 5
@@ -358,10 +367,10 @@ async fn a_detour_is_driven_as_planned_under_follow_path() {
     let harness = Harness::start().await;
     let mut sim_config = harness.sim_config(None);
     sim_config.seed = SEED;
-    let _sim = harness.start_sim(sim_config).await;
-    let _localization = harness.start_localization(None).await;
+    let _sim = harness.start_role(sim_config).await;
+    let _localization = harness.start_role(harness.localization_config(None)).await;
     let _controller = harness
-        .start_controller(ControllerConfig {
+        .start_role(ControllerConfig {
             // Lock-step waits on this test, not on the clock: no stale halts.
             stale_after_s: 60.0,
             apf: params.clone(),

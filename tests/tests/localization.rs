@@ -13,10 +13,10 @@ use roam_tests::{repo_path, within, Harness};
 async fn ranges_in_estimates_out_at_the_sim_rate() {
     let harness = Harness::start().await;
     let sim = harness
-        .start_sim(harness.sim_config(Some("config/scenarios/es1.yaml")))
+        .start_role(harness.sim_config(Some("config/scenarios/es1.yaml")))
         .await;
     let localization = harness
-        .start_localization(Some("config/scenarios/es1.yaml"))
+        .start_role(harness.localization_config(Some("config/scenarios/es1.yaml")))
         .await;
     let client = harness.client().await;
     let root = harness.root.clone();
@@ -87,13 +87,13 @@ async fn a_peb_field_on_es1_shows_the_well_covered_area() {
     let harness = Harness::start().await;
     // The map server on the same world as localization: a stack runs one world.
     let map_server = harness
-        .start_map_server(roam_map_server::MapServerConfig {
+        .start_role(roam_map_server::MapServerConfig {
             map: Some(repo_path("config/scenarios/es1.yaml")),
             ..harness.map_server_config()
         })
         .await;
     let localization = harness
-        .start_localization(Some("config/scenarios/es1.yaml"))
+        .start_role(harness.localization_config(Some("config/scenarios/es1.yaml")))
         .await;
     let client = harness.client().await;
     let root = harness.root.clone();

@@ -46,7 +46,7 @@ async fn refusal<T: roam_proto::Message + std::fmt::Debug>(
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_client_gets_every_layer_of_the_builtin_world() {
     let harness = Harness::start().await;
-    let server = harness.start_map_server(harness.map_server_config()).await;
+    let server = harness.start_role(harness.map_server_config()).await;
     let client = harness.client().await;
 
     let occupancy = get_layer(&client, &harness.root, "occupancy").await;
@@ -107,7 +107,7 @@ async fn a_client_gets_every_layer_of_the_builtin_world() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn an_update_is_published_and_a_stale_one_refused() {
     let harness = Harness::start().await;
-    let server = harness.start_map_server(harness.map_server_config()).await;
+    let server = harness.start_role(harness.map_server_config()).await;
     let client = harness.client().await;
     let subscriber = within(
         "subscribe",
@@ -183,7 +183,7 @@ async fn a_restarted_server_answers_with_the_same_versions_and_content() {
         data_dir: Some(data.path().to_owned()),
         ..harness.map_server_config()
     };
-    let server = harness.start_map_server(config.clone()).await;
+    let server = harness.start_role(config.clone()).await;
     let client = harness.client().await;
     let update_key = keys::map_update(&harness.root, "occupancy");
     within(
@@ -206,7 +206,7 @@ async fn a_restarted_server_answers_with_the_same_versions_and_content() {
         "the liveliness token is gone"
     );
 
-    let server = harness.start_map_server(config).await;
+    let server = harness.start_role(config).await;
     let after = get_layer(&client, &harness.root, "occupancy").await;
     assert_eq!(after.version, 3);
     assert_eq!(after, before);
@@ -229,7 +229,7 @@ async fn a_restarted_server_answers_with_the_same_versions_and_content() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn malformed_and_wrong_version_payloads_get_structured_errors() {
     let harness = Harness::start().await;
-    let server = harness.start_map_server(harness.map_server_config()).await;
+    let server = harness.start_role(harness.map_server_config()).await;
     let client = harness.client().await;
     let key = keys::map_update(&harness.root, "occupancy");
 
@@ -299,7 +299,7 @@ async fn oversize_updates_are_refused_naming_the_limit() {
         },
         ..harness.map_server_config()
     };
-    let server = harness.start_map_server(config).await;
+    let server = harness.start_role(config).await;
     let client = harness.client().await;
     let key = keys::map_update(&harness.root, "occupancy");
 
@@ -358,7 +358,7 @@ async fn loads_read_only_the_load_directories_and_name_what_is_wrong() {
     let dir = tempfile::tempdir().expect("tmp");
     let maps = concat!(env!("CARGO_MANIFEST_DIR"), "/../config/maps");
     let server = harness
-        .start_map_server(MapServerConfig {
+        .start_role(MapServerConfig {
             load_dirs: vec![dir.path().to_owned(), maps.into()],
             ..harness.map_server_config()
         })
@@ -433,7 +433,7 @@ async fn loads_read_only_the_load_directories_and_name_what_is_wrong() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn without_load_directories_loads_are_off() {
     let harness = Harness::start().await;
-    let server = harness.start_map_server(harness.map_server_config()).await;
+    let server = harness.start_role(harness.map_server_config()).await;
     let client = harness.client().await;
     let depot = concat!(env!("CARGO_MANIFEST_DIR"), "/../config/maps/depot.yaml");
     let off = refusal(client.request::<LoadMap, LayerList>(
@@ -463,7 +463,7 @@ async fn a_corrupt_persisted_layer_is_reported_and_the_last_good_copy_served() {
         load_dirs: vec![repo_path("config/maps")],
         ..harness.map_server_config()
     };
-    let server = harness.start_map_server(config.clone()).await;
+    let server = harness.start_role(config.clone()).await;
     let client = harness.client().await;
     let key = keys::map_update(&harness.root, "occupancy");
     within(
@@ -492,7 +492,7 @@ async fn a_corrupt_persisted_layer_is_reported_and_the_last_good_copy_served() {
     let bytes = std::fs::read(&file).expect("layer file");
     std::fs::write(&file, &bytes[..bytes.len() / 2]).expect("truncate");
 
-    let server = harness.start_map_server(config).await;
+    let server = harness.start_role(config).await;
     let list: LayerList = within(
         "index",
         client.request::<LayerList, LayerList>(&keys::map_index(&harness.root), None),
@@ -541,7 +541,7 @@ async fn inflated_always_matches_occupancy_after_a_kill_between_saves() {
         data_dir: Some(data.path().to_owned()),
         ..harness.map_server_config()
     };
-    let server = harness.start_map_server(config.clone()).await;
+    let server = harness.start_role(config.clone()).await;
     let client = harness.client().await;
     let key = keys::map_update(&harness.root, "occupancy");
     for (base, x) in [(1, 30), (2, 60)] {
@@ -581,7 +581,7 @@ async fn inflated_always_matches_occupancy_after_a_kill_between_saves() {
         .and_then(|mut f| std::io::Write::write_all(&mut f, &torn[..torn.len() / 2]))
         .expect("torn append");
 
-    let server = harness.start_map_server(config).await;
+    let server = harness.start_role(config).await;
     let occupancy = get_layer(&client, &harness.root, "occupancy").await;
     let inflated = get_layer(&client, &harness.root, "inflated").await;
     assert_eq!(occupancy.version, 3, "every acknowledged change, no more");
@@ -640,7 +640,7 @@ async fn inflated_always_matches_occupancy_after_a_kill_between_saves() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_free_layer_is_deleted_and_base_layers_are_refused() {
     let harness = Harness::start().await;
-    let server = harness.start_map_server(harness.map_server_config()).await;
+    let server = harness.start_role(harness.map_server_config()).await;
     let client = harness.client().await;
     let root = harness.root.as_str();
     let create = |base_version| LayerUpdate {
@@ -730,7 +730,7 @@ async fn a_free_layer_is_deleted_and_base_layers_are_refused() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_service_stops_within_two_seconds_and_drops_its_token() {
     let harness = Harness::start().await;
-    let server = harness.start_map_server(harness.map_server_config()).await;
+    let server = harness.start_role(harness.map_server_config()).await;
     assert!(harness.is_live(roam_map_server::SERVICE_NAME).await);
     let (took, outcome) = server.stop().await;
     outcome.expect("clean stop");

@@ -30,10 +30,10 @@ async fn sim_to_mapper_to_map_server_shows_where_the_blocks_move() {
     let harness = Harness::start().await;
     let mut map_config = harness.map_server_config();
     map_config.map = Some(repo_path(GRID004));
-    let _map_server = harness.start_map_server(map_config).await;
-    let _sim = harness.start_sim(harness.sim_config(Some(GRID004))).await;
+    let _map_server = harness.start_role(map_config).await;
+    let _sim = harness.start_role(harness.sim_config(Some(GRID004))).await;
     let _mapper = harness
-        .start_mapper(MapperConfig {
+        .start_role(MapperConfig {
             scenario: Some(repo_path(GRID004)),
             explore: vec!["robot".into()],
             publish_period_s: 0.2,
@@ -116,8 +116,9 @@ async fn sim_to_mapper_to_map_server_shows_where_the_blocks_move() {
         tokio::time::sleep(Duration::from_millis(100)).await;
     };
 
-    let scenario = roam_mapper::experiment::grid004().expect("grid004");
-    let truth = roam_mapper::truth::true_rates(&scenario, 1.0).expect("true rates");
+    let scenario = roam_experiments::reproduce::mapper::experiment::grid004().expect("grid004");
+    let truth =
+        roam_experiments::reproduce::mapper::truth::true_rates(&scenario, 1.0).expect("true rates");
     let changing: std::collections::BTreeSet<usize> = truth.changing.iter().copied().collect();
     let rates = f32_cells(&rate);
     let learned: Vec<usize> = (0..rates.len()).filter(|&i| rates[i] > 0.0).collect();
@@ -170,11 +171,11 @@ async fn sim_to_mapper_to_map_server_shows_where_the_blocks_move() {
     }
     let mut planner_config = harness.planner_config("curious-about-change");
     planner_config.information_layer = CHANGE_INFORMATION_LAYER.into();
-    let _planner = harness.start_planner(planner_config).await;
+    let _planner = harness.start_role(planner_config).await;
     // The change coupling: a planner on max(information, change_information).
     let mut coupled_config = harness.planner_config("coupled");
     coupled_config.change_layer = Some(CHANGE_INFORMATION_LAYER.into());
-    let _coupled = harness.start_planner(coupled_config).await;
+    let _coupled = harness.start_role(coupled_config).await;
     let plan_request = PlanRequest {
         request_id: None,
         cancel_token: None,
@@ -271,9 +272,9 @@ async fn step_until_merged(client: &roam_runtime::Requester, root: &str, than: u
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_forged_time_and_a_sim_reset_do_not_stop_the_mapper() {
     let harness = Harness::start().await;
-    let _sim = harness.start_sim(harness.sim_config(Some(GRID004))).await;
+    let _sim = harness.start_role(harness.sim_config(Some(GRID004))).await;
     let _mapper = harness
-        .start_mapper(MapperConfig {
+        .start_role(MapperConfig {
             scenario: Some(repo_path(GRID004)),
             ..harness.mapper_config()
         })

@@ -16,16 +16,16 @@ use roam_tests::{within, Harness};
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn the_demo_mission_is_on_time_and_more_curious_than_the_shortest_path() {
     let harness = Harness::start().await;
-    let _map_server = harness.start_map_server(harness.map_server_config()).await;
+    let _map_server = harness.start_role(harness.map_server_config()).await;
     let _planner = harness
-        .start_planner(harness.planner_config("planner-0"))
+        .start_role(harness.planner_config("planner-0"))
         .await;
     let mut sim_config = harness.sim_config(None);
     sim_config.rate = Some(10.0);
-    let _sim = harness.start_sim(sim_config).await;
-    let _localization = harness.start_localization(None).await;
+    let _sim = harness.start_role(sim_config).await;
+    let _localization = harness.start_role(harness.localization_config(None)).await;
     let _controller = harness
-        .start_controller(ControllerConfig {
+        .start_role(ControllerConfig {
             apf: roam::demo::indoor_apf(),
             ..harness.controller_config()
         })
@@ -39,28 +39,20 @@ async fn the_demo_mission_is_on_time_and_more_curious_than_the_shortest_path() {
     )
     .await
     .expect("subscriber");
-    let root = harness.root.clone();
-    let key = keys::liveliness_of(&root, roam_mission::service::SERVICE_NAME);
     let _mission = harness
-        .start_service(key, |zenoh, cancel| {
-            roam_mission::service::run(
-                MissionConfig {
-                    root,
-                    executive: ExecutiveConfig {
-                        // A pessimistic prior (a stale datasheet: the robot drives a
-                        // metre in 2 s, the executive believes 3 s), so the first
-                        // window's plan would arrive early: the slack rule must fire.
-                        time_model_prior: TimeModel {
-                            v_lin: 3.0,
-                            v_ang: 1.0,
-                        },
-                        ..ExecutiveConfig::default()
-                    },
-                    ..MissionConfig::default()
+        .start_role(MissionConfig {
+            root: harness.root.clone(),
+            executive: ExecutiveConfig {
+                // A pessimistic prior (a stale datasheet: the robot drives a metre in
+                // 2 s, the executive believes 3 s), so the first window's plan would
+                // arrive early: the slack rule must fire.
+                time_model_prior: TimeModel {
+                    v_lin: 3.0,
+                    v_ang: 1.0,
                 },
-                zenoh,
-                cancel,
-            )
+                ..ExecutiveConfig::default()
+            },
+            ..MissionConfig::default()
         })
         .await;
 

@@ -161,14 +161,14 @@ async fn boot_with(
     adjust: impl Fn(roam_planner::PlannerConfig) -> roam_planner::PlannerConfig,
 ) -> Running {
     let harness = Harness::start().await;
-    let map_server = harness.start_map_server(harness.map_server_config()).await;
+    let map_server = harness.start_role(harness.map_server_config()).await;
     let mut started = Vec::new();
     for (name, concurrent) in planners {
         let config = adjust(roam_planner::PlannerConfig {
             max_concurrent_plans: *concurrent,
             ..harness.planner_config(name)
         });
-        started.push(harness.start_planner(config).await);
+        started.push(harness.start_role(config).await);
     }
     Running {
         harness,

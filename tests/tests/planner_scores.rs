@@ -12,7 +12,7 @@ use roam_tests::{within, Harness};
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn scores_above_100_plan_as_if_clamped_to_100() {
     let harness = Harness::start().await;
-    let _server = harness.start_map_server(harness.map_server_config()).await;
+    let _server = harness.start_role(harness.map_server_config()).await;
     let client = harness.client().await;
     let root = harness.root.as_str();
     let information: Layer = within(
@@ -53,7 +53,7 @@ async fn scores_above_100_plan_as_if_clamped_to_100() {
     for name in ["bright", "bright_clamped"] {
         let mut config = harness.planner_config(name);
         config.information_layer = name.into();
-        services.push(harness.start_planner(config).await);
+        services.push(harness.start_role(config).await);
     }
     let request = PlanRequest {
         request_id: None,

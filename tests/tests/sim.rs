@@ -69,7 +69,7 @@ async fn command(client: &Requester, root: &str, robot: &str, u: [f64; 2]) {
 
 async fn boot() -> (Harness, RunningService, Requester) {
     let harness = Harness::start().await;
-    let sim = harness.start_sim(harness.sim_config(None)).await;
+    let sim = harness.start_role(harness.sim_config(None)).await;
     let client = harness.client().await;
     (harness, sim, client)
 }
@@ -268,7 +268,7 @@ async fn bad_requests_get_errors_that_name_what_to_fix() {
     let dir = tempfile::tempdir().expect("tmp");
     let mut config = harness.sim_config(None);
     config.load_dirs.push(dir.path().to_owned());
-    let sim = harness.start_sim(config).await;
+    let sim = harness.start_role(config).await;
     let client = harness.client().await;
     let root = harness.root.clone();
     let missing = refused(

@@ -5,12 +5,12 @@
 
 use std::time::Duration;
 
-use roam::stack::{Stack, StackOptions};
 use roam_localization::service::LocalizationConfig;
 use roam_proto::cells::Cells;
 use roam_proto::map::{LayerChange, LayerList, LayerUpdate, UpdateAck, WorldId};
 use roam_proto::{keys, ErrorCode};
 use roam_runtime::{ClientError, Requester};
+use roam_stack::stack::{Stack, StackOptions};
 use roam_tests::{repo_path, within, Harness};
 use tokio_util::sync::CancellationToken;
 
@@ -89,7 +89,7 @@ async fn a_stack_on_a_nav2_map_runs_every_service_on_that_map() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_service_given_another_world_refuses_it_naming_both() {
     let harness = Harness::start().await;
-    let server = harness.start_map_server(harness.map_server_config()).await;
+    let server = harness.start_role(harness.map_server_config()).await;
     // Localization on ES1's world, beside a map server on the built-in one.
     let config = LocalizationConfig {
         root: harness.root.clone(),

@@ -1,5 +1,5 @@
 //! roam's APF controller with adaptive information seeking (paper 002, Lite & Rinner,
-//! §3), and the reproduction of the paper's experiments (§4).
+//! §3). The reproduction of the paper's experiments (§4) is `roam_experiments`'s.
 //!
 //! Plain Rust over plain types: no Zenoh, no async. A [`Controller`] turns a robot's
 //! position (its localization estimate) and PEB into a motion command, paper 002 Eq. 3:
@@ -12,8 +12,9 @@
 //! carrot of pure pursuit on the mission's path: [`carrot`]), f_Tr Khatib's repulsion of the
 //! nearest obstacle, f_is the unit vector down the PEB's slope, and z_isa(ω) the
 //! information-seeking weight that adapts to the angle ω between f_a and f_is (Eq. 2).
-//! The Zenoh service ([`service`], a thin adapter) and the batch [`episode`] run the
-//! same controller, on estimates from the same [`roam_localization::Tracker`].
+//! The Zenoh service ([`service`], a thin adapter) and the batch closed loop
+//! (`roam_experiments::closed_loop`) run the same controller, on estimates from the same
+//! [`roam_localization::Tracker`].
 //!
 //! | module | what it holds |
 //! |---|---|
@@ -24,10 +25,6 @@
 //! | [`obstacle_field`] | η and the direction away from the nearest obstacle, from the exact EDT, built once per map |
 //! | [`information`] | the PEB field of the anchors and f_is = unit(−∇PEB) |
 //! | [`controller`] | the per-robot state machine (Idle, Active, Completed, Stuck, HaltedPeb, StepLimit) |
-//! | [`episode`] | one batch run: sim → ranges → localization ([`roam_localization::Tracker`]) → controller → sim |
-//! | [`stepper`] | the same run one step at a time, missions changed between steps (the mission executive's day runner) |
-//! | [`experiments`] | ES1, ES2, ES3, the paper's figures and the comparison table |
-//! | [`render`] | PNGs like the paper's Figs. 2 and 3 |
 //! | [`service`] | the Zenoh adapter: missions and estimates in, commands and status out |
 //!
 //! # Where paper 002 is ambiguous, and what roam chose
@@ -49,34 +46,28 @@
 //! - **f_Tr** ("cumulative") is Khatib's force of the nearest obstacle cell, from a
 //!   distance field measured to obstacle faces; off the map counts as an obstacle.
 //! - **The mission RMSE** with runs of different lengths: RMSE^k over the runs still
-//!   going at step k, averaged over k, over the successful runs ([`experiments`]).
+//!   going at step k, averaged over k, over the successful runs (`roam_experiments::reproduce::apf`).
 //! - **Safety** (not in the paper): a PEB above `max_peb_m` or unbounded holds the robot
 //!   (HaltedPeb); no progress over `stuck_window_steps` ends the mission (Stuck). The
-//!   reproduction turns the stuck rule off ([`experiments::paper::paper_params`]), as the
+//!   reproduction turns the stuck rule off (`roam_experiments::reproduce::apf::paper::paper_params`), as the
 //!   paper runs every mission to completion or max_steps, and ES2 turns the PEB guard off
 //!   (true positions).
 //! - **Scenarios**: the paper gives no coordinates. roam's ES1–ES3 scenarios
 //!   (`config/scenarios/es*.yaml`) are built to have the properties the text describes;
 //!   their comments say which. ES3's random missions are sampled as
-//!   [`experiments::es3`] documents.
+//!   `roam_experiments::reproduce::apf::es3` documents.
 
 pub mod carrot;
 pub mod controller;
-pub mod episode;
-pub mod experiments;
 pub mod forces;
 pub mod information;
 pub mod obstacle_field;
 pub mod params;
-pub mod render;
 pub mod service;
-pub mod stepper;
 pub mod weights;
 
 pub use controller::{Controller, Decision, MissionStatus};
-pub use episode::{run_episode, Episode, PositionSource, RobotMission, RobotTrack, Setup};
 pub use information::InformationField;
 pub use obstacle_field::ObstacleField;
 pub use params::{ApfParams, Follow, ParamError};
-pub use stepper::{RobotStep, StepOutcome, Stepper};
 pub use weights::{is_weight, Scheme};

@@ -6,8 +6,9 @@
 //! per cell (§3), and an [`Explorer`] per robot runs §4's loop (strategy choice by a
 //! tile-coded learner, goal sampling, §2's wavefront controller) and answers each
 //! update with the robot's next unit command. The batch experiment
-//! ([`experiment`], `roam reproduce mapper`), the bench ([`mod@bench`], `roam bench
-//! mapper`) and the network service all call the same code.
+//! (`roam_experiments::reproduce::mapper`, `roam reproduce mapper`), the bench
+//! (`roam_experiments::bench::mapper`, `roam bench mapper`) and the network service
+//! all call the same code.
 //!
 //! # Modules
 //!
@@ -22,9 +23,6 @@
 //! - [`wavefront`]: the wavefront planner with hill climbing and "as close as possible".
 //! - [`epoch`]: observation times against the sim clock; sim resets as epochs.
 //! - [`explorer`]: the per-robot loop: episodes, navigation, local exploration, reward.
-//! - [`truth`]: the true change rates of a scripted world, for scoring.
-//! - [`experiment`], [`plot`]: paper 004 §5 on grid004, its table and its Fig. 3.
-//! - [`mod@bench`]: observation updates per second on a 1000 × 1000 map.
 //! - [`seed`]: the seeded ChaCha8 streams every random choice draws from.
 //! - [`error`]: [`MapperError`], naming the limit when a size is refused.
 //!
@@ -69,7 +67,7 @@
 //!   changes; with no change, one random step; where a second would come the robot
 //!   *waits* one step (`AfterRandomStep::Wait`; `EndEpisode` ends the episode instead).
 //!   Every command counts toward the 42 steps, waiting too; |T| = 42 updates.
-//! - **Metrics** ([`experiment`], [`truth`]): the true rate of a cell is one process's
+//! - **Metrics** (`roam_experiments::reproduce::mapper`): the true rate of a cell is one process's
 //!   events per second over the world's cycle; the error is averaged over the 48 cells
 //!   that change (over all free cells it would be a constant multiple here); map quality
 //!   over all 625 cells, unknown counting as wrong; 5000 s per run (the paper's x-axis
@@ -78,7 +76,7 @@
 //! # The reproduction
 //!
 //! `roam reproduce mapper` with the defaults: grid004, 5 runs of 5000 steps per mode,
-//! seed 0, every mode of run r on run r's random numbers ([`experiment`]); about 0.5 s
+//! seed 0, every mode of run r on run r's random numbers (`roam_experiments::reproduce::mapper::experiment`); about 0.5 s
 //! in release on two cores.
 //!
 //! ```text
@@ -120,20 +118,16 @@
 //! updates per second with p and r after each (observe ≈ 42 µs, features ≈ 205 µs
 //! mean, 530 µs p99), 400 × real time; the plain sum the cache replaces takes 10 ms.
 
-pub mod bench;
 pub mod change_map;
 pub mod epoch;
 pub mod error;
-pub mod experiment;
 pub mod explorer;
 pub mod features;
 pub mod goals;
 pub mod learner;
-pub mod plot;
 pub mod poisson;
 pub use roam_world::seed;
 pub mod service;
-pub mod truth;
 pub mod wavefront;
 
 pub use change_map::{ChangeMap, MapParams, ObservationWindow, Update};

@@ -19,8 +19,8 @@
 //!   plans, one planner request each; its mission; the arrival; the next window planned
 //!   during the task; the report): events in, actions out.
 //! - [`information`]: the information a path gathers, on the planner's own scale.
-//! - [`experiment`]: `roam reproduce mission`, the couplings compared in batch.
-//! - [`days`]: `roam reproduce mission --days N`, the executive's whole day in batch
+//! - `roam_experiments::reproduce::mission`: `roam reproduce mission`, the couplings
+//!   compared in batch, and with `--days N` the executive's whole day in batch
 //!   (today's, the new one, each coupling left out, the shortest path) against issue
 //!   14's goals.
 //! - [`executive`]: the executive on Zenoh (a client of the planner, the controller,
@@ -30,9 +30,7 @@
 //! - [`service`]: `roam mission`, the executive as a service that publishes its reports.
 
 pub mod calibration;
-pub mod days;
 pub mod executive;
-pub mod experiment;
 pub mod information;
 mod inputs;
 pub mod margin;

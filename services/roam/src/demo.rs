@@ -27,8 +27,8 @@ use roam_world::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, P
 use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
-use crate::demo_today::{todays_plans, TodaysPlan};
-use crate::stack::{Stack, StackOptions};
+use roam_experiments::reproduce::mission::todays_plans::{todays_plans, TodaysPlan};
+use roam_stack::stack::{Stack, StackOptions};
 
 /// The colour of the path the robot drove (its true positions).
 pub const DRIVEN: Rgb<u8> = Rgb([220, 20, 20]);
@@ -88,7 +88,7 @@ pub struct DemoReport {
     /// The same along the planned curious paths.
     pub information_planned: f64,
     /// What today's executive (static map, Table I, one plan per window, paper 000's
-    /// initialization) would have planned per window ([`crate::demo_today`]), and the
+    /// initialization) would have planned per window ([`roam_experiments::reproduce::mission::todays_plans`]), and the
     /// information those plans promised, summed.
     pub todays_plans: Vec<Option<TodaysPlan>>,
     pub information_todays_plans: f64,
@@ -106,7 +106,7 @@ pub struct DemoReport {
 #[derive(Debug, thiserror::Error)]
 pub enum DemoError {
     #[error(transparent)]
-    Stack(#[from] crate::stack::StackError),
+    Stack(#[from] roam_stack::stack::StackError),
     #[error(transparent)]
     Executive(#[from] roam_mission::executive::ExecutiveError),
     #[error(transparent)]

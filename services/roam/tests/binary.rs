@@ -4,9 +4,9 @@
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use roam::router::free_loopback_port;
 use roam_runtime::wait_for_liveliness;
 use roam_runtime::SessionArgs;
+use roam_stack::router::free_loopback_port;
 
 const ROAM: &str = env!("CARGO_BIN_EXE_roam");
 

@@ -12,7 +12,7 @@ use std::sync::mpsc;
 use std::thread;
 use std::time::{Duration, Instant};
 
-use roam::router::free_loopback_port;
+use roam_stack::router::free_loopback_port;
 
 const ROAM: &str = env!("CARGO_BIN_EXE_roam");
 const READY_TIMEOUT: Duration = Duration::from_secs(60);

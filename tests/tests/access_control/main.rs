@@ -51,8 +51,8 @@ async fn only_the_controller_drives_and_only_map_writers_change_the_map() {
     let endpoint = harness.router.endpoint.clone();
 
     // The real services, each as its own role.
-    let map_server = harness.start_map_server(harness.map_server_config()).await;
-    let sim = harness.start_sim(harness.sim_config(None)).await;
+    let map_server = harness.start_role(harness.map_server_config()).await;
+    let sim = harness.start_role(harness.sim_config(None)).await;
 
     assert_only_the_right_credentials_open(&secrets, &endpoint).await;
 
@@ -212,7 +212,7 @@ async fn stop(service: RunningService) {
 async fn a_map_writer_cannot_read_the_routers_secrets_through_a_load() {
     let (secrets, harness) = secure_site().await;
     let map_server = harness
-        .start_map_server(MapServerConfig {
+        .start_role(MapServerConfig {
             load_dirs: vec![roam_tests::repo_path("config/maps")],
             ..harness.map_server_config()
         })
@@ -276,44 +276,33 @@ async fn a_map_writer_cannot_read_the_routers_secrets_through_a_load() {
 async fn every_role_does_its_job_through_the_secure_router() {
     let (_secrets, harness) = secure_site().await;
     let mut services = vec![
-        harness.start_map_server(harness.map_server_config()).await,
+        harness.start_role(harness.map_server_config()).await,
         harness
-            .start_planner(harness.planner_config("planner-0"))
+            .start_role(harness.planner_config("planner-0"))
             .await,
     ];
     let mut sim_config = harness.sim_config(None);
     sim_config.rate = Some(10.0);
-    services.push(harness.start_sim(sim_config).await);
-    services.push(harness.start_localization(None).await);
+    services.push(harness.start_role(sim_config).await);
+    services.push(harness.start_role(harness.localization_config(None)).await);
     services.push(
         harness
-            .start_controller(ControllerConfig {
+            .start_role(ControllerConfig {
                 apf: roam::demo::indoor_apf(),
                 ..harness.controller_config()
             })
             .await,
     );
-    services.push(harness.start_mapper(harness.mapper_config()).await);
+    services.push(harness.start_role(harness.mapper_config()).await);
 
     let operator = harness.client_as("operator").await;
     let reports = subscribe(&operator, &keys::robot_mission_report(ROOT, ROBOT)).await;
-    let mission_key = keys::liveliness_of(ROOT, roam_mission::service::SERVICE_NAME);
     services.push(
         harness
-            .start_service_as(
-                roam_mission::service::SERVICE_NAME,
-                mission_key,
-                |zenoh, cancel| {
-                    roam_mission::service::run(
-                        MissionConfig {
-                            root: ROOT.to_owned(),
-                            ..MissionConfig::default()
-                        },
-                        zenoh,
-                        cancel,
-                    )
-                },
-            )
+            .start_role(MissionConfig {
+                root: ROOT.to_owned(),
+                ..MissionConfig::default()
+            })
             .await,
     );
 

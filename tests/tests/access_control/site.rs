@@ -10,8 +10,8 @@ use rcgen::{
     BasicConstraints, CertificateParams, CertifiedIssuer, DnType, ExtendedKeyUsagePurpose, IsCa,
     KeyPair, KeyUsagePurpose,
 };
-use roam::router::{free_loopback_port, Router};
 use roam_runtime::SessionArgs;
+use roam_stack::router::{free_loopback_port, Router};
 use roam_tests::{repo_path, within, Harness, SecureSite};
 
 use crate::ROOT;

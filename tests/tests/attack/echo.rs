@@ -27,7 +27,7 @@ async fn refused_bytes(client: &Requester, key: &str, payload: Vec<u8>) -> usize
 
 /// Replies to huge fields stay small.
 pub(crate) async fn replies(harness: &Harness, client: &Requester) {
-    let server = harness.start_map_server(harness.map_server_config()).await;
+    let server = harness.start_role(harness.map_server_config()).await;
     let key = keys::map_update(&harness.root, "occupancy");
     let kind = "k".repeat(5_000_000);
     let huge_kind = format!(r#"{{"v":1,"kind":"{kind}","body":{{}}}}"#).into_bytes();
@@ -51,9 +51,9 @@ pub(crate) async fn replies(harness: &Harness, client: &Requester) {
 
 /// Floods of bad puts make a bounded log, and forged names stay on one escaped line.
 pub(crate) async fn logs(harness: &Harness, client: &Requester, log: &Captured) {
-    let localization = harness.start_localization(None).await;
-    let controller = harness.start_controller(harness.controller_config()).await;
-    let mapper = harness.start_mapper(harness.mapper_config()).await;
+    let localization = harness.start_role(harness.localization_config(None)).await;
+    let controller = harness.start_role(harness.controller_config()).await;
+    let mapper = harness.start_role(harness.mapper_config()).await;
     let root = harness.root.clone();
     let session = client.session();
 

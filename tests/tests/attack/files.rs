@@ -107,7 +107,7 @@ fn assert_no_content(reply: &ErrorReply, what: &str) {
 /// The map server's loads.
 pub(crate) async fn map_loads(harness: &Harness, client: &Requester, files: &Files) {
     let server = harness
-        .start_map_server(MapServerConfig {
+        .start_role(MapServerConfig {
             load_dirs: vec![files.maps()],
             ..harness.map_server_config()
         })
@@ -181,7 +181,7 @@ pub(crate) async fn map_loads(harness: &Harness, client: &Requester, files: &Fil
 pub(crate) async fn sim_loads(harness: &Harness, client: &Requester, files: &Files) {
     let mut config = harness.sim_config(None);
     config.load_dirs = vec![files.maps()];
-    let sim = harness.start_sim(config).await;
+    let sim = harness.start_role(config).await;
     let key = keys::sim_control(&harness.root);
     let load = |path: &str| SimControl::Load {
         path: path.to_owned(),

@@ -32,9 +32,9 @@ async fn step(client: &Requester, root: &str, n: u32) -> SimStatus {
 /// key, and to make localization publish on wildcard keys.
 pub(crate) async fn keys_decide(harness: &Harness, client: &Requester) {
     let root = harness.root.clone();
-    let sim = harness.start_sim(harness.sim_config(None)).await;
-    let localization = harness.start_localization(None).await;
-    let controller = harness.start_controller(harness.controller_config()).await;
+    let sim = harness.start_role(harness.sim_config(None)).await;
+    let localization = harness.start_role(harness.localization_config(None)).await;
+    let controller = harness.start_role(harness.controller_config()).await;
     let everything: Sub = within(
         "subscribe",
         client

@@ -138,12 +138,12 @@ async fn every_queryable_and_subscriber_survives_random_and_mutated_payloads() {
     }));
     let started = Instant::now();
     let harness = Harness::start().await;
-    let map_server = harness.start_map_server(harness.map_server_config()).await;
-    let planner = harness.start_planner(harness.planner_config("p1")).await;
-    let sim = harness.start_sim(harness.sim_config(None)).await;
-    let localization = harness.start_localization(None).await;
-    let controller = harness.start_controller(harness.controller_config()).await;
-    let mapper = harness.start_mapper(harness.mapper_config()).await;
+    let map_server = harness.start_role(harness.map_server_config()).await;
+    let planner = harness.start_role(harness.planner_config("p1")).await;
+    let sim = harness.start_role(harness.sim_config(None)).await;
+    let localization = harness.start_role(harness.localization_config(None)).await;
+    let controller = harness.start_role(harness.controller_config()).await;
+    let mapper = harness.start_role(harness.mapper_config()).await;
     let client = harness.client().await;
     let session = client.session().clone();
     let root = harness.root.clone();

@@ -15,6 +15,7 @@ use anyhow::bail;
 use clap::{Args, Parser, Subcommand};
 use roam_proto::keys;
 use roam_runtime::{Requester, SessionArgs};
+use roam_stack::{Role, RoleConfig};
 
 use map::MapCommand;
 use plan::PlanArgs;
@@ -147,39 +148,6 @@ pub(crate) struct ServiceArgs {
     pub(crate) session: SessionArgs,
 }
 
-/// What every role's config file has: a key root, an instance name, a Zenoh section.
-pub(crate) trait RoleConfig: serde::de::DeserializeOwned + Default {
-    fn root_mut(&mut self) -> &mut String;
-    fn instance_mut(&mut self) -> &mut Option<String>;
-    fn zenoh(&self) -> Option<&serde_json::Value>;
-}
-
-macro_rules! role_config {
-    ($($config:ty),*) => {$(
-        impl RoleConfig for $config {
-            fn root_mut(&mut self) -> &mut String {
-                &mut self.root
-            }
-            fn instance_mut(&mut self) -> &mut Option<String> {
-                &mut self.instance
-            }
-            fn zenoh(&self) -> Option<&serde_json::Value> {
-                self.zenoh.as_ref()
-            }
-        }
-    )*};
-}
-
-role_config!(
-    roam_map_server::MapServerConfig,
-    roam_planner::PlannerConfig,
-    roam_sim::service::SimConfig,
-    roam_localization::service::LocalizationConfig,
-    roam_controller::service::ControllerConfig,
-    roam_mapper::service::MapperConfig,
-    roam_mission::service::MissionConfig
-);
-
 impl ServiceArgs {
     /// The role's config: its file (or the defaults), then `--root` and `--instance`.
     pub(crate) fn load_config<T: RoleConfig>(&self) -> anyhow::Result<T> {
@@ -196,9 +164,13 @@ impl ServiceArgs {
         Ok(config)
     }
 
-    /// The Zenoh config: the role's file section, `ZENOH_CONFIG`, then the flags.
-    pub(crate) fn zenoh_config<T: RoleConfig>(&self, config: &T) -> anyhow::Result<zenoh::Config> {
-        Ok(self.session.zenoh_config(config.zenoh())?)
+    /// Runs `role` until SIGINT or SIGTERM, on the Zenoh config of its file section,
+    /// `ZENOH_CONFIG`, then the flags.
+    pub(crate) async fn run(&self, role: Role) -> anyhow::Result<()> {
+        let zenoh = self.session.zenoh_config(role.zenoh())?;
+        role.run(zenoh, roam_runtime::signals::cancel_on_signal())
+            .await
+            .map_err(anyhow::Error::msg)
     }
 }
 

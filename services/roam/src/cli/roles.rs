@@ -6,11 +6,13 @@ use std::time::Duration;
 use anyhow::{bail, Context};
 use clap::Args;
 use roam::report::{self, Mission};
-use roam::router::Router;
-use roam::stack::{Stack, StackOptions};
 use roam_map_server::MapServerConfig;
 use roam_planner::PlannerConfig;
 use roam_runtime::{signals, Requester, SessionArgs};
+use roam_stack::router::Router;
+use roam_stack::stack::{Stack, StackOptions};
+
+use roam_stack::Role;
 
 use super::ServiceArgs;
 
@@ -86,10 +88,7 @@ pub(crate) async fn map_server(args: MapServerArgs) -> anyhow::Result<()> {
     if !args.load_dirs.is_empty() {
         config.load_dirs = args.load_dirs;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    let cancel = signals::cancel_on_signal();
-    roam_map_server::run(config, zenoh, cancel).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }
 
 pub(crate) async fn planner(args: PlannerArgs) -> anyhow::Result<()> {
@@ -97,9 +96,7 @@ pub(crate) async fn planner(args: PlannerArgs) -> anyhow::Result<()> {
     if let Some(n) = args.max_concurrent_plans {
         config.max_concurrent_plans = n;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    roam_planner::run(config, zenoh, signals::cancel_on_signal()).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }
 
 /// The missions of a scenario: from its `start` place to each other place.
@@ -267,9 +264,7 @@ pub(crate) async fn controller(args: ControllerArgs) -> anyhow::Result<()> {
     if !args.robots.is_empty() {
         config.robots = args.robots;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    roam_controller::service::run(config, zenoh, signals::cancel_on_signal()).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }
 
 #[derive(Debug, Args)]
@@ -292,9 +287,7 @@ pub(crate) async fn mapper(args: MapperArgs) -> anyhow::Result<()> {
     if !args.explore.is_empty() {
         config.explore = args.explore;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    roam_mapper::service::run(config, zenoh, signals::cancel_on_signal()).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }
 
 #[derive(Debug, Args)]
@@ -311,9 +304,7 @@ pub(crate) async fn mission(args: MissionArgs) -> anyhow::Result<()> {
     if let Some(robot) = args.robot {
         config.executive.robot = robot;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    roam_mission::service::run(config, zenoh, signals::cancel_on_signal()).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }
 
 #[derive(Debug, Args)]
@@ -396,7 +387,5 @@ pub(crate) async fn localization(args: LocalizationArgs) -> anyhow::Result<()> {
     if args.scenario.is_some() {
         config.scenario = args.scenario;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    roam_localization::service::run(config, zenoh, signals::cancel_on_signal()).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }

@@ -4,10 +4,11 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use roam_runtime::signals;
 use roam_sim::service::SimConfig;
 use roam_sim::Sim;
 use roam_world::scenario::load_or_builtin;
+
+use roam_stack::Role;
 
 use super::ServiceArgs;
 
@@ -87,9 +88,7 @@ async fn run(args: SimRunArgs) -> anyhow::Result<()> {
     } else if args.rate.is_some() {
         config.rate = args.rate;
     }
-    let zenoh = args.service.zenoh_config(&config)?;
-    roam_sim::service::run(config, zenoh, signals::cancel_on_signal()).await?;
-    Ok(())
+    args.service.run(Role::from(config)).await
 }
 
 fn render(scenario: PathBuf, png: PathBuf, scale: Option<u32>) -> anyhow::Result<()> {

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use clap::Subcommand;
-use roam::bench;
+use roam_experiments::bench as benches;
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum BenchCommand {
@@ -116,16 +116,16 @@ pub(crate) enum ReproduceCommand {
         #[arg(long)]
         json: bool,
         /// ES1 runs per scheme (the paper: 100).
-        #[arg(long, default_value_t = roam_controller::experiments::DEFAULT_ES1_RUNS)]
+        #[arg(long, default_value_t = roam_experiments::reproduce::apf::DEFAULT_ES1_RUNS)]
         es1_runs: usize,
         /// ES2 runs per scheme and z_is.
-        #[arg(long, default_value_t = roam_controller::experiments::DEFAULT_ES2_RUNS)]
+        #[arg(long, default_value_t = roam_experiments::reproduce::apf::DEFAULT_ES2_RUNS)]
         es2_runs: usize,
         /// ES3 random missions (the paper: 10).
-        #[arg(long, default_value_t = roam_controller::experiments::DEFAULT_ES3_MISSIONS)]
+        #[arg(long, default_value_t = roam_experiments::reproduce::apf::DEFAULT_ES3_MISSIONS)]
         es3_missions: usize,
         /// ES3 runs per mission (the paper: 100).
-        #[arg(long, default_value_t = roam_controller::experiments::DEFAULT_ES3_RUNS)]
+        #[arg(long, default_value_t = roam_experiments::reproduce::apf::DEFAULT_ES3_RUNS)]
         es3_runs: usize,
         #[arg(long, default_value_t = 0)]
         seed: u64,
@@ -144,7 +144,7 @@ pub(crate) enum ReproduceCommand {
         #[arg(long, default_value_t = 5)]
         repetitions: usize,
         /// Steps per run (one second of sim time each).
-        #[arg(long, default_value_t = roam_mapper::experiment::DEFAULT_STEPS)]
+        #[arg(long, default_value_t = roam_experiments::reproduce::mapper::experiment::DEFAULT_STEPS)]
         steps: u64,
         #[arg(long, default_value_t = 0)]
         seed: u64,
@@ -191,7 +191,7 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             }
             let dir = std::env::temp_dir().join(format!("roam-bench-map-{}", std::process::id()));
             std::fs::create_dir_all(&dir)?;
-            let result = bench::map(side, iterations, &dir).await;
+            let result = benches::map::map(side, iterations, &dir).await;
             let _ = std::fs::remove_dir_all(&dir);
             let result = result?;
             print_json(&result, json)
@@ -201,7 +201,7 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
                 bail!("--estimates must be at least 1");
             }
             let result = tokio::task::spawn_blocking(move || {
-                roam::bench_localization::localization(estimates)
+                roam_experiments::bench::localization::localization(estimates)
             })
             .await??;
             print_json(&result, json)
@@ -219,14 +219,17 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             {
                 bail!("--robots must be 1..=1000, --rate-hz and --seconds positive");
             }
-            let result = roam::bench_sim::sim(robots, rate_hz, seconds).await?;
+            let result = roam_experiments::bench::sim::sim(robots, rate_hz, seconds).await?;
             print_json(&result, json)
         }
         BenchCommand::Load { json, requests } => {
-            if requests == 0 || requests > roam::bench_load::MAX_REQUESTS {
-                bail!("--requests must be 1..={}", roam::bench_load::MAX_REQUESTS);
+            if requests == 0 || requests > roam_experiments::bench::load::MAX_REQUESTS {
+                bail!(
+                    "--requests must be 1..={}",
+                    roam_experiments::bench::load::MAX_REQUESTS
+                );
             }
-            let result = roam::bench_load::load(requests).await?;
+            let result = roam_experiments::bench::load::load(requests).await?;
             print_json(&result, json)
         }
         BenchCommand::Mapper {
@@ -237,13 +240,15 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             if updates == 0 || !(128..=2048).contains(&side) {
                 bail!("--updates must be at least 1 and --side 128..=2048 cells");
             }
-            let options = roam_mapper::bench::BenchOptions {
+            let options = roam_experiments::bench::mapper::BenchOptions {
                 map_cells: side,
                 updates,
-                ..roam_mapper::bench::BenchOptions::default()
+                ..roam_experiments::bench::mapper::BenchOptions::default()
             };
-            let result =
-                tokio::task::spawn_blocking(move || roam_mapper::bench::bench(&options)).await??;
+            let result = tokio::task::spawn_blocking(move || {
+                roam_experiments::bench::mapper::bench(&options)
+            })
+            .await??;
             print_json(&result, json)
         }
         BenchCommand::Planner {
@@ -254,7 +259,7 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             if runs == 0 {
                 bail!("--runs must be at least 1");
             }
-            let result = roam::bench_planner::planner(runs, paper_init).await?;
+            let result = roam_experiments::bench::planner::planner(runs, paper_init).await?;
             print_json(&result, json)
         }
     }
@@ -297,14 +302,14 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             if missions == 0 || generations == 0 || !(w_loc.is_finite() && w_loc >= 0.0) {
                 bail!("--missions and --generations must be at least 1, --w-loc 0 or more");
             }
-            let options = roam_mission::experiment::MissionExperiment {
+            let options = roam_experiments::reproduce::mission::missions::MissionExperiment {
                 missions,
                 seed,
                 generations,
                 w_loc,
             };
             let result = tokio::task::spawn_blocking(move || {
-                roam_mission::experiment::run(&options, &|done, total| {
+                roam_experiments::reproduce::mission::missions::run(&options, &|done, total| {
                     eprint!("\rthe papers joined: mission {done}/{total}   ");
                     if done == total {
                         eprintln!();
@@ -312,16 +317,19 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 })
             })
             .await??;
-            let report = roam::reproduce_mission::MissionReport {
-                claims: roam::reproduce_mission::claims(&result),
+            let report = roam_experiments::reproduce::mission::runner::MissionReport {
+                claims: roam_experiments::reproduce::mission::runner::claims(&result),
                 reproduction: result,
             };
             if json {
                 println!("{}", serde_json::to_string(&report)?);
             } else {
-                print!("{}", roam_mission::experiment::table(&report.reproduction));
+                print!(
+                    "{}",
+                    roam_experiments::reproduce::mission::missions::table(&report.reproduction)
+                );
                 println!("claims, ours judged:");
-                print!("{}", roam::verdict::lines(&report.claims));
+                print!("{}", roam_experiments::verdict::lines(&report.claims));
             }
             Ok(())
         }
@@ -338,14 +346,16 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 bail!("--es1-runs, --es2-runs, --es3-missions and --es3-runs must be at least 1");
             }
             let (result, pictures) = tokio::task::spawn_blocking(move || {
-                roam::reproduce_apf::run(&roam::reproduce_apf::Sizes {
-                    es1_runs,
-                    es2_runs,
-                    es3_missions,
-                    es3_runs,
-                    seed,
-                    out_dir: out,
-                })
+                roam_experiments::reproduce::apf::runner::run(
+                    &roam_experiments::reproduce::apf::runner::Sizes {
+                        es1_runs,
+                        es2_runs,
+                        es3_missions,
+                        es3_runs,
+                        seed,
+                        out_dir: out,
+                    },
+                )
             })
             .await??;
             if json {
@@ -368,15 +378,15 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             if repetitions == 0 || steps == 0 {
                 bail!("--repetitions and --steps must be at least 1");
             }
-            let options = roam_mapper::experiment::ExperimentOptions {
+            let options = roam_experiments::reproduce::mapper::experiment::ExperimentOptions {
                 repetitions,
                 steps,
                 seed,
-                ..roam_mapper::experiment::ExperimentOptions::default()
+                ..roam_experiments::reproduce::mapper::experiment::ExperimentOptions::default()
             };
             let (result, picture) = tokio::task::spawn_blocking(move || {
-                let scenario = roam_mapper::experiment::grid004()?;
-                let progress = |p: roam_mapper::experiment::Progress| {
+                let scenario = roam_experiments::reproduce::mapper::experiment::grid004()?;
+                let progress = |p: roam_experiments::reproduce::mapper::experiment::Progress| {
                     eprint!(
                         "\rpaper 004: run {}/{} ({} #{})   ",
                         p.done,
@@ -385,25 +395,30 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                         p.repetition + 1
                     );
                 };
-                let result = roam_mapper::experiment::run(
-                    roam_mapper::experiment::GRID004_NAME,
+                let result = roam_experiments::reproduce::mapper::experiment::run(
+                    roam_experiments::reproduce::mapper::experiment::GRID004_NAME,
                     &scenario,
                     &options,
                     &progress,
                 )?;
                 eprintln!();
                 std::fs::create_dir_all(&out)?;
-                let picture = roam_mapper::plot::write_figure(&scenario, &result, &out)?;
+                let picture = roam_experiments::reproduce::mapper::plot::write_figure(
+                    &scenario, &result, &out,
+                )?;
                 anyhow::Ok((result, picture))
             })
             .await??;
-            let judged = roam::reproduce_mapper::judge(result);
+            let judged = roam_experiments::reproduce::mapper::runner::judge(result);
             if json {
                 println!("{}", serde_json::to_string(&judged)?);
             } else {
-                print!("{}", roam_mapper::experiment::table(&judged.reproduction));
+                print!(
+                    "{}",
+                    roam_experiments::reproduce::mapper::experiment::table(&judged.reproduction)
+                );
                 println!("claims, ours judged:");
-                print!("{}", roam::verdict::lines(&judged.claims));
+                print!("{}", roam_experiments::verdict::lines(&judged.claims));
                 println!("picture: {}", picture.display());
             }
             Ok(())
@@ -417,7 +432,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             init,
             paper_init,
         } => {
-            use roam::reproduce_planner::Initialization;
+            use roam_experiments::reproduce::planner::Initialization;
             let initializations = match (paper_init, init.as_str()) {
                 (true, _) | (false, "paper") => vec![Initialization::Paper],
                 (false, "roam") => vec![Initialization::Roam],
@@ -429,16 +444,17 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             {
                 bail!("--runs must be at least 1, --total positive and --generations-per-t at least 1");
             }
-            let options = roam::reproduce_planner::ReproduceOptions {
+            let options = roam_experiments::reproduce::planner::ReproduceOptions {
                 runs,
                 total_s: total,
                 generations_per_t,
                 out_dir: out,
                 initializations,
             };
-            let result =
-                tokio::task::spawn_blocking(move || roam::reproduce_planner::run(&options))
-                    .await??;
+            let result = tokio::task::spawn_blocking(move || {
+                roam_experiments::reproduce::planner::run(&options)
+            })
+            .await??;
             if json {
                 println!("{}", serde_json::to_string(&result)?);
             } else {
@@ -471,7 +487,7 @@ async fn reproduce_days(
     generations: u32,
     w_loc: f64,
 ) -> anyhow::Result<()> {
-    use roam_mission::days::{self, DaysOptions, Variant};
+    use roam_experiments::reproduce::mission::days::{self, DaysOptions, Variant};
     let mut options = DaysOptions {
         days,
         seed,

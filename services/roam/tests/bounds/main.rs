@@ -29,7 +29,7 @@ mod procs;
 mod sim;
 
 use procs::{wait_live, Proc};
-use roam::router::free_loopback_port;
+use roam_stack::router::free_loopback_port;
 
 /// The map server's peak under the update attack, MiB (measured 1.9 GB): one maximal
 /// update in work at a time (its payload budget) costs a few times its 90 MB, the

@@ -13,10 +13,10 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use roam::router::free_loopback_port;
 use roam_proto::mission::WindowReport;
 use roam_proto::{decode, keys};
 use roam_runtime::{Requester, SessionArgs};
+use roam_stack::router::free_loopback_port;
 
 mod fleet;
 mod watch;

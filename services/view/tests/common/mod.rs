@@ -5,7 +5,7 @@
 
 use std::collections::BTreeMap;
 use std::future::IntoFuture;
-use std::net::{SocketAddr, TcpListener};
+use std::net::SocketAddr;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Duration;
 
@@ -15,6 +15,7 @@ use roam_proto::keys;
 use roam_proto::map::Layer;
 use roam_runtime::{Requester, SessionArgs};
 use roam_sim::service::SimConfig;
+use roam_stack::{Role, Router};
 use roam_view::{Access, ViewConfig, ViewHandle, ViewStats};
 use serde_json::Value;
 use tokio::task::JoinHandle;
@@ -52,34 +53,20 @@ pub struct Stack {
 
 impl Stack {
     pub async fn start() -> Stack {
-        let mut last = None;
-        for _ in 0..5 {
-            let port = TcpListener::bind("127.0.0.1:0")
-                .and_then(|l| l.local_addr())
-                .expect("a free port")
-                .port();
-            let endpoint = format!("tcp/127.0.0.1:{port}");
-            let config = SessionArgs::router_on(&endpoint)
-                .zenoh_config(None)
-                .expect("router config");
-            match within("router", roam_runtime::session::open(config)).await {
-                Ok(router) => {
-                    return Stack {
-                        router,
-                        endpoint,
-                        root: format!(
-                            "view-test-{}-{}",
-                            std::process::id(),
-                            NEXT_ROOT.fetch_add(1, Ordering::Relaxed)
-                        ),
-                        cancel: CancellationToken::new(),
-                        services: Vec::new(),
-                    }
-                }
-                Err(e) => last = Some(e),
-            }
+        let router = within("router", Router::on_loopback())
+            .await
+            .expect("router on loopback");
+        Stack {
+            router: router.session,
+            endpoint: router.endpoint,
+            root: format!(
+                "view-test-{}-{}",
+                std::process::id(),
+                NEXT_ROOT.fetch_add(1, Ordering::Relaxed)
+            ),
+            cancel: CancellationToken::new(),
+            services: Vec::new(),
         }
-        panic!("no router: {last:?}");
     }
 
     pub fn client_config(&self) -> zenoh::Config {
@@ -110,37 +97,33 @@ impl Stack {
             .expect("token");
     }
 
+    /// Starts a service of roam's role table and waits for its liveliness token.
+    pub async fn start_role(&mut self, role: impl Into<Role>) {
+        let role = role.into();
+        let key = role.live_key();
+        let run = role.run(self.client_config(), self.cancel.child_token());
+        self.services.push(tokio::spawn(run));
+        self.wait_live(key).await;
+    }
+
+    /// The map server on the built-in world.
     pub async fn start_map_server(&mut self) {
-        let config = MapServerConfig {
-            root: self.root.clone(),
+        let root = self.root.clone();
+        self.start_role(MapServerConfig {
+            root,
             ..MapServerConfig::default()
-        };
-        let run = roam_map_server::run(config, self.client_config(), self.cancel.child_token());
-        self.services.push(tokio::spawn(
-            async move { run.await.map_err(|e| e.to_string()) },
-        ));
-        self.wait_live(keys::liveliness_of(
-            &self.root,
-            roam_map_server::SERVICE_NAME,
-        ))
+        })
         .await;
     }
 
     /// The sim on the built-in world, free-running at `rate` times real time.
     pub async fn start_sim(&mut self, rate: f64) {
-        let config = SimConfig {
-            root: self.root.clone(),
+        let root = self.root.clone();
+        self.start_role(SimConfig {
+            root,
             rate: Some(rate),
             ..SimConfig::default()
-        };
-        let run = roam_sim::service::run(config, self.client_config(), self.cancel.child_token());
-        self.services.push(tokio::spawn(
-            async move { run.await.map_err(|e| e.to_string()) },
-        ));
-        self.wait_live(keys::liveliness_of(
-            &self.root,
-            roam_sim::service::SERVICE_NAME,
-        ))
+        })
         .await;
     }
 

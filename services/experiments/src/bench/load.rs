@@ -1,0 +1,166 @@
+//! `roam bench load`: many concurrent plan requests against two planner instances. Every
+//! request must be answered, or refused `busy`, within its deadline; none may hang. It
+//! measures what a fleet's burst of downtime plans does to a small planner pool.
+//!
+//! A stack (router, map server, two planners) runs in process; `requests` clients ask at
+//! once through the round-robin [`PlannerClient`] (which skips busy instances and
+//! reports `busy` only when every instance is busy). Each plan is Model I on the built-in
+//! world with a 1 s deadline; a request counts as hung if no answer came within the
+//! deadline plus 5 s.
+
+use std::time::{Duration, Instant};
+
+use roam_planner::client::PlannerClient;
+use roam_proto::planner::{GaOverrides, PlanRequest, PlannerModel, ShortestPathUse};
+use roam_proto::ErrorCode;
+use roam_runtime::ClientError;
+use serde::Serialize;
+use tokio::task::JoinSet;
+
+use crate::bench::ms;
+use crate::ExperimentError;
+use roam_stack::stack::{Stack, StackOptions};
+
+/// The most concurrent requests one run sends.
+pub const MAX_REQUESTS: usize = 10_000;
+
+#[derive(Debug, Clone, Serialize)]
+pub struct LoadBench {
+    pub requests: usize,
+    pub planners: usize,
+    /// Plans returned.
+    pub answered: usize,
+    /// Refused with `busy` (every instance was at its concurrency limit).
+    pub refused_busy: usize,
+    /// Any other error (should be 0).
+    pub failed: usize,
+    /// No answer within the deadline plus 5 s (must be 0).
+    pub hung: usize,
+    /// Latency of the answered requests, request to decoded plan.
+    pub answered_p50_ms: f64,
+    pub answered_p99_ms: f64,
+    /// Latency of the refusals: how fast a client learns it must retry.
+    pub refused_p50_ms: f64,
+    pub max_ms: f64,
+    /// The deadline each request carried.
+    pub deadline_ms: f64,
+    pub wall_s: f64,
+    /// The process's peak resident memory (VmHWM), MiB.
+    pub peak_rss_mib: Option<f64>,
+}
+
+enum Outcome {
+    Answered(f64),
+    Busy(f64),
+    Failed(String),
+    Hung,
+}
+
+fn percentile(samples: &mut [f64], q: f64) -> f64 {
+    if samples.is_empty() {
+        return 0.0;
+    }
+    samples.sort_by(f64::total_cmp);
+    let i = ((samples.len() - 1) as f64 * q).round() as usize;
+    samples[i.min(samples.len() - 1)]
+}
+
+/// The process's peak resident set size from `/proc/self/status`, MiB (Linux).
+pub fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+pub async fn load(requests: usize) -> Result<LoadBench, ExperimentError> {
+    let planners = 2;
+    let stack = Stack::start(
+        StackOptions {
+            root: Some("roam-bench-load".into()),
+            planners,
+            ..StackOptions::default()
+        },
+        Duration::from_secs(30),
+    )
+    .await
+    .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+    let deadline = Duration::from_secs(1);
+    let patience = deadline + Duration::from_secs(5);
+    let client = PlannerClient::new(stack.router.session.clone(), &stack.root);
+    let client = std::sync::Arc::new(client);
+    let started = Instant::now();
+    let mut tasks = JoinSet::new();
+    for i in 0..requests {
+        let client = client.clone();
+        tasks.spawn(async move {
+            let request = PlanRequest {
+                request_id: Some(format!("load-{i}")),
+                cancel_token: None,
+                start: [-8.0, -8.0],
+                goal: [-2.0, 4.0],
+                t_exec_s: 60.0,
+                deadline_s: deadline.as_secs_f64(),
+                model: PlannerModel::Model1,
+                params: GaOverrides {
+                    max_generations: Some(300),
+                    ..GaOverrides::default()
+                },
+                seed: i as u64,
+                map_version: None,
+                shortest: ShortestPathUse::Omit,
+            };
+            let asked = Instant::now();
+            match tokio::time::timeout(patience, client.plan(&request)).await {
+                Err(_) => Outcome::Hung,
+                Ok(Ok(_)) => Outcome::Answered(ms(asked.elapsed())),
+                Ok(Err(ClientError::Refused(reply))) if reply.code == ErrorCode::Busy => {
+                    Outcome::Busy(ms(asked.elapsed()))
+                }
+                Ok(Err(e)) => Outcome::Failed(e.to_string()),
+            }
+        });
+    }
+    let (mut answered, mut busy, mut failed, mut hung) = (Vec::new(), Vec::new(), 0, 0);
+    while let Some(joined) = tasks.join_next().await {
+        match joined {
+            Ok(Outcome::Answered(t)) => answered.push(t),
+            Ok(Outcome::Busy(t)) => busy.push(t),
+            Ok(Outcome::Failed(e)) => {
+                tracing::warn!("a load request failed: {e}");
+                failed += 1;
+            }
+            Ok(Outcome::Hung) => hung += 1,
+            Err(e) => {
+                tracing::warn!("a load request task failed: {e}");
+                failed += 1;
+            }
+        }
+    }
+    let wall_s = started.elapsed().as_secs_f64();
+    let max_ms = answered
+        .iter()
+        .chain(busy.iter())
+        .copied()
+        .fold(0.0, f64::max);
+    let result = LoadBench {
+        requests,
+        planners,
+        answered: answered.len(),
+        refused_busy: busy.len(),
+        failed,
+        hung,
+        answered_p50_ms: percentile(&mut answered, 0.5),
+        answered_p99_ms: percentile(&mut answered, 0.99),
+        refused_p50_ms: percentile(&mut busy, 0.5),
+        max_ms,
+        deadline_ms: ms(deadline),
+        wall_s,
+        peak_rss_mib: peak_rss_mib(),
+    };
+    stack
+        .shutdown()
+        .await
+        .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+    Ok(result)
+}

@@ -1,0 +1,22 @@
+//! `roam bench …`: each benchmark measures one thing on this machine and prints JSON.
+//!
+//! - [`map`]: get and publish of a ~1.7-million-cell layer through Zenoh;
+//! - [`localization`]: WLS estimates per second and a PEB field;
+//! - [`planner`]: the GA per curiosity model, in process and through the service;
+//! - [`load`]: a burst of concurrent plan requests against two planners;
+//! - [`sim`]: many robots publishing their sensors at a fixed rate;
+//! - [`mapper`]: change-map observation updates per second.
+
+pub mod load;
+pub mod localization;
+pub mod map;
+pub mod mapper;
+pub mod planner;
+pub mod sim;
+
+use std::time::Duration;
+
+/// A duration in milliseconds, as the benchmarks print them.
+pub fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1000.0
+}

@@ -1,0 +1,176 @@
+//! `roam bench sim`: many robots at a fixed sim rate, publishing their sensors.
+//!
+//! A router and the sim service run in this process on the built-in world; a client
+//! adds `robots` robots on free cells spread over the map, resumes the sim at the real-
+//! time factor that gives `rate_hz` steps per second, subscribes to every robot's
+//! ranges, and lets it run for `seconds`. The sim counts a free-running step as late
+//! when its messages are not all out before the next step is due.
+//!
+//! `cpu_share` is the process's CPU time (user + system, from `/proc/self/stat`, in
+//! Linux's 100 Hz clock ticks) over wall time and cores: 1.0 would be every core busy.
+
+use std::time::{Duration, Instant};
+
+use roam_proto::keys;
+use roam_proto::sim::{SimControl, SimStatus};
+use roam_runtime::{Requester, SessionArgs};
+use roam_sim::service::SimConfig;
+use roam_world::grid::cell_center;
+use roam_world::scenario::load_or_builtin;
+use serde::Serialize;
+use tokio_util::sync::CancellationToken;
+
+use crate::ExperimentError;
+use roam_stack::router::Router;
+use roam_stack::stack::wait_until_live;
+
+#[derive(Debug, Clone, Serialize)]
+pub struct SimBench {
+    pub robots: usize,
+    pub rate_hz: f64,
+    pub seconds: f64,
+    pub steps: u64,
+    pub on_time_share: f64,
+    pub cpu_share: f64,
+    /// Range scans received by the subscriber, and how many the steps should give.
+    pub ranges_received: u64,
+    pub ranges_expected: u64,
+}
+
+/// CPU seconds used by this process so far, `None` off Linux.
+fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which is in parentheses and may hold spaces).
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
+}
+
+fn setup<E: std::fmt::Display>(e: E) -> ExperimentError {
+    ExperimentError::Setup(e.to_string())
+}
+
+pub async fn sim(robots: usize, rate_hz: f64, seconds: f64) -> Result<SimBench, ExperimentError> {
+    let router = Router::on_loopback().await.map_err(setup)?;
+    let root = "roam-bench-sim".to_owned();
+    let cancel = CancellationToken::new();
+    let config = SimConfig {
+        root: root.clone(),
+        rate: None,
+        ..SimConfig::default()
+    };
+    let zenoh_config = SessionArgs::client_of(&router.endpoint)
+        .zenoh_config(None)
+        .map_err(setup)?;
+    let token = cancel.clone();
+    let service =
+        tokio::spawn(async move { roam_sim::service::run(config, zenoh_config, token).await });
+    let result = async {
+        wait_until_live(
+            &router.session,
+            &root,
+            roam_sim::service::SERVICE_NAME,
+            Duration::from_secs(30),
+        )
+        .await
+        .map_err(setup)?;
+        let session = roam_runtime::session::open(
+            SessionArgs::client_of(&router.endpoint)
+                .zenoh_config(None)
+                .map_err(setup)?,
+        )
+        .await
+        .map_err(setup)?;
+        let client = Requester::new(session.clone(), Duration::from_secs(10));
+        let control_key = keys::sim_control(&root);
+
+        // Robots on free cells, spread over the map.
+        let (_, scenario) = load_or_builtin(None).map_err(setup)?;
+        let free: Vec<usize> = scenario
+            .occupancy
+            .cells
+            .iter()
+            .enumerate()
+            .filter(|(_, &c)| c == 0)
+            .map(|(i, _)| i)
+            .collect();
+        if free.len() < robots {
+            return Err(ExperimentError::Setup(format!(
+                "the built-in world has only {} free cells",
+                free.len()
+            )));
+        }
+        let stride = free.len() / robots.max(1);
+        let width = scenario.occupancy.meta.width as usize;
+        for k in 0..robots {
+            let i = free[k * stride];
+            let (x, y) = cell_center(&scenario.occupancy.meta, i % width, i / width);
+            let request = SimControl::AddRobot {
+                name: format!("bench-{k}"),
+                at: [x, y],
+            };
+            client
+                .request::<SimControl, SimStatus>(&control_key, Some(&request))
+                .await?;
+        }
+        let counter = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+        let subscriber = {
+            let counter = counter.clone();
+            session
+                .declare_subscriber(format!("{root}/robot/*/ranges"))
+                .callback(move |_| {
+                    counter.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                })
+                .await
+                .map_err(setup)?
+        };
+        let status: SimStatus = client
+            .request(&control_key, Some(&SimControl::Status))
+            .await?;
+        let factor = rate_hz * status.step_s;
+        let cpu_before = process_cpu_seconds();
+        let started = Instant::now();
+        client
+            .request::<SimControl, SimStatus>(
+                &control_key,
+                Some(&SimControl::Resume { rate: factor }),
+            )
+            .await?;
+        tokio::time::sleep(Duration::from_secs_f64(seconds)).await;
+        let end: SimStatus = client
+            .request(&control_key, Some(&SimControl::Pause))
+            .await?;
+        let wall = started.elapsed().as_secs_f64();
+        let cpu = match (cpu_before, process_cpu_seconds()) {
+            (Some(a), Some(b)) => b - a,
+            _ => f64::NAN,
+        };
+        // Let the last publications arrive.
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        drop(subscriber);
+        let _ = session.close().await;
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
+        let total_robots = end.robots.len() as u64;
+        Ok(SimBench {
+            robots,
+            rate_hz,
+            seconds: wall,
+            steps: end.free_steps,
+            on_time_share: if end.free_steps == 0 {
+                0.0
+            } else {
+                1.0 - end.late_steps as f64 / end.free_steps as f64
+            },
+            cpu_share: cpu / wall / cores,
+            ranges_received: counter.load(std::sync::atomic::Ordering::Relaxed),
+            ranges_expected: end.free_steps * total_robots,
+        })
+    }
+    .await;
+    cancel.cancel();
+    let _ = tokio::time::timeout(Duration::from_secs(5), service).await;
+    router.close().await;
+    result
+}

@@ -1,0 +1,320 @@
+//! One batch run of the controller in the sim world, without any network: the loop the
+//! experiments repeat and that the services reproduce step for step.
+//!
+//! The structure is kept literally like the services' (sim → ranges → localization →
+//! controller → commands → sim):
+//!
+//! 1. `Sim::with_params(scenario, seed)`, a [`Tracker`] with the scenario's sensing model
+//!    and default [`FimOptions`], one [`Controller`] per robot with its mission.
+//! 2. `sim.step(&[])`: the first step, without commands.
+//! 3. For each robot's report: its messages ([`robot_messages`]), the estimate from its
+//!    range scan ([`Tracker::on_scan`], exactly what the localization service publishes),
+//!    then the controller's update from the estimate and its PEB
+//!    ([`PositionSource::Estimate`]) or from the true position and the PEB there
+//!    ([`PositionSource::Truth`], paper 002 ES2's "nominal conditions").
+//! 4. The commands of the robots whose mission is Active; `sim.step(&commands)`; back to 3.
+//!
+//! The run stops when every robot's mission is completed, stuck, at its step limit, or
+//! held for its PEB for a whole stuck window (a lost fix that does not come back: a
+//! robot at rest stays where its fix was lost), or after `max_steps` + 1 sim steps.
+//!
+//! The sim runs with the scenario's parameters except the local grid observation, which
+//! is turned off: it draws no random numbers and does not move anything (roam-sim draws
+//! two transition and one range value per robot per step whatever it observes), so the
+//! trajectories are bit for bit those of the sim service with the observation on.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Arc;
+
+use roam_localization::fim::FimOptions;
+use roam_localization::model::RangingModel;
+use roam_localization::{LocalizationError, Tracker};
+use roam_sim::messages::robot_messages;
+use roam_sim::{Command, Sim, SimError, SimParams};
+use roam_world::scenario::Scenario;
+use serde::Serialize;
+
+use roam_controller::controller::{Controller, MissionStatus};
+use roam_controller::information::InformationField;
+use roam_controller::obstacle_field::ObstacleField;
+use roam_controller::params::{ApfParams, ParamError};
+
+/// Where the controller's position comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PositionSource {
+    /// The localization estimate and its PEB (paper 002 ES1, ES3).
+    Estimate,
+    /// The true position and the PEB there (paper 002 ES2: "nominal conditions").
+    Truth,
+}
+
+/// The waypoints one robot is to visit, in order.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RobotMission {
+    pub robot: String,
+    pub waypoints: Vec<[f64; 2]>,
+}
+
+/// What an episode cannot start with.
+#[derive(Debug, thiserror::Error)]
+pub enum EpisodeError {
+    #[error("the sim refused the scenario: {0}")]
+    Sim(#[from] SimError),
+    #[error("the scenario's sensing model is unusable: {0}")]
+    Model(#[from] LocalizationError),
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    #[error("a mission names robot '{0}', which the scenario does not have")]
+    UnknownRobot(String),
+    #[error("robot '{0}' has two missions")]
+    DuplicateMission(String),
+    #[error(transparent)]
+    Scenario(#[from] roam_world::scenario::ScenarioError),
+    #[error("scenario {0} has no robot")]
+    NoRobot(String),
+}
+
+/// A scenario made ready for many episodes: the sim's parameters and the two fields,
+/// built once.
+#[derive(Debug, Clone)]
+pub struct Setup {
+    pub scenario: Scenario,
+    pub sim_params: SimParams,
+    pub obstacles: Arc<ObstacleField>,
+    pub information: Arc<InformationField>,
+}
+
+impl Setup {
+    /// The scenario's sim parameters without the observation (module doc), its obstacle
+    /// field, and its anchors' information field with default [`FimOptions`].
+    pub fn new(scenario: &Scenario) -> Result<Setup, EpisodeError> {
+        let mut sim_params = SimParams::from_file(&scenario.file);
+        sim_params.sensing.observation_radius_m = 0.0;
+        sim_params.check(scenario.occupancy.meta.resolution)?;
+        let anchors: Vec<[f64; 2]> = scenario.file.anchors.iter().map(|a| a.at).collect();
+        let model = RangingModel::from_spec(&anchors, &scenario.file.sensing)?;
+        Ok(Setup {
+            scenario: scenario.clone(),
+            sim_params,
+            obstacles: Arc::new(ObstacleField::new(&scenario.occupancy)),
+            information: Arc::new(InformationField::new(model, FimOptions::default())),
+        })
+    }
+
+    /// The scenario's start of robot `name`.
+    pub fn start_of(&self, name: &str) -> Option<[f64; 2]> {
+        self.scenario
+            .file
+            .robots
+            .iter()
+            .find(|r| r.name == name)
+            .map(|r| r.at)
+    }
+}
+
+/// What one robot did in an episode. The per-step vectors hold one entry per update
+/// made while its mission was on (at most `max_steps` + 1).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RobotTrack {
+    pub robot: String,
+    pub waypoints: Vec<[f64; 2]>,
+    /// The mission's status when the episode ended.
+    pub status: MissionStatus,
+    /// Every waypoint reached.
+    pub success: bool,
+    /// Updates of the mission until it ended (the sim step at which it completed, when
+    /// it did).
+    pub steps: u64,
+    /// The length of the true path while the mission was on, metres.
+    pub distance_m: f64,
+    /// The true position at each update, world metres.
+    pub truth: Vec<[f64; 2]>,
+    /// The estimate at each update (the prior when degraded), world metres.
+    pub estimate: Vec<[f64; 2]>,
+    /// ‖p̂ − p‖ at each update, metres.
+    pub error_m: Vec<f64>,
+    /// Consecutive updates the PEB guard was holding the robot when its mission ended
+    /// (0: it was not held). The experiments tell a failure the guard caused (a robot
+    /// held until it is given up) from one the robot drove into ([`crate::reproduce::apf::failure`]).
+    pub held_updates: u64,
+}
+
+/// The result of one episode.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Episode {
+    pub seed: u64,
+    pub source: PositionSource,
+    /// Sim steps taken.
+    pub sim_steps: u64,
+    /// One entry per mission, in the missions' order.
+    pub robots: Vec<RobotTrack>,
+}
+
+impl Episode {
+    /// Every robot reached every waypoint.
+    pub fn success(&self) -> bool {
+        self.robots.iter().all(|r| r.success)
+    }
+}
+
+struct Driven {
+    index: usize,
+    controller: Controller,
+    track: RobotTrack,
+    done: bool,
+}
+
+/// Runs one episode (module doc) of `setup`'s scenario with seed `seed`.
+pub fn run_episode(
+    setup: &Setup,
+    params: &ApfParams,
+    source: PositionSource,
+    missions: &[RobotMission],
+    seed: u64,
+) -> Result<Episode, EpisodeError> {
+    params.check()?;
+    let mut sim = Sim::with_params(&setup.scenario, setup.sim_params, seed)?;
+    let mut tracker = Tracker::new(setup.scenario.file.sensing, FimOptions::default());
+    let mut driven: BTreeMap<&str, Driven> = BTreeMap::new();
+    for (index, m) in missions.iter().enumerate() {
+        if sim.robot(&m.robot).is_none() {
+            return Err(EpisodeError::UnknownRobot(m.robot.clone()));
+        }
+        let mut controller = Controller::new(
+            params.clone(),
+            setup.obstacles.clone(),
+            setup.information.clone(),
+        );
+        controller.set_mission(m.waypoints.clone());
+        let d = Driven {
+            index,
+            done: !controller.is_active(),
+            controller,
+            track: RobotTrack {
+                robot: m.robot.clone(),
+                waypoints: m.waypoints.clone(),
+                status: MissionStatus::Idle,
+                success: m.waypoints.is_empty(),
+                steps: 0,
+                distance_m: 0.0,
+                truth: Vec::new(),
+                estimate: Vec::new(),
+                error_m: Vec::new(),
+                held_updates: 0,
+            },
+        };
+        if driven.insert(m.robot.as_str(), d).is_some() {
+            return Err(EpisodeError::DuplicateMission(m.robot.clone()));
+        }
+    }
+    let max_sim_steps = params.max_steps.saturating_add(1);
+    let mut report = sim.step(&[])?;
+    loop {
+        let mut commands = Vec::new();
+        for r in &report.robots {
+            let messages = robot_messages(&sim, report.step, report.time_s, r);
+            // The localization service ignores a scan it refuses; so does the episode.
+            let Ok(estimate) = tracker.on_scan(&messages.ranges) else {
+                continue;
+            };
+            let Some(d) = driven.get_mut(r.name.as_str()) else {
+                continue;
+            };
+            if d.done {
+                continue;
+            }
+            let truth = r.readings.truth;
+            let (position, peb) = match source {
+                PositionSource::Estimate => (estimate.position, estimate.peb_m),
+                PositionSource::Truth => (truth, setup.information.peb_m(truth)),
+            };
+            let decision = d.controller.update(position, peb);
+            let t = &mut d.track;
+            if let Some(last) = t.truth.last() {
+                t.distance_m += (truth[0] - last[0]).hypot(truth[1] - last[1]);
+            }
+            t.truth.push(truth);
+            t.estimate.push(estimate.position);
+            t.error_m
+                .push((estimate.position[0] - truth[0]).hypot(estimate.position[1] - truth[1]));
+            t.status = decision.status;
+            t.steps = decision.steps;
+            t.held_updates = decision.halted_updates;
+            t.success = decision.status == MissionStatus::Completed;
+            d.done = decision.status.is_final()
+                || decision.status == MissionStatus::Idle
+                || (decision.status == MissionStatus::HaltedPeb
+                    && decision.halted_updates >= params.stuck_window_steps);
+            if decision.status == MissionStatus::Active {
+                commands.push(Command {
+                    robot: r.name.clone(),
+                    u: decision.u,
+                });
+            }
+        }
+        if driven.values().all(|d| d.done) || sim.steps() >= max_sim_steps {
+            break;
+        }
+        report = sim.step(&commands)?;
+    }
+    let sim_steps = sim.steps();
+    let mut robots: Vec<(usize, RobotTrack)> =
+        driven.into_values().map(|d| (d.index, d.track)).collect();
+    robots.sort_by_key(|(i, _)| *i);
+    Ok(Episode {
+        seed,
+        source,
+        sim_steps,
+        robots: robots.into_iter().map(|(_, t)| t).collect(),
+    })
+}
+
+/// A robot's mission from a scenario's waypoints: all of them in order, without a first
+/// one the robot already stands on (within `g_thres_m`), followed by `and_back` (paper
+/// 002 ES2 returns to A).
+pub fn mission_from_waypoints(
+    setup: &Setup,
+    robot: &str,
+    g_thres_m: f64,
+    and_back: bool,
+) -> Result<RobotMission, EpisodeError> {
+    let start = setup
+        .start_of(robot)
+        .ok_or_else(|| EpisodeError::UnknownRobot(robot.to_owned()))?;
+    let all: Vec<[f64; 2]> = setup.scenario.file.waypoints.iter().map(|w| w.at).collect();
+    let skip = all
+        .first()
+        .is_some_and(|w| (w[0] - start[0]).hypot(w[1] - start[1]) <= g_thres_m);
+    let mut waypoints: Vec<[f64; 2]> = all.iter().skip(usize::from(skip)).copied().collect();
+    if and_back {
+        if let Some(first) = all.first() {
+            waypoints.push(*first);
+        }
+    }
+    Ok(RobotMission {
+        robot: robot.to_owned(),
+        waypoints,
+    })
+}
+
+/// Loads a scenario file as the services do (`roam_world::scenario::load_or_builtin`).
+pub fn load_scenario(path: &Path) -> Result<Scenario, EpisodeError> {
+    Ok(roam_world::scenario::load_or_builtin(Some(path))?.1)
+}
+
+/// One ES1 mission in batch (paper 002 §4): the scenario at `path`'s first robot from its
+/// start (A) through the scenario's waypoints (B), on estimates, with `params` and
+/// `seed`. The integration tests compare the running services with this.
+pub fn es1_mission(path: &Path, params: &ApfParams, seed: u64) -> Result<Episode, EpisodeError> {
+    let scenario = load_scenario(path)?;
+    let setup = Setup::new(&scenario)?;
+    let robot = scenario
+        .file
+        .robots
+        .first()
+        .ok_or_else(|| EpisodeError::NoRobot(path.display().to_string()))?;
+    let mission = mission_from_waypoints(&setup, &robot.name, params.g_thres_m, false)?;
+    run_episode(&setup, params, PositionSource::Estimate, &[mission], seed)
+}

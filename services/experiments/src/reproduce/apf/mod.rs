@@ -1,0 +1,480 @@
+//! The reproduction of paper 002 §4: ES1 ([`es1`]), ES2 ([`es2`]) and ES3 ([`es3`]), the
+//! paper's published figures and the comparison table ([`paper`]), and why runs failed
+//! ([`failure`]).
+//!
+//! **ES1 twice.** ES1 runs with roam's PEB guard (the paper's parameters,
+//! [`paper::paper_params`]) and again with the guard off (`max_peb_m = ∞`) on the same
+//! seeds (issue 18): with the guard on, a robot that loses its fix is held until it is
+//! given up, a failure paper 002 does not have; only the run without it shows whether a
+//! scheme fails for the paper's reason (driving into poor coverage). Both are reported,
+//! each failure with its cause ([`failure`]).
+//!
+//! **Determinism and common random numbers.** Every run's seed is derived from the base
+//! seed and the run's place in the experiment ([`run_seed`]: experiment, mission, run),
+//! never from the order in which runs happen, and never from the scheme: run r of
+//! mission m starts from the same seed for every scheme (and every z_is in ES2), so the
+//! schemes are compared on the same noise draws rather than on different ones (issue 18:
+//! with the scheme in the seed, ES1's RMSE ordering and ES3's fixed-scheme cost mixed the
+//! schemes' effect with their noise). The draws stay aligned as long as the runs consume
+//! them alike; once trajectories part, so do the streams. Runs are spread over `threads` scoped threads and their results
+//! are put back in run order before anything is summed, so the output is the same bit
+//! for bit whatever the thread count.
+//!
+//! **Summaries** ([`summarize`]): a run succeeds when every robot reached every waypoint;
+//! steps, distance and the mission RMSE are taken over the successful runs (`None` when
+//! none succeeded), and beside them the failures are counted and RMSE, steps and
+//! distance are given over all runs (a failed run counts the steps and distance until it
+//! was given up, e.g. at the step limit), so a scheme whose failures are its slowest runs
+//! does not look faster for them; each failure is put in one class ([`failure`]). The
+//! mission RMSE is the
+//! paper's: per step k, RMSE^k = √(mean over runs of ‖p̂_k − p_k‖²) (§4), averaged over
+//! the mission's steps. Runs end at different steps, so RMSE^k at step k is taken over
+//! the runs still on their mission at k, and the average runs over k = 1 … the longest
+//! run (one run still going is one sample of RMSE^k). With several robots (ES3), a run's
+//! squared error at k is the mean over its robots still on their missions at k (the
+//! PEB's 1/N_a of §2.2).
+//!
+//! Why the successful runs: one run whose first fix lands on the wrong solution of the
+//! range equations (see [`es1`]) keeps an error of tens of metres until it is given up,
+//! and would dominate RMSE^k for every k it lasts; the paper reports RMSE for the schemes
+//! that complete.
+
+pub mod claims;
+pub mod es1;
+pub mod es2;
+pub mod es3;
+pub mod failure;
+pub mod paper;
+pub mod render;
+pub mod runner;
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+use roam_world::scenario::Scenario;
+use serde::Serialize;
+
+use crate::closed_loop::episode::{Episode, EpisodeError, Setup};
+use roam_controller::params::{ApfParams, ParamError};
+use roam_controller::weights::Scheme;
+
+pub use es1::{es1, Es1Outcome, Es1Row};
+pub use es2::{es2, Es2Outcome, Es2Row};
+pub use es3::{es3, Es3Outcome, Es3Row};
+pub use failure::{FailureCause, FailureCauses};
+
+/// How many runs, from which seed, on how many threads, reporting progress how.
+#[derive(Clone, Copy)]
+pub struct RunOptions<'a> {
+    /// Runs per configuration (ES1: per scheme; ES2: per scheme and z_is; ES3: per
+    /// scheme and mission).
+    pub runs: usize,
+    /// The base seed every run's seed is derived from.
+    pub seed: u64,
+    /// Worker threads (at least one is used).
+    pub threads: usize,
+    /// The controller's parameters; each experiment sets the scheme and z_is (and what
+    /// else it says) on top.
+    pub params: &'a ApfParams,
+    /// Called after every finished run with (experiment, runs done, runs in total).
+    pub progress: &'a (dyn Fn(&str, usize, usize) + Sync),
+}
+
+impl std::fmt::Debug for RunOptions<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RunOptions")
+            .field("runs", &self.runs)
+            .field("seed", &self.seed)
+            .field("threads", &self.threads)
+            .field("params", self.params)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The most runs one configuration may have.
+pub const MAX_RUNS: usize = 100_000;
+/// The most ES3 missions.
+pub const MAX_MISSIONS: usize = 10_000;
+
+/// Why an experiment could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum ApfError {
+    #[error(transparent)]
+    Episode(#[from] EpisodeError),
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    #[error("{name} is {value}: {expected}")]
+    BadOption {
+        name: &'static str,
+        value: usize,
+        expected: &'static str,
+    },
+    #[error("scenario {scenario}: {reason}")]
+    Scenario { scenario: String, reason: String },
+}
+
+impl RunOptions<'_> {
+    pub(crate) fn check(&self) -> Result<(), ApfError> {
+        if !(1..=MAX_RUNS).contains(&self.runs) {
+            return Err(ApfError::BadOption {
+                name: "runs",
+                value: self.runs,
+                expected: "use 1 to 100000 runs",
+            });
+        }
+        self.params.check()?;
+        Ok(())
+    }
+}
+
+/// The seed of one run: a hash of the base seed and the run's place (experiment,
+/// mission, run), so a run's noise does not depend on which other runs exist. The scheme
+/// is left out on purpose: every scheme meets the same noise (common random numbers,
+/// module doc).
+pub fn run_seed(base: u64, experiment: &str, mission: usize, run: usize) -> u64 {
+    roam_world::seed::labelled(base, &format!("{experiment}/{mission}/{run}"))
+}
+
+/// Runs `job` on every element of `jobs` over up to `threads` threads and returns the
+/// results in the order of `jobs`, whatever order they finished in. Reports progress
+/// after each job as (`name`, done, `offset` + done of `total`).
+pub(crate) fn run_parallel<J: Sync, R: Send>(
+    jobs: &[J],
+    threads: usize,
+    job: impl Fn(&J) -> R + Sync,
+    progress: impl Fn(usize) + Sync,
+) -> Vec<R> {
+    let threads = threads.clamp(1, jobs.len().max(1));
+    let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(0);
+    let slots: Mutex<Vec<Option<R>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(j) = jobs.get(i) else {
+                    return;
+                };
+                let r = job(j);
+                if let Some(slot) = slots.lock().unwrap_or_else(|p| p.into_inner()).get_mut(i) {
+                    *slot = Some(r);
+                }
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1);
+            });
+        }
+    });
+    slots
+        .into_inner()
+        .unwrap_or_else(|p| p.into_inner())
+        .into_iter()
+        .flatten()
+        .collect()
+}
+
+/// One run reduced to what the summaries need.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSummary {
+    pub success: bool,
+    /// Sim steps until every robot's mission ended (completed or given up).
+    pub steps: u64,
+    /// The robots' true path lengths, summed, metres.
+    pub distance_m: f64,
+    /// The squared localization error at each step, averaged over the robots still on
+    /// their missions then (module doc).
+    pub squared_error: Vec<f64>,
+    /// Why the run failed ([`failure`]); `None` when it succeeded.
+    pub failure: Option<FailureCause>,
+}
+
+impl RunSummary {
+    /// `episode` summarised; `setup` is its scenario's, for the coverage where a failed
+    /// robot ended.
+    pub fn of(episode: &Episode, setup: &Setup) -> RunSummary {
+        let longest = episode
+            .robots
+            .iter()
+            .map(|r| r.error_m.len())
+            .max()
+            .unwrap_or(0);
+        let squared_error = (0..longest)
+            .map(|k| {
+                let (sum, n) = episode
+                    .robots
+                    .iter()
+                    .filter_map(|r| r.error_m.get(k))
+                    .fold((0.0, 0usize), |(s, n), e| (s + e * e, n + 1));
+                sum / n.max(1) as f64
+            })
+            .collect();
+        RunSummary {
+            success: episode.success(),
+            steps: episode.robots.iter().map(|r| r.steps).max().unwrap_or(0),
+            distance_m: episode.robots.iter().map(|r| r.distance_m).sum(),
+            squared_error,
+            failure: failure::cause(episode, setup),
+        }
+    }
+}
+
+/// The summary of one configuration's runs (module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Summary {
+    pub runs: usize,
+    /// Share of runs in which every robot reached every waypoint.
+    pub success_rate: f64,
+    /// The mission RMSE of the successful runs (module doc), metres.
+    pub rmse_m: Option<f64>,
+    /// The mission RMSE of all runs, metres; `None` without any sample.
+    pub rmse_all_m: Option<f64>,
+    /// Mean steps of the successful runs.
+    pub steps: Option<f64>,
+    /// Mean distance of the successful runs, metres.
+    pub distance_m: Option<f64>,
+    /// Runs in which some robot missed a waypoint.
+    pub failures: usize,
+    /// Mean steps of all runs (failed runs until given up).
+    pub steps_all: Option<f64>,
+    /// Mean distance of all runs, metres.
+    pub distance_all_m: Option<f64>,
+    /// The failed runs by cause ([`failure`]).
+    pub causes: FailureCauses,
+}
+
+/// The paper's mission RMSE over `runs` (module doc): RMSE^k over the runs still going
+/// at k, averaged over k; `None` without any sample.
+fn mission_rmse(runs: &[&RunSummary]) -> Option<f64> {
+    let longest = runs
+        .iter()
+        .map(|r| r.squared_error.len())
+        .max()
+        .unwrap_or(0);
+    let sum: f64 = (0..longest)
+        .map(|k| {
+            let (sum, n) = runs
+                .iter()
+                .filter_map(|r| r.squared_error.get(k))
+                .fold((0.0, 0usize), |(s, n), e| (s + e, n + 1));
+            (sum / n.max(1) as f64).sqrt()
+        })
+        .sum();
+    (longest > 0).then(|| sum / longest as f64)
+}
+
+/// Summarises runs given in run order (module doc).
+pub fn summarize(runs: &[RunSummary]) -> Summary {
+    let ok: Vec<&RunSummary> = runs.iter().filter(|r| r.success).collect();
+    let mean = |values: Vec<f64>| {
+        (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+    };
+    Summary {
+        runs: runs.len(),
+        success_rate: if runs.is_empty() {
+            0.0
+        } else {
+            ok.len() as f64 / runs.len() as f64
+        },
+        rmse_m: mission_rmse(&ok),
+        rmse_all_m: mission_rmse(&runs.iter().collect::<Vec<_>>()),
+        steps: mean(ok.iter().map(|r| r.steps as f64).collect()),
+        distance_m: mean(ok.iter().map(|r| r.distance_m).collect()),
+        failures: runs.len() - ok.len(),
+        steps_all: mean(runs.iter().map(|r| r.steps as f64).collect()),
+        distance_all_m: mean(runs.iter().map(|r| r.distance_m).collect()),
+        causes: FailureCauses::count(runs.iter().filter_map(|r| r.failure)),
+    }
+}
+
+/// A robot's true path in one run, for the figures.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Trajectory {
+    pub scheme: Scheme,
+    pub z_is: f64,
+    pub robot: String,
+    pub success: bool,
+    pub truth: Vec<[f64; 2]>,
+}
+
+impl Trajectory {
+    pub(crate) fn of(scheme: Scheme, z_is: f64, episode: &Episode) -> Vec<Trajectory> {
+        episode
+            .robots
+            .iter()
+            .map(|r| Trajectory {
+                scheme,
+                z_is,
+                robot: r.robot.clone(),
+                success: r.success,
+                truth: r.truth.clone(),
+            })
+            .collect()
+    }
+}
+
+/// The whole reproduction: what `roam reproduce controller` prints and writes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Reproduction {
+    /// ES1 with roam's PEB guard on (the paper's parameters).
+    pub es1: Vec<Es1Row>,
+    /// ES1 on the same seeds with the guard off (`max_peb_m = ∞`, module doc).
+    pub es1_no_guard: Vec<Es1Row>,
+    pub es2: Vec<Es2Row>,
+    pub es3: Vec<Es3Row>,
+    /// One run per configuration, for the figures (not serialized).
+    #[serde(skip)]
+    pub es1_trajectories: Vec<Trajectory>,
+    #[serde(skip)]
+    pub es2_trajectories: Vec<Trajectory>,
+}
+
+/// How big the whole reproduction is.
+#[derive(Clone, Copy)]
+pub struct ReproduceOptions<'a> {
+    /// ES1 runs per scheme (paper 002: 100).
+    pub es1_runs: usize,
+    /// ES2 runs per scheme and z_is (paper 002 does not say; roam: 10).
+    pub es2_runs: usize,
+    /// ES3 missions (paper 002: 10) and runs per mission (paper 002: 100).
+    pub es3_missions: usize,
+    pub es3_runs: usize,
+    pub seed: u64,
+    pub threads: usize,
+    pub params: &'a ApfParams,
+    pub progress: &'a (dyn Fn(&str, usize, usize) + Sync),
+}
+
+impl std::fmt::Debug for ReproduceOptions<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ReproduceOptions")
+            .field("es1_runs", &self.es1_runs)
+            .field("es2_runs", &self.es2_runs)
+            .field("es3_missions", &self.es3_missions)
+            .field("es3_runs", &self.es3_runs)
+            .field("seed", &self.seed)
+            .field("threads", &self.threads)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The paper's sizes: 100 ES1 runs per scheme, 10 ES2 runs per point, ES3 10 missions ×
+/// 100 runs.
+pub const DEFAULT_ES1_RUNS: usize = 100;
+pub const DEFAULT_ES2_RUNS: usize = 10;
+pub const DEFAULT_ES3_MISSIONS: usize = 10;
+pub const DEFAULT_ES3_RUNS: usize = 100;
+
+/// Runs ES1, ES2 and ES3 on their scenarios.
+pub fn reproduce(
+    es1_scenario: &Scenario,
+    es2_scenario: &Scenario,
+    es3_scenario: &Scenario,
+    options: &ReproduceOptions<'_>,
+) -> Result<Reproduction, ApfError> {
+    let run = |runs: usize| RunOptions {
+        runs,
+        seed: options.seed,
+        threads: options.threads,
+        params: options.params,
+        progress: options.progress,
+    };
+    let one = es1(es1_scenario, &run(options.es1_runs))?;
+    let unguarded = ApfParams {
+        max_peb_m: f64::INFINITY,
+        ..options.params.clone()
+    };
+    let no_guard = es1(
+        es1_scenario,
+        &RunOptions {
+            params: &unguarded,
+            ..run(options.es1_runs)
+        },
+    )?;
+    let two = es2(es2_scenario, &run(options.es2_runs), &es2::Z_IS)?;
+    let three = es3(es3_scenario, &run(options.es3_runs), options.es3_missions)?;
+    Ok(Reproduction {
+        es1: one.rows,
+        es1_no_guard: no_guard.rows,
+        es2: two.rows,
+        es3: three.rows,
+        es1_trajectories: one.trajectories,
+        es2_trajectories: two.trajectories,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn run_seeds_differ_by_every_part_and_repeat() {
+        let s = run_seed(7, "es1", 0, 3);
+        assert_eq!(s, run_seed(7, "es1", 0, 3));
+        for other in [
+            run_seed(8, "es1", 0, 3),
+            run_seed(7, "es3", 0, 3),
+            run_seed(7, "es1", 1, 3),
+            run_seed(7, "es1", 0, 4),
+        ] {
+            assert_ne!(s, other);
+        }
+    }
+
+    #[test]
+    fn parallel_results_come_back_in_job_order() {
+        let jobs: Vec<u64> = (0..50).collect();
+        let done = AtomicUsize::new(0);
+        for threads in [1, 2, 7] {
+            let out = run_parallel(
+                &jobs,
+                threads,
+                |j| {
+                    // Uneven work, so threads finish out of order.
+                    std::thread::sleep(std::time::Duration::from_micros((j * 37) % 200));
+                    j * j
+                },
+                |_| {
+                    done.fetch_add(1, Ordering::Relaxed);
+                },
+            );
+            assert_eq!(out, jobs.iter().map(|j| j * j).collect::<Vec<_>>());
+        }
+        assert_eq!(done.load(Ordering::Relaxed), 150);
+    }
+
+    fn run(success: bool, steps: u64, distance_m: f64, errors: &[f64]) -> RunSummary {
+        RunSummary {
+            success,
+            steps,
+            distance_m,
+            squared_error: errors.iter().map(|e| e * e).collect(),
+            failure: (!success).then_some(FailureCause::Other),
+        }
+    }
+
+    #[test]
+    fn the_summary_averages_rmse_per_step_over_the_runs_still_going() {
+        // All runs: step 1, errors 3 and 4 → √((9 + 16)/2) = √12.5; step 2, only the
+        // first run, error 2 → 2; mission RMSE = (√12.5 + 2)/2.
+        let s = summarize(&[
+            run(true, 10, 2.0, &[3.0, 2.0]),
+            run(false, 4, 9.0, &[4.0]),
+            run(true, 12, 4.0, &[1.0]),
+        ]);
+        assert_eq!(s.runs, 3);
+        assert!((s.success_rate - 2.0 / 3.0).abs() < 1e-15);
+        let all = ((9.0f64 + 16.0 + 1.0) / 3.0).sqrt();
+        assert!((s.rmse_all_m.expect("rmse") - (all + 2.0) / 2.0).abs() < 1e-12);
+        // Successful runs: step 1, errors 3 and 1 → √5; step 2 → 2.
+        assert!((s.rmse_m.expect("rmse") - (5f64.sqrt() + 2.0) / 2.0).abs() < 1e-12);
+        // Steps and distance over the successful runs only.
+        assert_eq!((s.steps, s.distance_m), (Some(11.0), Some(3.0)));
+        // The one failure, with its cause.
+        assert_eq!((s.failures, s.causes.other, s.causes.total()), (1, 1, 1));
+        let none = summarize(&[run(false, 4, 9.0, &[])]);
+        assert_eq!(
+            (none.steps, none.distance_m, none.rmse_m),
+            (None, None, None)
+        );
+        assert_eq!(none.rmse_all_m, None);
+        assert_eq!(none.success_rate, 0.0);
+    }
+}

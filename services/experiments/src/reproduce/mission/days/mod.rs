@@ -1,0 +1,252 @@
+//! `roam reproduce mission --days N`: issue 14's item 7 measured in batch. The
+//! executive's day ([`roam_mission::tasks::day`] on [`roam_mission::tasks::DAY_SCENARIO`]: four
+//! windows, one a round trip, a cart on the docks, a north-east room no anchor covers)
+//! is run N times per variant with the services' own code and no network:
+//!
+//! - **planning**: the planner's batch [`roam_planner::plan::plan`] with the request the
+//!   executive sends (Model I, `max_generations`, the time model, W_loc), on the map the
+//!   planner service holds ([`planning`]); a curious plan costs a fixed `plan_cost_s`
+//!   of mission time (the services' 1 s deadline at 1× real time), never wall time;
+//! - **driving**: the sim, localization's tracker and the APF controller one step at a
+//!   time ([`crate::closed_loop::stepper::Stepper`]), the mapper's change map fed the
+//!   robot's observation every step ([`robot`]); mission time is sim time;
+//! - **watching**: the executive's replan policy ([`roam_mission::watch::Watch`]) on every
+//!   step's estimate and status, its replans, its time model learning from each arrived
+//!   mission ([`roam_mission::calibration::Calibration::add_planned`]) and the next window
+//!   planned during the task ([`window`], [`day`]).
+//!
+//! The variants ([`Variant`]) are today's executive, the new one, the new one without
+//! each coupling, and the shortest path. **Common random numbers**: a day's sim seed and
+//! its plans' seeds depend on the day (and the window and the plan's rank in it), never
+//! on the variant, so every variant of a day meets the same range and motion noise step
+//! by step and its first plan of each window draws the same GA stream. Days are
+//! independent: each starts from Table I and an empty change map. The same options give
+//! the same report bit for bit, whatever the number of threads (`jobs`).
+//!
+//! Measured per window ([`measure::WindowResult`]): the share of the window driven, late
+//! arrivals, the information driven (paper 000's distinct cells on the static map,
+//! along the true path) and planned, the change seen, the PEB, and the time model's
+//! prediction error; then per variant and window of the day ([`summary`]), against the
+//! goals with verdicts computed from the figures ([`goals`]), as a table ([`table`]).
+
+pub mod day;
+pub mod goals;
+pub mod measure;
+pub mod planning;
+pub mod robot;
+pub mod stats;
+pub mod summary;
+pub mod table;
+pub mod thin;
+pub mod variant;
+pub mod window;
+pub mod world;
+
+#[cfg(test)]
+mod tests;
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+use serde::Serialize;
+
+pub use day::DayResult;
+pub use goals::{Goal, Verdict};
+pub use summary::{Effect, Paired, VariantSummary};
+pub use variant::Variant;
+pub use world::DayWorld;
+
+use roam_mission::calibration::CalibrationError;
+
+/// The most days one batch runs.
+pub const MAX_DAYS: usize = 10_000;
+
+/// The most a curious plan may cost on the mission clock, seconds (a window is minutes).
+pub const MAX_PLAN_COST_S: f64 = 600.0;
+
+/// What to run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DaysOptions {
+    pub days: usize,
+    pub seed: u64,
+    /// GA generations per curious plan (the executive's `max_generations`).
+    pub generations: u32,
+    /// W_loc of the PEB cost (as `roam reproduce mission`: 2000).
+    pub w_loc: f64,
+    /// What a curious plan costs on the mission clock, seconds (the services' default
+    /// deadline, 1 s, at 1× real time).
+    pub plan_cost_s: f64,
+    pub variants: Vec<Variant>,
+    /// Threads the days run on (the report does not depend on it).
+    pub jobs: usize,
+}
+
+impl Default for DaysOptions {
+    fn default() -> Self {
+        DaysOptions {
+            days: 50,
+            seed: 0,
+            generations: 1000,
+            w_loc: 2000.0,
+            plan_cost_s: 1.0,
+            variants: Variant::ALL.to_vec(),
+            jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        }
+    }
+}
+
+/// Why a batch could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum DaysError {
+    /// An option out of its range, named as [`DaysOptions`] spells it.
+    #[error("{field} is {value}; give {limit}")]
+    Invalid {
+        field: &'static str,
+        value: String,
+        limit: String,
+    },
+    #[error("the day's world: {0}")]
+    World(String),
+    #[error("driving: {0}")]
+    Drive(#[from] crate::closed_loop::episode::EpisodeError),
+    #[error("the time model: {0}")]
+    Calibration(#[from] CalibrationError),
+    #[error("the change map: {0}")]
+    Mapper(String),
+}
+
+/// The batch's report: the options, the figures, the goals, every window.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DaysReport {
+    pub days: usize,
+    pub seed: u64,
+    pub generations: u32,
+    pub w_loc: f64,
+    pub plan_cost_s: f64,
+    /// Cells the day's cart covers at some step.
+    pub changing_cells: usize,
+    pub variants: Vec<VariantSummary>,
+    pub information_vs_shortest: Option<Paired>,
+    pub information_vs_today: Option<Paired>,
+    pub effects: Vec<Effect>,
+    pub goals: Vec<Goal>,
+    pub results: Vec<DayResult>,
+}
+
+/// The options' ranges; the first out of range is refused, naming its field and limit.
+fn check(o: &DaysOptions) -> Result<(), DaysError> {
+    let invalid = |field, value: &dyn std::fmt::Display, limit: String| {
+        Err(DaysError::Invalid {
+            field,
+            value: value.to_string(),
+            limit,
+        })
+    };
+    let max_generations = roam_planner::params::MAX_GENERATIONS;
+    if o.days == 0 || o.days > MAX_DAYS {
+        return invalid("days", &o.days, format!("1 to {MAX_DAYS} (MAX_DAYS)"));
+    }
+    if o.generations == 0 || o.generations > max_generations {
+        return invalid(
+            "generations",
+            &o.generations,
+            format!("1 to {max_generations}"),
+        );
+    }
+    if !(o.w_loc.is_finite() && o.w_loc >= 0.0) {
+        return invalid("w_loc", &o.w_loc, "a finite 0 or more".into());
+    }
+    if !(o.plan_cost_s.is_finite() && (0.0..=MAX_PLAN_COST_S).contains(&o.plan_cost_s)) {
+        return invalid(
+            "plan_cost_s",
+            &o.plan_cost_s,
+            format!("0 to {MAX_PLAN_COST_S} seconds"),
+        );
+    }
+    if o.variants.is_empty() {
+        return invalid("variants", &"empty", "at least one".into());
+    }
+    if o.jobs == 0 {
+        return invalid("jobs", &o.jobs, "at least 1".into());
+    }
+    Ok(())
+}
+
+/// Runs the batch; `progress(done, total)` after each (variant, day).
+pub fn run(
+    options: &DaysOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<DaysReport, DaysError> {
+    check(options)?;
+    let world = DayWorld::new()?;
+    let mut variants = options.variants.clone();
+    variants.sort();
+    variants.dedup();
+    let units: Vec<(Variant, usize)> = (0..options.days)
+        .flat_map(|d| variants.iter().map(move |&v| (v, d)))
+        .collect();
+    let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(0);
+    let slots: Mutex<Vec<Option<Result<DayResult, DaysError>>>> =
+        Mutex::new((0..units.len()).map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..options.jobs.clamp(1, units.len()) {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(&(variant, d)) = units.get(i) else {
+                    break;
+                };
+                let result = day::run_day(&world, variant, options, d);
+                let failed = result.is_err();
+                if let Ok(mut slots) = slots.lock() {
+                    slots[i] = Some(result);
+                }
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, units.len());
+                if failed {
+                    // Stop taking work: the batch fails with the first error in order.
+                    next.store(units.len(), Ordering::Relaxed);
+                }
+            });
+        }
+    });
+    let slots = slots
+        .into_inner()
+        .map_err(|_| DaysError::World("a day's thread panicked".into()))?;
+    let mut results = Vec::with_capacity(units.len());
+    for slot in slots {
+        match slot {
+            Some(r) => results.push(r?),
+            None => continue,
+        }
+    }
+    Ok(report(options, &world, results))
+}
+
+/// The report of `results`.
+pub fn report(options: &DaysOptions, world: &DayWorld, results: Vec<DayResult>) -> DaysReport {
+    let summaries: Vec<VariantSummary> = Variant::ALL
+        .iter()
+        .filter_map(|&v| summary::variant_summary(&results, v))
+        .collect();
+    let vs_shortest = summary::paired(&results, Variant::New, Variant::Shortest);
+    let vs_today = summary::paired(&results, Variant::New, Variant::Today);
+    let effects = [("change", Variant::NewNoChange), ("peb", Variant::NewNoPeb)]
+        .into_iter()
+        .filter_map(|(c, without)| summary::effect(&results, c, without))
+        .collect();
+    let goals = goals::goals(&summaries, vs_shortest.as_ref(), vs_today.as_ref());
+    DaysReport {
+        days: options.days,
+        seed: options.seed,
+        generations: options.generations,
+        w_loc: options.w_loc,
+        plan_cost_s: options.plan_cost_s,
+        changing_cells: world.changing_cells,
+        variants: summaries,
+        information_vs_shortest: vs_shortest,
+        information_vs_today: vs_today,
+        effects,
+        goals,
+        results,
+    }
+}

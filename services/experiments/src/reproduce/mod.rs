@@ -1,0 +1,12 @@
+//! Each paper's evaluation, reproduced and judged next to the paper's figures.
+//!
+//! - [`planner`]: paper 000 §III, Models 0 / I / II on the built-in world.
+//! - [`apf`]: paper 002 §4, ES1–ES3 for plain APF and the four weighting schemes.
+//! - [`mapper`]: paper 004 §5, curious against recency- and Poisson-only mapping.
+//! - [`mission`]: the papers joined: seeded downtime missions, and the executive's
+//!   whole day in batch.
+
+pub mod apf;
+pub mod mapper;
+pub mod mission;
+pub mod planner;

@@ -1,0 +1,202 @@
+//! The role table: every service roam runs, what configures it, how it announces
+//! itself and how it runs.
+//!
+//! A role is a service with its config. The `roam` binary builds one from a config file
+//! and its flags (`roam planner --config …`), [`crate::Stack`] builds one per service it
+//! runs, and the integration tests build them from test configs; all three then start
+//! it the same way: [`Role::run`] with a Zenoh config and a cancellation token, and
+//! wait for [`Role::live_key`]. Adding a service means adding a variant here (and its
+//! command-line flags in the binary).
+
+use std::future::Future;
+use std::pin::Pin;
+
+use roam_controller::service::ControllerConfig;
+use roam_localization::service::LocalizationConfig;
+use roam_map_server::MapServerConfig;
+use roam_mapper::service::MapperConfig;
+use roam_mission::service::MissionConfig;
+use roam_planner::PlannerConfig;
+use roam_proto::keys;
+use roam_sim::service::SimConfig;
+use tokio_util::sync::CancellationToken;
+
+/// What every role's config has: a key root, an instance name and a Zenoh section.
+pub trait RoleConfig: serde::de::DeserializeOwned + Default {
+    fn root(&self) -> &str;
+    fn root_mut(&mut self) -> &mut String;
+    fn instance(&self) -> Option<&str>;
+    fn instance_mut(&mut self) -> &mut Option<String>;
+    /// The config file's `zenoh:` section, a Zenoh config fragment.
+    fn zenoh(&self) -> Option<&serde_json::Value>;
+}
+
+macro_rules! role_config {
+    ($($config:ty),*) => {$(
+        impl RoleConfig for $config {
+            fn root(&self) -> &str {
+                &self.root
+            }
+            fn root_mut(&mut self) -> &mut String {
+                &mut self.root
+            }
+            fn instance(&self) -> Option<&str> {
+                self.instance.as_deref()
+            }
+            fn instance_mut(&mut self) -> &mut Option<String> {
+                &mut self.instance
+            }
+            fn zenoh(&self) -> Option<&serde_json::Value> {
+                self.zenoh.as_ref()
+            }
+        }
+    )*};
+}
+
+role_config!(
+    MapServerConfig,
+    PlannerConfig,
+    SimConfig,
+    LocalizationConfig,
+    ControllerConfig,
+    MapperConfig,
+    MissionConfig
+);
+
+/// One service of roam with its config.
+#[derive(Debug, Clone)]
+pub enum Role {
+    MapServer(Box<MapServerConfig>),
+    Planner(Box<PlannerConfig>),
+    Sim(Box<SimConfig>),
+    Localization(Box<LocalizationConfig>),
+    Controller(Box<ControllerConfig>),
+    Mapper(Box<MapperConfig>),
+    Mission(Box<MissionConfig>),
+}
+
+/// A running role: it ends with the service, with its error as text.
+pub type RoleFuture = Pin<Box<dyn Future<Output = Result<(), String>> + Send + 'static>>;
+
+/// Runs a role's config through the same body for every variant.
+macro_rules! each_role {
+    ($role:expr, $config:ident => $body:expr) => {
+        match $role {
+            Role::MapServer($config) => $body,
+            Role::Planner($config) => $body,
+            Role::Sim($config) => $body,
+            Role::Localization($config) => $body,
+            Role::Controller($config) => $body,
+            Role::Mapper($config) => $body,
+            Role::Mission($config) => $body,
+        }
+    };
+}
+
+/// Boxes a service's run future as a [`RoleFuture`].
+fn boxed<E: std::fmt::Display>(
+    run: impl Future<Output = Result<(), E>> + Send + 'static,
+) -> RoleFuture {
+    Box::pin(async move { run.await.map_err(|e| e.to_string()) })
+}
+
+impl Role {
+    /// The service's name: its liveliness tokens' `<service>`, its command, and its
+    /// credentials' user name on a secure site.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Role::MapServer(_) => roam_map_server::SERVICE_NAME,
+            Role::Planner(_) => roam_planner::SERVICE_NAME,
+            Role::Sim(_) => roam_sim::service::SERVICE_NAME,
+            Role::Localization(_) => roam_localization::service::SERVICE_NAME,
+            Role::Controller(_) => roam_controller::service::SERVICE_NAME,
+            Role::Mapper(_) => roam_mapper::service::SERVICE_NAME,
+            Role::Mission(_) => roam_mission::service::SERVICE_NAME,
+        }
+    }
+
+    pub fn root(&self) -> &str {
+        each_role!(self, c => c.root())
+    }
+
+    pub fn instance(&self) -> Option<&str> {
+        each_role!(self, c => c.instance())
+    }
+
+    /// The config file's `zenoh:` section.
+    pub fn zenoh(&self) -> Option<&serde_json::Value> {
+        each_role!(self, c => c.zenoh())
+    }
+
+    /// Whether the role needs a sim world (robots, anchors): on a map alone the sim,
+    /// localization and the controller have nothing to do.
+    pub fn needs_sim_world(&self) -> bool {
+        matches!(
+            self,
+            Role::Sim(_) | Role::Localization(_) | Role::Controller(_)
+        )
+    }
+
+    /// The liveliness key to wait for: the instance's own token when the config names
+    /// the instance, any instance of the service otherwise.
+    pub fn live_key(&self) -> String {
+        match self.instance() {
+            Some(instance) => keys::liveliness(self.root(), self.name(), instance),
+            None => keys::liveliness_of(self.root(), self.name()),
+        }
+    }
+
+    /// Runs the service until `cancel` is cancelled (or it fails).
+    pub fn run(self, zenoh: zenoh::Config, cancel: CancellationToken) -> RoleFuture {
+        match self {
+            Role::MapServer(c) => boxed(roam_map_server::run(*c, zenoh, cancel)),
+            Role::Planner(c) => boxed(roam_planner::run(*c, zenoh, cancel)),
+            Role::Sim(c) => boxed(roam_sim::service::run(*c, zenoh, cancel)),
+            Role::Localization(c) => boxed(roam_localization::service::run(*c, zenoh, cancel)),
+            Role::Controller(c) => boxed(roam_controller::service::run(*c, zenoh, cancel)),
+            Role::Mapper(c) => boxed(roam_mapper::service::run(*c, zenoh, cancel)),
+            Role::Mission(c) => boxed(roam_mission::service::run(*c, zenoh, cancel)),
+        }
+    }
+}
+
+macro_rules! role_from {
+    ($($variant:ident($config:ty)),*) => {$(
+        impl From<$config> for Role {
+            fn from(config: $config) -> Role {
+                Role::$variant(Box::new(config))
+            }
+        }
+    )*};
+}
+
+role_from!(
+    MapServer(MapServerConfig),
+    Planner(PlannerConfig),
+    Sim(SimConfig),
+    Localization(LocalizationConfig),
+    Controller(ControllerConfig),
+    Mapper(MapperConfig),
+    Mission(MissionConfig)
+);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_named_instance_is_awaited_by_its_own_token() {
+        let planner = Role::from(PlannerConfig {
+            root: "r".into(),
+            instance: Some("p-1".into()),
+            ..PlannerConfig::default()
+        });
+        assert_eq!(planner.name(), "planner");
+        assert_eq!(planner.live_key(), keys::liveliness("r", "planner", "p-1"));
+        let sim = Role::from(SimConfig {
+            root: "r".into(),
+            ..SimConfig::default()
+        });
+        assert_eq!(sim.live_key(), keys::liveliness_of("r", "sim"));
+    }
+}
