@@ -22,7 +22,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use roam_proto::planner::{FitnessTerms, PlannerModel, StopReason};
+use roam_proto::planner::{FitnessTerms, PlannerModel, ShortestPathUse, StopReason};
 use roam_proto::{ErrorCode, ErrorReply};
 
 use crate::best::{best_of, PlanSource, Scored};
@@ -55,6 +55,10 @@ pub struct PlanSpec {
     pub threads: usize,
     /// The size limits a GA plan is checked against before any work.
     pub limits: PlanLimits,
+    /// Whether a budget below the shortest path's ETA is refused or answered with the
+    /// shortest path ([`ShortestPathUse::Fallback`]); the outcome carries the shortest
+    /// path either way, and the service attaches it to the reply unless `Omit`.
+    pub shortest: ShortestPathUse,
 }
 
 impl PlanSpec {
@@ -82,6 +86,7 @@ impl PlanSpec {
             seed,
             threads: crate::ga::default_threads(),
             limits: PlanLimits::default(),
+            shortest: ShortestPathUse::Omit,
         }
     }
 }
@@ -89,6 +94,9 @@ impl PlanSpec {
 /// A plan before it becomes a message.
 #[derive(Debug, Clone)]
 pub struct PlanOutcome {
+    /// The model that answered: the spec's, or [`PlannerModel::Shortest`] when the
+    /// budget did not fit the shortest path and the spec asked for the fallback.
+    pub model: PlannerModel,
     pub path: Vec<Cell>,
     pub t_eta_s: f64,
     pub reaches_goal: bool,
@@ -106,6 +114,18 @@ pub struct PlanOutcome {
     pub source: PlanSource,
     /// The via-point seeds the first population held ([`crate::seeds`]).
     pub via_seeds: usize,
+    /// The shortest path (found for every plan, [`check`]) when the spec asked for it
+    /// (its `shortest` is not [`ShortestPathUse::Omit`]).
+    pub shortest: Option<ShortestOutcome>,
+}
+
+/// The shortest path of a plan, measured as the plan is.
+#[derive(Debug, Clone)]
+pub struct ShortestOutcome {
+    pub path: Vec<Cell>,
+    /// Paper 000 Eq. 2 under the spec's time model, seconds.
+    pub t_eta_s: f64,
+    pub metrics: PathMetrics,
 }
 
 /// Why a plan was refused. Each says what to change.
@@ -228,7 +248,11 @@ pub fn check_spec(spec: &PlanSpec) -> Result<(), PlanError> {
 struct Checked {
     start: Cell,
     goal: Cell,
+    /// The shortest path, its ETA, and whether the budget fits it (it does unless the
+    /// spec asked for the shortest path as a fallback).
     shortest: Vec<Cell>,
+    shortest_t_eta_s: f64,
+    budget_fits: bool,
     /// The GA's size; `None` for the baseline.
     size: Option<PlanSize>,
 }
@@ -243,7 +267,9 @@ impl Checked {
     }
 }
 
-/// Everything [`plan`] refuses before any work, and the shortest path.
+/// Everything [`plan`] refuses before any work, and the shortest path: the one place
+/// where "shortest" is decided, for the refusal, the GA's seed, the fallback and the
+/// path attached to the reply.
 fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
     check_spec(spec)?;
     let start = locate(world, "start", spec.start)?;
@@ -268,7 +294,8 @@ fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
     }
     let shortest = shortest_path(world, start, goal).ok_or(PlanError::NoPath)?;
     let needed = path_eta(world, params, &shortest);
-    if needed > spec.t_exec_s {
+    let budget_fits = needed <= spec.t_exec_s;
+    if !budget_fits && spec.shortest != ShortestPathUse::Fallback {
         return Err(PlanError::BudgetTooShort {
             given_s: spec.t_exec_s,
             needed_s: needed,
@@ -279,6 +306,8 @@ fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
         start,
         goal,
         shortest,
+        shortest_t_eta_s: needed,
+        budget_fits,
         size,
     })
 }
@@ -288,7 +317,7 @@ fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
 /// anyone who wants to see them.
 pub fn via_seeds(world: &World, spec: &PlanSpec) -> Result<ViaSeeds, PlanError> {
     let checked = check(world, spec)?;
-    if checked.size.is_none() {
+    if checked.size.is_none() || !checked.budget_fits {
         return Ok(ViaSeeds::default());
     }
     let field = distance_field(world, checked.goal);
@@ -327,8 +356,20 @@ pub fn plan(
     let params = &spec.params;
     let (start, goal) = (checked.start, checked.goal);
     let deadline = started + Duration::from_secs_f64(spec.deadline_s);
+    // A budget the shortest path does not fit (asked for as a fallback): the shortest
+    // path answers, as the baseline would.
+    let model = if checked.budget_fits {
+        spec.model
+    } else {
+        PlannerModel::Shortest
+    };
+    let shortest = (spec.shortest != ShortestPathUse::Omit).then(|| ShortestOutcome {
+        metrics: path_metrics(world, params, &checked.shortest),
+        path: checked.shortest.clone(),
+        t_eta_s: checked.shortest_t_eta_s,
+    });
     let (chosen, generations, (evaluations, evaluated_genes), stop_reason, via_seeds) =
-        match Model::of(spec.model) {
+        match Model::of(model) {
             None => {
                 // The baseline's fitness terms are scored with Model I, the paper's best,
                 // so that they compare with the curious plans.
@@ -421,6 +462,7 @@ pub fn plan(
     let evaluation = chosen.evaluation;
     let metrics = path_metrics(world, params, &chosen.path);
     Ok(PlanOutcome {
+        model,
         t_eta_s: evaluation.t_eta,
         reaches_goal: evaluation.reaches_goal,
         within_budget: evaluation.t_eta <= spec.t_exec_s,
@@ -434,5 +476,6 @@ pub fn plan(
         stop_reason,
         source: chosen.source,
         via_seeds,
+        shortest,
     })
 }

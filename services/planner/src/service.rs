@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 
 use roam_proto::excerpt;
 use roam_proto::map::Layer;
-use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, StopReason};
+use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, ShortestPath, StopReason};
 use roam_proto::{keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, Requester, Service, ServiceError};
@@ -56,7 +56,9 @@ pub enum PlannerError {
     Config(String),
 }
 
-struct State {
+/// This planner instance, shared by its queryables and subscribers: its maps, the plans
+/// it has in flight, its limits and its CPU budget.
+struct PlannerInstance {
     root: String,
     instance: String,
     session: zenoh::Session,
@@ -70,20 +72,20 @@ struct State {
     cancel_warnings: WarnLimiter,
 }
 
-impl State {
+impl PlannerInstance {
     fn maps(&self) -> MutexGuard<'_, MapCache> {
         roam_runtime::lock(&self.maps)
     }
 }
 
-/// Frees a plan slot and its entry in the table of plans in flight however the plan
-/// ends.
-struct Slot<'a> {
-    state: &'a State,
+/// A plan's place among the instance's `max_concurrent_plans`: frees it, and the plan's
+/// entry in the table of plans in flight, however the plan ends.
+struct PlanSlot<'a> {
+    state: &'a PlannerInstance,
     request_id: Option<String>,
 }
 
-impl Drop for Slot<'_> {
+impl Drop for PlanSlot<'_> {
     fn drop(&mut self) {
         if let Some(id) = &self.request_id {
             self.state.plans.remove(id);
@@ -137,7 +139,7 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let state = Arc::new(State {
+    let state = Arc::new(PlannerInstance {
         root: config.root.clone(),
         instance: service.instance().to_owned(),
         session: service.session().clone(),
@@ -161,7 +163,7 @@ pub async fn run(
             .subscribe(
                 &keys::map_layer(root, layer),
                 state.clone(),
-                |state: &Arc<State>, layer: Layer| take_layer(state, layer),
+                |state: &Arc<PlannerInstance>, layer: Layer| take_layer(state, layer),
             )
             .await?;
     }
@@ -175,7 +177,7 @@ pub async fn run(
             &keys::planner_cancel_any(root),
             MAX_CANCEL_BYTES,
             state.clone(),
-            |state: &Arc<State>, key: &str, request: CancelPlan| {
+            |state: &Arc<PlannerInstance>, key: &str, request: CancelPlan| {
                 // Keys decide: the request a cancel is for is the one its key names.
                 if key.rsplit('/').next() == Some(request.request_id.as_str()) {
                     take_cancel(state, &request)
@@ -224,7 +226,7 @@ pub async fn run(
     Ok(())
 }
 
-fn take_layer(state: &State, layer: Layer) {
+fn take_layer(state: &PlannerInstance, layer: Layer) {
     if let Some(version) = state.maps().update(layer) {
         tracing::info!(
             inflated = version.inflated,
@@ -236,7 +238,7 @@ fn take_layer(state: &State, layer: Layer) {
 
 /// A cancel: honoured only with the plan's own token ([`InFlight::cancel`]); refusals
 /// are logged, rate-limited, with the id cut to an excerpt and never the token.
-fn take_cancel(state: &State, request: &CancelPlan) {
+fn take_cancel(state: &PlannerInstance, request: &CancelPlan) {
     let verdict = state
         .plans
         .cancel(&request.request_id, request.token.as_deref());
@@ -268,7 +270,7 @@ fn take_cancel(state: &State, request: &CancelPlan) {
 }
 
 /// Gets the two layers from the map server, retrying until both arrive.
-async fn fetch_maps(state: Arc<State>, requester: Requester, cancel: CancellationToken) {
+async fn fetch_maps(state: Arc<PlannerInstance>, requester: Requester, cancel: CancellationToken) {
     loop {
         let layers = state.maps().layers();
         for name in &layers {
@@ -290,7 +292,7 @@ async fn fetch_maps(state: Arc<State>, requester: Requester, cancel: Cancellatio
     }
 }
 
-async fn answer_plan(state: Arc<State>, query: Query) {
+async fn answer_plan(state: Arc<PlannerInstance>, query: Query) {
     let request = match reply::decode_request::<PlanRequest>(&query, MAX_REQUEST_BYTES) {
         Ok(r) => r,
         // The codec's refusals quote the payload only as a bounded excerpt.
@@ -329,7 +331,7 @@ fn request_id(request: &PlanRequest) -> Result<String, ErrorReply> {
 }
 
 /// The refusal of a plan the CPU budget has no time for.
-fn exhausted(state: &State, e: Exhausted) -> ErrorReply {
+fn exhausted(state: &PlannerInstance, e: Exhausted) -> ErrorReply {
     let config = state.budget.config();
     let burst = config.plan_seconds_burst;
     ErrorReply::limit(
@@ -349,10 +351,10 @@ fn exhausted(state: &State, e: Exhausted) -> ErrorReply {
 }
 
 /// Checks a request against this instance's state, plans, and builds the reply.
-fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply> {
+fn plan_request(state: &PlannerInstance, request: PlanRequest) -> Result<Plan, ErrorReply> {
     // A bounded number of plans at once; the next is refused now, never queued.
     let running = state.in_flight.fetch_add(1, Ordering::AcqRel);
-    let mut slot = Slot {
+    let mut slot = PlanSlot {
         state,
         request_id: None,
     };
@@ -415,6 +417,7 @@ fn plan_request(state: &State, request: PlanRequest) -> Result<Plan, ErrorReply>
         seed: request.seed,
         threads: crate::ga::default_threads(),
         limits: state.limits,
+        shortest: request.shortest,
     };
     // The deadline is checked before the budget takes it as the grant it asks for.
     check_spec(&spec).map_err(|e| e.to_reply())?;
@@ -475,9 +478,17 @@ pub fn to_message(
 ) -> Plan {
     let cells = world.grid_cells(&outcome.path);
     let points = world.centers(&outcome.path);
+    // Only when the request asked ([`plan`] measures it only then): a client from
+    // before the field never sees it.
+    let shortest = outcome.shortest.as_ref().map(|s| ShortestPath {
+        cells: world.grid_cells(&s.path),
+        points: world.centers(&s.path),
+        t_eta_s: s.t_eta_s,
+        distinct_information: s.metrics.distinct_information,
+    });
     Plan {
         request_id,
-        model: request.model,
+        model: outcome.model,
         cells,
         points,
         t_eta_s: outcome.t_eta_s,
@@ -494,5 +505,6 @@ pub fn to_message(
         seed: request.seed,
         map_version,
         instance: instance.to_owned(),
+        shortest,
     }
 }
