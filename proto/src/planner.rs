@@ -114,6 +114,38 @@ pub struct PlanRequest {
     /// Plan on this map version; refused when the planner no longer has it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub map_version: Option<MapVersion>,
+    /// What the reply carries of the shortest path, which the planner finds for every
+    /// request anyway; absent: [`ShortestPathUse::Omit`], what requests before the field
+    /// got.
+    #[serde(default, skip_serializing_if = "ShortestPathUse::is_omit")]
+    pub shortest: ShortestPathUse,
+}
+
+/// What a plan request wants of the shortest path (roam, not paper 000). The planner
+/// finds it before any curious planning (to refuse a budget it does not fit, and to
+/// seed the GA), so attaching it costs a copy, not a second request.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShortestPathUse {
+    /// Nothing: the reply has no `shortest`, and a budget below the shortest path's ETA
+    /// is refused (`invalid_request`, "give at least N s").
+    #[default]
+    Omit,
+    /// The reply carries the shortest path as [`Plan::shortest`]; a budget below its ETA
+    /// is still refused.
+    Attach,
+    /// As `attach`, and a budget below the shortest path's ETA is answered with the
+    /// shortest path itself as the plan (`model: shortest`, `within_budget: false`,
+    /// `stop_reason: complete`) instead of a refusal: a client that drives whatever
+    /// comes back (the mission executive, when a window is shorter than its task is
+    /// far) needs one request per plan.
+    Fallback,
+}
+
+impl ShortestPathUse {
+    pub fn is_omit(&self) -> bool {
+        *self == ShortestPathUse::Omit
+    }
 }
 
 impl Message for PlanRequest {
@@ -156,6 +188,9 @@ pub enum StopReason {
 #[serde(deny_unknown_fields)]
 pub struct Plan {
     pub request_id: String,
+    /// The model that answered: the request's, or `shortest` when the request asked for
+    /// the shortest path as its fallback (`shortest: fallback`) and the budget did not
+    /// fit it.
     pub model: PlannerModel,
     /// Map cells `[x, y]` (the `inflated` layer's grid) from start to end, 8-connected
     /// without cutting corners, every one free: the path the robot drives, also when
@@ -189,6 +224,26 @@ pub struct Plan {
     pub map_version: MapVersion,
     /// The planner instance that answered.
     pub instance: String,
+    /// The shortest path from the start's cell to the goal's, when the request asked for
+    /// it (`shortest: attach` or `fallback`); absent otherwise, so a client that did not
+    /// ask never sees the field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shortest: Option<ShortestPath>,
+}
+
+/// The shortest path a plan reply carries ([`Plan::shortest`]): what `model: shortest`
+/// would have answered for the same request.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShortestPath {
+    /// Grid cells `[x, y]` from start to end, 8-connected.
+    pub cells: Vec<[u32; 2]>,
+    /// The cells' centres in world metres.
+    pub points: Vec<[f64; 2]>,
+    /// Its driving time under the request's time model (paper 000 Eq. 2), seconds.
+    pub t_eta_s: f64,
+    /// Information of the distinct cells seen along it (as [`Plan::distinct_information`]).
+    pub distinct_information: f64,
 }
 
 impl Message for Plan {

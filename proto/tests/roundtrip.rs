@@ -233,8 +233,33 @@ mod planner_messages {
     use super::*;
     use roam_proto::planner::{
         CancelPlan, FitnessTerms, GaOverrides, MapVersion, Plan, PlanProgress, PlanRequest,
-        PlannerModel, StopReason,
+        PlannerModel, ShortestPath, ShortestPathUse, StopReason,
     };
+
+    fn shortest_use() -> impl Strategy<Value = ShortestPathUse> {
+        prop_oneof![
+            Just(ShortestPathUse::Omit),
+            Just(ShortestPathUse::Attach),
+            Just(ShortestPathUse::Fallback),
+        ]
+    }
+
+    fn shortest_path() -> impl Strategy<Value = ShortestPath> {
+        (
+            prop::collection::vec([any::<u32>(), any::<u32>()], 0..40),
+            finite(),
+            finite(),
+        )
+            .prop_map(|(cells, t_eta_s, distinct_information)| ShortestPath {
+                points: cells
+                    .iter()
+                    .map(|c| [f64::from(c[0]) * 0.2, f64::from(c[1]) * 0.2])
+                    .collect(),
+                cells,
+                t_eta_s,
+                distinct_information,
+            })
+    }
 
     fn model() -> impl Strategy<Value = PlannerModel> {
         prop_oneof![
@@ -287,6 +312,7 @@ mod planner_messages {
             overrides(),
             any::<u64>(),
             prop::option::of(version()),
+            shortest_use(),
         )
             .prop_map(
                 |(
@@ -298,6 +324,7 @@ mod planner_messages {
                     params,
                     seed,
                     map_version,
+                    shortest,
                 )| PlanRequest {
                     request_id,
                     cancel_token,
@@ -309,6 +336,7 @@ mod planner_messages {
                     params,
                     seed,
                     map_version,
+                    shortest,
                 },
             )
     }
@@ -329,6 +357,7 @@ mod planner_messages {
                 Just(StopReason::Complete)
             ],
             (any::<u64>(), version(), name(), prop::option::of(finite())),
+            prop::option::of(shortest_path()),
         )
             .prop_map(
                 |(
@@ -340,6 +369,7 @@ mod planner_messages {
                     (u_ges, density, distinct_information, generations, planning_ms),
                     stop_reason,
                     (seed, map_version, instance, budget_s),
+                    shortest,
                 )| {
                     let points = cells
                         .iter()
@@ -373,6 +403,7 @@ mod planner_messages {
                         seed,
                         map_version,
                         instance,
+                        shortest,
                     }
                 },
             )
@@ -383,7 +414,12 @@ mod planner_messages {
         fn plan_request_round_trips(m in request()) { round_trips(&m); }
 
         #[test]
-        fn plan_round_trips(m in plan()) { round_trips(&m); }
+        fn plan_round_trips(m in plan()) {
+            round_trips(&m);
+            // A client that did not ask for the shortest path never sees the field.
+            let text = String::from_utf8(encode(&m)).expect("utf-8");
+            prop_assert_eq!(text.contains(r#""shortest":"#), m.shortest.is_some());
+        }
 
         #[test]
         fn progress_and_cancel_round_trip(id in name(), best in prop::collection::vec((any::<u32>(), finite()), 0..20), done in any::<bool>()) {
@@ -425,6 +461,30 @@ mod planner_messages {
         }))
         .expect("utf-8");
         assert!(!text.contains("token"), "{text}");
+    }
+
+    /// A request that does not ask for the shortest path is written as before the field
+    /// (so a planner from before it reads it), and a plan without one likewise (so a
+    /// client from before it reads the reply); an old request means `omit`.
+    #[test]
+    fn the_shortest_path_fields_are_absent_unless_asked_for() {
+        let request: PlanRequest = decode(
+            br#"{"v":1,"kind":"plan_request","body":{"start":[0,0],"goal":[1,1],"t_exec_s":10,"deadline_s":1,"model":"model1"}}"#,
+        )
+        .expect("an old request");
+        assert_eq!(request.shortest, ShortestPathUse::Omit);
+        let text = String::from_utf8(encode(&request)).expect("utf-8");
+        assert!(!text.contains("shortest"), "{text}");
+        let fallback = PlanRequest {
+            shortest: ShortestPathUse::Fallback,
+            ..request
+        };
+        let text = String::from_utf8(encode(&fallback)).expect("utf-8");
+        assert!(text.contains(r#""shortest":"fallback""#), "{text}");
+        let refused = decode::<PlanRequest>(
+            br#"{"v":1,"kind":"plan_request","body":{"start":[0,0],"goal":[1,1],"t_exec_s":10,"deadline_s":1,"model":"model1","shortest":"sometimes"}}"#,
+        );
+        assert!(refused.is_err(), "{refused:?}");
     }
 }
 

@@ -11,7 +11,7 @@ use roam_proto::mapper::{
     ExplorationGoal, MapperStatus, CHANGE_INFORMATION_LAYER, CHANGE_PROBABILITY_LAYER,
     CHANGE_RATE_LAYER, RECENCY_LAYER,
 };
-use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
+use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel, ShortestPathUse};
 use roam_proto::sim::{RobotCommand, SimControl, SimStatus};
 use roam_proto::{decode, keys};
 use roam_tests::{repo_path, within, Harness};
@@ -190,6 +190,7 @@ async fn sim_to_mapper_to_map_server_shows_where_the_blocks_move() {
         },
         seed: 1,
         map_version: None,
+        shortest: ShortestPathUse::Omit,
     };
     let request = |instance: &'static str| {
         let (client, key, body) = (

@@ -12,7 +12,8 @@ use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::{
-    CancelPlan, GaOverrides, MapVersion, Plan, PlanProgress, PlanRequest, PlannerModel, StopReason,
+    CancelPlan, GaOverrides, MapVersion, Plan, PlanProgress, PlanRequest, PlannerModel,
+    ShortestPathUse, StopReason,
 };
 use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::{ClientError, Requester};
@@ -36,6 +37,7 @@ fn request(start: [f64; 2], goal: [f64; 2], t_exec_s: f64, generations: u32) -> 
         },
         seed: 11,
         map_version: None,
+        shortest: ShortestPathUse::Omit,
     }
 }
 
@@ -236,6 +238,7 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         seed: req.seed,
         threads: roam_planner::ga::default_threads(),
         limits: roam_planner::limits::PlanLimits::default(),
+        shortest: ShortestPathUse::Omit,
     };
     let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local plan");
     let local_cells = world.grid_cells(&local.path);
@@ -251,6 +254,79 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         .await
         .expect("plan");
     assert_eq!(again.cells, remote.cells);
+    running.stop().await;
+}
+
+/// The shortest path rides with the plan when asked (the executive's one request per
+/// plan): attached exactly as `model: shortest` answers it, and with `fallback` a budget
+/// it does not fit is answered with it instead of a refusal.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn the_shortest_path_comes_with_the_plan_when_asked() {
+    let running = boot(&[("solo", 2)]).await;
+    let client = running.harness.client().await;
+    let root = running.harness.root.clone();
+    let curious = PlanRequest {
+        shortest: ShortestPathUse::Attach,
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 20)
+    };
+    let plan = ask(&client, &root, &curious).await.expect("plan");
+    let alone = ask(
+        &client,
+        &root,
+        &PlanRequest {
+            model: PlannerModel::Shortest,
+            shortest: ShortestPathUse::Omit,
+            ..curious.clone()
+        },
+    )
+    .await
+    .expect("the shortest path");
+    assert!(alone.shortest.is_none(), "not asked for, not sent");
+    assert_eq!(plan.model, PlannerModel::Model1);
+    let attached = plan.shortest.expect("attached");
+    assert_eq!(attached.cells, alone.cells);
+    assert_eq!(attached.points, alone.points);
+    assert_eq!(attached.t_eta_s.to_bits(), alone.t_eta_s.to_bits());
+    assert_eq!(
+        attached.distinct_information.to_bits(),
+        alone.distinct_information.to_bits()
+    );
+
+    // Half the shortest path's ETA: refused when only attached, the shortest path
+    // itself with the fallback.
+    let short = 0.5 * alone.t_eta_s;
+    let refused = refusal(
+        &client,
+        &root,
+        &PlanRequest {
+            t_exec_s: short,
+            ..curious.clone()
+        },
+    )
+    .await;
+    assert!(
+        refused
+            .message
+            .contains("shorter than the shortest path's ETA"),
+        "{}",
+        refused.message
+    );
+    let fallback = ask(
+        &client,
+        &root,
+        &PlanRequest {
+            t_exec_s: short,
+            shortest: ShortestPathUse::Fallback,
+            ..curious.clone()
+        },
+    )
+    .await
+    .expect("the fallback");
+    assert_eq!(fallback.model, PlannerModel::Shortest);
+    assert!(fallback.reaches_goal && !fallback.within_budget);
+    assert_eq!(fallback.stop_reason, StopReason::Complete);
+    assert_eq!(fallback.cells, alone.cells);
+    assert_eq!(fallback.shortest.expect("attached").cells, alone.cells);
     running.stop().await;
 }
 
@@ -569,6 +645,7 @@ async fn a_round_trip_through_zenoh_uses_the_budget() {
             seed: req.seed,
             threads: roam_planner::ga::default_threads(),
             limits: roam_planner::limits::PlanLimits::default(),
+            shortest: ShortestPathUse::Omit,
         };
         let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local");
         assert_eq!(remote.cells, world.grid_cells(&local.path));

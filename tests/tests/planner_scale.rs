@@ -12,7 +12,8 @@ use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_planner::PlannerConfig;
 use roam_proto::planner::{
-    CancelPlan, GaOverrides, Plan, PlanProgress, PlanRequest, PlannerModel, StopReason,
+    CancelPlan, GaOverrides, Plan, PlanProgress, PlanRequest, PlannerModel, ShortestPathUse,
+    StopReason,
 };
 use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply};
 use roam_runtime::{ClientError, Requester};
@@ -38,6 +39,7 @@ fn request(start: [f64; 2], goal: [f64; 2], t_exec_s: f64, generations: u32) -> 
         },
         seed: 23,
         map_version: None,
+        shortest: ShortestPathUse::Omit,
     }
 }
 
@@ -127,6 +129,7 @@ async fn a_coarse_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         seed: req.seed,
         threads: roam_planner::ga::default_threads(),
         limits: roam_planner::limits::PlanLimits::default(),
+        shortest: ShortestPathUse::Omit,
     };
     let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local");
     assert_eq!(remote.cells, local.cells);

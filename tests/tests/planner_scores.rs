@@ -6,7 +6,7 @@
 use roam_proto::cells::Cells;
 use roam_proto::keys;
 use roam_proto::map::{Layer, LayerChange, LayerUpdate, UpdateAck};
-use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
+use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel, ShortestPathUse};
 use roam_tests::{within, Harness};
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
@@ -70,6 +70,7 @@ async fn scores_above_100_plan_as_if_clamped_to_100() {
         },
         seed: 5,
         map_version: None,
+        shortest: ShortestPathUse::Omit,
     };
     let mut plans = Vec::new();
     for name in ["bright", "bright_clamped"] {

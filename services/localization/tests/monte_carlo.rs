@@ -19,7 +19,7 @@ fn paper_noise() -> ToaNoise {
 }
 
 /// Noisy ranges to every anchor whose true distance is within the sensing range
-/// (roam-sim's default gate), drawn with roam-sim's noise model.
+/// (roam-sim's default gate), drawn with roam-world's noise model (the sim's).
 fn draw(model: &RangingModel, truth: [f64; 2], rng: &mut ChaCha8Rng) -> Vec<Range> {
     model
         .anchors()

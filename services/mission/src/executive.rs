@@ -4,11 +4,16 @@
 //! | key | kind | payload |
 //! |---|---|---|
 //! | `<root>/map/layer/{inflated,information}` | get, at start | `layer` (to thin paths and score them) |
-//! | `<root>/planner/…/plan` | get, per window and replan | `plan_request` → `plan` |
+//! | `<root>/planner/…/plan` | get, one per plan (a window's first, a replan, the next window's; a second only when a curious replan fails) | `plan_request` (`shortest: fallback`) → `plan` (with the shortest path) |
 //! | `<root>/robot/<id>/mission` | put, per plan | `mission` (the thinned waypoints) |
 //! | `<root>/robot/<id>/estimate` | subscription | `position_estimate` |
 //! | `<root>/robot/<id>/controller` | subscription | `controller_status` |
 //! | `<root>/sim/clock` | subscription | `sim_clock` (the mission clock; wall time without a sim) |
+//!
+//! The window's rules live in a plain state machine ([`crate::window`], with the replan
+//! policy in [`crate::watch`]); this module is the thin async loop around it: it decodes
+//! what it hears, feeds the machine, and performs its actions (plan requests, one per
+//! plan; missions published; progress; the calibration's file).
 //!
 //! **Time.** Task start times are on the mission clock: sim seconds when a sim world
 //! publishes its clock. The planner's deadline is wall time, so what planning costs on
@@ -16,29 +21,30 @@
 //! 20× charges a 0.5 s plan 10 s of downtime); the driving budget t_exec is the time to
 //! the task's start minus that.
 
-use roam_runtime::Delivery;
+use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use roam_planner::client::PlannerClient;
 use roam_planner::params::GaParams;
-use roam_planner::world::World;
-use roam_proto::controller::{Mission, MissionState};
+use roam_proto::controller::Mission;
 use roam_proto::keys;
-use roam_proto::mission::{TimeModelReport, WindowReport};
-use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
-use roam_runtime::{ClientError, Requester};
+use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel, ShortestPathUse};
+use roam_runtime::{lock, ClientError, Delivery, Requester};
 use serde::Deserialize;
+use tokio::time::MissedTickBehavior;
 use tokio_util::sync::CancellationToken;
 
 use crate::calibration::{path_measure, store, Calibration, CalibrationConfig, TimeModel};
-use crate::information::gathered;
+use crate::information::InformationScale;
 use crate::inputs::{listen, wait_for_world, Inputs};
 use crate::margin::ArrivalMargin;
-use crate::path::{distance, mission_waypoints};
 use crate::tasks::{self, Task, TaskError};
-use crate::watch::{Decision, Reason, Status, Watch, WatchParams};
-use roam_runtime::lock;
+use crate::watch::WatchParams;
+pub use crate::window::WindowOutcome;
+use crate::window::{
+    DowntimeWindow, DrivenMission, Handover, Now, PlanAsk, WindowAction, WindowEvent, WindowSetup,
+};
 
 /// How the executive plans and watches.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -162,18 +168,6 @@ pub enum ExecutiveError {
     Cancelled,
 }
 
-/// A window's outcome with the paths, for pictures.
-#[derive(Debug, Clone)]
-pub struct WindowOutcome {
-    pub report: WindowReport,
-    /// Every plan the robot was given in the window, in order.
-    pub plans: Vec<Vec<[f64; 2]>>,
-    /// The shortest path of the window, for comparison.
-    pub shortest: Vec<[f64; 2]>,
-    /// The estimates the robot drove on.
-    pub driven: Vec<[f64; 2]>,
-}
-
 /// What the executive is doing, for a progress display.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Progress {
@@ -205,22 +199,6 @@ pub enum Progress {
         task: String,
     },
 }
-
-/// How often the executive asks again for a window's first plans when none came.
-const PLAN_RETRY: Duration = Duration::from_secs(1);
-
-/// A window's plans made ahead, while the robot did the previous task.
-struct Preplanned {
-    window: usize,
-    from: [f64; 2],
-    shortest: Plan,
-    plan: Plan,
-    budget: f64,
-}
-
-/// A preplanned window is used when the robot sets off at most this far from where the
-/// plans start, metres.
-const PREPLAN_FROM_M: f64 = 0.5;
 
 /// A curious plan is expected to take this times the slowest recent one, plus
 /// [`PLAN_WALL_SLACK_S`].
@@ -269,32 +247,34 @@ fn check(config: &ExecutiveConfig) -> Result<(), ExecutiveError> {
     Ok(())
 }
 
-/// The executive's view of one robot while it runs its tasks.
-struct Run<'a> {
+/// How often the loop ticks: the watch's clock rules (give up, lost mission), the plan
+/// retries and the end of the task.
+const TICK: Duration = Duration::from_millis(20);
+
+/// The executive on one robot while it runs its tasks: its Zenoh ends, and what it
+/// keeps from window to window.
+struct Executive<'a> {
     session: &'a zenoh::Session,
     root: &'a str,
     config: &'a ExecutiveConfig,
     planner: PlannerClient,
-    world: World,
-    params: GaParams,
     inputs: Inputs,
+    /// The robot's last good estimate.
     position: Option<[f64; 2]>,
-    missions_sent: u64,
     /// The robot's time model, fitted as it drives.
     calibration: Calibration,
     /// Wall seconds the recent curious plans took (request to reply), the slowest.
-    plan_wall_s: std::sync::Mutex<Option<f64>>,
-    /// What each plan leaves unspent of the time to its task ([`crate::margin`]).
-    margin: ArrivalMargin,
-    /// The next window's plans, made while the robot did its task.
-    preplanned: Option<Preplanned>,
+    plan_wall_s: Option<f64>,
+    /// What the last window handed the next (the arrival margin, the mission count, the
+    /// next window's plan).
+    handover: Handover,
     /// This executive's own tag in its mission ids (from its Zenoh session id), so a
     /// restarted executive never reuses an id its predecessor sent: the controller's
     /// statuses on an old mission are not taken for a new one's.
     tag: String,
 }
 
-impl Run<'_> {
+impl Executive<'_> {
     fn now(&self) -> f64 {
         lock(&self.inputs.clock).now_s()
     }
@@ -308,37 +288,43 @@ impl Run<'_> {
         }
     }
 
-    fn watch_params(&self) -> WatchParams {
-        self.config.watch_params(self.time_model())
-    }
-
     /// What a curious plan costs on the mission clock: the wall time the last ones
     /// took (with a margin; the deadline until one was measured) at the clock's rate.
     /// Charging the whole deadline would waste it whenever the GA ends sooner (its
     /// generations, on a small map): at a sim running 20x, a 1 s deadline is 20 s of
     /// downtime the robot would wait through.
     fn planning_cost_s(&self) -> f64 {
-        let wall = lock(&self.plan_wall_s).map_or(self.config.plan_deadline_s, |w| {
+        let wall = self.plan_wall_s.map_or(self.config.plan_deadline_s, |w| {
             (w * PLAN_WALL_MARGIN + PLAN_WALL_SLACK_S).min(self.config.plan_deadline_s)
         });
         wall * lock(&self.inputs.clock).rate()
     }
 
-    async fn plan(
-        &self,
-        from: [f64; 2],
-        to: [f64; 2],
-        model: PlannerModel,
-        t_exec_s: f64,
-    ) -> Result<Plan, ClientError> {
+    /// The machine's time: the mission clock, wall seconds since `began`, and what a
+    /// plan costs now.
+    fn moment(&self, began: Instant) -> Now {
+        Now {
+            mission_s: self.now(),
+            wall_s: began.elapsed().as_secs_f64(),
+            planning_cost_s: self.planning_cost_s(),
+        }
+    }
+
+    /// One request for the plan `ask` describes, with the shortest path as its fallback
+    /// and attached ([`crate::window`]'s one-request rule).
+    async fn plan(&mut self, ask: &PlanAsk) -> Result<Plan, ClientError> {
         let request = PlanRequest {
             request_id: None,
             cancel_token: None,
-            start: from,
-            goal: to,
-            t_exec_s,
+            start: ask.from,
+            goal: ask.to,
+            t_exec_s: ask.t_exec_s,
             deadline_s: self.config.plan_deadline_s,
-            model,
+            model: if ask.curious {
+                self.config.model
+            } else {
+                PlannerModel::Shortest
+            },
             params: GaOverrides {
                 max_generations: self.config.max_generations,
                 w_loc: self.config.w_loc,
@@ -346,96 +332,23 @@ impl Run<'_> {
             },
             seed: self.config.seed,
             map_version: None,
+            shortest: ShortestPathUse::Fallback,
         };
         let asked = Instant::now();
         let plan = self.planner.plan(&request).await?;
-        if model != PlannerModel::Shortest {
+        // Only what the GA took says what a curious plan costs (a fallback to the
+        // shortest path is answered at once).
+        if plan.model != PlannerModel::Shortest {
             let took = asked.elapsed().as_secs_f64();
-            let mut slowest = lock(&self.plan_wall_s);
             // The slowest of the recent plans, forgetting slowly.
-            *slowest = Some(slowest.map_or(took, |w| took.max(0.8 * w)));
+            self.plan_wall_s = Some(self.plan_wall_s.map_or(took, |w| took.max(0.8 * w)));
         }
         Ok(plan)
     }
 
-    /// The curious plan for the budget, or the shortest when curiosity does not fit.
-    /// `leave_at_s`: when the robot can set off at the earliest (a window planned while
-    /// the robot is still at its task), on the mission clock.
-    async fn plan_window(
-        &self,
-        from: [f64; 2],
-        task: &Task,
-        shortest: &Plan,
-        curious: bool,
-        leave_at_s: Option<f64>,
-    ) -> Result<(Plan, f64), ClientError> {
-        let earliest = self.now() + self.planning_cost_s();
-        let time_left = task.start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
-        let budget = self.margin.budget(time_left);
-        if !curious || budget <= shortest.t_eta_s {
-            return Ok((shortest.clone(), budget));
-        }
-        let plan = self.plan(from, task.at, self.config.model, budget).await?;
-        if plan.reaches_goal && plan.within_budget {
-            Ok((plan, budget))
-        } else {
-            Ok((shortest.clone(), budget))
-        }
-    }
-
-    fn send(&mut self, window: usize, waypoints: Vec<[f64; 2]>) -> String {
-        self.missions_sent += 1;
-        let id = format!(
-            "{}-{}-w{window}-m{}",
-            self.config.robot, self.tag, self.missions_sent
-        );
-        let mission = Mission {
-            robot: self.config.robot.clone(),
-            id: id.clone(),
-            waypoints,
-        };
+    fn publish(&self, mission: &Mission) {
         let key = keys::robot_mission(self.root, &self.config.robot);
-        roam_runtime::publish_wait(self.session, &key, &mission, Delivery::Reliable);
-        id
-    }
-
-    fn waypoints(&self, plan: &Plan) -> Vec<[f64; 2]> {
-        mission_waypoints(&plan.points, self.config.waypoint_spacing_m)
-    }
-
-    /// The window's shortest and curious plans, asked again every [`PLAN_RETRY`] while
-    /// no planner answers (a router restart, every planner down); `None` when the
-    /// window is given up meanwhile. An outage costs downtime, not the mission.
-    async fn first_plans(
-        &self,
-        from: [f64; 2],
-        task: &Task,
-        leave_at_s: Option<f64>,
-        cancel: &CancellationToken,
-    ) -> Result<Option<(Plan, Plan, f64)>, ExecutiveError> {
-        loop {
-            let planned = match self
-                .plan(from, task.at, PlannerModel::Shortest, 86_400.0)
-                .await
-            {
-                Ok(shortest) => self
-                    .plan_window(from, task, &shortest, true, leave_at_s)
-                    .await
-                    .map(|(plan, budget)| (shortest, plan, budget)),
-                Err(e) => Err(e),
-            };
-            match planned {
-                Ok(plans) => return Ok(Some(plans)),
-                Err(e) => tracing::warn!(task = %task.name, "planning failed, asking again: {e}"),
-            }
-            if self.now() > task.start_s + self.config.give_up_after_s {
-                return Ok(None);
-            }
-            tokio::select! {
-                _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
-                _ = tokio::time::sleep(PLAN_RETRY) => {}
-            }
-        }
+        roam_runtime::publish_wait(self.session, &key, mission, Delivery::Reliable);
     }
 
     /// Waits briefly for the sim's clock, so that an executive restarted mid-mission
@@ -481,310 +394,143 @@ impl Run<'_> {
         }
     }
 
-    /// What the window's last mission says about the time model: the plan it drove
-    /// (its Σd and Σθ as Eq. 2 counts them on the cells) and how long driving it took.
-    /// Reported against what `model` (the one the window was planned with) predicted;
-    /// when calibrating, the fit learns from it and is kept in the calibration file.
-    fn learn(
-        &mut self,
-        window: usize,
-        model: &TimeModel,
-        drive: Option<(&[[f64; 2]], f64)>,
-        driving_s: f64,
-        window_s: f64,
-    ) -> TimeModelReport {
-        let predicted_s = drive.map_or(0.0, |(points, _)| {
-            let (d, theta) = path_measure(points);
-            model.eta(d, theta)
-        });
-        if let Some((_, took_s)) = drive {
-            self.margin.learn(predicted_s, took_s);
+    /// The calibration learns from the mission that arrived (its Σd and Σθ as Eq. 2
+    /// counts them on the cells, and how long driving it took) and keeps the fit in the
+    /// calibration file.
+    fn calibrate(&mut self, window: usize, drive: &DrivenMission) {
+        if !self.config.calibrate {
+            return;
         }
-        if let (true, Some((points, took_s))) = (self.config.calibrate, drive) {
-            let (d, theta) = path_measure(points);
-            if self.calibration.add_planned(d, theta, took_s) {
-                if let Some(path) = &self.config.calibration_file {
-                    if let Err(e) = store::save(path, &self.config.robot, &self.calibration) {
-                        tracing::warn!("{e}");
-                    }
-                }
-                let fitted = self.calibration.model();
-                tracing::info!(
-                    window,
-                    v_lin = fitted.v_lin,
-                    v_ang = fitted.v_ang,
-                    predicted_s,
-                    took_s,
-                    "time model updated from the window's driving"
-                );
+        let (d, theta) = path_measure(&drive.path);
+        if !self.calibration.add_planned(d, theta, drive.took_s) {
+            return;
+        }
+        if let Some(path) = &self.config.calibration_file {
+            if let Err(e) = store::save(path, &self.config.robot, &self.calibration) {
+                tracing::warn!("{e}");
             }
         }
-        TimeModelReport {
-            v_lin: model.v_lin,
-            v_ang: model.v_ang,
-            predicted_s,
-            driving_s: drive.map_or(0.0, |(_, t)| t),
-            driven_share: if window_s > 0.0 {
-                driving_s / window_s
-            } else {
-                0.0
-            },
-        }
+        let fitted = self.calibration.model();
+        tracing::info!(
+            window,
+            v_lin = fitted.v_lin,
+            v_ang = fitted.v_ang,
+            took_s = drive.took_s,
+            "time model updated from the window's driving"
+        );
     }
 
+    /// Window `window` toward `task`: the machine ([`DowntimeWindow`]) fed with what the
+    /// executive hears, its actions performed in order; `None` when the task was over
+    /// before the window began.
     async fn window(
         &mut self,
         window: usize,
         task: &Task,
         next: Option<&Task>,
+        scale: InformationScale<'_>,
         cancel: &CancellationToken,
         progress: &(dyn Fn(Progress) + Sync),
     ) -> Result<Option<WindowOutcome>, ExecutiveError> {
         // The first estimate comes through the router with the clock, so after it the
         // mission time is known even when the executive (re)started with the router down.
         let from = self.first_position(cancel).await?;
-        let began = self.now();
-        if began >= task.start_s + task.duration_s {
-            progress(Progress::Skipped {
-                window,
-                task: task.name.clone(),
-            });
-            return Ok(None);
-        }
-        let preplanned = self
-            .preplanned
-            .take()
-            .filter(|p| p.window == window && distance(p.from, from) <= PREPLAN_FROM_M);
-        let planned = match preplanned {
-            Some(p) => Some((p.shortest, p.plan, p.budget)),
-            None => self.first_plans(from, task, None, cancel).await?,
-        };
-        let Some((shortest, plan, budget)) = planned else {
-            // Given up before a plan came: reported like any window that was given up.
-            progress(Progress::GaveUp {
-                window,
-                task: task.name.clone(),
-            });
-            let report = WindowReport {
-                robot: self.config.robot.clone(),
-                task: task.name.clone(),
-                window,
-                began_s: began,
-                task_start_s: task.start_s,
-                arrival_s: None,
-                on_time: false,
-                budget_s: task.start_s - began,
-                planned_information: 0.0,
-                driven_information: 0.0,
-                shortest_information: 0.0,
-                peb_mean_m: None,
-                replans: 0,
-                replan_reasons: vec!["no planner answered before the window was given up".into()],
-                time_model: None,
-            };
-            return Ok(Some(WindowOutcome {
-                report,
-                plans: Vec::new(),
-                shortest: Vec::new(),
-                driven: vec![from],
-            }));
-        };
-        progress(Progress::Planned {
+        let began = Instant::now();
+        let setup = WindowSetup {
             window,
-            task: task.name.clone(),
-            budget_s: budget,
-            eta_s: plan.t_eta_s,
-            curious: plan.model != PlannerModel::Shortest,
-        });
-        // On the static map, as the driven path's: a planner on the change coupling
-        // reports its own figure on the coupled map, which changes with the mapper.
-        let planned_information = gathered(&self.world, &self.params, &plan.points);
-        let model = self.time_model();
-        let mut plans = vec![plan.points.clone()];
-        let mut waypoints = self.waypoints(&plan);
-        let mut mission = self.send(window, waypoints.clone());
-        let first_sent_at = self.now();
-        let mut sent_at = first_sent_at;
-        let mut current_path: Vec<[f64; 2]> = std::iter::once(from)
-            .chain(plan.points.iter().copied())
-            .collect();
-        let wall = Instant::now();
-        let wall_s = || wall.elapsed().as_secs_f64();
-        let mut watch = Watch::new(
-            self.watch_params(),
-            task.start_s,
-            plan.points.clone(),
-            self.now(),
-            wall_s(),
-        );
-        let mut driven = vec![from];
-        let mut pebs = Vec::new();
-        let mut reasons: Vec<String> = Vec::new();
-        let mut arrival = None;
-        let mut tick = tokio::time::interval(Duration::from_millis(100));
+            task: task.clone(),
+            next: next.cloned(),
+            robot: self.config.robot.clone(),
+            mission_tag: self.tag.clone(),
+            from,
+            time_model: self.time_model(),
+            watch: self.config.watch_params(self.time_model()),
+            give_up_after_s: self.config.give_up_after_s,
+            waypoint_spacing_m: self.config.waypoint_spacing_m,
+            scale,
+        };
+        let handover = std::mem::replace(&mut self.handover, Handover::first(self.config.margin()));
+        let (mut machine, actions) = DowntimeWindow::begin(setup, handover, self.moment(began));
+        let mut pending = VecDeque::from(actions);
+        let mut tick = tokio::time::interval(TICK);
+        tick.set_missed_tick_behavior(MissedTickBehavior::Delay);
+        let name = || task.name.clone();
         loop {
-            let decision = tokio::select! {
+            while let Some(action) = pending.pop_front() {
+                match action {
+                    WindowAction::Drive(mission) | WindowAction::Hold(mission) => {
+                        self.publish(&mission)
+                    }
+                    WindowAction::RequestPlan(ask) => {
+                        let event = tokio::select! {
+                            _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
+                            reply = self.plan(&ask) => match reply {
+                                Ok(plan) => WindowEvent::PlanReply(Box::new(plan)),
+                                Err(e) => {
+                                    tracing::warn!(task = %task.name, curious = ask.curious, "the plan request failed: {e}");
+                                    WindowEvent::PlanFailed
+                                }
+                            },
+                        };
+                        pending.extend(machine.handle(event, self.moment(began)));
+                    }
+                    WindowAction::Planned {
+                        budget_s,
+                        eta_s,
+                        curious,
+                    } => progress(Progress::Planned {
+                        window,
+                        task: name(),
+                        budget_s,
+                        eta_s,
+                        curious,
+                    }),
+                    WindowAction::Replanned { reason } => progress(Progress::Replanned {
+                        window,
+                        reason: reason.as_str().to_owned(),
+                    }),
+                    WindowAction::Arrived { at_s, drive } => {
+                        progress(Progress::Arrived {
+                            window,
+                            task: name(),
+                            at_s,
+                            start_s: task.start_s,
+                        });
+                        self.calibrate(window, &drive);
+                    }
+                    WindowAction::GaveUp => progress(Progress::GaveUp {
+                        window,
+                        task: name(),
+                    }),
+                    WindowAction::Skipped => progress(Progress::Skipped {
+                        window,
+                        task: name(),
+                    }),
+                    WindowAction::Done(end) => {
+                        self.handover = end.handover;
+                        self.position = Some(end.position);
+                        // What was heard at the task is not the next window's drive.
+                        while self.inputs.estimates.try_recv().ok().flatten().is_some() {}
+                        return Ok(end.outcome);
+                    }
+                }
+            }
+            let event = tokio::select! {
                 _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
-                _ = tick.tick() => watch.on_tick(self.now(), wall_s()),
+                _ = tick.tick() => WindowEvent::Tick,
                 sample = self.inputs.estimates.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
                     let Some(e) = self.inputs.estimate(&sample) else { continue };
-                    if e.degraded {
-                        continue;
-                    }
-                    self.position = Some(e.position);
-                    driven.push(e.position);
-                    if let Some(p) = e.peb_m {
-                        pebs.push(p);
-                    }
-                    watch.on_estimate(e.position)
+                    WindowEvent::Estimate { position: e.position, peb_m: e.peb_m, degraded: e.degraded }
                 }
                 sample = self.inputs.statuses.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
                     let Some(s) = self.inputs.status(&sample) else { continue };
-                    if s.mission.as_deref() != Some(mission.as_str()) {
-                        continue;
-                    }
-                    let status = match s.state {
-                        MissionState::Completed => Status::Completed,
-                        MissionState::Stuck | MissionState::StepLimit => Status::Stuck,
-                        MissionState::Active => Status::Active {
-                            distance_left_m: s.distance_left_m.unwrap_or(0.0),
-                        },
-                        _ => Status::Other,
-                    };
-                    watch.on_status(status, self.now(), wall_s(), self.planning_cost_s())
+                    WindowEvent::Status(s)
                 }
             };
-            let (reason, curious, resend) = match decision {
-                Decision::Keep => continue,
-                Decision::Arrived { at_s } => {
-                    arrival = Some(at_s);
-                    progress(Progress::Arrived {
-                        window,
-                        task: task.name.clone(),
-                        at_s,
-                        start_s: task.start_s,
-                    });
-                    break;
-                }
-                Decision::GiveUp => {
-                    progress(Progress::GaveUp {
-                        window,
-                        task: task.name.clone(),
-                    });
-                    break;
-                }
-                Decision::Replan {
-                    reason,
-                    curious,
-                    resend,
-                } => (reason, curious, resend),
-            };
-            if reason == Reason::Slack {
-                // Slack pays for the robot waiting while it plans, so the new path
-                // starts where the robot is rather than where it was.
-                mission = self.send(window, Vec::new());
-            }
-            let here = self.position.unwrap_or(from);
-            let shortest_here = match self
-                .plan(here, task.at, PlannerModel::Shortest, 86_400.0)
-                .await
-            {
-                Ok(p) => p,
-                Err(e) => {
-                    tracing::warn!("replanning failed: {e}");
-                    if reason == Reason::Slack {
-                        // Held for nothing: back on the path it had.
-                        mission = self.send(window, waypoints.clone());
-                    }
-                    continue;
-                }
-            };
-            // A curious plan that fails (busy, an outage) leaves the shortest way.
-            let plan = match self
-                .plan_window(here, task, &shortest_here, curious, None)
-                .await
-            {
-                Ok((plan, _)) => plan,
-                Err(e) => {
-                    tracing::warn!("the curious replan failed, taking the shortest path: {e}");
-                    shortest_here
-                }
-            };
-            reasons.push(reason.as_str().to_owned());
-            progress(Progress::Replanned {
-                window,
-                reason: reason.as_str().to_owned(),
-            });
-            let path = std::iter::once(here)
-                .chain(plan.points.iter().copied())
-                .collect();
-            watch.replanned(path, resend, self.now(), wall_s());
-            plans.push(plan.points.clone());
-            waypoints = self.waypoints(&plan);
-            mission = self.send(window, waypoints.clone());
-            sent_at = self.now();
-            current_path = std::iter::once(here)
-                .chain(plan.points.iter().copied())
-                .collect();
+            pending.extend(machine.handle(event, self.moment(began)));
         }
-        // The time model learns from the mission that arrived, driven as planned from
-        // where it was sent (the path following keeps the robot on it).
-        let drive = arrival.map(|at| (current_path.as_slice(), at - sent_at));
-        let driving_s = arrival.map_or(0.0, |at| at - first_sent_at);
-        let time_model = Some(self.learn(window, &model, drive, driving_s, task.start_s - began));
-        // The next window is planned while the robot does this task, from its place,
-        // so that planning costs the next window nothing.
-        if let (Some(_), Some(next)) = (arrival, next) {
-            let leave_at = task.start_s + task.duration_s;
-            if let Ok(Some((shortest, plan, budget))) = self
-                .first_plans(task.at, next, Some(leave_at), cancel)
-                .await
-            {
-                if self.now() <= leave_at {
-                    self.preplanned = Some(Preplanned {
-                        window: window + 1,
-                        from: task.at,
-                        shortest,
-                        plan,
-                        budget,
-                    });
-                }
-            }
-        }
-        // The task keeps the robot at its place until it ends.
-        while arrival.is_some() && self.now() < task.start_s + task.duration_s {
-            tokio::select! {
-                _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
-                _ = tokio::time::sleep(Duration::from_millis(20)) => {}
-            }
-        }
-        while self.inputs.estimates.try_recv().ok().flatten().is_some() {}
-        let driven_information = gathered(&self.world, &self.params, &driven);
-        let report = WindowReport {
-            robot: self.config.robot.clone(),
-            task: task.name.clone(),
-            window,
-            began_s: began,
-            task_start_s: task.start_s,
-            arrival_s: arrival,
-            on_time: arrival.is_some_and(|a| a <= task.start_s),
-            budget_s: budget,
-            planned_information,
-            driven_information,
-            shortest_information: gathered(&self.world, &self.params, &shortest.points),
-            peb_mean_m: (!pebs.is_empty()).then(|| pebs.iter().sum::<f64>() / pebs.len() as f64),
-            replans: reasons.len() as u32,
-            replan_reasons: reasons,
-            time_model,
-        };
-        Ok(Some(WindowOutcome {
-            report,
-            plans,
-            shortest: shortest.points,
-            driven,
-        }))
     }
 }
 
@@ -820,28 +566,35 @@ pub async fn run(
     check(config)?;
     let requester = Requester::new(session.clone(), Duration::from_secs(10));
     let world = wait_for_world(&requester, root, cancel).await?;
+    let params = GaParams::default();
+    // The report's information is measured on the static map, as the driven path's: a
+    // planner on the change coupling reports its own figure on the coupled map, which
+    // changes with the mapper.
+    let scale = InformationScale {
+        world: &world,
+        params: &params,
+    };
     let inputs = listen(session, root, &config.robot).await?;
-    let mut run = Run {
+    let mut executive = Executive {
         session,
         root,
         config,
         planner: PlannerClient::new(session.clone(), root),
-        world,
-        params: GaParams::default(),
         inputs,
         position: None,
-        missions_sent: 0,
         calibration: load_calibration(config)?,
-        plan_wall_s: std::sync::Mutex::new(None),
-        margin: config.margin(),
-        preplanned: None,
+        plan_wall_s: None,
+        handover: Handover::first(config.margin()),
         tag: session.zid().to_string().chars().take(8).collect(),
     };
-    run.hear_the_clock(cancel).await?;
+    executive.hear_the_clock(cancel).await?;
     let mut outcomes = Vec::with_capacity(config.tasks.len());
     for (window, task) in config.tasks.iter().enumerate() {
         let next = config.tasks.get(window + 1);
-        if let Some(outcome) = run.window(window, task, next, cancel, progress).await? {
+        if let Some(outcome) = executive
+            .window(window, task, next, scale, cancel, progress)
+            .await?
+        {
             on_window(&outcome);
             outcomes.push(outcome);
         }

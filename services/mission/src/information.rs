@@ -19,3 +19,19 @@ pub fn gathered(world: &World, params: &GaParams, trajectory: &[[f64; 2]]) -> f6
     }
     path_metrics(world, params, &cells).distinct_information
 }
+
+/// The scale a window's report measures its paths on (planned, driven, shortest): the
+/// static information map and the planner's perception window, so the three compare
+/// whatever map the planner planned on.
+#[derive(Debug, Clone, Copy)]
+pub struct InformationScale<'a> {
+    pub world: &'a World,
+    pub params: &'a GaParams,
+}
+
+impl InformationScale<'_> {
+    /// [`gathered`] along `trajectory`.
+    pub fn of(&self, trajectory: &[[f64; 2]]) -> f64 {
+        gathered(self.world, self.params, trajectory)
+    }
+}

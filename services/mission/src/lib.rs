@@ -15,14 +15,18 @@
 //! - [`path`]: a planned path's waypoints (every turn kept); off-path distance; ETA slip.
 //! - [`watch`]: the replan policy of a window (arrived, given up, lost mission, blocked,
 //!   late, pushed off the path, slack), a plain state machine.
+//! - [`window`]: one downtime window as a plain state machine around the watch (its
+//!   plans, one planner request each; its mission; the arrival; the next window planned
+//!   during the task; the report): events in, actions out.
 //! - [`information`]: the information a path gathers, on the planner's own scale.
 //! - `roam_experiments::reproduce::mission`: `roam reproduce mission`, the couplings
 //!   compared in batch, and with `--days N` the executive's whole day in batch
 //!   (today's, the new one, each coupling left out, the shortest path) against issue
 //!   14's goals.
 //! - [`executive`]: the executive on Zenoh (a client of the planner, the controller,
-//!   localization and the sim clock); `inputs`: what it hears (clock, estimates,
-//!   controller status, the world).
+//!   localization and the sim clock), a thin loop that feeds the window's machine and
+//!   performs its actions; `inputs`: what it hears (clock, estimates, controller
+//!   status, the world).
 //! - [`service`]: `roam mission`, the executive as a service that publishes its reports.
 
 pub mod calibration;
@@ -37,3 +41,4 @@ pub mod path;
 pub mod service;
 pub mod tasks;
 pub mod watch;
+pub mod window;

@@ -19,7 +19,7 @@ use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::map::{GridMeta, Origin};
-use roam_proto::planner::PlannerModel;
+use roam_proto::planner::{PlannerModel, ShortestPathUse};
 use roam_world::grid::{occupancy, Grid};
 
 fn status_kib(field: &str) -> Option<u64> {
@@ -67,6 +67,7 @@ fn main() {
         seed: 1,
         threads: roam_planner::ga::default_threads(),
         limits: roam_planner::limits::PlanLimits::default(),
+        shortest: ShortestPathUse::Omit,
     };
     let done = Arc::new(AtomicBool::new(false));
     let sampler = {

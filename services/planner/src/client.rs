@@ -210,7 +210,7 @@ impl PlannerClient {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use roam_proto::planner::{GaOverrides, PlannerModel};
+    use roam_proto::planner::{GaOverrides, PlannerModel, ShortestPathUse};
 
     fn request() -> PlanRequest {
         PlanRequest {
@@ -224,6 +224,7 @@ mod tests {
             params: GaOverrides::default(),
             seed: 0,
             map_version: None,
+            shortest: ShortestPathUse::Omit,
         }
     }
 

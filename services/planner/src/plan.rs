@@ -22,7 +22,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use roam_proto::planner::{FitnessTerms, PlannerModel, StopReason};
+use roam_proto::planner::{FitnessTerms, PlannerModel, ShortestPathUse, StopReason};
 use roam_proto::{ErrorCode, ErrorReply};
 
 use crate::best::{ranked, PlanSource, Scored};
@@ -57,6 +57,10 @@ pub struct PlanSpec {
     pub threads: usize,
     /// The size limits a GA plan is checked against before any work.
     pub limits: PlanLimits,
+    /// Whether a budget below the shortest path's ETA is refused or answered with the
+    /// shortest path ([`ShortestPathUse::Fallback`]); the outcome carries the shortest
+    /// path either way, and the service attaches it to the reply unless `Omit`.
+    pub shortest: ShortestPathUse,
 }
 
 impl PlanSpec {
@@ -84,6 +88,7 @@ impl PlanSpec {
             seed,
             threads: crate::ga::default_threads(),
             limits: PlanLimits::default(),
+            shortest: ShortestPathUse::Omit,
         }
     }
 }
@@ -91,6 +96,9 @@ impl PlanSpec {
 /// A plan before it becomes a message.
 #[derive(Debug, Clone)]
 pub struct PlanOutcome {
+    /// The model that answered: the spec's, or [`PlannerModel::Shortest`] when the
+    /// budget did not fit the fastest path and the spec asked for the fallback.
+    pub model: PlannerModel,
     /// The planned path on the planning grid (the world's cells).
     pub path: Vec<Cell>,
     /// The path the robot drives, in map cells `[x, y]`: `path` itself at the map's
@@ -118,21 +126,23 @@ pub struct PlanOutcome {
     /// The via-point seeds the first population held ([`crate::seeds`]).
     pub via_seeds: usize,
     /// The fastest path (the floor the budget was checked against, what `model:
-    /// shortest` answers) as the robot would drive it: for a reply that carries it
-    /// beside the plan.
-    pub fastest: FastestPath,
+    /// shortest` answers; found for every plan, [`check`]) as the robot would drive it,
+    /// when the spec asked for it (its `shortest` is not [`ShortestPathUse::Omit`]).
+    pub shortest: Option<ShortestOutcome>,
 }
 
 /// The fastest path of a plan, measured as the plan is.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FastestPath {
-    /// Map cells `[x, y]`, as [`PlanOutcome::cells`].
+#[derive(Debug, Clone)]
+pub struct ShortestOutcome {
+    /// On the planning grid.
+    pub path: Vec<Cell>,
+    /// As driven: map cells `[x, y]` (as [`PlanOutcome::cells`]) and their centres.
     pub cells: Vec<[u32; 2]>,
     pub points: Vec<[f64; 2]>,
-    /// Eq. 2 on `cells`.
+    /// Paper 000 Eq. 2 on `cells` under the spec's time model, seconds.
     pub t_eta_s: f64,
-    /// The information of the distinct planning cells seen along it.
-    pub distinct_information: f64,
+    /// On the planning cells it passes through.
+    pub metrics: PathMetrics,
 }
 
 /// Why a plan was refused. Each says what to change.
@@ -313,6 +323,10 @@ struct Checked {
     /// The path of least Eq. 2 time ([`fastest_path`]): the floor every budget is
     /// checked against, and what the `shortest` baseline returns.
     fastest: Vec<Cell>,
+    /// Its Eq. 2 time as driven, and whether the budget fits it (it does unless the
+    /// spec asked for the fastest path as a fallback).
+    fastest_t_eta_s: f64,
+    budget_fits: bool,
     /// The path the GA's first population holds and [`best_of`] never falls below: the
     /// distance-shortest path when it fits the budget (as before issue 16, so plans
     /// whose budget admits it are unchanged bit for bit), else the fastest path.
@@ -340,7 +354,9 @@ impl Checked {
     }
 }
 
-/// Everything [`plan`] refuses before any work, and the shortest path.
+/// Everything [`plan`] refuses before any work, and the shortest path: the one place
+/// where "shortest" is decided, for the refusal, the GA's seed, the fallback and the
+/// path attached to the reply.
 fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
     check_spec(spec)?;
     let (start, start_anchor) = locate(world, "start", spec.start)?;
@@ -374,7 +390,8 @@ fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
         _ => (planned_eta, None, None),
     };
     let planning_budget_s = spec.t_exec_s - (needed - planned_eta).max(0.0);
-    if needed > spec.t_exec_s {
+    let budget_fits = needed <= spec.t_exec_s;
+    if !budget_fits && spec.shortest != ShortestPathUse::Fallback {
         return Err(PlanError::BudgetTooShort {
             given_s: spec.t_exec_s,
             needed_s: needed,
@@ -392,6 +409,8 @@ fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
         start,
         goal,
         fastest,
+        fastest_t_eta_s: needed,
+        budget_fits,
         shortest,
         size,
         anchors,
@@ -405,7 +424,7 @@ fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
 /// anyone who wants to see them.
 pub fn via_seeds(world: &World, spec: &PlanSpec) -> Result<ViaSeeds, PlanError> {
     let checked = check(world, spec)?;
-    if checked.size.is_none() {
+    if checked.size.is_none() || !checked.budget_fits {
         return Ok(ViaSeeds::default());
     }
     let field = distance_field(world, checked.goal);
@@ -444,9 +463,16 @@ pub fn plan(
     let params = &spec.params;
     let (start, goal) = (checked.start, checked.goal);
     let deadline = started + Duration::from_secs_f64(spec.deadline_s);
+    // A budget the fastest path does not fit (asked for as a fallback): the fastest
+    // path answers, as the baseline would.
+    let model = if checked.budget_fits {
+        spec.model
+    } else {
+        PlannerModel::Shortest
+    };
     let budget = checked.planning_budget_s;
     let world_for_model;
-    let world = if Model::of(spec.model) == Some(Model::Heterogeneity)
+    let world = if Model::of(model) == Some(Model::Heterogeneity)
         && params.heuristic_compression != world.heuristic_compression
     {
         let mut w = world.clone();
@@ -457,7 +483,7 @@ pub fn plan(
         world
     };
     let (ranked, scoring, generations, (evaluations, evaluated_genes), stop_reason, via_seeds) =
-        match Model::of(spec.model) {
+        match Model::of(model) {
             None => {
                 // The baseline's fitness terms are scored with Model I, the paper's best,
                 // so that they compare with the curious plans.
@@ -479,7 +505,7 @@ pub fn plan(
                     0,
                 )
             }
-            Some(_) if spec.model == PlannerModel::Greedy => {
+            Some(_) if model == PlannerModel::Greedy => {
                 let field = distance_field(world, goal);
                 let problem = GreedyProblem {
                     world,
@@ -580,8 +606,10 @@ pub fn plan(
             }
         };
     let driven = drive(world, spec, &checked, scoring, ranked);
-    let fastest = fastest_as_driven(world, params, &checked);
+    let shortest = (spec.shortest != ShortestPathUse::Omit)
+        .then(|| fastest_as_driven(world, params, &checked));
     Ok(PlanOutcome {
+        model,
         t_eta_s: driven.t_eta_s,
         reaches_goal: driven.chosen.evaluation.reaches_goal,
         within_budget: driven.t_eta_s <= spec.t_exec_s,
@@ -598,26 +626,30 @@ pub fn plan(
         stop_reason,
         source: driven.chosen.source,
         via_seeds,
-        fastest,
+        shortest,
     })
 }
 
-/// [`FastestPath`] of a checked request.
-fn fastest_as_driven(world: &World, params: &GaParams, checked: &Checked) -> FastestPath {
+/// [`ShortestOutcome`] of a checked request: its fastest path as driven, measured as
+/// the `shortest` baseline measures it.
+fn fastest_as_driven(world: &World, params: &GaParams, checked: &Checked) -> ShortestOutcome {
     match (&world.fine, &checked.fastest_driven) {
-        (Some(fine), Some(driven)) => FastestPath {
-            cells: fine.grid_cells(driven),
-            points: fine.centers(driven),
-            t_eta_s: fine.eta(params, driven),
-            distinct_information: path_metrics(world, params, &fine.planning_cells(driven))
-                .distinct_information,
-        },
-        _ => FastestPath {
+        (Some(fine), Some(driven)) => {
+            let path = fine.planning_cells(driven);
+            ShortestOutcome {
+                metrics: path_metrics(world, params, &path),
+                path,
+                cells: fine.grid_cells(driven),
+                points: fine.centers(driven),
+                t_eta_s: checked.fastest_t_eta_s,
+            }
+        }
+        _ => ShortestOutcome {
+            metrics: path_metrics(world, params, &checked.fastest),
+            path: checked.fastest.clone(),
             cells: world.grid_cells(&checked.fastest),
             points: world.centers(&checked.fastest),
-            t_eta_s: path_eta(world, params, &checked.fastest),
-            distinct_information: path_metrics(world, params, &checked.fastest)
-                .distinct_information,
+            t_eta_s: checked.fastest_t_eta_s,
         },
     }
 }

@@ -20,7 +20,9 @@ use std::time::{Duration, Instant};
 
 use roam_proto::excerpt;
 use roam_proto::map::Layer;
-use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, PlannerModel, StopReason};
+use roam_proto::planner::{
+    CancelPlan, Plan, PlanProgress, PlanRequest, PlannerModel, ShortestPath, StopReason,
+};
 use roam_proto::{keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, Requester, Service, ServiceError};
@@ -69,7 +71,9 @@ pub struct SettingError {
     pub allowed: String,
 }
 
-struct State {
+/// This planner instance, shared by its queryables and subscribers: its maps, its queue
+/// and the plans it has in flight, its limits and its CPU budget.
+struct PlannerInstance {
     root: String,
     instance: String,
     session: zenoh::Session,
@@ -85,7 +89,7 @@ struct State {
     cancel_warnings: WarnLimiter,
 }
 
-impl State {
+impl PlannerInstance {
     fn maps(&self) -> MutexGuard<'_, MapCache> {
         roam_runtime::lock(&self.maps)
     }
@@ -170,7 +174,7 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let state = Arc::new(State {
+    let state = Arc::new(PlannerInstance {
         root: config.root.clone(),
         instance: service.instance().to_owned(),
         session: service.session().clone(),
@@ -198,7 +202,7 @@ pub async fn run(
             .subscribe(
                 &keys::map_layer(root, layer),
                 state.clone(),
-                |state: &Arc<State>, layer: Layer| take_layer(state, layer),
+                |state: &Arc<PlannerInstance>, layer: Layer| take_layer(state, layer),
             )
             .await?;
     }
@@ -212,7 +216,7 @@ pub async fn run(
             &keys::planner_cancel_any(root),
             MAX_CANCEL_BYTES,
             state.clone(),
-            |state: &Arc<State>, key: &str, request: CancelPlan| {
+            |state: &Arc<PlannerInstance>, key: &str, request: CancelPlan| {
                 // Keys decide: the request a cancel is for is the one its key names.
                 if key.rsplit('/').next() == Some(request.request_id.as_str()) {
                     take_cancel(state, &request)
@@ -264,7 +268,7 @@ pub async fn run(
     Ok(())
 }
 
-fn take_layer(state: &State, layer: Layer) {
+fn take_layer(state: &PlannerInstance, layer: Layer) {
     if let Some(version) = state.maps().update(layer) {
         tracing::info!(
             inflated = version.inflated,
@@ -276,7 +280,7 @@ fn take_layer(state: &State, layer: Layer) {
 
 /// A cancel: honoured only with the plan's own token ([`InFlight::cancel`]); refusals
 /// are logged, rate-limited, with the id cut to an excerpt and never the token.
-fn take_cancel(state: &State, request: &CancelPlan) {
+fn take_cancel(state: &PlannerInstance, request: &CancelPlan) {
     let verdict = state
         .plans
         .cancel(&request.request_id, request.token.as_deref());
@@ -308,7 +312,7 @@ fn take_cancel(state: &State, request: &CancelPlan) {
 }
 
 /// Gets the two layers from the map server, retrying until both arrive.
-async fn fetch_maps(state: Arc<State>, requester: Requester, cancel: CancellationToken) {
+async fn fetch_maps(state: Arc<PlannerInstance>, requester: Requester, cancel: CancellationToken) {
     loop {
         let layers = state.maps().layers();
         for name in &layers {
@@ -330,7 +334,7 @@ async fn fetch_maps(state: Arc<State>, requester: Requester, cancel: Cancellatio
     }
 }
 
-async fn answer_plan(state: Arc<State>, query: Query, seq: u64, arrived: Instant) {
+async fn answer_plan(state: Arc<PlannerInstance>, query: Query, seq: u64, arrived: Instant) {
     let request = match reply::decode_request::<PlanRequest>(&query, MAX_REQUEST_BYTES) {
         Ok(r) => r,
         // The codec's refusals quote the payload only as a bounded excerpt.
@@ -357,7 +361,7 @@ struct Prepared<'a> {
 
 /// Admits a request to the queue or refuses it at once, waits for its turn, plans.
 async fn serve_plan(
-    state: &Arc<State>,
+    state: &Arc<PlannerInstance>,
     request: PlanRequest,
     seq: u64,
     arrived: Instant,
@@ -465,7 +469,7 @@ pub fn reply_margin_s(deadline_s: f64) -> f64 {
 }
 
 /// Checks a request against this instance's state and registers it.
-fn prepare(state: &State, request: PlanRequest) -> Result<Prepared<'_>, ErrorReply> {
+fn prepare(state: &PlannerInstance, request: PlanRequest) -> Result<Prepared<'_>, ErrorReply> {
     let request_id = request_id(&request)?;
     if let Some(token) = &request.cancel_token {
         token::check_token(token)
@@ -518,6 +522,7 @@ fn prepare(state: &State, request: PlanRequest) -> Result<Prepared<'_>, ErrorRep
         seed: request.seed,
         threads: crate::ga::default_threads(),
         limits: state.limits,
+        shortest: request.shortest,
     };
     // The numbers and the plan's size, before it is queued: what is refused for its
     // content is refused at once, not after a wait.
@@ -537,7 +542,7 @@ fn prepare(state: &State, request: PlanRequest) -> Result<Prepared<'_>, ErrorRep
 }
 
 /// The refusal of a request the queue cannot serve within its deadline.
-fn busy(state: &State, refusal: Refusal) -> ErrorReply {
+fn busy(state: &PlannerInstance, refusal: Refusal) -> ErrorReply {
     let (running, queued) = state.queue.load();
     let wait = refusal.expected_wait_s();
     let reply = match refusal {
@@ -587,7 +592,7 @@ fn request_id(request: &PlanRequest) -> Result<String, ErrorReply> {
 }
 
 /// The refusal of a plan the CPU budget has no time for.
-fn exhausted(state: &State, e: Exhausted) -> ErrorReply {
+fn exhausted(state: &PlannerInstance, e: Exhausted) -> ErrorReply {
     let config = state.budget.config();
     let burst = config.plan_seconds_burst;
     ErrorReply::limit(
@@ -611,7 +616,7 @@ fn exhausted(state: &State, e: Exhausted) -> ErrorReply {
 /// within the CPU budget, and builds the reply; with the share of its generations it
 /// ran, for the queue's rate.
 fn plan_now(
-    state: &State,
+    state: &PlannerInstance,
     request: &PlanRequest,
     request_id: String,
     map_version: roam_proto::planner::MapVersion,
@@ -679,9 +684,17 @@ pub fn to_message(
     instance: &str,
     outcome: PlanOutcome,
 ) -> Plan {
+    // Only when the request asked ([`plan`] measures it only then): a client from
+    // before the field never sees it. The fastest path, as driven (map cells).
+    let shortest = outcome.shortest.as_ref().map(|s| ShortestPath {
+        cells: s.cells.clone(),
+        points: s.points.clone(),
+        t_eta_s: s.t_eta_s,
+        distinct_information: s.metrics.distinct_information,
+    });
     Plan {
         request_id,
-        model: request.model,
+        model: outcome.model,
         cells: outcome.cells,
         points: outcome.points,
         planning_resolution_m: Some(world.meta.resolution),
@@ -699,5 +712,6 @@ pub fn to_message(
         seed: request.seed,
         map_version,
         instance: instance.to_owned(),
+        shortest,
     }
 }

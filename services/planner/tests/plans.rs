@@ -10,7 +10,7 @@ use proptest::prelude::*;
 use roam_planner::best::PlanSource;
 use roam_planner::plan::{plan, PlanError, PlanOutcome, PlanSpec};
 use roam_planner::world::World;
-use roam_proto::planner::PlannerModel;
+use roam_proto::planner::{PlannerModel, ShortestPathUse, StopReason};
 
 fn spec(
     model: PlannerModel,
@@ -124,6 +124,65 @@ fn curious_plans_use_the_budget_and_gather_more_than_the_shortest_path() {
             shortest.metrics.distinct_information
         );
     }
+}
+
+/// The shortest path comes with a plan only when asked, exactly as the baseline finds
+/// and measures it; with the fallback, a budget it does not fit is answered with it.
+#[test]
+fn the_shortest_path_is_attached_when_asked_and_is_the_fallback() {
+    let world = common::builtin_world();
+    let (from, to) = ([-8.0, -8.0], [6.0, -7.0]);
+    let baseline = run(&world, &spec(PlannerModel::Shortest, from, to, 100.0, 1, 5));
+    let curious = spec(PlannerModel::Model1, from, to, 100.0, 1, 5);
+    assert!(run(&world, &curious).shortest.is_none(), "not asked for");
+    let attached = run(
+        &world,
+        &PlanSpec {
+            shortest: ShortestPathUse::Attach,
+            ..curious.clone()
+        },
+    );
+    assert_eq!(attached.model, PlannerModel::Model1);
+    let shortest = attached.shortest.expect("attached");
+    assert_eq!(shortest.path, baseline.path);
+    assert_eq!(shortest.t_eta_s.to_bits(), baseline.t_eta_s.to_bits());
+    assert_eq!(
+        shortest.metrics.distinct_information.to_bits(),
+        baseline.metrics.distinct_information.to_bits()
+    );
+
+    let short = PlanSpec {
+        t_exec_s: 0.5 * baseline.t_eta_s,
+        ..curious
+    };
+    for refused in [ShortestPathUse::Omit, ShortestPathUse::Attach] {
+        let outcome = plan(
+            &world,
+            &PlanSpec {
+                shortest: refused,
+                ..short.clone()
+            },
+            &AtomicBool::new(false),
+            |_, _| {},
+        );
+        assert!(
+            matches!(outcome, Err(PlanError::BudgetTooShort { .. })),
+            "{refused:?}: {outcome:?}"
+        );
+    }
+    let fallback = run(
+        &world,
+        &PlanSpec {
+            shortest: ShortestPathUse::Fallback,
+            ..short
+        },
+    );
+    assert_eq!(fallback.model, PlannerModel::Shortest);
+    assert_eq!(fallback.path, baseline.path);
+    assert!(fallback.reaches_goal && !fallback.within_budget);
+    assert_eq!(fallback.stop_reason, StopReason::Complete);
+    assert_eq!(fallback.generations, 0);
+    assert_eq!(fallback.shortest.expect("attached").path, baseline.path);
 }
 
 #[test]
@@ -322,15 +381,22 @@ fn the_fastest_path_floor_admits_a_budget_the_distance_shortest_path_would_refus
         PlannerModel::Model1,
         PlannerModel::Model2,
     ] {
-        let outcome = run(&world, &spec(model, start, goal, budget, 3, 20));
+        let outcome = run(
+            &world,
+            &PlanSpec {
+                shortest: ShortestPathUse::Attach,
+                ..spec(model, start, goal, budget, 3, 20)
+            },
+        );
         assert!(outcome.within_budget && outcome.reaches_goal, "{model:?}");
         assert!(outcome.t_eta_s <= budget);
         if model == PlannerModel::Shortest {
             assert_eq!(outcome.t_eta_s.to_bits(), fastest.to_bits());
         }
-        // Every plan carries the floor it was checked against, as driven.
-        assert_eq!(outcome.fastest.t_eta_s.to_bits(), fastest.to_bits());
-        assert_eq!(outcome.fastest.cells.len(), outcome.fastest.points.len());
+        // The path attached as `shortest` is the floor it was checked against.
+        let attached = outcome.shortest.expect("attached");
+        assert_eq!(attached.t_eta_s.to_bits(), fastest.to_bits());
+        assert_eq!(attached.cells.len(), attached.points.len());
     }
     let refused = plan(
         &world,

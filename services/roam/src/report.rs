@@ -9,7 +9,7 @@ use roam_proto::cells::Cells;
 use roam_proto::keys;
 use roam_proto::map::{Layer, LayerList};
 use roam_proto::map::{INFORMATION_LAYER as INFORMATION, OCCUPANCY_LAYER as OCCUPANCY};
-use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
+use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel, ShortestPathUse};
 use roam_runtime::{ClientError, Requester};
 use roam_world::grid::Grid;
 use roam_world::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, PATH};
@@ -185,6 +185,7 @@ async fn plan_mission(
         params: GaOverrides::default(),
         seed: REPORT_SEED,
         map_version: None,
+        shortest: ShortestPathUse::Omit,
     };
     let shortest = planner.plan(&request).await?;
     request.t_exec_s = 2.0 * shortest.t_eta_s;

@@ -10,13 +10,12 @@
 //! Needs `python3` with `eclipse-zenoh==1.10.2` and `rosbags==0.11.9`. Without them the
 //! test prints a notice and passes, except in CI (`CI` set), where it fails.
 
-use std::io::{BufRead, BufReader, Read};
-use std::path::PathBuf;
-use std::process::{Child, Command, ExitStatus, Stdio};
-use std::sync::mpsc;
-use std::thread;
-use std::time::{Duration, Instant};
+mod clients;
 
+use std::path::PathBuf;
+use std::time::Duration;
+
+use clients::{python_has, run_python, RoamProcess};
 use roam_proto::cells::Cells;
 use roam_proto::controller::Mission;
 use roam_proto::keys;
@@ -24,129 +23,29 @@ use roam_proto::map::Layer;
 use roam_runtime::{Requester, SessionArgs};
 use roam_stack::router::free_loopback_port;
 
-const ROAM: &str = env!("CARGO_BIN_EXE_roam");
-const READY_TIMEOUT: Duration = Duration::from_secs(60);
 const SCRIPT_TIMEOUT: Duration = Duration::from_secs(180);
 
 fn script() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/clients/python/ros2_client.py")
 }
 
-/// Stops a child on every way out of the test: SIGTERM, up to 10 s, then SIGKILL.
-struct Guard(Child);
-
-impl Guard {
-    fn stop(&mut self) -> Option<ExitStatus> {
-        let _ = Command::new("kill")
-            .args(["-TERM", &self.0.id().to_string()])
-            .status();
-        let started = Instant::now();
-        while started.elapsed() < Duration::from_secs(10) {
-            if let Ok(Some(status)) = self.0.try_wait() {
-                return Some(status);
-            }
-            thread::sleep(Duration::from_millis(50));
-        }
-        let _ = self.0.kill();
-        self.0.wait().ok()
-    }
-}
-
-impl Drop for Guard {
-    fn drop(&mut self) {
-        if let Ok(None) = self.0.try_wait() {
-            self.stop();
-        }
-    }
-}
-
-/// Starts `roam <args>` and returns once a stderr line contains `ready` (the rest of
-/// stderr keeps being drained).
-fn start(args: &[&str], root: &str, ready: &str) -> Guard {
-    let mut child = Command::new(ROAM)
-        .args(args)
-        .env("ROAM_ROOT", root)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn roam");
-    let stderr = child.stderr.take().expect("stderr");
-    let guard = Guard(child);
-    let (tx, rx) = mpsc::channel::<String>();
-    thread::spawn(move || {
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            let _ = tx.send(line);
-        }
-    });
-    let started = Instant::now();
-    let mut seen = Vec::new();
-    loop {
-        match rx.recv_timeout(READY_TIMEOUT.saturating_sub(started.elapsed())) {
-            Ok(line) if line.contains(ready) => return guard,
-            Ok(line) => seen.push(line),
-            Err(_) => panic!("roam {args:?} not ready; stderr:\n{}", seen.join("\n")),
-        }
-    }
-}
-
-fn python(args: &[&str]) -> (ExitStatus, String, String) {
-    let mut child = Command::new("python3")
-        .arg(script())
-        .args(args)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn python3");
-    let drain = |mut pipe: Box<dyn Read + Send>| {
-        thread::spawn(move || {
-            let mut text = String::new();
-            let _ = pipe.read_to_string(&mut text);
-            text
-        })
-    };
-    let out = drain(Box::new(child.stdout.take().expect("stdout")));
-    let err = drain(Box::new(child.stderr.take().expect("stderr")));
-    let started = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait().expect("wait") {
-            break status;
-        }
-        if started.elapsed() > SCRIPT_TIMEOUT {
-            let _ = child.kill();
-            panic!("ros2_client.py {args:?} took longer than {SCRIPT_TIMEOUT:?}");
-        }
-        thread::sleep(Duration::from_millis(50));
-    };
-    (status, out.join().expect("out"), err.join().expect("err"))
-}
-
-fn python_has_packages() -> bool {
-    Command::new("python3")
-        .args(["-c", "import zenoh, zenoh.ext, rosbags"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
+fn python(args: &[&str]) -> clients::ScriptRun {
+    run_python(&script(), args, SCRIPT_TIMEOUT)
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_ros2_client_reads_the_map_and_plans_and_calls_the_planner() {
-    if !python_has_packages() {
-        if std::env::var_os("CI").is_some() {
-            panic!("python3 cannot import zenoh and rosbags; CI installs eclipse-zenoh==1.10.2 and rosbags==0.11.9");
-        }
-        eprintln!(
-            "SKIPPED a_ros2_client_reads_the_map_and_plans_and_calls_the_planner: python3 cannot \
-             import zenoh and rosbags (pip install eclipse-zenoh==1.10.2 rosbags==0.11.9)"
-        );
+    if !python_has(
+        "zenoh, zenoh.ext, rosbags",
+        "a_ros2_client_reads_the_map_and_plans_and_calls_the_planner",
+        "eclipse-zenoh==1.10.2 rosbags==0.11.9",
+    ) {
         return;
     }
     let port = free_loopback_port().expect("port");
     let endpoint = format!("tcp/127.0.0.1:{port}");
     let root = format!("ros2-{}", std::process::id());
-    let _stack = start(
+    let _stack = RoamProcess::start(
         &["stack", "--ros2", "--listen", &endpoint],
         &root,
         "roam stack up",
@@ -154,7 +53,7 @@ async fn a_ros2_client_reads_the_map_and_plans_and_calls_the_planner() {
     let tmp = tempfile::tempdir().expect("tmp");
     let bag_dir = tmp.path().join("run");
     let bag = bag_dir.to_str().expect("utf-8");
-    let mut recorder = start(
+    let mut recorder = RoamProcess::start(
         &[
             "view",
             "--no-ws",
@@ -177,6 +76,23 @@ async fn a_ros2_client_reads_the_map_and_plans_and_calls_the_planner() {
     )
     .await
     .expect("session");
+    // The recorder is a second ROS 2 node under the root: once its liveliness token is
+    // seen beside the stack's, its subscriptions reached the router (a session's
+    // declarations arrive in order), so the mission below is recorded.
+    let tokens = session
+        .liveliness()
+        .declare_subscriber(keys::liveliness_of(&root, roam_ros2::node::SERVICE_NAME))
+        .history(true)
+        .await
+        .expect("liveliness subscriber");
+    let mut nodes = std::collections::BTreeSet::new();
+    while nodes.len() < 2 {
+        let token = tokio::time::timeout(clients::READY_TIMEOUT, tokens.recv_async())
+            .await
+            .expect("the stack's ROS 2 node and the recorder announce themselves")
+            .expect("token");
+        nodes.insert(token.key_expr().to_string());
+    }
     let waypoints = vec![[-8.0, -8.0], [-7.5, -8.0], [-7.0, -7.5]];
     let mission = Mission {
         robot: "r1".into(),
@@ -197,7 +113,7 @@ async fn a_ros2_client_reads_the_map_and_plans_and_calls_the_planner() {
         .expect("occupancy");
 
     let waypoints_json = serde_json::to_string(&waypoints).expect("json");
-    let (status, stdout, stderr) = tokio::task::spawn_blocking(move || {
+    let live = tokio::task::spawn_blocking(move || {
         python(&[
             "live",
             "--connect",
@@ -210,11 +126,8 @@ async fn a_ros2_client_reads_the_map_and_plans_and_calls_the_planner() {
     })
     .await
     .expect("python");
-    assert!(
-        status.success(),
-        "exit {status:?}\nstdout:\n{stdout}\nstderr:\n{stderr}"
-    );
-    let out: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    assert!(live.status.success(), "{live:?}");
+    let out: serde_json::Value = serde_json::from_str(&live.stdout).expect("json");
 
     // The map, cell by cell.
     let map = &out["map"];
@@ -251,12 +164,9 @@ async fn a_ros2_client_reads_the_map_and_plans_and_calls_the_planner() {
     // The rosbag2 recording, complete once the recorder stopped.
     let stopped = recorder.stop().expect("the recorder stops");
     assert!(stopped.success(), "roam view --rosbag exited {stopped:?}");
-    let (status, stdout, stderr) = python(&["bag", bag]);
-    assert!(
-        status.success(),
-        "exit {status:?}\nstdout:\n{stdout}\nstderr:\n{stderr}"
-    );
-    let out: serde_json::Value = serde_json::from_str(&stdout).expect("json");
+    let recording = python(&["bag", bag]);
+    assert!(recording.status.success(), "{recording:?}");
+    let out: serde_json::Value = serde_json::from_str(&recording.stdout).expect("json");
     let topics = &out["topics"];
     assert_eq!(
         topics["/map"]["type"], "nav_msgs/msg/OccupancyGrid",

@@ -7,7 +7,7 @@
 use roam_proto::cells::Cells;
 use roam_proto::localization::PositionEstimate;
 use roam_proto::map::{GridMeta, Layer, Origin};
-use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
+use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel, ShortestPathUse};
 use roam_proto::{ErrorCode, ErrorReply};
 
 use crate::msg::{
@@ -375,6 +375,7 @@ pub fn plan_downtime_request(request: &PlanDowntimeRequest) -> Result<PlanReques
         params: GaOverrides::default(),
         seed: request.seed,
         map_version: None,
+        shortest: ShortestPathUse::Omit,
     })
 }
 

@@ -8,7 +8,7 @@ mod common;
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use common::{within, FoxgloveClient, Stack};
+use common::{start_view, within, FoxgloveClient, Stack};
 use foxglove::messages::{Grid, SceneUpdate};
 use foxglove::Decode;
 use roam_proto::cells::Cells;
@@ -35,22 +35,7 @@ async fn a_foxglove_client_sees_the_channels_and_receives_the_map() {
 
     // The view on its own client session, a WebSocket server on a free port.
     let view_session = stack.client().await;
-    let cancel = CancellationToken::new();
-    let view = within(
-        "view start",
-        roam_view::run(
-            view_session.clone(),
-            ViewConfig {
-                root: stack.root.clone(),
-                listen: Some("127.0.0.1:0".parse().expect("addr")),
-                mcap: None,
-                access: Access::default(),
-            },
-            cancel.clone(),
-        ),
-    )
-    .await
-    .expect("the view starts");
+    let (view, cancel) = start_view(&view_session, &stack.root, Access::default(), None).await;
     let addr = view.websocket_addr().expect("listening");
     assert_ne!(addr.port(), 0);
     assert_eq!(view.websocket_url(), Some(format!("ws://{addr}")));

@@ -13,11 +13,10 @@ use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use common::{within, Stack};
+use common::{start_view, within, Stack};
 use roam_proto::cells::Cells;
 use roam_runtime::Requester;
-use roam_view::{Access, ViewConfig};
-use tokio_util::sync::CancellationToken;
+use roam_view::Access;
 
 fn client_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/clients/node")
@@ -52,22 +51,7 @@ async fn the_ws_protocol_client_receives_the_map() {
     let requester = Requester::new(stack.client().await, Duration::from_secs(5));
     let occupancy = stack.occupancy(&requester).await;
     let view_session = stack.client().await;
-    let cancel = CancellationToken::new();
-    let view = within(
-        "view start",
-        roam_view::run(
-            view_session.clone(),
-            ViewConfig {
-                root: stack.root.clone(),
-                listen: Some("127.0.0.1:0".parse().expect("addr")),
-                mcap: None,
-                access: Access::default(),
-            },
-            cancel.clone(),
-        ),
-    )
-    .await
-    .expect("the view starts");
+    let (view, cancel) = start_view(&view_session, &stack.root, Access::default(), None).await;
     let url = view.websocket_url().expect("listening");
 
     // The script gives up by itself after 60 s.

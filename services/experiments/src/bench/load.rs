@@ -11,7 +11,7 @@
 use std::time::{Duration, Instant};
 
 use roam_planner::client::PlannerClient;
-use roam_proto::planner::{GaOverrides, PlanRequest, PlannerModel};
+use roam_proto::planner::{GaOverrides, PlanRequest, PlannerModel, ShortestPathUse};
 use roam_proto::ErrorCode;
 use roam_runtime::ClientError;
 use serde::Serialize;
@@ -123,6 +123,7 @@ pub async fn load(requests: usize, deadline_s: f64) -> Result<LoadBench, Experim
                 },
                 seed: i as u64,
                 map_version: None,
+                shortest: ShortestPathUse::Omit,
             };
             let asked = Instant::now();
             match tokio::time::timeout(patience, client.plan(&request)).await {

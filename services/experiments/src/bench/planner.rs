@@ -15,7 +15,7 @@ use roam_map_server::map_file;
 use roam_planner::client::PlannerClient;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
-use roam_proto::planner::{GaOverrides, PlanRequest, PlannerModel};
+use roam_proto::planner::{GaOverrides, PlanRequest, PlannerModel, ShortestPathUse};
 use roam_runtime::SessionArgs;
 use roam_world::layers::inflate;
 use roam_world::DEFAULT_MAX_CELLS;
@@ -181,6 +181,7 @@ async fn zenoh_overhead(world: &World, budget: f64, runs: usize) -> Result<f64, 
             },
             seed: 5,
             map_version: None,
+            shortest: ShortestPathUse::Omit,
         };
         let never = AtomicBool::new(false);
         let (mut local, mut remote) = (Vec::new(), Vec::new());

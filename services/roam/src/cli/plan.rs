@@ -8,7 +8,7 @@ use roam_planner::client::{PlanTicket, PlannerClient};
 use roam_proto::cells::Cells;
 use roam_proto::keys;
 use roam_proto::map::Layer;
-use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel};
+use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel, ShortestPathUse};
 use roam_runtime::Requester;
 use roam_world::grid::Grid;
 use roam_world::render;
@@ -90,6 +90,7 @@ pub(crate) async fn plan(args: PlanArgs) -> anyhow::Result<()> {
         },
         seed: args.seed,
         map_version: None,
+        shortest: ShortestPathUse::Omit,
     };
     // A fresh random id and cancel token for this request: Ctrl-C cancels the plan with
     // the token, and the planner replies with its best path so far.

@@ -4,7 +4,9 @@
 
 use std::time::{Duration, Instant};
 
-use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel, StopReason};
+use roam_proto::planner::{
+    GaOverrides, Plan, PlanRequest, PlannerModel, ShortestPathUse, StopReason,
+};
 use roam_proto::{keys, ErrorCode};
 use roam_runtime::{ClientError, Requester};
 
@@ -38,6 +40,7 @@ pub(crate) async fn maximal_plans(session: &zenoh::Session, root: &str) -> Durat
         },
         seed: 0,
         map_version: None,
+        shortest: ShortestPathUse::Omit,
     };
     let key = keys::planner_plan(root);
     let asks: Vec<_> = (0..3)

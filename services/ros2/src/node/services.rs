@@ -21,7 +21,7 @@
 use std::sync::Arc;
 
 use roam_planner::client::PlannerClient;
-use roam_proto::planner::{PlanRequest, PlannerModel};
+use roam_proto::planner::{PlanRequest, PlannerModel, ShortestPathUse};
 use roam_proto::{ErrorCode, ErrorReply};
 use roam_runtime::{ClientError, Service};
 use serde::Serialize;
@@ -206,6 +206,7 @@ async fn get_plan_path(
         params: Default::default(),
         seed: 0,
         map_version: None,
+        shortest: ShortestPathUse::Omit,
     };
     let shortest = state.planner.plan(&probe).await.map_err(client_error)?;
     if !shortest.reaches_goal {

@@ -19,7 +19,7 @@ use roam_mission::tasks::Task;
 use roam_mission::watch::WatchParams;
 
 /// How often the executive asks again for a window's first plans when none came
-/// (its `PLAN_RETRY`), mission seconds.
+/// ([`roam_mission::window::PLAN_RETRY_S`], wall seconds there), mission seconds.
 const PLAN_RETRY_S: f64 = 1.0;
 
 /// The steps the day may take to get the robot's first fix.
@@ -43,7 +43,7 @@ pub struct DayResult {
 }
 
 /// A window's plans made ahead, while the robot did the previous task.
-pub(super) struct Preplanned {
+pub(super) struct PlannedAhead {
     pub window: usize,
     pub from: [f64; 2],
     pub shortest: Planned,
@@ -66,7 +66,7 @@ pub(super) struct DayRun<'a> {
     pub margin: ArrivalMargin,
     pub plan_cost_s: f64,
     pub day_seed: u64,
-    pub preplanned: Option<Preplanned>,
+    pub planned_ahead: Option<PlannedAhead>,
     /// The whole day's true path.
     pub truth: Vec<[f64; 2]>,
 }
@@ -109,7 +109,7 @@ pub fn run_day(
         executive,
         plan_cost_s: options.plan_cost_s,
         day_seed: seed,
-        preplanned: None,
+        planned_ahead: None,
         truth: Vec::new(),
     };
     run.first_fix()?;
@@ -202,7 +202,7 @@ impl DayRun<'_> {
     }
 
     /// The curious plan for the budget, or the shortest when curiosity does not fit
-    /// (the executive's `plan_window`), with the budget. A curious plan costs
+    /// (the executive's rule, [`roam_mission::window`]), with the budget. A curious plan costs
     /// `plan_cost_s` of mission time, through which the robot goes on as it was (its
     /// mission, a hold, or standing at its task). `leave_at_s`: the robot cannot set
     /// off before (a window planned during the previous task). `rank` counts the
@@ -240,7 +240,7 @@ impl DayRun<'_> {
         }
     }
 
-    /// A window's shortest and curious plans (the executive's `first_plans`): asked
+    /// A window's shortest and curious plans (the executive's first plan): asked
     /// again every [`PLAN_RETRY_S`] while the planner refuses (the estimate in an
     /// inflated cell), `None` once the window is given up.
     #[allow(clippy::too_many_arguments)]

@@ -1,24 +1,26 @@
-//! One downtime window, as the executive's window loop runs it (`executive.rs`), on the
-//! mission clock of the sim: the plans (made ahead during the last task, or now), the
+//! One downtime window, as the executive's window machine runs it (`roam_mission::window`), on
+//! the mission clock of the sim: the plans (made ahead during the last task, or now), the
 //! mission, the [`Watch`]'s decisions on every step's estimate and controller status,
 //! the replans they ask for, the arrival, the time model learning from the arrived
 //! mission, the next window planned during the task, and the wait at the task.
 //!
 //! Every step is an estimate and a controller status, in that order, then a tick (the
-//! executive's 100 ms timer is finer than the sim's 0.4 s step). Wall time is mission
+//! executive's 20 ms tick is finer than the sim's 0.4 s step). Wall time is mission
 //! time: statuses come every step, so the lost-mission rule never fires here.
+//!
+//! The planner is asked in process here, for the shortest path and then (when
+//! curiosity fits the budget) the curious one, as the executive did before its plan
+//! reply carried the shortest path: the same paths and the same GA seeds, and no
+//! request to save.
 
-use super::day::{DayRun, Preplanned};
+use super::day::{DayRun, PlannedAhead};
 use super::measure::{planned_path, Leg, TimeModelUse, Track, WindowResult};
 use super::DaysError;
 use roam_mission::calibration::path_measure;
 use roam_mission::path::distance;
 use roam_mission::tasks::Task;
 use roam_mission::watch::{Decision, Reason, Status, Watch};
-
-/// A preplanned window is used when the robot sets off at most this far from where the
-/// plans start (the executive's `PREPLAN_FROM_M`), metres.
-const PREPLAN_FROM_M: f64 = 0.5;
+use roam_mission::window::PREPLAN_FROM_M;
 
 /// A replan's reason as the report names it.
 pub fn reason_name(reason: Reason) -> &'static str {
@@ -50,11 +52,11 @@ impl DayRun<'_> {
             track.truth.push(at);
         }
         let mut rank = 0;
-        let preplanned = self
-            .preplanned
+        let planned_ahead = self
+            .planned_ahead
             .take()
             .filter(|p| p.window == w && distance(p.from, from) <= PREPLAN_FROM_M);
-        let planned = match preplanned {
+        let planned = match planned_ahead {
             Some(p) => {
                 rank = p.ranks;
                 Some((p.shortest, p.plan, p.budget_s))
@@ -224,7 +226,7 @@ impl DayRun<'_> {
                 self.first_plans(Some(task.at), next, w + 1, &mut ranks, Some(leave_at), None)?;
             if let Some((shortest, plan, budget_s)) = plans {
                 if self.robot.now_s() <= leave_at {
-                    self.preplanned = Some(Preplanned {
+                    self.planned_ahead = Some(PlannedAhead {
                         window: w + 1,
                         from: task.at,
                         shortest,

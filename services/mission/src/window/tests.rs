@@ -1,0 +1,790 @@
+//! Each rule of the window, event by event: a 4 m square world of 0.2 m cells, a task
+//! 3 m east of the robot at 100 s, the next one 3 m north of the robot at 200 s.
+
+use super::*;
+use roam_planner::params::GaParams;
+use roam_planner::world::World;
+use roam_proto::map::{GridMeta, Origin};
+use roam_proto::planner::{FitnessTerms, MapVersion, Plan, PlannerModel, ShortestPath, StopReason};
+use roam_world::grid::Grid;
+
+const FROM: [f64; 2] = [0.1, 0.1];
+const GOAL: [f64; 2] = [3.1, 0.1];
+const NEXT: [f64; 2] = [0.1, 3.1];
+const CURIOUS_ETA_S: f64 = 40.0;
+const SHORTEST_ETA_S: f64 = 6.0;
+
+struct Fixture {
+    world: World,
+    params: GaParams,
+}
+
+fn fixture() -> Fixture {
+    let meta = GridMeta {
+        width: 20,
+        height: 20,
+        resolution: 0.2,
+        origin: Origin::default(),
+    };
+    // Information that differs cell by cell, so that paths differ in what they see.
+    let mut information = Grid::filled(meta, 0u8);
+    for (i, cell) in information.cells.iter_mut().enumerate() {
+        *cell = (i % 7 * 10) as u8;
+    }
+    Fixture {
+        world: World::new(&Grid::filled(meta, 0i8), &information, 0.25).expect("world"),
+        params: GaParams::default(),
+    }
+}
+
+fn task(name: &str, at: [f64; 2], start_s: f64) -> Task {
+    Task {
+        name: name.into(),
+        at,
+        start_s,
+        duration_s: 5.0,
+    }
+}
+
+fn margin() -> ArrivalMargin {
+    ArrivalMargin::new(0.08, 2.0)
+}
+
+fn watch_params() -> WatchParams {
+    WatchParams {
+        off_path_m: 0.5,
+        speed_m_per_s: 0.5,
+        expected_speed_m_per_s: 0.5,
+        max_replans: 3,
+        give_up_after_s: 60.0,
+        controller_silence_s: 3.0,
+        slack_s: 10.0,
+        slack_interval_s: 5.0,
+        behind: true,
+    }
+}
+
+impl Fixture {
+    fn scale(&self) -> InformationScale<'_> {
+        InformationScale {
+            world: &self.world,
+            params: &self.params,
+        }
+    }
+
+    fn setup(&self, window: usize, from: [f64; 2], next: bool) -> WindowSetup<'_> {
+        let (task, next) = match window {
+            0 => (
+                task("goal1", GOAL, 100.0),
+                next.then(|| task("goal2", NEXT, 200.0)),
+            ),
+            _ => (task("goal2", NEXT, 200.0), None),
+        };
+        WindowSetup {
+            window,
+            task,
+            next,
+            robot: "robot".into(),
+            mission_tag: "tag".into(),
+            from,
+            time_model: TimeModel::table_i(),
+            watch: watch_params(),
+            give_up_after_s: 60.0,
+            waypoint_spacing_m: 1.0,
+            scale: self.scale(),
+        }
+    }
+
+    /// The first window, begun at 0 s.
+    fn begin(&self, next: bool) -> (DowntimeWindow<'_>, Vec<WindowAction>) {
+        DowntimeWindow::begin(
+            self.setup(0, FROM, next),
+            Handover::first(margin()),
+            at(0.0, 0.0),
+        )
+    }
+
+    /// The first window with its curious plan sent at 1 s (wall 0 s).
+    fn driving(&self, next: bool) -> (DowntimeWindow<'_>, Mission) {
+        let (mut w, _) = self.begin(next);
+        let actions = w.handle(curious_reply(true), at(1.0, 0.0));
+        (w, sent(&actions))
+    }
+}
+
+/// Mission time `mission_s`, wall time `wall_s`, a plan costing 1 s.
+fn at(mission_s: f64, wall_s: f64) -> Now {
+    Now {
+        mission_s,
+        wall_s,
+        planning_cost_s: 1.0,
+    }
+}
+
+/// Cell centres from `a` to `b` along x or y, 0.2 m apart, both ends included.
+fn line(a: [f64; 2], b: [f64; 2]) -> Vec<[f64; 2]> {
+    let n = ((b[0] - a[0]).abs().max((b[1] - a[1]).abs()) / 0.2).round() as usize;
+    (0..=n)
+        .map(|k| {
+            let t = k as f64 / n.max(1) as f64;
+            [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+        })
+        .collect()
+}
+
+fn joined(legs: &[Vec<[f64; 2]>]) -> Vec<[f64; 2]> {
+    let mut out: Vec<[f64; 2]> = Vec::new();
+    for leg in legs {
+        let skip = usize::from(!out.is_empty());
+        out.extend(leg.iter().skip(skip));
+    }
+    out
+}
+
+/// The curious route: north 1 m, east 3 m, south to the task.
+fn curious_points() -> Vec<[f64; 2]> {
+    joined(&[
+        line(FROM, [0.1, 1.1]),
+        line([0.1, 1.1], [3.1, 1.1]),
+        line([3.1, 1.1], GOAL),
+    ])
+}
+
+fn shortest_points(from: [f64; 2]) -> Vec<[f64; 2]> {
+    line(from, [GOAL[0], from[1]])
+}
+
+fn plan(model: PlannerModel, points: Vec<[f64; 2]>, t_eta_s: f64) -> Plan {
+    Plan {
+        request_id: "r".into(),
+        model,
+        cells: points
+            .iter()
+            .map(|p| [(p[0] / 0.2) as u32, (p[1] / 0.2) as u32])
+            .collect(),
+        points,
+        t_eta_s,
+        reaches_goal: true,
+        within_budget: true,
+        fitness: FitnessTerms::default(),
+        u_ges: 0.0,
+        density: 0.0,
+        distinct_information: 0.0,
+        generations: 10,
+        planning_ms: 1.0,
+        stop_reason: StopReason::MaxGenerations,
+        planning_resolution_m: None,
+        budget_s: None,
+        seed: 0,
+        map_version: MapVersion {
+            inflated: 1,
+            information: 1,
+            change: None,
+        },
+        instance: "planner".into(),
+        shortest: None,
+    }
+}
+
+fn attached(points: Vec<[f64; 2]>) -> Option<ShortestPath> {
+    Some(ShortestPath {
+        cells: Vec::new(),
+        points,
+        t_eta_s: SHORTEST_ETA_S,
+        distinct_information: 0.0,
+    })
+}
+
+/// A curious plan with the shortest path attached, within its budget or not.
+fn curious_reply(within_budget: bool) -> WindowEvent {
+    WindowEvent::PlanReply(Box::new(Plan {
+        within_budget,
+        shortest: attached(shortest_points(FROM)),
+        ..plan(PlannerModel::Model1, curious_points(), CURIOUS_ETA_S)
+    }))
+}
+
+/// The shortest path from `from`, as the planner answers `model: shortest` (or the
+/// fallback).
+fn shortest_reply(from: [f64; 2]) -> WindowEvent {
+    let points = shortest_points(from);
+    WindowEvent::PlanReply(Box::new(Plan {
+        within_budget: false,
+        stop_reason: StopReason::Complete,
+        shortest: attached(points.clone()),
+        ..plan(PlannerModel::Shortest, points, SHORTEST_ETA_S)
+    }))
+}
+
+fn estimate(position: [f64; 2], peb_m: f64) -> WindowEvent {
+    WindowEvent::Estimate {
+        position,
+        peb_m: Some(peb_m),
+        degraded: false,
+    }
+}
+
+fn status(mission: &str, state: MissionState, distance_left_m: f64) -> WindowEvent {
+    WindowEvent::Status(ControllerStatus {
+        robot: "robot".into(),
+        mission: Some(mission.into()),
+        state,
+        waypoint: Some(0),
+        waypoints: 1,
+        distance_left_m: Some(distance_left_m),
+        steps: 1,
+        estimate_step: Some(1),
+        peb_m: None,
+        omega_deg: 0.0,
+        z_isa: 0.0,
+        u: [0.0, 0.0],
+    })
+}
+
+/// The one request among `actions`.
+fn asked(actions: &[WindowAction]) -> PlanAsk {
+    let asks: Vec<PlanAsk> = actions
+        .iter()
+        .filter_map(|a| match a {
+            WindowAction::RequestPlan(ask) => Some(*ask),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(asks.len(), 1, "{actions:?}");
+    asks[0]
+}
+
+/// The one mission sent to drive among `actions`.
+fn sent(actions: &[WindowAction]) -> Mission {
+    let missions: Vec<&Mission> = actions
+        .iter()
+        .filter_map(|a| match a {
+            WindowAction::Drive(m) => Some(m),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(missions.len(), 1, "{actions:?}");
+    missions[0].clone()
+}
+
+/// How the window ended, from the last of `actions`.
+fn ended(actions: &[WindowAction]) -> WindowEnd {
+    match actions.last() {
+        Some(WindowAction::Done(end)) => (**end).clone(),
+        _ => panic!("not done: {actions:?}"),
+    }
+}
+
+fn report(actions: &[WindowAction]) -> WindowReport {
+    ended(actions).outcome.expect("an outcome").report
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() < 1e-9
+}
+
+#[test]
+fn the_first_plan_is_asked_for_then_sent_as_a_mission() {
+    let f = fixture();
+    let (mut w, actions) = f.begin(false);
+    // 100 s to the task, minus the plan's 1 s, minus the margin (8%).
+    let ask = asked(&actions);
+    assert_eq!(actions.len(), 1);
+    assert_eq!((ask.from, ask.to, ask.curious), (FROM, GOAL, true));
+    assert!(close(ask.t_exec_s, margin().budget(99.0)), "{ask:?}");
+    let actions = w.handle(curious_reply(true), at(1.0, 0.0));
+    assert_eq!(
+        actions[0],
+        WindowAction::Planned {
+            budget_s: margin().budget(99.0),
+            eta_s: CURIOUS_ETA_S,
+            curious: true
+        }
+    );
+    let mission = sent(&actions);
+    assert_eq!(mission.id, "robot-tag-w0-m1");
+    assert_eq!(mission.robot, "robot");
+    assert_eq!(
+        mission.waypoints,
+        mission_waypoints(&curious_points(), 1.0),
+        "every turn kept"
+    );
+    assert_eq!(actions.len(), 2);
+}
+
+#[test]
+fn a_plan_that_does_not_fit_drives_the_shortest_path_it_carries() {
+    let f = fixture();
+    // The GA's path over its budget: the attached shortest path is driven.
+    let (mut w, _) = f.begin(false);
+    let actions = w.handle(curious_reply(false), at(1.0, 0.0));
+    assert!(matches!(
+        actions[0],
+        WindowAction::Planned { curious: false, eta_s, .. } if eta_s == SHORTEST_ETA_S
+    ));
+    assert_eq!(
+        sent(&actions).waypoints,
+        mission_waypoints(&shortest_points(FROM), 1.0)
+    );
+    // The planner's fallback for a budget the shortest path does not fit.
+    let (mut w, _) = f.begin(false);
+    let actions = w.handle(shortest_reply(FROM), at(1.0, 0.0));
+    assert!(matches!(
+        actions[0],
+        WindowAction::Planned { curious: false, .. }
+    ));
+    // A curious reply without the shortest path (a planner that did not attach it)
+    // cannot be compared or fallen back from: asked again, as a failure.
+    let (mut w, _) = f.begin(false);
+    let bare = WindowEvent::PlanReply(Box::new(plan(
+        PlannerModel::Model1,
+        curious_points(),
+        CURIOUS_ETA_S,
+    )));
+    assert!(w.handle(bare, at(1.0, 0.0)).is_empty());
+    let again = w.handle(WindowEvent::Tick, at(1.2, PLAN_RETRY_S));
+    assert!(asked(&again).curious);
+}
+
+#[test]
+fn a_window_without_time_left_asks_for_the_shortest_path() {
+    let f = fixture();
+    let (_, actions) = DowntimeWindow::begin(
+        f.setup(0, FROM, false),
+        Handover::first(margin()),
+        at(99.5, 0.0),
+    );
+    let ask = asked(&actions);
+    assert!(!ask.curious, "{ask:?}");
+    assert!(
+        ask.t_exec_s > 0.0,
+        "the planner takes only positive budgets"
+    );
+}
+
+#[test]
+fn estimates_are_recorded_and_fed_to_the_watch() {
+    let f = fixture();
+    let (mut w, _) = f.driving(false);
+    let on_path = [0.1, 0.5];
+    assert!(w.handle(estimate(on_path, 0.2), at(2.0, 0.1)).is_empty());
+    // A degraded estimate is neither recorded nor watched, however far off.
+    let degraded = WindowEvent::Estimate {
+        position: [3.9, 3.9],
+        peb_m: Some(9.0),
+        degraded: true,
+    };
+    assert!(w.handle(degraded, at(2.5, 0.2)).is_empty());
+    // Pushed off the path: a curious replan from where the robot is.
+    let pushed = [2.0, 2.5];
+    let actions = w.handle(estimate(pushed, 0.4), at(3.0, 0.3));
+    let ask = asked(&actions);
+    assert_eq!((ask.from, ask.curious), (pushed, true));
+    assert!(close(ask.t_exec_s, margin().budget(96.0)), "{ask:?}");
+    // While the plan is being made, estimates are recorded, nothing is decided.
+    let waiting = [2.0, 2.7];
+    assert!(w.handle(estimate(waiting, 0.6), at(3.1, 0.3)).is_empty());
+    assert!(w.handle(WindowEvent::Tick, at(3.2, 9.0)).is_empty());
+    let route = line(pushed, [2.0, 0.1]);
+    let reply = WindowEvent::PlanReply(Box::new(Plan {
+        shortest: attached(route.clone()),
+        ..plan(PlannerModel::Model1, route, 10.0)
+    }));
+    let actions = w.handle(reply, at(4.0, 0.4));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::PushedOffPath
+        }
+    );
+    let mission = sent(&actions);
+    let done = w.handle(
+        status(&mission.id, MissionState::Completed, 0.0),
+        at(60.0, 1.0),
+    );
+    assert!(matches!(done[0], WindowAction::Arrived { .. }));
+    let r = report(&w.handle(WindowEvent::Tick, at(105.0, 2.0)));
+    assert_eq!(
+        r.driven_information,
+        f.scale().of(&[FROM, on_path, pushed, waiting])
+    );
+    assert!(close(r.peb_mean_m.expect("pebs"), 0.4), "{r:?}");
+}
+
+#[test]
+fn arrival_ends_the_window_with_its_report_when_the_task_ends() {
+    let f = fixture();
+    let (mut w, mission) = f.driving(false);
+    // Statuses on another mission are not about this one.
+    let other = status("robot-old-w0-m7", MissionState::Completed, 0.0);
+    assert!(w.handle(other, at(20.0, 0.1)).is_empty());
+    let actions = w.handle(
+        status(&mission.id, MissionState::Completed, 0.0),
+        at(80.0, 0.2),
+    );
+    let path: Vec<[f64; 2]> = std::iter::once(FROM).chain(curious_points()).collect();
+    assert_eq!(
+        actions,
+        vec![WindowAction::Arrived {
+            at_s: 80.0,
+            drive: DrivenMission {
+                path: path.clone(),
+                took_s: 79.0
+            }
+        }],
+        "no next task: nothing to plan"
+    );
+    // At the task until it ends (100 + 5 s).
+    assert!(w.handle(WindowEvent::Tick, at(104.9, 0.3)).is_empty());
+    let actions = w.handle(WindowEvent::Tick, at(105.0, 0.4));
+    let end = ended(&actions);
+    let outcome = end.outcome.expect("outcome");
+    let r = &outcome.report;
+    assert_eq!((r.task.as_str(), r.window, r.began_s), ("goal1", 0, 0.0));
+    assert_eq!((r.arrival_s, r.on_time), (Some(80.0), true));
+    assert!(close(r.budget_s, margin().budget(99.0)));
+    assert_eq!(r.planned_information, f.scale().of(&curious_points()));
+    assert_eq!(r.shortest_information, f.scale().of(&shortest_points(FROM)));
+    assert_eq!(r.driven_information, f.scale().of(&[FROM]));
+    assert!(r.planned_information > r.shortest_information);
+    assert_eq!((r.replans, r.peb_mean_m), (0, None));
+    let (d, theta) = path_measure(&path);
+    let predicted_s = TimeModel::table_i().eta(d, theta);
+    let time_model = r.time_model.expect("time model");
+    assert!(close(time_model.predicted_s, predicted_s));
+    assert!(close(time_model.driving_s, 79.0));
+    assert!(close(time_model.driven_share, 0.79), "79 s of 100");
+    assert_eq!(outcome.plans, vec![curious_points()]);
+    assert_eq!(outcome.shortest, shortest_points(FROM));
+    // The margin learnt from the drive (it took far longer than predicted).
+    let mut learnt = margin();
+    learnt.learn(predicted_s, 79.0);
+    assert_eq!(end.handover.margin, learnt);
+    assert_ne!(learnt, margin());
+    assert_eq!(end.handover.missions_sent, 1);
+    assert_eq!(end.position, FROM);
+    // Done is done.
+    assert!(w.handle(WindowEvent::Tick, at(106.0, 0.5)).is_empty());
+}
+
+#[test]
+fn a_window_is_given_up_past_its_task_start() {
+    let f = fixture();
+    let (mut w, _) = f.driving(true);
+    // 60 s after the task's start, not before.
+    assert!(w.handle(WindowEvent::Tick, at(160.0, 1.0)).is_empty());
+    let actions = w.handle(WindowEvent::Tick, at(160.5, 1.0));
+    assert_eq!(actions[0], WindowAction::GaveUp);
+    assert_eq!(actions.len(), 2, "no plan for the next window: {actions:?}");
+    let end = ended(&actions);
+    let r = end.outcome.expect("outcome").report;
+    assert_eq!((r.arrival_s, r.on_time), (None, false));
+    let time_model = r.time_model.expect("time model");
+    assert_eq!(
+        (time_model.predicted_s, time_model.driven_share),
+        (0.0, 0.0)
+    );
+    assert_eq!(end.handover.margin, margin(), "nothing to learn from");
+    assert!(end.handover.planned_ahead.is_none());
+}
+
+#[test]
+fn stuck_replans_the_shortest_way_and_the_report_counts_it() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    let here = [0.1, 0.7];
+    assert!(w.handle(estimate(here, 0.1), at(5.0, 0.1)).is_empty());
+    let actions = w.handle(status(&first.id, MissionState::Stuck, 8.0), at(6.0, 0.2));
+    let ask = asked(&actions);
+    assert_eq!((ask.from, ask.curious), (here, false));
+    let actions = w.handle(shortest_reply(here), at(6.0, 0.3));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::Stuck
+        }
+    );
+    let second = sent(&actions);
+    assert_eq!(second.id, "robot-tag-w0-m2");
+    assert_eq!(
+        second.waypoints,
+        mission_waypoints(&shortest_points(here), 1.0)
+    );
+    // The first mission's statuses no longer count.
+    let stale = status(&first.id, MissionState::Completed, 0.0);
+    assert!(w.handle(stale, at(7.0, 0.4)).is_empty());
+    let actions = w.handle(
+        status(&second.id, MissionState::Completed, 0.0),
+        at(30.0, 0.5),
+    );
+    let WindowAction::Arrived { drive, .. } = &actions[0] else {
+        panic!("{actions:?}");
+    };
+    let path: Vec<[f64; 2]> = std::iter::once(here).chain(shortest_points(here)).collect();
+    assert_eq!(
+        drive.path, path,
+        "the mission that arrived, from where it was sent"
+    );
+    assert!(close(drive.took_s, 24.0));
+    let r = report(&w.handle(WindowEvent::Tick, at(105.0, 0.6)));
+    assert_eq!(r.replans, 1);
+    assert_eq!(r.replan_reasons, vec![Reason::Stuck.as_str().to_owned()]);
+    // The share driven counts from the first mission (1 s), the time model's from the
+    // last (6 s).
+    let time_model = r.time_model.expect("time model");
+    assert!(close(time_model.driven_share, 0.29));
+    assert!(close(time_model.driving_s, 24.0));
+    assert_eq!(r.planned_information, f.scale().of(&curious_points()));
+}
+
+/// The robot on the curious path at 7 s, 2 m from the task: at the model's 0.5 m/s it
+/// arrives at 11 s, 89 s early. Slack.
+fn slack(w: &mut DowntimeWindow<'_>, mission: &Mission) -> Vec<WindowAction> {
+    assert!(w.handle(estimate([0.1, 0.9], 0.1), at(6.0, 0.1)).is_empty());
+    w.handle(status(&mission.id, MissionState::Active, 2.0), at(7.0, 0.2))
+}
+
+#[test]
+fn slack_holds_the_robot_then_replans_from_where_it_is() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    let actions = slack(&mut w, &first);
+    let WindowAction::Hold(hold) = &actions[0] else {
+        panic!("{actions:?}");
+    };
+    assert!(hold.waypoints.is_empty());
+    assert_eq!(hold.id, "robot-tag-w0-m2");
+    let ask = asked(&actions);
+    assert_eq!((ask.from, ask.curious), ([0.1, 0.9], true));
+    assert!(close(ask.t_exec_s, margin().budget(92.0)));
+    let actions = w.handle(curious_reply(true), at(8.0, 0.3));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::Slack
+        }
+    );
+    assert_eq!(sent(&actions).id, "robot-tag-w0-m3");
+}
+
+#[test]
+fn a_failed_replan_after_a_slack_hold_resends_the_old_path() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    slack(&mut w, &first);
+    // The curious request fails: the shortest path is asked for, from the same place.
+    let actions = w.handle(WindowEvent::PlanFailed, at(8.0, 0.3));
+    let ask = asked(&actions);
+    assert_eq!((ask.from, ask.curious), ([0.1, 0.9], false));
+    // That fails too: back on the path it had, as a new mission.
+    let actions = w.handle(WindowEvent::PlanFailed, at(8.1, 0.4));
+    let resent = sent(&actions);
+    assert_eq!(actions.len(), 1);
+    assert_eq!(resent.id, "robot-tag-w0-m3");
+    assert_eq!(resent.waypoints, first.waypoints);
+    // Its statuses are heard; nothing was replanned.
+    let actions = w.handle(
+        status(&resent.id, MissionState::Completed, 0.0),
+        at(50.0, 0.5),
+    );
+    assert!(matches!(actions[0], WindowAction::Arrived { .. }));
+    let r = report(&w.handle(WindowEvent::Tick, at(105.0, 0.6)));
+    assert_eq!(r.replans, 0);
+}
+
+#[test]
+fn a_failed_curious_replan_falls_back_to_the_shortest_path() {
+    let f = fixture();
+    let (mut w, _) = f.driving(false);
+    let pushed = [2.0, 2.5];
+    let actions = w.handle(estimate(pushed, 0.1), at(3.0, 0.1));
+    assert!(asked(&actions).curious);
+    assert!(
+        !actions.iter().any(|a| matches!(a, WindowAction::Hold(_))),
+        "only slack holds the robot"
+    );
+    let actions = w.handle(WindowEvent::PlanFailed, at(3.5, 0.2));
+    let ask = asked(&actions);
+    assert_eq!((ask.from, ask.curious), (pushed, false));
+    let actions = w.handle(shortest_reply(pushed), at(3.6, 0.3));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::PushedOffPath
+        }
+    );
+    assert_eq!(
+        sent(&actions).waypoints,
+        mission_waypoints(&shortest_points(pushed), 1.0)
+    );
+}
+
+#[test]
+fn a_failed_shortest_replan_changes_nothing() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    let actions = w.handle(status(&first.id, MissionState::Stuck, 5.0), at(4.0, 0.1));
+    assert!(!asked(&actions).curious);
+    assert!(w.handle(WindowEvent::PlanFailed, at(4.1, 0.2)).is_empty());
+    // The first mission is still the one watched.
+    let actions = w.handle(
+        status(&first.id, MissionState::Completed, 0.0),
+        at(40.0, 0.3),
+    );
+    assert!(matches!(actions[0], WindowAction::Arrived { .. }));
+}
+
+#[test]
+fn a_lost_mission_is_sent_again_from_where_the_robot_is() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    // The controller said nothing for 3 wall seconds.
+    assert!(w.handle(WindowEvent::Tick, at(2.0, 2.9)).is_empty());
+    let actions = w.handle(WindowEvent::Tick, at(2.2, 3.0));
+    let ask = asked(&actions);
+    assert_eq!((ask.from, ask.curious), (FROM, true));
+    let actions = w.handle(curious_reply(true), at(2.5, 3.1));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::ControllerSilent
+        }
+    );
+    let again = sent(&actions);
+    assert_ne!(again.id, first.id);
+    let actions = w.handle(
+        status(&again.id, MissionState::Completed, 0.0),
+        at(50.0, 3.2),
+    );
+    assert!(matches!(actions[0], WindowAction::Arrived { .. }));
+    let r = report(&w.handle(WindowEvent::Tick, at(105.0, 3.3)));
+    assert_eq!(
+        r.replan_reasons,
+        vec![Reason::ControllerSilent.as_str().to_owned()]
+    );
+}
+
+/// The first window driven and arrived at 80 s (wall 1 s); the actions of the arrival.
+fn arrived(w: &mut DowntimeWindow<'_>, mission: &Mission) -> Vec<WindowAction> {
+    w.handle(
+        status(&mission.id, MissionState::Completed, 0.0),
+        at(80.0, 1.0),
+    )
+}
+
+/// The margin after the first window's drive (predicted by Table I, took 79 s).
+fn learnt_margin() -> ArrivalMargin {
+    let path: Vec<[f64; 2]> = std::iter::once(FROM).chain(curious_points()).collect();
+    let (d, theta) = path_measure(&path);
+    let mut m = margin();
+    m.learn(TimeModel::table_i().eta(d, theta), 79.0);
+    m
+}
+
+#[test]
+fn the_next_window_is_planned_during_the_task() {
+    let f = fixture();
+    let (mut w, mission) = f.driving(true);
+    let actions = arrived(&mut w, &mission);
+    assert!(matches!(actions[0], WindowAction::Arrived { .. }));
+    // From the task's place, for the time from the task's end (105 s) to the next
+    // task (200 s), with the margin the drive just taught.
+    let ask = asked(&actions);
+    assert_eq!((ask.from, ask.to, ask.curious), (GOAL, NEXT, true));
+    let budget_s = learnt_margin().budget(95.0);
+    assert!(close(ask.t_exec_s, budget_s), "{ask:?} {budget_s}");
+    let next_route = line(GOAL, NEXT);
+    let reply = WindowEvent::PlanReply(Box::new(Plan {
+        shortest: attached(next_route.clone()),
+        ..plan(PlannerModel::Model1, next_route.clone(), 50.0)
+    }));
+    assert!(
+        w.handle(reply, at(81.0, 1.5)).is_empty(),
+        "at the task still"
+    );
+    let end = ended(&w.handle(WindowEvent::Tick, at(105.0, 2.0)));
+    let ahead = end.handover.planned_ahead.clone().expect("planned ahead");
+    assert_eq!((ahead.window, ahead.from), (1, GOAL));
+    assert!(close(ahead.budget_s, budget_s));
+
+    // The next window starts on it at once when the robot is where it starts...
+    let near = [3.2, 0.2];
+    let (_, actions) = DowntimeWindow::begin(
+        f.setup(1, near, false),
+        end.handover.clone(),
+        at(105.0, 0.0),
+    );
+    assert_eq!(
+        actions[0],
+        WindowAction::Planned {
+            budget_s,
+            eta_s: 50.0,
+            curious: true
+        }
+    );
+    let mission = sent(&actions);
+    assert_eq!(mission.id, "robot-tag-w1-m2", "ids go on counting");
+    assert_eq!(mission.waypoints, mission_waypoints(&next_route, 1.0));
+    // ...and asks again when it is not (0.9 m away).
+    let far = [3.1, 1.0];
+    let (_, actions) = DowntimeWindow::begin(f.setup(1, far, false), end.handover, at(105.0, 0.0));
+    assert_eq!(asked(&actions).from, far);
+}
+
+#[test]
+fn a_plan_for_the_next_window_after_the_task_ended_is_dropped() {
+    let f = fixture();
+    let (mut w, mission) = f.driving(true);
+    arrived(&mut w, &mission);
+    // No planner answered: asked again a second later (wall), while the task lasts.
+    assert!(w.handle(WindowEvent::PlanFailed, at(81.0, 2.0)).is_empty());
+    assert!(w.handle(WindowEvent::Tick, at(82.0, 2.5)).is_empty());
+    let actions = w.handle(WindowEvent::Tick, at(83.0, 3.0));
+    assert_eq!(asked(&actions).from, GOAL);
+    // The answer comes after the task ended: the window is done without it.
+    let late = WindowEvent::PlanReply(Box::new(Plan {
+        shortest: attached(line(GOAL, NEXT)),
+        ..plan(PlannerModel::Model1, line(GOAL, NEXT), 50.0)
+    }));
+    let end = ended(&w.handle(late, at(106.0, 4.0)));
+    assert!(end.handover.planned_ahead.is_none());
+}
+
+#[test]
+fn the_first_plan_is_asked_again_until_the_window_is_given_up() {
+    let f = fixture();
+    let (mut w, _) = f.begin(false);
+    assert!(w.handle(WindowEvent::PlanFailed, at(1.0, 0.5)).is_empty());
+    assert!(w.handle(WindowEvent::Tick, at(1.2, 1.0)).is_empty());
+    let actions = w.handle(WindowEvent::Tick, at(2.0, 1.5));
+    let ask = asked(&actions);
+    assert!(
+        close(ask.t_exec_s, margin().budget(97.0)),
+        "asked anew: {ask:?}"
+    );
+    // Past the give-up time (60 s after the task's start) the window is given up.
+    let actions = w.handle(WindowEvent::PlanFailed, at(161.0, 2.0));
+    assert_eq!(actions[0], WindowAction::GaveUp);
+    let end = ended(&actions);
+    let outcome = end.outcome.expect("outcome");
+    let r = &outcome.report;
+    assert_eq!(r.replan_reasons, vec![NO_PLAN_REASON.to_owned()]);
+    assert_eq!((r.budget_s, r.time_model), (100.0, None));
+    assert_eq!(outcome.driven, vec![FROM]);
+    assert_eq!(end.handover.missions_sent, 0);
+}
+
+#[test]
+fn a_task_over_before_its_window_is_skipped() {
+    let f = fixture();
+    let handover = Handover {
+        missions_sent: 4,
+        ..Handover::first(margin())
+    };
+    let (mut w, actions) = DowntimeWindow::begin(f.setup(0, FROM, true), handover, at(105.0, 0.0));
+    assert_eq!(actions[0], WindowAction::Skipped);
+    let end = ended(&actions);
+    assert!(end.outcome.is_none());
+    assert_eq!(end.handover.missions_sent, 4);
+    assert!(w.handle(WindowEvent::Tick, at(106.0, 1.0)).is_empty());
+}
