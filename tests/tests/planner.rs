@@ -307,7 +307,7 @@ async fn the_shortest_path_comes_with_the_plan_when_asked() {
     assert!(
         refused
             .message
-            .contains("shorter than the shortest path's ETA"),
+            .contains("shorter than the fastest path's ETA"),
         "{}",
         refused.message
     );
