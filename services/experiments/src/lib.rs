@@ -10,11 +10,13 @@
 //!   a network, one run at a time ([`closed_loop::episode`]) or a step at a time with
 //!   missions changed between steps ([`closed_loop::stepper`]).
 //! - [`bench`]: `roam bench …`, each printing JSON.
+//! - [`parallel`]: runs spread over threads, put back in order before anything is summed.
 //! - [`error`]: [`ExperimentError`], what a run or a benchmark can fail with.
 
 pub mod bench;
 pub mod closed_loop;
 pub mod error;
+pub mod parallel;
 pub mod reproduce;
 pub mod verdict;
 

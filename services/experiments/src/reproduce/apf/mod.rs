@@ -48,10 +48,9 @@ pub mod paper;
 pub mod render;
 pub mod runner;
 
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
-
 use roam_world::scenario::Scenario;
+
+use crate::parallel::run_in_order;
 use serde::Serialize;
 
 use crate::closed_loop::episode::{Episode, EpisodeError, Setup};
@@ -135,37 +134,15 @@ pub fn run_seed(base: u64, experiment: &str, mission: usize, run: usize) -> u64 
     roam_world::seed::labelled(base, &format!("{experiment}/{mission}/{run}"))
 }
 
-/// Runs `job` on every element of `jobs` over up to `threads` threads and returns the
-/// results in the order of `jobs`, whatever order they finished in. Reports progress
-/// after each job as (`name`, done, `offset` + done of `total`).
+/// Runs `job` on every element of `jobs` over up to `threads` threads, the results in
+/// the order of `jobs` ([`crate::parallel::run_in_order`]); `progress(done)` after each.
 pub(crate) fn run_parallel<J: Sync, R: Send>(
     jobs: &[J],
     threads: usize,
     job: impl Fn(&J) -> R + Sync,
     progress: impl Fn(usize) + Sync,
 ) -> Vec<R> {
-    let threads = threads.clamp(1, jobs.len().max(1));
-    let next = AtomicUsize::new(0);
-    let done = AtomicUsize::new(0);
-    let slots: Mutex<Vec<Option<R>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some(j) = jobs.get(i) else {
-                    return;
-                };
-                let r = job(j);
-                if let Some(slot) = slots.lock().unwrap_or_else(|p| p.into_inner()).get_mut(i) {
-                    *slot = Some(r);
-                }
-                progress(done.fetch_add(1, Ordering::Relaxed) + 1);
-            });
-        }
-    });
-    slots
-        .into_inner()
-        .unwrap_or_else(|p| p.into_inner())
+    run_in_order(jobs, threads, job, |_| false, |done, _| progress(done))
         .into_iter()
         .flatten()
         .collect()
@@ -403,6 +380,7 @@ pub fn reproduce(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
 
     #[test]
     fn run_seeds_differ_by_every_part_and_repeat() {

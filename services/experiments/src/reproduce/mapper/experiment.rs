@@ -39,8 +39,8 @@
 //! curve's last value, `mean_map_quality` its time average.
 
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::OnceLock;
+
+use crate::parallel::run_in_order;
 
 use roam_sim::{Command, Sim, SimError};
 use roam_world::scenario::{self, Scenario};
@@ -275,38 +275,23 @@ pub fn run(
         n => n,
     }
     .clamp(1, jobs.len().max(1));
-    let slots: Vec<OnceLock<Result<RunResult, MappingError>>> =
-        (0..jobs.len()).map(|_| OnceLock::new()).collect();
-    let (next, done, failed) = (
-        AtomicUsize::new(0),
-        AtomicUsize::new(0),
-        AtomicBool::new(false),
+    let slots = run_in_order(
+        &jobs,
+        threads,
+        |&(mode, repetition)| run_one(scenario, &truth, options, mode, repetition, &mut |_| {}),
+        Result::is_err,
+        |done, &(mode, repetition)| {
+            progress(Progress {
+                done,
+                total: jobs.len(),
+                mode,
+                repetition,
+            })
+        },
     );
-    std::thread::scope(|s| {
-        for _ in 0..threads {
-            s.spawn(|| loop {
-                let j = next.fetch_add(1, Ordering::Relaxed);
-                let Some(&(mode, repetition)) = jobs.get(j) else {
-                    break;
-                };
-                if failed.load(Ordering::Relaxed) {
-                    break;
-                }
-                let result = run_one(scenario, &truth, options, mode, repetition, &mut |_| {});
-                failed.fetch_or(result.is_err(), Ordering::Relaxed);
-                let _ = slots[j].set(result);
-                progress(Progress {
-                    done: done.fetch_add(1, Ordering::Relaxed) + 1,
-                    total: jobs.len(),
-                    mode,
-                    repetition,
-                });
-            });
-        }
-    });
     let mut results = Vec::with_capacity(jobs.len());
     for slot in slots {
-        match slot.into_inner() {
+        match slot {
             Some(Ok(r)) => results.push(r),
             Some(Err(e)) => return Err(e),
             None => {

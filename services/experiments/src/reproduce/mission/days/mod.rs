@@ -45,8 +45,7 @@ pub mod world;
 #[cfg(test)]
 mod tests;
 
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
+use crate::parallel::run_in_order;
 
 use serde::Serialize;
 
@@ -185,33 +184,13 @@ pub fn run(
     let units: Vec<(Variant, usize)> = (0..options.days)
         .flat_map(|d| variants.iter().map(move |&v| (v, d)))
         .collect();
-    let next = AtomicUsize::new(0);
-    let done = AtomicUsize::new(0);
-    let slots: Mutex<Vec<Option<Result<DayResult, DaysError>>>> =
-        Mutex::new((0..units.len()).map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..options.jobs.clamp(1, units.len()) {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some(&(variant, d)) = units.get(i) else {
-                    break;
-                };
-                let result = day::run_day(&world, variant, options, d);
-                let failed = result.is_err();
-                if let Ok(mut slots) = slots.lock() {
-                    slots[i] = Some(result);
-                }
-                progress(done.fetch_add(1, Ordering::Relaxed) + 1, units.len());
-                if failed {
-                    // Stop taking work: the batch fails with the first error in order.
-                    next.store(units.len(), Ordering::Relaxed);
-                }
-            });
-        }
-    });
-    let slots = slots
-        .into_inner()
-        .map_err(|_| DaysError::World("a day's thread panicked".into()))?;
+    let slots = run_in_order(
+        &units,
+        options.jobs,
+        |&(variant, d)| day::run_day(&world, variant, options, d),
+        Result::is_err,
+        |done, _| progress(done, units.len()),
+    );
     let mut results = Vec::with_capacity(units.len());
     for slot in slots {
         match slot {
