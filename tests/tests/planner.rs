@@ -12,49 +12,17 @@ use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::{
-    CancelPlan, GaOverrides, MapVersion, Plan, PlanProgress, PlanRequest, PlannerModel,
-    ShortestPathUse, StopReason,
+    GaOverrides, MapVersion, Plan, PlanProgress, PlanRequest, PlannerModel, ShortestPathUse,
+    StopReason,
 };
-use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply};
+use roam_proto::{decode, keys, ErrorCode};
 use roam_runtime::{ClientError, Requester};
-use roam_tests::{within, Harness, RunningService};
+use roam_tests::within;
 use roam_world::layers::inflate;
 use roam_world::DEFAULT_MAX_CELLS;
 
-fn request(start: [f64; 2], goal: [f64; 2], t_exec_s: f64, generations: u32) -> PlanRequest {
-    PlanRequest {
-        request_id: None,
-        cancel_token: None,
-        start,
-        goal,
-        t_exec_s,
-        deadline_s: 60.0,
-        model: PlannerModel::Model1,
-        params: GaOverrides {
-            max_generations: Some(generations),
-            population: Some(60),
-            ..GaOverrides::default()
-        },
-        seed: 11,
-        map_version: None,
-        shortest: ShortestPathUse::Omit,
-    }
-}
-
-async fn ask(client: &Requester, root: &str, request: &PlanRequest) -> Result<Plan, ClientError> {
-    within(
-        "plan",
-        client.request(&keys::planner_plan(root), Some(request)),
-    )
-    .await
-}
-
-async fn refusal(client: &Requester, root: &str, request: &PlanRequest) -> ErrorReply {
-    match ask(client, root, request).await {
-        Err(ClientError::Refused(reply)) => reply,
-        other => panic!("expected a refusal, got {other:?}"),
-    }
-}
+mod planner_client;
+use planner_client::{ask, cancel, refusal, request, Running};
 
 type ProgressSubscriber =
     zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>;
@@ -123,33 +91,11 @@ async fn planning(subscriber: &ProgressSubscriber) {
         .expect("the plan is planning");
 }
 
-/// Puts a cancel for `id` with `token` from `client`'s session.
-async fn cancel(client: &Requester, root: &str, id: &str, token: Option<&str>) {
-    within(
-        "cancel",
-        client.session().put(
-            keys::planner_cancel(root, id),
-            encode(&CancelPlan {
-                request_id: id.into(),
-                token: token.map(str::to_owned),
-            }),
-        ),
-    )
-    .await
-    .expect("put");
-}
-
 const TOKEN_A: &str = "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa";
 const TOKEN_B: &str = "bbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbb";
 const TOKEN_C: &str = "cccccccccccccccccccccccccccccccc";
 /// Right length, right alphabet, wrong secret.
 const GUESS: &str = "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaab";
-
-struct Running {
-    harness: Harness,
-    map_server: RunningService,
-    planners: Vec<RunningService>,
-}
 
 async fn boot(planners: &[(&str, usize)]) -> Running {
     boot_with(planners, |config| config).await
@@ -160,35 +106,18 @@ async fn boot_with(
     planners: &[(&str, usize)],
     adjust: impl Fn(roam_planner::PlannerConfig) -> roam_planner::PlannerConfig,
 ) -> Running {
-    let harness = Harness::start().await;
-    let map_server = harness.start_role(harness.map_server_config()).await;
-    let mut started = Vec::new();
-    for (name, concurrent) in planners {
-        let config = adjust(roam_planner::PlannerConfig {
-            max_concurrent_plans: *concurrent,
-            ..harness.planner_config(name)
-        });
-        started.push(harness.start_role(config).await);
-    }
-    Running {
-        harness,
-        map_server,
-        planners: started,
-    }
-}
-
-impl Running {
-    async fn stop(self) {
-        for planner in self.planners {
-            planner.stop().await.1.expect("planner stops cleanly");
-        }
-        self.map_server
-            .stop()
-            .await
-            .1
-            .expect("map server stops cleanly");
-        self.harness.close().await;
-    }
+    planner_client::boot(None, |harness| {
+        planners
+            .iter()
+            .map(|(name, concurrent)| {
+                adjust(roam_planner::PlannerConfig {
+                    max_concurrent_plans: *concurrent,
+                    ..harness.planner_config(name)
+                })
+            })
+            .collect()
+    })
+    .await
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
@@ -676,7 +605,7 @@ async fn progress_is_published_and_a_plan_can_be_cancelled() {
         "{seen:?}"
     );
 
-    cancel(&client, &root, id, Some(TOKEN_A)).await;
+    cancel(client.session(), &root, id, Some(TOKEN_A)).await;
     let plan = within("cancelled plan", pending)
         .await
         .expect("join")
@@ -732,7 +661,7 @@ async fn a_full_planner_refuses_at_once_with_busy() {
         .expect("the expected wait is in the error");
     assert!(wait > 2.0, "{busy}");
     assert!(busy.message.contains("deadline_s"), "{}", busy.message);
-    cancel(&client, &root, id, Some(TOKEN_A)).await;
+    cancel(client.session(), &root, id, Some(TOKEN_A)).await;
     within("hog", pending).await.expect("join").expect("plan");
     running.stop().await;
 }
@@ -810,11 +739,11 @@ async fn a_strangers_cancel_does_nothing_and_the_requesters_cancel_ends_the_plan
         planning(progress).await;
     }
     for id in ["plan-a", "plan-b"] {
-        cancel(&stranger, &root, id, Some(GUESS)).await;
-        cancel(&stranger, &root, id, None).await;
-        cancel(&stranger, &root, id, Some(TOKEN_C)).await;
+        cancel(stranger.session(), &root, id, Some(GUESS)).await;
+        cancel(stranger.session(), &root, id, None).await;
+        cancel(stranger.session(), &root, id, Some(TOKEN_C)).await;
     }
-    cancel(&stranger, &root, "plan-c", Some(TOKEN_C)).await;
+    cancel(stranger.session(), &root, "plan-c", Some(TOKEN_C)).await;
     let c = within("the stranger's own plan", c)
         .await
         .expect("join")
@@ -825,7 +754,7 @@ async fn a_strangers_cancel_does_nothing_and_the_requesters_cancel_ends_the_plan
         "A and B must still be planning when the stranger's cancels have been handled"
     );
 
-    cancel(&requester, &root, "plan-b", Some(TOKEN_B)).await;
+    cancel(requester.session(), &root, "plan-b", Some(TOKEN_B)).await;
     let b = within("the requester's cancel", b)
         .await
         .expect("join")

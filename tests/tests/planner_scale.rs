@@ -12,75 +12,32 @@ use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_planner::PlannerConfig;
 use roam_proto::planner::{
-    CancelPlan, GaOverrides, Plan, PlanProgress, PlanRequest, PlannerModel, ShortestPathUse,
-    StopReason,
+    GaOverrides, Plan, PlanProgress, PlanRequest, ShortestPathUse, StopReason,
 };
 use roam_proto::{decode, encode, keys, ErrorCode, ErrorReply};
-use roam_runtime::{ClientError, Requester};
-use roam_tests::{repo_path, within, Harness, RunningService};
+
+use roam_runtime::ClientError;
+use roam_tests::{repo_path, within, Harness};
 use roam_world::layers::inflate;
 use roam_world::DEFAULT_MAX_CELLS;
 
+mod planner_client;
+use planner_client::{ask, cancel, request, Running};
+
 const DEPOT: &str = "config/scenarios/depot.yaml";
-
-fn request(start: [f64; 2], goal: [f64; 2], t_exec_s: f64, generations: u32) -> PlanRequest {
-    PlanRequest {
-        request_id: None,
-        cancel_token: None,
-        start,
-        goal,
-        t_exec_s,
-        deadline_s: 60.0,
-        model: PlannerModel::Model1,
-        params: GaOverrides {
-            max_generations: Some(generations),
-            population: Some(60),
-            ..GaOverrides::default()
-        },
-        seed: 23,
-        map_version: None,
-        shortest: ShortestPathUse::Omit,
-    }
-}
-
-struct Running {
-    harness: Harness,
-    map_server: RunningService,
-    planners: Vec<RunningService>,
-}
 
 /// A map server on `map` (the built-in world when `None`) and one planner per config.
 async fn boot(map: Option<&str>, planners: Vec<PlannerConfig>) -> Running {
-    let harness = Harness::start().await;
-    let map_server = harness
-        .start_role(roam_map_server::MapServerConfig {
-            map: map.map(repo_path),
-            ..harness.map_server_config()
-        })
-        .await;
-    let mut started = Vec::new();
-    for config in planners {
-        let config = PlannerConfig {
-            root: harness.root.clone(),
-            ..config
-        };
-        started.push(harness.start_role(config).await);
-    }
-    Running {
-        harness,
-        map_server,
-        planners: started,
-    }
-}
-
-impl Running {
-    async fn stop(self) {
-        for planner in self.planners {
-            planner.stop().await.1.expect("planner stops cleanly");
-        }
-        self.map_server.stop().await.1.expect("map server stops");
-        self.harness.close().await;
-    }
+    planner_client::boot(map, |harness| {
+        planners
+            .into_iter()
+            .map(|config| PlannerConfig {
+                root: harness.root.clone(),
+                ..config
+            })
+            .collect()
+    })
+    .await
 }
 
 fn planner(name: &str) -> PlannerConfig {
@@ -88,14 +45,6 @@ fn planner(name: &str) -> PlannerConfig {
         instance: Some(name.to_owned()),
         ..PlannerConfig::default()
     }
-}
-
-async fn ask(client: &Requester, root: &str, request: &PlanRequest) -> Result<Plan, ClientError> {
-    within(
-        "plan",
-        client.request(&keys::planner_plan(root), Some(request)),
-    )
-    .await
 }
 
 /// The depot is a 5 cm map; the planner plans at its default 0.2 m. Through Zenoh the
@@ -200,21 +149,6 @@ async fn answer(replies: Replies) -> (Result<Plan, ErrorReply>, Instant) {
 
 const TOKEN: &str = "0123456789abcdef0123456789abcdef";
 
-async fn cancel(session: &zenoh::Session, root: &str, id: &str) {
-    within(
-        "cancel",
-        session.put(
-            keys::planner_cancel(root, id),
-            encode(&CancelPlan {
-                request_id: id.to_owned(),
-                token: Some(TOKEN.to_owned()),
-            }),
-        ),
-    )
-    .await
-    .expect("cancel put");
-}
-
 /// One plan at a time: behind a plan in progress, four requests with 60 s deadlines
 /// wait in the queue and are answered in the order they arrived, each within its
 /// deadline; a request whose deadline the queue cannot make is refused `busy` at once
@@ -302,7 +236,7 @@ async fn queued_requests_are_answered_in_order_and_a_late_one_is_refused_at_once
         .expect("progress");
     let note: PlanProgress = decode(&queued_note.payload().to_bytes()).expect("progress");
     assert!(note.best_fitness.is_empty() && !note.done);
-    cancel(&session, &root, "doomed").await;
+    cancel(&session, &root, "doomed", Some(TOKEN)).await;
     let (doomed, _) = answer(doomed_replies).await;
     let doomed = doomed.expect("a cancelled queued request gets its floor");
     assert_eq!(doomed.stop_reason, StopReason::Cancelled);
@@ -313,7 +247,7 @@ async fn queued_requests_are_answered_in_order_and_a_late_one_is_refused_at_once
         "the plan ahead of it still runs"
     );
 
-    cancel(&session, &root, "hog").await;
+    cancel(&session, &root, "hog", Some(TOKEN)).await;
     let (hog, _) = answer(hog_replies).await;
     assert_eq!(hog.expect("hog").stop_reason, StopReason::Cancelled);
     let mut times = Vec::new();

@@ -38,4 +38,4 @@ pub use lock::lock;
 pub use publish::{publish, publish_bytes, publish_wait, Delivery};
 pub use service::{PayloadBudget, Service, ServiceError};
 pub use session::{SessionArgs, SessionError};
-pub use subscribe::{subscribe_latest, LatestSamples};
+pub use subscribe::{subscribe_latest, FleetStreams, LatestSamples};

@@ -23,3 +23,58 @@ pub async fn subscribe_latest(
         .with(RingChannel::new(capacity))
         .await
 }
+
+/// The streams a follower of the whole fleet reads (the live view, the ROS 2 node):
+/// every map layer, and every robot's true position, estimate and mission, each a ring
+/// of its newest samples.
+pub struct FleetStreams {
+    pub layers: LatestSamples,
+    pub truth: LatestSamples,
+    pub estimate: LatestSamples,
+    pub mission: LatestSamples,
+}
+
+impl std::fmt::Debug for FleetStreams {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FleetStreams")
+            .field("layers", &self.layers.key_expr().as_str())
+            .field("truth", &self.truth.key_expr().as_str())
+            .field("estimate", &self.estimate.key_expr().as_str())
+            .field("mission", &self.mission.key_expr().as_str())
+            .finish()
+    }
+}
+
+impl FleetStreams {
+    /// Layers the layer ring holds before the oldest go (a follower fetches a dropped
+    /// one again at its next refresh of the map index, whose version check sees it
+    /// missing).
+    pub const LAYER_QUEUE: usize = 8;
+    /// Samples each robot ring holds before the oldest go.
+    pub const ROBOT_QUEUE: usize = 256;
+
+    /// Declares the four subscriptions under `root`; declare them before anything that
+    /// should be seen is published.
+    pub async fn declare(
+        session: &zenoh::Session,
+        root: &str,
+    ) -> Result<Self, crate::service::ServiceError> {
+        use roam_proto::keys;
+        let ring = |key: String, capacity: usize| async move {
+            subscribe_latest(session, &key, capacity)
+                .await
+                .map_err(|e| crate::service::ServiceError::Declare {
+                    what: "subscriber",
+                    key,
+                    reason: e.to_string(),
+                })
+        };
+        Ok(FleetStreams {
+            layers: ring(keys::map_layer_any(root), Self::LAYER_QUEUE).await?,
+            // `robot_truth` with the robot `*`: every robot's true position.
+            truth: ring(keys::robot_truth(root, "*"), Self::ROBOT_QUEUE).await?,
+            estimate: ring(keys::robot_estimate_any(root), Self::ROBOT_QUEUE).await?,
+            mission: ring(keys::robot_mission_any(root), Self::ROBOT_QUEUE).await?,
+        })
+    }
+}

@@ -27,7 +27,7 @@ use roam_proto::localization::PositionEstimate;
 use roam_proto::map::{Layer, LayerList};
 use roam_proto::sim::{GroundTruth, NamedPoint, SimControl, SimStatus};
 use roam_proto::{keys, Message};
-use roam_runtime::{subscribe_latest, LatestSamples};
+use roam_runtime::{FleetStreams, LatestSamples};
 use tokio::sync::watch;
 use tokio::time::{Instant, MissedTickBehavior};
 use tokio_util::sync::CancellationToken;
@@ -38,7 +38,6 @@ use crate::convert::{self, DrivenPath};
 use crate::output::{Outputs, Topic};
 use crate::roster::{Roster, Touched};
 use crate::wire::{self, clipped, decode_bounded, shown};
-use crate::ViewError;
 
 /// The most map layers shown (the map server's own default limit, `max_layers`).
 pub const MAX_LAYERS: usize = DEFAULT_LIMITS.max_layers as usize;
@@ -49,11 +48,6 @@ pub const MAX_LAYER_CELLS: u64 = DEFAULT_LIMITS.max_layer_cells;
 pub const MAX_LAYER_BYTES_SHOWN: usize = 1 << 30;
 /// The most robots whose missions are kept, and the most whose driven paths are.
 pub const MAX_ROBOTS: usize = 256;
-/// Samples a robot subscription holds before the oldest go.
-pub const ROBOT_QUEUE: usize = 256;
-/// Layers the layer subscription holds before the oldest go (a dropped one is fetched
-/// again at the next refresh, whose version check sees it missing).
-pub const LAYER_QUEUE: usize = 8;
 /// The most points kept per driven path, and the least distance between two of them.
 pub const DRIVEN_POINTS: usize = 4096;
 pub const DRIVEN_STEP_M: f64 = 0.05;
@@ -75,31 +69,6 @@ type Ring = LatestSamples;
 
 /// The names of the robots in the sim's last status.
 type SimRobots = Arc<BTreeSet<String>>;
-
-/// The subscriptions, declared before `run` returns so nothing published after is missed.
-pub(crate) struct Subscriptions {
-    layers: Ring,
-    truth: Ring,
-    estimate: Ring,
-    mission: Ring,
-}
-
-impl Subscriptions {
-    pub(crate) async fn declare(session: &Session, root: &str) -> Result<Self, ViewError> {
-        let ring = |key: String, capacity: usize| async move {
-            subscribe_latest(session, &key, capacity)
-                .await
-                .map_err(|e| ViewError::Zenoh(format!("subscribing to '{key}': {e}")))
-        };
-        Ok(Subscriptions {
-            layers: ring(keys::map_layer_any(root), LAYER_QUEUE).await?,
-            // `robot_truth` with the robot `*`: every robot's true position.
-            truth: ring(keys::robot_truth(root, "*"), ROBOT_QUEUE).await?,
-            estimate: ring(keys::robot_estimate_any(root), ROBOT_QUEUE).await?,
-            mission: ring(keys::robot_mission_any(root), ROBOT_QUEUE).await?,
-        })
-    }
-}
 
 /// Decodes a sample's payload of at most `max` bytes, or counts it dropped.
 fn decode_sample<T: Message>(out: &Outputs, sample: &Sample, max: usize) -> Option<T> {
@@ -158,11 +127,11 @@ impl RobotTopics {
 pub(crate) async fn follow(
     session: Session,
     root: String,
-    subscriptions: Subscriptions,
+    subscriptions: FleetStreams,
     out: Arc<Outputs>,
     cancel: CancellationToken,
 ) {
-    let Subscriptions {
+    let FleetStreams {
         layers,
         truth,
         estimate,

@@ -166,7 +166,9 @@ pub async fn run(
         None => None,
     };
     let listening = public.as_ref().map(|(_, bound)| *bound);
-    let subscriptions = follow::Subscriptions::declare(&session, &config.root).await?;
+    let subscriptions = roam_runtime::FleetStreams::declare(&session, &config.root)
+        .await
+        .map_err(|e| ViewError::Zenoh(e.to_string()))?;
     let out = Arc::new(output::Outputs::start(public.is_some(), config.mcap.as_deref()).await?);
     let gate = match (public, out.inner) {
         (Some((listener, _)), Some(inner)) => {

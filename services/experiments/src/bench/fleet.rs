@@ -37,8 +37,8 @@ use roam_world::scenario::load_or_builtin;
 use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
-use crate::bench::load::peak_rss_mib;
-use crate::bench::scaling::rss_mib;
+use crate::bench::process::{peak_rss_mib, rss_mib};
+use crate::bench::sim::{run_sim_for, TimedRun};
 use crate::ExperimentError as BenchError;
 use roam_stack::router::Router;
 use roam_stack::stack::wait_until_live;
@@ -69,16 +69,6 @@ pub struct FleetBench {
 
 fn setup<E: std::fmt::Display>(e: E) -> BenchError {
     BenchError::Setup(e.to_string())
-}
-
-/// CPU seconds used by this process so far (100 Hz ticks), `None` off Linux.
-pub fn process_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let rest = stat.rsplit_once(')')?.1;
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let utime: f64 = fields.get(11)?.parse().ok()?;
-    let stime: f64 = fields.get(12)?.parse().ok()?;
-    Some((utime + stime) / 100.0)
 }
 
 /// What the subscribers saw.
@@ -328,21 +318,8 @@ async fn run(
     let status: SimStatus = client
         .request(&control_key, Some(&SimControl::Status))
         .await?;
-    let factor = rate_hz * status.step_s;
-    let cpu_before = process_cpu_seconds();
-    let started = Instant::now();
-    client
-        .request::<SimControl, SimStatus>(&control_key, Some(&SimControl::Resume { rate: factor }))
-        .await?;
-    tokio::time::sleep(Duration::from_secs_f64(seconds)).await;
-    let end: SimStatus = client
-        .request(&control_key, Some(&SimControl::Pause))
-        .await?;
-    let wall = started.elapsed().as_secs_f64();
-    let cpu = match (cpu_before, process_cpu_seconds()) {
-        (Some(a), Some(b)) => b - a,
-        _ => f64::NAN,
-    };
+    let TimedRun { end, wall, cpu } =
+        run_sim_for(&client, &control_key, rate_hz * status.step_s, seconds).await?;
     // The last step's commands.
     tokio::time::sleep(Duration::from_millis(500)).await;
     let rss_after = rss_mib();

@@ -18,6 +18,7 @@ use serde::Serialize;
 use tokio::task::JoinSet;
 
 use crate::bench::ms;
+use crate::bench::process::peak_rss_mib;
 use crate::ExperimentError;
 use roam_stack::stack::{Stack, StackOptions};
 
@@ -66,14 +67,6 @@ fn percentile(samples: &mut [f64], q: f64) -> f64 {
     samples.sort_by(f64::total_cmp);
     let i = ((samples.len() - 1) as f64 * q).round() as usize;
     samples[i.min(samples.len() - 1)]
-}
-
-/// The process's peak resident set size from `/proc/self/status`, MiB (Linux).
-pub fn peak_rss_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024.0)
 }
 
 pub async fn load(requests: usize, deadline_s: f64) -> Result<LoadBench, ExperimentError> {

@@ -17,6 +17,7 @@ pub mod map;
 pub mod mapper;
 pub mod peer;
 pub mod planner;
+pub mod process;
 pub mod scaling;
 pub mod sim;
 

@@ -30,9 +30,8 @@ use roam_world::grid::{cell_center, world_to_cell, Grid};
 use roam_world::layers::inflate;
 use serde::Serialize;
 
-use crate::bench::fleet::process_cpu_seconds;
-use crate::bench::load::peak_rss_mib;
 use crate::bench::planner::{builtin_world, GOAL, START};
+use crate::bench::process::{peak_rss_mib, process_cpu_seconds, rss_mib};
 use crate::ExperimentError as BenchError;
 
 /// The map resolutions of the built-in world the bench plans on.
@@ -260,14 +259,6 @@ fn layer(name: &str, meta: GridMeta, cells: Cells) -> Layer {
         meta,
         cells,
     }
-}
-
-/// VmRSS of this process, MiB (Linux).
-pub fn rss_mib() -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024.0)
 }
 
 /// The memory a planner's map cache takes holding the warehouse (the layers as they

@@ -20,6 +20,7 @@ use roam_world::scenario::load_or_builtin;
 use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
+use crate::bench::process::process_cpu_seconds;
 use crate::ExperimentError;
 use roam_stack::router::Router;
 use roam_stack::stack::wait_until_live;
@@ -35,17 +36,6 @@ pub struct SimBench {
     /// Range scans received by the subscriber, and how many the steps should give.
     pub ranges_received: u64,
     pub ranges_expected: u64,
-}
-
-/// CPU seconds used by this process so far, `None` off Linux.
-fn process_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name (which is in parentheses and may hold spaces).
-    let rest = stat.rsplit_once(')')?.1;
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let utime: f64 = fields.get(11)?.parse().ok()?;
-    let stime: f64 = fields.get(12)?.parse().ok()?;
-    Some((utime + stime) / 100.0)
 }
 
 fn setup<E: std::fmt::Display>(e: E) -> ExperimentError {
@@ -129,24 +119,8 @@ pub async fn sim(robots: usize, rate_hz: f64, seconds: f64) -> Result<SimBench, 
         let status: SimStatus = client
             .request(&control_key, Some(&SimControl::Status))
             .await?;
-        let factor = rate_hz * status.step_s;
-        let cpu_before = process_cpu_seconds();
-        let started = Instant::now();
-        client
-            .request::<SimControl, SimStatus>(
-                &control_key,
-                Some(&SimControl::Resume { rate: factor }),
-            )
-            .await?;
-        tokio::time::sleep(Duration::from_secs_f64(seconds)).await;
-        let end: SimStatus = client
-            .request(&control_key, Some(&SimControl::Pause))
-            .await?;
-        let wall = started.elapsed().as_secs_f64();
-        let cpu = match (cpu_before, process_cpu_seconds()) {
-            (Some(a), Some(b)) => b - a,
-            _ => f64::NAN,
-        };
+        let TimedRun { end, wall, cpu } =
+            run_sim_for(&client, &control_key, rate_hz * status.step_s, seconds).await?;
         // Let the last publications arrive.
         tokio::time::sleep(Duration::from_millis(300)).await;
         drop(subscriber);
@@ -173,4 +147,39 @@ pub async fn sim(robots: usize, rate_hz: f64, seconds: f64) -> Result<SimBench, 
     let _ = tokio::time::timeout(Duration::from_secs(5), service).await;
     router.close().await;
     result
+}
+
+/// What [`run_sim_for`] measured.
+pub(crate) struct TimedRun {
+    /// The sim's status when it was paused again.
+    pub end: SimStatus,
+    /// Wall-clock seconds from the resume to the pause.
+    pub wall: f64,
+    /// CPU seconds this process used meanwhile (NaN off Linux).
+    pub cpu: f64,
+}
+
+/// Resumes the sim at `factor` × real time, lets it run `seconds`, pauses it, and says
+/// what it did meanwhile: the window every sim-driven benchmark times.
+pub(crate) async fn run_sim_for(
+    client: &Requester,
+    control_key: &str,
+    factor: f64,
+    seconds: f64,
+) -> Result<TimedRun, roam_runtime::ClientError> {
+    let cpu_before = process_cpu_seconds();
+    let started = Instant::now();
+    client
+        .request::<SimControl, SimStatus>(control_key, Some(&SimControl::Resume { rate: factor }))
+        .await?;
+    tokio::time::sleep(Duration::from_secs_f64(seconds)).await;
+    let end: SimStatus = client
+        .request(control_key, Some(&SimControl::Pause))
+        .await?;
+    let wall = started.elapsed().as_secs_f64();
+    let cpu = match (cpu_before, process_cpu_seconds()) {
+        (Some(a), Some(b)) => b - a,
+        _ => f64::NAN,
+    };
+    Ok(TimedRun { end, wall, cpu })
 }

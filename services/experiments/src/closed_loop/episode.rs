@@ -35,7 +35,7 @@ use roam_sim::{Command, Sim, SimError, SimParams};
 use roam_world::scenario::Scenario;
 use serde::Serialize;
 
-use roam_controller::controller::{Controller, MissionStatus};
+use roam_controller::controller::{Controller, Decision, MissionStatus};
 use roam_controller::information::InformationField;
 use roam_controller::obstacle_field::ObstacleField;
 use roam_controller::params::{ApfParams, ParamError};
@@ -141,6 +141,36 @@ pub struct RobotTrack {
     pub held_updates: u64,
 }
 
+impl RobotTrack {
+    /// Records one update (the true position, the estimate and the controller's
+    /// decision on it) and says whether the robot's part in the episode is over: its
+    /// mission ended, it has none, or the PEB guard has held it for
+    /// `stuck_window_steps` updates (given up, as a robot that cannot localize is).
+    pub(crate) fn record(
+        &mut self,
+        truth: [f64; 2],
+        estimate: [f64; 2],
+        decision: &Decision,
+        stuck_window_steps: u64,
+    ) -> bool {
+        if let Some(last) = self.truth.last() {
+            self.distance_m += (truth[0] - last[0]).hypot(truth[1] - last[1]);
+        }
+        self.truth.push(truth);
+        self.estimate.push(estimate);
+        self.error_m
+            .push((estimate[0] - truth[0]).hypot(estimate[1] - truth[1]));
+        self.status = decision.status;
+        self.steps = decision.steps;
+        self.held_updates = decision.halted_updates;
+        self.success = decision.status == MissionStatus::Completed;
+        decision.status.is_final()
+            || decision.status == MissionStatus::Idle
+            || (decision.status == MissionStatus::HaltedPeb
+                && decision.halted_updates >= stuck_window_steps)
+    }
+}
+
 /// The result of one episode.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Episode {
@@ -231,22 +261,12 @@ pub fn run_episode(
                 PositionSource::Truth => (truth, setup.information.peb_m(truth)),
             };
             let decision = d.controller.update(position, peb);
-            let t = &mut d.track;
-            if let Some(last) = t.truth.last() {
-                t.distance_m += (truth[0] - last[0]).hypot(truth[1] - last[1]);
-            }
-            t.truth.push(truth);
-            t.estimate.push(estimate.position);
-            t.error_m
-                .push((estimate.position[0] - truth[0]).hypot(estimate.position[1] - truth[1]));
-            t.status = decision.status;
-            t.steps = decision.steps;
-            t.held_updates = decision.halted_updates;
-            t.success = decision.status == MissionStatus::Completed;
-            d.done = decision.status.is_final()
-                || decision.status == MissionStatus::Idle
-                || (decision.status == MissionStatus::HaltedPeb
-                    && decision.halted_updates >= params.stuck_window_steps);
+            d.done = d.track.record(
+                truth,
+                estimate.position,
+                &decision,
+                params.stuck_window_steps,
+            );
             if decision.status == MissionStatus::Active {
                 commands.push(Command {
                     robot: r.name.clone(),

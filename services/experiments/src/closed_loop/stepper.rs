@@ -236,22 +236,12 @@ mod tests {
                 let Some((t, done)) = tracks.get_mut(&r.robot) else {
                     continue;
                 };
-                let truth = r.messages.truth.at;
-                if let Some(last) = t.truth.last() {
-                    t.distance_m += (truth[0] - last[0]).hypot(truth[1] - last[1]);
-                }
-                t.truth.push(truth);
-                t.estimate.push(e.position);
-                t.error_m
-                    .push((e.position[0] - truth[0]).hypot(e.position[1] - truth[1]));
-                t.status = d.status;
-                t.steps = d.steps;
-                t.held_updates = d.halted_updates;
-                t.success = d.status == MissionStatus::Completed;
-                *done = d.status.is_final()
-                    || d.status == MissionStatus::Idle
-                    || (d.status == MissionStatus::HaltedPeb
-                        && d.halted_updates >= params.stuck_window_steps);
+                *done = t.record(
+                    r.messages.truth.at,
+                    e.position,
+                    &d,
+                    params.stuck_window_steps,
+                );
                 if *done {
                     s.retire(&r.robot);
                 }

@@ -16,13 +16,13 @@ use roam_proto::localization::PositionEstimate;
 use roam_proto::map::{Layer, LayerList};
 use roam_proto::sim::GroundTruth;
 use roam_proto::{decode, keys, Message};
-use roam_runtime::{subscribe_latest, LatestSamples, Requester};
+use roam_runtime::{FleetStreams, LatestSamples, Requester};
 use tokio::time::MissedTickBehavior;
 use tokio_util::sync::CancellationToken;
 use zenoh::sample::Sample;
 use zenoh::Session;
 
-use super::{Output, Ros2Error};
+use super::Output;
 use crate::convert::{self, LAYER_TOPICS};
 use crate::msg::Time;
 use crate::names::{self, Qos};
@@ -46,33 +46,6 @@ const MAX_ESTIMATE_BYTES: usize = 64 * 1024;
 const MAX_TRUTH_BYTES: usize = 4 * 1024;
 
 type Ring = LatestSamples;
-
-pub(super) struct Subscriptions {
-    layers: Ring,
-    estimate: Ring,
-    mission: Ring,
-    truth: Ring,
-}
-
-impl Subscriptions {
-    pub(super) async fn declare(session: &Session, root: &str) -> Result<Self, Ros2Error> {
-        let ring = |key: String, capacity: usize| async move {
-            subscribe_latest(session, &key, capacity)
-                .await
-                .map_err(|e| Ros2Error::Declare {
-                    what: "subscriber",
-                    key,
-                    reason: e.to_string(),
-                })
-        };
-        Ok(Subscriptions {
-            layers: ring(keys::map_layer_any(root), 8).await?,
-            estimate: ring(keys::robot_estimate_any(root), 256).await?,
-            mission: ring(keys::robot_mission_any(root), 256).await?,
-            truth: ring(keys::robot_truth(root, "*"), 256).await?,
-        })
-    }
-}
 
 fn now() -> Time {
     Time::from_nanos(attachment::now_ns())
@@ -107,11 +80,11 @@ fn decode_sample<T: Message>(out: &Output, sample: &Sample, max: usize) -> Optio
 pub(super) async fn run(
     session: Session,
     root: String,
-    subscriptions: Subscriptions,
+    subscriptions: FleetStreams,
     out: Arc<Output>,
     cancel: CancellationToken,
 ) {
-    let Subscriptions {
+    let FleetStreams {
         layers,
         estimate,
         mission,

@@ -148,7 +148,7 @@ pub async fn run(
     } else {
         None
     };
-    let subscriptions = follow::Subscriptions::declare(&session, &config.root).await?;
+    let subscriptions = roam_runtime::FleetStreams::declare(&session, &config.root).await?;
     if config.offer {
         services::declare(&service, output.clone(), &config.root).await?;
     }
