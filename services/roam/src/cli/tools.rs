@@ -237,13 +237,7 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             rate_hz,
             seconds,
         } => {
-            if robots == 0
-                || robots > roam_sim::sim::MAX_ROBOTS
-                || !(rate_hz.is_finite() && rate_hz > 0.0)
-                || !(seconds.is_finite() && seconds > 0.0)
-            {
-                bail!("--robots must be 1..=1000, --rate-hz and --seconds positive");
-            }
+            check_robots_run(robots, rate_hz, seconds)?;
             let result = roam_experiments::bench::sim::sim(robots, rate_hz, seconds).await?;
             print_json(&result, json)
         }
@@ -270,13 +264,7 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             rate_hz,
             seconds,
         } => {
-            if robots == 0
-                || robots > roam_sim::sim::MAX_ROBOTS
-                || !(rate_hz.is_finite() && rate_hz > 0.0)
-                || !(seconds.is_finite() && seconds > 0.0)
-            {
-                bail!("--robots must be 1..=1000, --rate-hz and --seconds positive");
-            }
+            check_robots_run(robots, rate_hz, seconds)?;
             let result = roam_experiments::bench::fleet::fleet(robots, rate_hz, seconds).await?;
             print_json(&result, json)
         }
@@ -598,4 +586,44 @@ async fn reproduce_days(
         print!("{}", days::table::table(&report));
     }
     Ok(())
+}
+
+/// The arguments of the benchmarks that run robots in the sim (`sim`, `fleet`): at most
+/// the sim's robot limit, a positive rate and duration.
+fn check_robots_run(robots: usize, rate_hz: f64, seconds: f64) -> anyhow::Result<()> {
+    let most = roam_sim::sim::MAX_ROBOTS;
+    if robots == 0 || robots > most {
+        bail!("--robots must be 1..={most} (the sim's robot limit), not {robots}");
+    }
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    if !positive(rate_hz) || !positive(seconds) {
+        bail!("--rate-hz and --seconds must be positive, not {rate_hz} and {seconds}");
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::check_robots_run;
+
+    #[test]
+    fn a_robots_run_outside_its_limits_is_refused_naming_them() {
+        assert!(check_robots_run(100, 10.0, 20.0).is_ok());
+        let limit = roam_sim::sim::MAX_ROBOTS;
+        let too_many = check_robots_run(limit + 1, 10.0, 20.0).expect_err("too many");
+        assert!(
+            too_many.to_string().contains(&format!("1..={limit}")),
+            "{too_many}"
+        );
+        assert!(check_robots_run(0, 10.0, 20.0).is_err());
+        for (rate_hz, seconds) in [
+            (0.0, 1.0),
+            (f64::NAN, 1.0),
+            (1.0, -1.0),
+            (1.0, f64::INFINITY),
+        ] {
+            let e = check_robots_run(1, rate_hz, seconds).expect_err("refused");
+            assert!(e.to_string().contains("must be positive"), "{e}");
+        }
+    }
 }

@@ -118,14 +118,13 @@ pub fn es2(
     let mut results = results.into_iter();
     for scheme in Scheme::IS {
         for &z_is in z_values {
-            let mut runs = Vec::with_capacity(options.runs);
-            for _ in 0..options.runs {
-                if let Some(r) = results.next() {
-                    let (summary, example) = r?;
-                    runs.push(summary);
-                    trajectories.extend(example.into_iter().flatten());
-                }
-            }
+            let (runs, examples): (Vec<RunSummary>, Vec<_>) = results
+                .by_ref()
+                .take(options.runs)
+                .collect::<Result<Vec<_>, _>>()?
+                .into_iter()
+                .unzip();
+            trajectories.extend(examples.into_iter().flatten().flatten());
             let s = summarize(&runs);
             rows.push(Es2Row {
                 scheme,

@@ -222,12 +222,10 @@ pub fn es3(
     let mut summaries = Vec::new();
     for scheme in Scheme::ALL {
         for m in 0..missions {
-            let mut runs = Vec::with_capacity(options.runs);
-            for _ in 0..options.runs {
-                if let Some(r) = results.next() {
-                    runs.push(r?);
-                }
-            }
+            let runs = results
+                .by_ref()
+                .take(options.runs)
+                .collect::<Result<Vec<_>, _>>()?;
             summaries.push((scheme, m, summarize(&runs)));
         }
     }
