@@ -6,7 +6,7 @@ use roam_controller::params::{ApfParams, Follow};
 use serde::Serialize;
 
 use super::measure::{Track, WindowResult};
-use super::planning::{mix, plan_seed, Planned, Planner};
+use super::planning::{plan_seed, Planned, Planner};
 use super::robot::{Robot, Step};
 use super::variant::{Settings, Variant};
 use super::world::DayWorld;
@@ -17,6 +17,7 @@ use roam_mission::margin::ArrivalMargin;
 use roam_mission::path::mission_waypoints;
 use roam_mission::tasks::Task;
 use roam_mission::watch::WatchParams;
+use roam_world::seed::splitmix64;
 
 /// How often the executive asks again for a window's first plans when none came
 /// ([`roam_mission::window::PLAN_RETRY_S`], wall seconds there), mission seconds.
@@ -73,7 +74,7 @@ pub(super) struct DayRun<'a> {
 
 /// The seed of day `day` in a batch seeded `seed`.
 pub fn day_seed(seed: u64, day: usize) -> u64 {
-    mix(seed ^ mix(day as u64))
+    splitmix64(seed ^ splitmix64(day as u64))
 }
 
 /// Runs day `day` of `variant`.
@@ -99,7 +100,7 @@ pub fn run_day(
             w_loc: settings.w_loc,
             change: settings.change,
         },
-        robot: Robot::new(world, &apf, mix(seed ^ SIM_STREAM))?,
+        robot: Robot::new(world, &apf, splitmix64(seed ^ SIM_STREAM))?,
         calibration: Calibration::new(TimeModel::table_i(), CalibrationConfig::default())?,
         margin: if settings.arrival_guard {
             executive.margin()

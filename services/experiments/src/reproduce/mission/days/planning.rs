@@ -28,6 +28,7 @@ use roam_planner::params::GaParams;
 use roam_planner::plan::{plan, PlanError, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
+use roam_world::seed::splitmix64;
 
 use super::world::DayWorld;
 use roam_mission::calibration::TimeModel;
@@ -60,15 +61,7 @@ pub struct Planner<'a> {
 /// A seed from the day's seed, the window and the plan's rank in it (splitmix64's
 /// finaliser over their mix, so that nearby inputs give unrelated seeds).
 pub fn plan_seed(day_seed: u64, window: usize, rank: u32) -> u64 {
-    mix(day_seed ^ mix((window as u64) << 32 | u64::from(rank)))
-}
-
-/// splitmix64's finaliser.
-pub fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+    splitmix64(day_seed ^ splitmix64((window as u64) << 32 | u64::from(rank)))
 }
 
 impl Planner<'_> {
