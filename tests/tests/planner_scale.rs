@@ -28,7 +28,7 @@ const DEPOT: &str = "config/scenarios/depot.yaml";
 
 /// A map server on `map` (the built-in world when `None`) and one planner per config.
 async fn boot(map: Option<&str>, planners: Vec<PlannerConfig>) -> Running {
-    planner_client::boot(map, |harness| {
+    planner_client::boot_on(map, |harness| {
         planners
             .into_iter()
             .map(|config| PlannerConfig {

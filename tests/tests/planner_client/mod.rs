@@ -80,7 +80,7 @@ pub struct Running {
 
 /// A map server on `map` (a repository path; the built-in world when `None`) and one
 /// planner per config `planners` makes for the harness.
-pub async fn boot(
+pub async fn boot_on(
     map: Option<&str>,
     planners: impl FnOnce(&Harness) -> Vec<PlannerConfig>,
 ) -> Running {
@@ -100,6 +100,30 @@ pub async fn boot(
         map_server,
         planners: started,
     }
+}
+
+/// A map server on the built-in world and a planner per (instance name, plans at once).
+pub async fn boot(planners: &[(&str, usize)]) -> Running {
+    boot_with(planners, |config| config).await
+}
+
+/// [`boot`] with each planner's config changed by `adjust`.
+pub async fn boot_with(
+    planners: &[(&str, usize)],
+    adjust: impl Fn(PlannerConfig) -> PlannerConfig,
+) -> Running {
+    boot_on(None, |harness| {
+        planners
+            .iter()
+            .map(|(name, concurrent)| {
+                adjust(PlannerConfig {
+                    max_concurrent_plans: *concurrent,
+                    ..harness.planner_config(name)
+                })
+            })
+            .collect()
+    })
+    .await
 }
 
 impl Running {
