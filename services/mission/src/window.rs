@@ -33,6 +33,7 @@
 //! each request before it reads the next input, so the watch decides on a path the robot
 //! has been given.
 
+mod ending;
 mod events;
 mod handover;
 mod routes;
@@ -43,9 +44,8 @@ pub use routes::{routes, PlannedAhead, Route};
 
 use roam_planner::plan::MAX_T_EXEC_S;
 use roam_proto::controller::{ControllerStatus, Mission, MissionState};
-use roam_proto::mission::{TimeModelReport, WindowReport};
 
-use crate::calibration::{path_measure, TimeModel};
+use crate::calibration::TimeModel;
 use crate::information::InformationScale;
 use crate::margin::ArrivalMargin;
 use crate::path::{distance, mission_waypoints};
@@ -575,165 +575,6 @@ impl<'a> DowntimeWindow<'a> {
                 self.finish_at_task_end(now)
             }
         }
-    }
-
-    fn arrive(&mut self, at_s: f64, now: Now) -> Vec<WindowAction> {
-        let Phase::Driving(drive) = std::mem::replace(&mut self.phase, Phase::Done) else {
-            return Vec::new();
-        };
-        let model = self.setup.time_model;
-        let took_s = at_s - drive.sent_at_s;
-        let (d, theta) = path_measure(&drive.path);
-        let predicted_s = model.eta(d, theta);
-        self.margin.learn(predicted_s, took_s);
-        let time_model = TimeModelReport {
-            v_lin: model.v_lin,
-            v_ang: model.v_ang,
-            predicted_s,
-            driving_s: took_s,
-            driven_share: self.share_driven(at_s - drive.first_sent_at_s),
-        };
-        let arrived = WindowAction::Arrived {
-            at_s,
-            drive: DrivenMission {
-                path: drive.path.clone(),
-                took_s,
-            },
-        };
-        let outcome = self.outcome(*drive, Some(at_s), time_model);
-        let task = &self.setup.task;
-        let leave_at_s = task.start_s + task.duration_s;
-        self.phase = Phase::AtTask {
-            outcome: Box::new(outcome),
-            leave_at_s,
-            retry_at_wall_s: None,
-        };
-        let mut actions = vec![arrived];
-        if self.setup.next.is_some() {
-            actions.extend(self.ask_next_window(now, leave_at_s));
-        } else {
-            actions.extend(self.finish_at_task_end(now));
-        }
-        actions
-    }
-
-    fn give_up(&mut self) -> Vec<WindowAction> {
-        let Phase::Driving(drive) = std::mem::replace(&mut self.phase, Phase::Done) else {
-            return Vec::new();
-        };
-        let model = self.setup.time_model;
-        let time_model = TimeModelReport {
-            v_lin: model.v_lin,
-            v_ang: model.v_ang,
-            predicted_s: 0.0,
-            driving_s: 0.0,
-            driven_share: 0.0,
-        };
-        let outcome = self.outcome(*drive, None, time_model);
-        vec![WindowAction::GaveUp, self.finish(Some(outcome))]
-    }
-
-    /// Given up before any plan came: reported like any window given up, with nothing
-    /// planned or driven.
-    fn give_up_without_a_plan(&mut self) -> Vec<WindowAction> {
-        let task = &self.setup.task;
-        let report = WindowReport {
-            robot: self.setup.robot.clone(),
-            task: task.name.clone(),
-            window: self.setup.window,
-            began_s: self.began_s,
-            task_start_s: task.start_s,
-            arrival_s: None,
-            on_time: false,
-            budget_s: task.start_s - self.began_s,
-            planned_information: 0.0,
-            driven_information: 0.0,
-            shortest_information: 0.0,
-            peb_mean_m: None,
-            replans: 0,
-            replan_reasons: vec![NO_PLAN_REASON.into()],
-            time_model: None,
-        };
-        let outcome = WindowOutcome {
-            report,
-            plans: Vec::new(),
-            shortest: Vec::new(),
-            driven: vec![self.setup.from],
-        };
-        vec![WindowAction::GaveUp, self.finish(Some(outcome))]
-    }
-
-    /// The share of the window's time (its begin to the task's start) that `driving_s`
-    /// is.
-    fn share_driven(&self, driving_s: f64) -> f64 {
-        let window_s = self.setup.task.start_s - self.began_s;
-        if window_s > 0.0 {
-            driving_s / window_s
-        } else {
-            0.0
-        }
-    }
-
-    fn outcome(
-        &mut self,
-        drive: Drive,
-        arrival_s: Option<f64>,
-        time_model: TimeModelReport,
-    ) -> WindowOutcome {
-        let task = &self.setup.task;
-        let driven = std::mem::take(&mut self.driven);
-        let pebs = &self.pebs;
-        let report = WindowReport {
-            robot: self.setup.robot.clone(),
-            task: task.name.clone(),
-            window: self.setup.window,
-            began_s: self.began_s,
-            task_start_s: task.start_s,
-            arrival_s,
-            on_time: arrival_s.is_some_and(|a| a <= task.start_s),
-            budget_s: drive.budget_s,
-            planned_information: drive.planned_information,
-            driven_information: self.setup.scale.of(&driven),
-            shortest_information: self.setup.scale.of(&drive.shortest),
-            peb_mean_m: (!pebs.is_empty()).then(|| pebs.iter().sum::<f64>() / pebs.len() as f64),
-            replans: drive.reasons.len() as u32,
-            replan_reasons: drive.reasons,
-            time_model: Some(time_model),
-        };
-        WindowOutcome {
-            report,
-            plans: drive.plans,
-            shortest: drive.shortest,
-            driven,
-        }
-    }
-
-    /// At the task: done once it ends and no request is in flight.
-    fn finish_at_task_end(&mut self, now: Now) -> Vec<WindowAction> {
-        let Phase::AtTask { leave_at_s, .. } = self.phase else {
-            return Vec::new();
-        };
-        if self.asked.is_some() || now.mission_s < leave_at_s {
-            return Vec::new();
-        }
-        let Phase::AtTask { outcome, .. } = std::mem::replace(&mut self.phase, Phase::Done) else {
-            return Vec::new();
-        };
-        vec![self.finish(Some(*outcome))]
-    }
-
-    fn finish(&mut self, outcome: Option<WindowOutcome>) -> WindowAction {
-        self.phase = Phase::Done;
-        self.asked = None;
-        WindowAction::Done(Box::new(WindowEnd {
-            outcome,
-            handover: Handover {
-                margin: self.margin,
-                missions_sent: self.ids.sent,
-                planned_ahead: self.planned_ahead.take(),
-            },
-            position: self.here,
-        }))
     }
 }
 

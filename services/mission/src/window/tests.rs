@@ -2,9 +2,11 @@
 //! 3 m east of the robot at 100 s, the next one 3 m north of the robot at 200 s.
 
 use super::*;
+use crate::calibration::path_measure;
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
 use roam_proto::map::{GridMeta, Origin};
+use roam_proto::mission::WindowReport;
 use roam_proto::planner::{FitnessTerms, MapVersion, Plan, PlannerModel, ShortestPath, StopReason};
 use roam_world::grid::Grid;
 
