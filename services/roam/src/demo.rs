@@ -52,6 +52,9 @@ pub struct DemoOptions {
     pub view_access: roam_view::Access,
     /// Offer the demo to ROS 2 (`roam ros2` in the stack).
     pub ros2: Option<roam_ros2::node::Ros2Config>,
+    /// The stack router's endpoint, where other processes connect (a ROS 2 system
+    /// over rmw_zenoh, `roam plan`, a Zenoh client); a free loopback port when `None`.
+    pub listen: Option<String>,
 }
 
 impl Default for DemoOptions {
@@ -65,6 +68,7 @@ impl Default for DemoOptions {
             record: None,
             view_access: roam_view::Access::default(),
             ros2: None,
+            listen: None,
         }
     }
 }
@@ -150,11 +154,18 @@ pub async fn run(
             sim_rate: Some(options.rate),
             apf: Some(indoor_apf()),
             ros2: options.ros2.clone(),
+            listen: options.listen.clone(),
             ..StackOptions::default()
         },
         Duration::from_secs(30),
     )
     .await?;
+    if options.listen.is_some() || options.ros2.is_some() {
+        progress(&format!(
+            "router {} (root '{}'); connect with --connect {}",
+            stack.router.endpoint, stack.root, stack.router.endpoint
+        ));
+    }
     let view_cancel = CancellationToken::new();
     let view = match start_view(&stack, options, &view_cancel, progress).await {
         Ok(view) => view,

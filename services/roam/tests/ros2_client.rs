@@ -179,3 +179,52 @@ async fn a_ros2_client_reads_the_map_and_plans_and_calls_the_planner() {
     assert_eq!(topics["/r1/plan"]["type"], "nav_msgs/msg/Path", "{out}");
     assert_eq!(out["map"]["width"], layer.meta.width);
 }
+
+/// `roam demo --ros2 --listen`: a ROS 2 client on the demo's router follows the robot
+/// the demo drives: `/map`, its `/robot/plan` (the executive's missions) and its
+/// `/robot/pose` with the CRB as covariance, each decoded by `rosbags`.
+#[test]
+fn a_ros2_client_follows_the_demos_robot() {
+    if !python_has(
+        "zenoh, zenoh.ext, rosbags",
+        "a_ros2_client_follows_the_demos_robot",
+        "eclipse-zenoh==1.10.2 rosbags==0.11.9",
+    ) {
+        return;
+    }
+    let port = free_loopback_port().expect("port");
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let out = tempfile::tempdir().expect("tmp");
+    let out_dir = out.path().to_str().expect("utf-8");
+    // At twice real time the first window (75 s) outlasts the client's checks.
+    let _demo = RoamProcess::start(
+        &[
+            "demo", "--ros2", "--listen", &endpoint, "--rate", "2", "--out", out_dir,
+        ],
+        &format!("ros2-demo-{}", std::process::id()),
+        "connect with --connect",
+    );
+    let run = python(&["watch", "--connect", &endpoint, "--robot", "robot"]);
+    assert!(
+        run.status.success(),
+        "ros2_client.py watch failed:\n{}",
+        run.stderr
+    );
+    let seen: serde_json::Value = serde_json::from_str(&run.stdout).expect("json");
+    // The day world: 100 × 100 cells of 0.2 m.
+    assert_eq!(seen["map"]["width"], 100, "{seen}");
+    assert_eq!(seen["map"]["height"], 100, "{seen}");
+    let plan = seen["plan"].as_array().expect("plan");
+    assert!(plan.len() >= 2, "{seen}");
+    let inside = |v: &serde_json::Value| v.as_f64().is_some_and(|x| (-10.0..=10.0).contains(&x));
+    assert!(
+        inside(&seen["pose"]["x"]) && inside(&seen["pose"]["y"]),
+        "{seen}"
+    );
+    assert!(
+        seen["pose"]["var_x"]
+            .as_f64()
+            .is_some_and(|v| v > 0.0 && v < 1.0),
+        "{seen}"
+    );
+}

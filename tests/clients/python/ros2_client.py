@@ -3,6 +3,7 @@ spec with PyPI's `eclipse-zenoh` (1.10.2) and `rosbags` (0.11.9, an independent 
 message implementation: CDR, RIHS01 hashes, rosbag2 reading).
 
     python3 ros2_client.py live --connect tcp/127.0.0.1:7447 --robot r1 --waypoints '[[..]]'
+    python3 ros2_client.py watch --connect tcp/127.0.0.1:7447 --robot robot
     python3 ros2_client.py bag DIR
 
 `live` finds roam's liveliness tokens, subscribes to /map and /<robot>/plan as
@@ -10,7 +11,9 @@ rmw_zenoh's transient-local subscriber does (an AdvancedSubscriber asking the
 publishers' caches), checks the attachments, calls /roam/plan_downtime and
 /roam/get_plan with rmw_zenoh's query conventions (good and bad requests), and prints
 one JSON object (the map's cells in hex, for the caller to compare with the map
-server's layer). `bag` reads a rosbag2 directory and prints its topics and counts.
+server's layer). `watch` follows a robot that roam drives (the demo): /map, the
+robot's /<robot>/plan and its /<robot>/pose with the CRB as covariance. `bag` reads a
+rosbag2 directory and prints its topics and counts.
 Exit code 0 when every check passed; 1 with the failed check on stderr otherwise.
 """
 
@@ -136,11 +139,7 @@ class Caller:
 def live(args):
     register_services()
     domain = args.domain
-    conf = zenoh.Config()
-    conf.insert_json5('mode', '"client"')
-    conf.insert_json5('connect/endpoints', json.dumps([args.connect]))
-    conf.insert_json5('scouting/multicast/enabled', 'false')
-    session = zenoh.open(conf)
+    session = open_client(args.connect)
     out = {}
 
     h_grid = STORE.hash_rihs01('nav_msgs/msg/OccupancyGrid')
@@ -250,6 +249,45 @@ def live(args):
     print(json.dumps(out))
 
 
+def open_client(endpoint):
+    conf = zenoh.Config()
+    conf.insert_json5('mode', '"client"')
+    conf.insert_json5('connect/endpoints', json.dumps([endpoint]))
+    conf.insert_json5('scouting/multicast/enabled', 'false')
+    return zenoh.open(conf)
+
+
+def watch(args):
+    session = open_client(args.connect)
+    domain = args.domain
+    h_grid = STORE.hash_rihs01('nav_msgs/msg/OccupancyGrid')
+    h_path = STORE.hash_rihs01('nav_msgs/msg/Path')
+    h_pose = STORE.hash_rihs01('geometry_msgs/msg/PoseWithCovarianceStamped')
+    out = {}
+    sample = latest(session, topic_key(domain, '/map', 'nav_msgs/msg/OccupancyGrid', h_grid), 60)
+    grid = STORE.deserialize_cdr(sample.payload.to_bytes(), 'nav_msgs/msg/OccupancyGrid')
+    out['map'] = {'width': int(grid.info.width), 'height': int(grid.info.height),
+                  'resolution': float(grid.info.resolution)}
+    sample = latest(session, topic_key(domain, f'/{args.robot}/plan', 'nav_msgs/msg/Path', h_path), 60)
+    path = STORE.deserialize_cdr(sample.payload.to_bytes(), 'nav_msgs/msg/Path')
+    out['plan'] = [[p.pose.position.x, p.pose.position.y] for p in path.poses]
+    check(len(out['plan']) >= 2, f'/{args.robot}/plan holds a path')
+    pose_key = topic_key(domain, f'/{args.robot}/pose',
+                         'geometry_msgs/msg/PoseWithCovarianceStamped', h_pose)
+    sample = latest(session, pose_key, 60)
+    parse_attachment(sample.attachment)
+    pose = STORE.deserialize_cdr(sample.payload.to_bytes(),
+                                 'geometry_msgs/msg/PoseWithCovarianceStamped')
+    cov = [float(c) for c in pose.pose.covariance]
+    check(pose.header.frame_id == 'map', 'the pose is in frame map')
+    check(len(cov) == 36 and cov[0] > 0 and cov[7] > 0 and all(math.isfinite(c) for c in cov),
+          f'the pose carries a covariance (the CRB): {cov[:8]}')
+    out['pose'] = {'x': pose.pose.pose.position.x, 'y': pose.pose.pose.position.y,
+                   'var_x': cov[0], 'var_y': cov[7]}
+    session.close()
+    print(json.dumps(out))
+
+
 def bag(args):
     from rosbags.rosbag2 import Reader
     out = {'topics': {}}
@@ -276,10 +314,14 @@ def main():
     p.add_argument('--domain', type=int, default=0)
     p.add_argument('--robot', default='r1')
     p.add_argument('--waypoints', required=True)
+    p = sub.add_parser('watch')
+    p.add_argument('--connect', required=True)
+    p.add_argument('--domain', type=int, default=0)
+    p.add_argument('--robot', default='robot')
     p = sub.add_parser('bag')
     p.add_argument('dir')
     args = parser.parse_args()
-    {'live': live, 'bag': bag}[args.command](args)
+    {'live': live, 'watch': watch, 'bag': bag}[args.command](args)
 
 
 if __name__ == '__main__':

@@ -342,6 +342,10 @@ pub(crate) struct DemoArgs {
     ros2: bool,
     #[command(flatten)]
     ros: super::ros2::RosFlags,
+    /// The stack router's endpoint, e.g. tcp/127.0.0.1:7447, where a ROS 2 system
+    /// (with --ros2) or any Zenoh client connects; a free loopback port when absent.
+    #[arg(long, value_name = "ENDPOINT")]
+    listen: Option<String>,
 }
 
 pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
@@ -366,6 +370,7 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
             None => roam_view::Access::default(),
         },
         ros2: args.ros2.then(|| args.ros.config()),
+        listen: args.listen,
     };
     let say = |line: &str| eprintln!("roam demo: {line}");
     let report = roam::demo::run(&options, &say).await?;
