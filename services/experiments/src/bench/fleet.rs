@@ -315,11 +315,7 @@ async fn run(
             .map_err(setup)?
     };
 
-    let status: SimStatus = client
-        .request(&control_key, Some(&SimControl::Status))
-        .await?;
-    let TimedRun { end, wall, cpu } =
-        run_sim_for(&client, &control_key, rate_hz * status.step_s, seconds).await?;
+    let TimedRun { end, wall, cpu } = run_sim_for(&client, &control_key, rate_hz, seconds).await?;
     // The last step's commands.
     tokio::time::sleep(Duration::from_millis(500)).await;
     let rss_after = rss_mib();

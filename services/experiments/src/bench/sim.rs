@@ -109,18 +109,15 @@ pub async fn sim(robots: usize, rate_hz: f64, seconds: f64) -> Result<SimBench, 
         let subscriber = {
             let counter = counter.clone();
             session
-                .declare_subscriber(format!("{root}/robot/*/ranges"))
+                .declare_subscriber(keys::robot_ranges_any(&root))
                 .callback(move |_| {
                     counter.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 })
                 .await
                 .map_err(setup)?
         };
-        let status: SimStatus = client
-            .request(&control_key, Some(&SimControl::Status))
-            .await?;
         let TimedRun { end, wall, cpu } =
-            run_sim_for(&client, &control_key, rate_hz * status.step_s, seconds).await?;
+            run_sim_for(&client, &control_key, rate_hz, seconds).await?;
         // Let the last publications arrive.
         tokio::time::sleep(Duration::from_millis(300)).await;
         drop(subscriber);
@@ -159,14 +156,19 @@ pub(crate) struct TimedRun {
     pub cpu: f64,
 }
 
-/// Resumes the sim at `factor` × real time, lets it run `seconds`, pauses it, and says
-/// what it did meanwhile: the window every sim-driven benchmark times.
+/// Resumes the sim at `rate_hz` steps per wall second, lets it run `seconds`, pauses
+/// it, and says what it did meanwhile: the window every sim-driven benchmark times.
 pub(crate) async fn run_sim_for(
     client: &Requester,
     control_key: &str,
-    factor: f64,
+    rate_hz: f64,
     seconds: f64,
 ) -> Result<TimedRun, roam_runtime::ClientError> {
+    let status: SimStatus = client
+        .request(control_key, Some(&SimControl::Status))
+        .await?;
+    // The sim's rate is a real-time factor: steps of `step_s` sim seconds.
+    let factor = rate_hz * status.step_s;
     let cpu_before = process_cpu_seconds();
     let started = Instant::now();
     client
