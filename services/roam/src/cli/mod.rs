@@ -1,12 +1,13 @@
 //! Command-line interface: one subcommand per role, client commands, benchmarks and
 //! experiment runners. Each submodule holds one group of commands.
 
+mod bench;
 mod map;
 mod plan;
+mod reproduce;
 mod roles;
 mod ros2;
 mod sim;
-mod tools;
 mod view;
 
 use std::path::PathBuf;
@@ -18,10 +19,11 @@ use roam_proto::keys;
 use roam_runtime::{Requester, SessionArgs};
 use roam_stack::{Role, RoleConfig};
 
+use bench::BenchCommand;
 use map::MapCommand;
 use plan::PlanArgs;
+use reproduce::ReproduceCommand;
 use roles::{MapServerArgs, PlannerArgs, RouterArgs, StackArgs};
-use tools::{BenchCommand, ReproduceCommand};
 
 const ABOUT: &str = "roam: curious, time-aware robot navigation as Zenoh services.";
 
@@ -207,8 +209,8 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Ros2(args) => ros2::ros2(args).await,
         Command::View(args) => view::view(args).await,
         Command::Map(command) => map::map(command).await,
-        Command::Bench(command) => tools::bench(command).await,
-        Command::Reproduce(command) => tools::reproduce(command).await,
+        Command::Bench(command) => bench::bench(command).await,
+        Command::Reproduce(command) => reproduce::reproduce(command).await,
     }
 }
 
@@ -221,4 +223,14 @@ pub(crate) async fn connect(client: &ClientArgs) -> anyhow::Result<(Requester, z
         Requester::new(session.clone(), Duration::from_secs_f64(client.timeout)),
         session,
     ))
+}
+
+/// Prints `value` as JSON on stdout: one line when `compact`, else indented.
+pub(crate) fn print_json<T: serde::Serialize>(value: &T, compact: bool) -> anyhow::Result<()> {
+    if compact {
+        println!("{}", serde_json::to_string(value)?);
+    } else {
+        println!("{}", serde_json::to_string_pretty(value)?);
+    }
+    Ok(())
 }

@@ -1,100 +1,9 @@
-//! `roam bench` and `roam reproduce`: benchmarks and the papers' experiments.
+//! `roam reproduce`: the papers' experiments, our figures next to theirs with verdicts.
 
 use std::path::PathBuf;
 
 use anyhow::bail;
 use clap::Subcommand;
-use roam_experiments::bench as benches;
-
-#[derive(Debug, Subcommand)]
-pub(crate) enum BenchCommand {
-    /// Get and publish of a ~1.7-million-cell layer through Zenoh.
-    Map {
-        #[arg(long)]
-        json: bool,
-        /// Map side in cells (1304² ≈ 1.7 million).
-        #[arg(long, default_value_t = 1304)]
-        side: u32,
-        #[arg(long, default_value_t = 20)]
-        iterations: usize,
-    },
-    /// WLS estimates per second with 7 anchors and a 500 x 500 PEB field.
-    Localization {
-        #[arg(long)]
-        json: bool,
-        #[arg(long, default_value_t = 200_000)]
-        estimates: usize,
-    },
-    /// Many robots at a fixed sim rate publishing their sensors over Zenoh.
-    Sim {
-        #[arg(long)]
-        json: bool,
-        #[arg(long, default_value_t = 100)]
-        robots: usize,
-        /// Steps per second.
-        #[arg(long, default_value_t = 10.0)]
-        rate_hz: f64,
-        /// How long to run, seconds.
-        #[arg(long, default_value_t = 10.0)]
-        seconds: f64,
-    },
-    /// Many concurrent plan requests to two planners: answered or refused `busy`, none hung.
-    Load {
-        #[arg(long)]
-        json: bool,
-        /// Concurrent plan requests.
-        #[arg(long, default_value_t = 100)]
-        requests: usize,
-        /// Each request's deadline, seconds.
-        #[arg(long, default_value_t = 1.0)]
-        deadline_s: f64,
-    },
-    /// Robots in closed loop through Zenoh (sim → localization → controller → sim) at a
-    /// fixed rate: steps on time, CPU share and memory per robot.
-    Fleet {
-        #[arg(long)]
-        json: bool,
-        #[arg(long, default_value_t = 100)]
-        robots: usize,
-        /// Steps per second.
-        #[arg(long, default_value_t = 10.0)]
-        rate_hz: f64,
-        /// How long to run, seconds.
-        #[arg(long, default_value_t = 20.0)]
-        seconds: f64,
-    },
-    /// Change-map observation updates per second on a 1000 x 1000 map (paper 004 §3).
-    Mapper {
-        #[arg(long)]
-        json: bool,
-        /// Map side in cells.
-        #[arg(long, default_value_t = 1000)]
-        side: u32,
-        /// Observation updates to run.
-        #[arg(long, default_value_t = 4000)]
-        updates: u64,
-    },
-    /// The GA per curiosity model (2000 generations, population 200) and the service overhead.
-    Planner {
-        #[arg(long)]
-        json: bool,
-        /// Plans per model.
-        #[arg(long, default_value_t = 5)]
-        runs: usize,
-        /// Plan with paper 000's own initialization (random walks that stop at the goal,
-        /// no via-point seeds), to compare with roam's default.
-        #[arg(long)]
-        paper_init: bool,
-        /// Instead: the same world at 0.2, 0.1, 0.05 and 0.03 m and a 1.7-million-cell
-        /// warehouse, planned at 0.2 m and at the map's resolution, and the memory of a
-        /// planner holding the warehouse.
-        #[arg(long, conflicts_with = "peer")]
-        scaling: bool,
-        /// Instead: model greedy against Model I at equal wall time on several worlds.
-        #[arg(long)]
-        peer: bool,
-    },
-}
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum ReproduceCommand {
@@ -202,118 +111,6 @@ pub(crate) enum ReproduceCommand {
         #[arg(long)]
         paper_init: bool,
     },
-}
-
-pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
-    match command {
-        BenchCommand::Map {
-            json,
-            side,
-            iterations,
-        } => {
-            if iterations == 0 || side < 8 {
-                bail!("--iterations must be at least 1 and --side at least 8");
-            }
-            let dir = std::env::temp_dir().join(format!("roam-bench-map-{}", std::process::id()));
-            std::fs::create_dir_all(&dir)?;
-            let result = benches::map::map(side, iterations, &dir).await;
-            let _ = std::fs::remove_dir_all(&dir);
-            let result = result?;
-            print_json(&result, json)
-        }
-        BenchCommand::Localization { json, estimates } => {
-            if estimates == 0 {
-                bail!("--estimates must be at least 1");
-            }
-            let result = tokio::task::spawn_blocking(move || {
-                roam_experiments::bench::localization::localization(estimates)
-            })
-            .await??;
-            print_json(&result, json)
-        }
-        BenchCommand::Sim {
-            json,
-            robots,
-            rate_hz,
-            seconds,
-        } => {
-            check_robots_run(robots, rate_hz, seconds)?;
-            let result = roam_experiments::bench::sim::sim(robots, rate_hz, seconds).await?;
-            print_json(&result, json)
-        }
-        BenchCommand::Load {
-            json,
-            requests,
-            deadline_s,
-        } => {
-            if requests == 0 || requests > roam_experiments::bench::load::MAX_REQUESTS {
-                bail!(
-                    "--requests must be 1..={}",
-                    roam_experiments::bench::load::MAX_REQUESTS
-                );
-            }
-            if !(deadline_s.is_finite() && deadline_s > 0.0 && deadline_s <= 600.0) {
-                bail!("--deadline-s must be in (0, 600] seconds");
-            }
-            let result = roam_experiments::bench::load::load(requests, deadline_s).await?;
-            print_json(&result, json)
-        }
-        BenchCommand::Fleet {
-            json,
-            robots,
-            rate_hz,
-            seconds,
-        } => {
-            check_robots_run(robots, rate_hz, seconds)?;
-            let result = roam_experiments::bench::fleet::fleet(robots, rate_hz, seconds).await?;
-            print_json(&result, json)
-        }
-        BenchCommand::Mapper {
-            json,
-            side,
-            updates,
-        } => {
-            if updates == 0 || !(128..=2048).contains(&side) {
-                bail!("--updates must be at least 1 and --side 128..=2048 cells");
-            }
-            let options = roam_experiments::bench::mapper::BenchOptions {
-                map_cells: side,
-                updates,
-                ..roam_experiments::bench::mapper::BenchOptions::default()
-            };
-            let result = tokio::task::spawn_blocking(move || {
-                roam_experiments::bench::mapper::bench(&options)
-            })
-            .await??;
-            print_json(&result, json)
-        }
-        BenchCommand::Planner {
-            json,
-            runs,
-            paper_init,
-            scaling,
-            peer,
-        } => {
-            if runs == 0 {
-                bail!("--runs must be at least 1");
-            }
-            if scaling {
-                let result = tokio::task::spawn_blocking(move || {
-                    roam_experiments::bench::scaling::scaling(runs)
-                })
-                .await??;
-                return print_json(&result, json);
-            }
-            if peer {
-                let result =
-                    tokio::task::spawn_blocking(move || roam_experiments::bench::peer::peer(runs))
-                        .await??;
-                return print_json(&result, json);
-            }
-            let result = roam_experiments::bench::planner::planner(runs, paper_init).await?;
-            print_json(&result, json)
-        }
-    }
 }
 
 pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
@@ -516,15 +313,6 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
     }
 }
 
-fn print_json<T: serde::Serialize>(value: &T, compact: bool) -> anyhow::Result<()> {
-    if compact {
-        println!("{}", serde_json::to_string(value)?);
-    } else {
-        println!("{}", serde_json::to_string_pretty(value)?);
-    }
-    Ok(())
-}
-
 /// `roam reproduce mission --days N`: the days' batch, its table or JSON on stdout and
 /// its progress and runtime on stderr (so the JSON repeats bit for bit).
 #[allow(clippy::too_many_arguments)]
@@ -586,44 +374,4 @@ async fn reproduce_days(
         print!("{}", days::table::table(&report));
     }
     Ok(())
-}
-
-/// The arguments of the benchmarks that run robots in the sim (`sim`, `fleet`): at most
-/// the sim's robot limit, a positive rate and duration.
-fn check_robots_run(robots: usize, rate_hz: f64, seconds: f64) -> anyhow::Result<()> {
-    let most = roam_sim::sim::MAX_ROBOTS;
-    if robots == 0 || robots > most {
-        bail!("--robots must be 1..={most} (the sim's robot limit), not {robots}");
-    }
-    let positive = |x: f64| x.is_finite() && x > 0.0;
-    if !positive(rate_hz) || !positive(seconds) {
-        bail!("--rate-hz and --seconds must be positive, not {rate_hz} and {seconds}");
-    }
-    Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::check_robots_run;
-
-    #[test]
-    fn a_robots_run_outside_its_limits_is_refused_naming_them() {
-        assert!(check_robots_run(100, 10.0, 20.0).is_ok());
-        let limit = roam_sim::sim::MAX_ROBOTS;
-        let too_many = check_robots_run(limit + 1, 10.0, 20.0).expect_err("too many");
-        assert!(
-            too_many.to_string().contains(&format!("1..={limit}")),
-            "{too_many}"
-        );
-        assert!(check_robots_run(0, 10.0, 20.0).is_err());
-        for (rate_hz, seconds) in [
-            (0.0, 1.0),
-            (f64::NAN, 1.0),
-            (1.0, -1.0),
-            (1.0, f64::INFINITY),
-        ] {
-            let e = check_robots_run(1, rate_hz, seconds).expect_err("refused");
-            assert!(e.to_string().contains("must be positive"), "{e}");
-        }
-    }
 }
