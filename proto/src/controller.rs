@@ -36,6 +36,12 @@ pub struct Mission {
     /// World metres; at most [`MAX_WAYPOINTS`] (the parse stops at one more).
     #[serde(deserialize_with = "crate::bounded::vec::<_, MAX_WAYPOINTS, _>")]
     pub waypoints: Vec<[f64; 2]>,
+    /// A recovery: drive these waypoints even while the PEB is above the controller's
+    /// guard (`max_peb_m`), to get a robot the guard holds back to where it had a fix.
+    /// The executive sends one along the robot's own driven path, backwards; every
+    /// other rule (stuck, step limit, stale estimates) still holds. Absent: `false`.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub recovery: bool,
 }
 
 impl Message for Mission {

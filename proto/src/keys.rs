@@ -271,6 +271,13 @@ pub fn robot_mission_report(root: &str, robot: &str) -> String {
     format!("{root}/robot/{robot}/mission_report")
 }
 
+/// `<root>/robot/<robot>/executive`: the mission executive publishes an
+/// [`ExecutiveStatus`](crate::mission::ExecutiveStatus) after each estimate, controller
+/// status and plan reply it handled (what it is doing; a lock-step driver waits on it).
+pub fn robot_executive(root: &str, robot: &str) -> String {
+    format!("{root}/robot/{robot}/executive")
+}
+
 /// `<root>/mapper/status`: the mapper answers a `get` (no payload) with a
 /// [`MapperStatus`](crate::mapper::MapperStatus).
 pub fn mapper_status(root: &str) -> String {

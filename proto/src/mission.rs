@@ -39,6 +39,19 @@ pub struct WindowReport {
     /// predicted what the robot drove.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_model: Option<TimeModelReport>,
+    /// The probability that the window's first plan arrives late, as the arrival margin
+    /// bounds it from the robot's own prediction errors (`roam_mission::margin`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub late_probability: Option<f64>,
+    /// Times the controller's PEB guard held the robot long enough for the executive to
+    /// act, the seconds it was held in all, and the recoveries sent (back along the
+    /// driven path to where it had a fix).
+    #[serde(default)]
+    pub holds: u32,
+    #[serde(default)]
+    pub held_s: f64,
+    #[serde(default)]
+    pub recoveries: u32,
 }
 
 /// A window's time model and its prediction error.
@@ -59,4 +72,28 @@ pub struct TimeModelReport {
 
 impl Message for WindowReport {
     const KIND: &'static str = "window_report";
+}
+
+/// What the mission executive is doing, on `<root>/robot/<id>/executive` after each
+/// estimate, controller status and plan reply it handled: for an operator's display,
+/// and for a lock-step driver, which steps the sim once the executive has heard the
+/// step and has no plan in flight.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExecutiveStatus {
+    pub robot: String,
+    /// The window it is in (0 for the first).
+    pub window: usize,
+    /// The mission time of the last event it handled, seconds.
+    pub heard_s: f64,
+    /// The mission time when it handled the controller's last status, if that was the
+    /// last event, seconds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub status_s: Option<f64>,
+    /// Plan requests it waits on.
+    pub plans_in_flight: u32,
+}
+
+impl Message for ExecutiveStatus {
+    const KIND: &'static str = "executive_status";
 }

@@ -613,7 +613,7 @@ mod controller_and_mapper_messages {
     proptest! {
         #[test]
         fn controller_messages_round_trip(id in name(), waypoints in prop::collection::vec([finite(), finite()], 0..6), state in state(), steps in any::<u64>(), peb in prop::option::of(finite()), x in finite()) {
-            let mission = Mission { robot: id.clone(), id: id.clone(), waypoints };
+            let mission = Mission { robot: id.clone(), id: id.clone(), waypoints, recovery: false };
             round_trips(&mission);
             round_trips(&ControllerStatus { robot: id.clone(), mission: Some(id), state, waypoint: Some(2), waypoints: 5, distance_left_m: Some(x), steps, estimate_step: Some(steps), peb_m: peb, omega_deg: x, z_isa: x, u: [x, x] });
         }
@@ -626,7 +626,7 @@ mod controller_and_mapper_messages {
 
         #[test]
         fn controller_messages_refuse_garbage_and_versions(id in name(), g in garbage(), v in other_version()) {
-            let m = Mission { robot: id.clone(), id, waypoints: vec![[1.0, 2.0]] };
+            let m = Mission { robot: id.clone(), id, waypoints: vec![[1.0, 2.0]], recovery: false };
             refuses_trailing(&m, &g);
             refuses_version(&m, v);
         }
@@ -640,7 +640,7 @@ mod mission_messages {
     proptest! {
         #[test]
         fn window_reports_round_trip(robot in name(), x in finite(), arrival in prop::option::of(finite()), on_time in any::<bool>()) {
-            round_trips(&WindowReport { robot: robot.clone(), task: robot, window: 1, began_s: x, task_start_s: x, arrival_s: arrival, on_time, budget_s: x, planned_information: x, driven_information: x, shortest_information: x, peb_mean_m: arrival, replans: 2, replan_reasons: vec!["off_path".into()], time_model: None });
+            round_trips(&WindowReport { robot: robot.clone(), task: robot, window: 1, began_s: x, task_start_s: x, arrival_s: arrival, on_time, budget_s: x, planned_information: x, driven_information: x, shortest_information: x, peb_mean_m: arrival, replans: 2, replan_reasons: vec!["off_path".into()], time_model: None, late_probability: arrival, holds: 1, held_s: x, recoveries: 1 });
         }
     }
 }

@@ -53,6 +53,7 @@ async fn give_path(
         robot: "robot".into(),
         id: id.into(),
         waypoints,
+        recovery: false,
     };
     put(client, keys::robot_mission(root, "robot"), &mission).await;
 }

@@ -3,15 +3,15 @@
 //! obstacle, budgets too short, bad parameters, stale map versions, malformed and
 //! oversized payloads. Real map server and planner in process, used only as a client.
 
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
-use roam_proto::planner::{GaOverrides, MapVersion, Plan, PlanRequest};
+use roam_proto::planner::{GaOverrides, MapVersion, Plan, PlanRequest, StopReason};
 use roam_proto::{keys, ErrorCode};
 use roam_runtime::ClientError;
 use roam_tests::within;
 
 mod planner_client;
-use planner_client::{boot, refusal, request};
+use planner_client::{ask, boot, refusal, request};
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn every_refusal_is_structured_and_says_what_to_change() {
@@ -286,5 +286,41 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
     for named in ["start (-1.5, -1.5)", "no legal move", "t_exec_s"] {
         assert!(enclosed.message.contains(named), "{}", enclosed.message);
     }
+    running.stop().await;
+}
+
+/// Issue 26 item 5: a deadline bounds the work, so a request is not refused for work it
+/// could only do after its deadline. Model I at Table I's population with 100,000
+/// generations and an 80 s budget (paths of at most 201 cells) would cost 4.02e9, over
+/// `max_plan_cost`; with a 2 s deadline only the generations that can start before it
+/// count, and the plan comes back within the deadline, cut there with its best path.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_deadline_bounds_the_work_instead_of_refusing_it() {
+    let running = boot(&[("solo", 2)]).await;
+    let client = running.harness.client().await;
+    let root = running.harness.root.clone();
+    let curious = PlanRequest {
+        deadline_s: 2.0,
+        params: GaOverrides {
+            max_generations: Some(100_000),
+            ..GaOverrides::default()
+        },
+        ..request([-8.0, -8.0], [6.0, -7.0], 80.0, 100_000)
+    };
+    let started = Instant::now();
+    let plan = ask(&client, &root, &curious)
+        .await
+        .expect("planned, not refused");
+    let wall = started.elapsed();
+    assert!(wall < Duration::from_secs_f64(2.5), "{wall:?}");
+    assert!(plan.reaches_goal, "{plan:?}");
+    assert!(plan.within_budget, "{plan:?}");
+    // Cut at the deadline: the reply says so, and how many generations ran.
+    assert_eq!(plan.stop_reason, StopReason::Deadline, "{plan:?}");
+    assert!(
+        (1..100_000).contains(&plan.generations),
+        "{}",
+        plan.generations
+    );
     running.stop().await;
 }

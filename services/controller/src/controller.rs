@@ -109,6 +109,8 @@ pub struct Controller {
     /// Under `follow: path`: the mission's index of each path point after the first
     /// (the robot's start), for [`Decision::waypoint`].
     path_waypoints: Vec<usize>,
+    /// The mission is a recovery: the PEB guard does not hold it.
+    recovery: bool,
 }
 
 impl Controller {
@@ -132,6 +134,7 @@ impl Controller {
             legs_after: Vec::new(),
             path: None,
             path_waypoints: Vec::new(),
+            recovery: false,
         }
     }
 
@@ -159,6 +162,15 @@ impl Controller {
         self.checkpoint = None;
         self.path = None;
         self.path_waypoints.clear();
+        self.recovery = false;
+    }
+
+    /// A recovery mission ([`roam_proto::controller::Mission::recovery`]): as
+    /// [`Controller::set_mission`], but the PEB guard does not hold the robot on it, so
+    /// that a robot held where it has no fix can drive back to where it had one.
+    pub fn set_recovery(&mut self, waypoints: Vec<[f64; 2]>) {
+        self.set_mission(waypoints);
+        self.recovery = true;
     }
 
     /// Ends the mission as if emptied: zero commands, status Idle.
@@ -244,7 +256,7 @@ impl Controller {
         let finite = position[0].is_finite() && position[1].is_finite();
         // An unbounded PEB (`None`, or NaN) counts as +∞: held unless the guard is off.
         let peb = peb_m.filter(|p| !p.is_nan()).unwrap_or(f64::INFINITY);
-        if !(finite && peb <= self.params.max_peb_m) {
+        if !(finite && (self.recovery || peb <= self.params.max_peb_m)) {
             self.status = MissionStatus::HaltedPeb;
             self.halted_updates += 1;
             return self.decision(position, None);
@@ -507,6 +519,19 @@ mod tests {
         let d = c.update([20.0, 20.0], Some(2.0));
         assert_eq!((d.status, d.halted_updates), (MissionStatus::Active, 0));
         assert_eq!(d.u, [1.0, 0.0]);
+    }
+
+    #[test]
+    fn a_recovery_drives_through_a_bad_peb_and_the_next_mission_is_guarded_again() {
+        let mut c = controller(plain());
+        c.set_recovery(vec![[25.0, 20.0]]);
+        let d = c.update([20.0, 20.0], None);
+        assert_eq!((d.status, d.u), (MissionStatus::Active, [1.0, 0.0]));
+        c.set_mission(vec![[25.0, 20.0]]);
+        assert_eq!(
+            c.update([20.0, 20.0], None).status,
+            MissionStatus::HaltedPeb
+        );
     }
 
     #[test]

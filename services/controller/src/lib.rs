@@ -65,6 +65,7 @@ pub mod obstacle_field;
 pub mod params;
 #[cfg(feature = "zenoh")]
 pub mod service;
+pub mod status;
 pub mod weights;
 
 pub use controller::{Controller, Decision, MissionStatus};

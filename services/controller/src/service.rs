@@ -222,37 +222,13 @@ impl ControllerShared {
     }
 }
 
-fn state_of(status: MissionStatus) -> MissionState {
-    match status {
-        MissionStatus::Idle => MissionState::Idle,
-        MissionStatus::Active => MissionState::Active,
-        MissionStatus::Completed => MissionState::Completed,
-        MissionStatus::Stuck => MissionState::Stuck,
-        MissionStatus::HaltedPeb => MissionState::HaltedPeb,
-        MissionStatus::StepLimit => MissionState::StepLimit,
-    }
-}
-
 fn status_of(
     robot: &str,
     driven: &ControlledRobot,
     decision: &Decision,
     estimate: Option<&PositionEstimate>,
 ) -> ControllerStatus {
-    ControllerStatus {
-        robot: robot.to_owned(),
-        mission: Some(driven.mission.clone()),
-        state: state_of(decision.status),
-        waypoint: decision.waypoint,
-        waypoints: driven.waypoints,
-        distance_left_m: Some(decision.distance_left_m),
-        steps: decision.steps,
-        estimate_step: estimate.map(|e| e.step),
-        peb_m: estimate.and_then(|e| e.peb_m),
-        omega_deg: decision.omega_deg,
-        z_isa: decision.z_isa,
-        u: decision.u,
-    }
+    crate::status::controller_status(robot, &driven.mission, driven.waypoints, decision, estimate)
 }
 
 /// Checks a mission before it replaces the robot's current one.
@@ -329,7 +305,11 @@ fn install_mission(state: &ControllerShared, robot: &str, mission: &Mission) {
             stale: false,
             last: None,
         });
-    driven.controller.set_mission(mission.waypoints.clone());
+    if mission.recovery {
+        driven.controller.set_recovery(mission.waypoints.clone());
+    } else {
+        driven.controller.set_mission(mission.waypoints.clone());
+    }
     driven.mission = mission.id.clone();
     driven.waypoints = mission.waypoints.len();
     driven.last_estimate = Instant::now();

@@ -22,133 +22,32 @@
 //! the task's start minus that.
 
 use std::collections::VecDeque;
-use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use roam_planner::client::PlannerClient;
 use roam_planner::params::GaParams;
 use roam_proto::controller::Mission;
 use roam_proto::keys;
-use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel, ShortestPathUse};
+use roam_proto::mission::ExecutiveStatus;
+use roam_proto::planner::{Plan, PlannerModel};
 use roam_runtime::{lock, ClientError, Delivery, Requester};
-use serde::Deserialize;
+use tokio::task::JoinSet;
 use tokio::time::MissedTickBehavior;
 use tokio_util::sync::CancellationToken;
 
 use crate::calibration::{path_measure, store, Calibration, CalibrationConfig, TimeModel};
 use crate::information::InformationScale;
 use crate::inputs::{listen, wait_for_world, Inputs};
-use crate::margin::ArrivalMargin;
-use crate::tasks::{self, Task, TaskError};
-use crate::watch::WatchParams;
+use crate::request::plan_request;
+use crate::tasks::{Task, TaskError};
 pub use crate::window::WindowOutcome;
 use crate::window::{
-    DowntimeWindow, DrivenMission, Handover, Now, PlanAsk, WindowAction, WindowEvent, WindowSetup,
+    DowntimeWindow, DrivenMission, Handover, Now, PlanAsk, WindowAction, WindowEvent, WindowRules,
+    WindowSetup,
 };
 
-/// How the executive plans and watches.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ExecutiveConfig {
-    /// The robot this executive drives.
-    pub robot: String,
-    pub tasks: Vec<Task>,
-    /// The curiosity model for downtime paths (paper 000).
-    pub model: PlannerModel,
-    /// The planner's deadline, wall seconds (paper 000's t_plan).
-    pub plan_deadline_s: f64,
-    /// Generations the GA may run at most (it stops at the deadline anyway).
-    pub max_generations: Option<u32>,
-    /// The planner's localizability cost W_loc (paper 002's PEB in paper 000's fitness;
-    /// see the planner's `w_loc`). `None`: the planner's default, off.
-    pub w_loc: Option<f64>,
-    pub seed: u64,
-    /// Waypoints are at most this far apart along the planned path, metres.
-    pub waypoint_spacing_m: f64,
-    /// An estimate farther than this from the planned path means the robot was pushed
-    /// off it: replan from where it is, metres.
-    pub off_path_m: f64,
-    /// The robot's top speed for the ETA-slip check, m/s.
-    pub speed_m_per_s: f64,
-    /// Replans per window at most.
-    pub max_replans: u32,
-    /// A window is given up this long after its task's start, seconds.
-    pub give_up_after_s: f64,
-    /// No status from the controller on the current mission for this long (wall
-    /// seconds) means the controller lost it (it restarted, or the robot's link was
-    /// down when the mission was sent): replan from where the robot is and send again.
-    pub controller_silence_s: f64,
-    /// Arriving this much earlier than the task's start is slack: the executive replans
-    /// a curious path from where the robot is with the time left (the mirror of the ETA
-    /// slip rule), seconds. Infinity turns the rule off.
-    pub slack_s: f64,
-    /// Mission seconds between two slack replans at least.
-    pub slack_interval_s: f64,
-    /// What a plan leaves unspent of the time to the task: this share of it (or the
-    /// robot's recent underestimate if more), and at least `arrival_margin_min_s`
-    /// ([`crate::margin`]).
-    pub arrival_margin_share: f64,
-    pub arrival_margin_min_s: f64,
-    /// Plan with paper 000 Eq. 2's v_lin and v_ang fitted to what this robot drove
-    /// (Table I as the prior; see [`crate::calibration`]); `false`: Table I throughout.
-    pub calibrate: bool,
-    /// Where the robot's fit is kept across restarts; absent: in memory only.
-    pub calibration_file: Option<PathBuf>,
-    /// The time model before anything was driven (the calibration's prior): Table I's
-    /// v_lin 2.0 s/m and v_ang 1.0 s/rad by default; a robot's datasheet figures where
-    /// they are known. Bounded as the calibration's fits are.
-    pub time_model_prior: TimeModel,
-}
-
-impl ExecutiveConfig {
-    /// The replan policy's parameters for plans made with `model`.
-    pub fn watch_params(&self, model: TimeModel) -> WatchParams {
-        let expected = 1.0 / model.v_lin;
-        WatchParams {
-            off_path_m: self.off_path_m,
-            speed_m_per_s: self.speed_m_per_s.min(expected),
-            expected_speed_m_per_s: expected,
-            max_replans: self.max_replans,
-            give_up_after_s: self.give_up_after_s,
-            controller_silence_s: self.controller_silence_s,
-            slack_s: self.slack_s,
-            slack_interval_s: self.slack_interval_s,
-            behind: true,
-        }
-    }
-
-    /// The arrival margin this config asks for ([`crate::margin`]).
-    pub fn margin(&self) -> ArrivalMargin {
-        ArrivalMargin::new(self.arrival_margin_share, self.arrival_margin_min_s)
-    }
-}
-
-impl Default for ExecutiveConfig {
-    fn default() -> Self {
-        ExecutiveConfig {
-            robot: "robot".to_owned(),
-            tasks: tasks::builtin(),
-            model: PlannerModel::Model1,
-            plan_deadline_s: 1.0,
-            max_generations: Some(1000),
-            w_loc: None,
-            seed: 0,
-            waypoint_spacing_m: 1.0,
-            off_path_m: 1.5,
-            speed_m_per_s: 0.5,
-            max_replans: 5,
-            give_up_after_s: 60.0,
-            controller_silence_s: 3.0,
-            slack_s: 10.0,
-            slack_interval_s: 10.0,
-            arrival_margin_share: 0.08,
-            arrival_margin_min_s: 2.0,
-            calibrate: true,
-            calibration_file: None,
-            time_model_prior: TimeModel::table_i(),
-        }
-    }
-}
+pub use crate::config::ExecutiveConfig;
 
 #[derive(Debug, thiserror::Error)]
 pub enum ExecutiveError {
@@ -156,6 +55,8 @@ pub enum ExecutiveError {
     Tasks(#[from] TaskError),
     #[error("invalid config: {0}")]
     Config(String),
+    #[error(transparent)]
+    Settings(#[from] crate::config::ConfigError),
     #[error(transparent)]
     Client(#[from] ClientError),
     #[error("the map server's {0} layer is not usable: {1}")]
@@ -177,10 +78,17 @@ pub enum Progress {
         budget_s: f64,
         eta_s: f64,
         curious: bool,
+        /// The plan's probability of arriving late ([`crate::margin`]).
+        late_probability: f64,
     },
     Replanned {
         window: usize,
         reason: String,
+    },
+    /// The PEB guard held the robot this long: it is driven back to its last fix.
+    Recovering {
+        window: usize,
+        held_s: f64,
     },
     Arrived {
         window: usize,
@@ -208,45 +116,6 @@ const PLAN_WALL_SLACK_S: f64 = 0.05;
 /// How long the executive waits for the sim's clock at its start.
 const CLOCK_WAIT: Duration = Duration::from_secs(2);
 
-fn check(config: &ExecutiveConfig) -> Result<(), ExecutiveError> {
-    tasks::check(&config.tasks)?;
-    keys::check_name("robot", &config.robot).map_err(|e| ExecutiveError::Config(e.to_string()))?;
-    for (name, value) in [
-        ("plan_deadline_s", config.plan_deadline_s),
-        ("waypoint_spacing_m", config.waypoint_spacing_m),
-        ("off_path_m", config.off_path_m),
-        ("speed_m_per_s", config.speed_m_per_s),
-        ("give_up_after_s", config.give_up_after_s),
-        ("controller_silence_s", config.controller_silence_s),
-        ("slack_interval_s", config.slack_interval_s),
-    ] {
-        if !(value.is_finite() && value > 0.0) {
-            return Err(ExecutiveError::Config(format!(
-                "{name} is {value}; give a positive number"
-            )));
-        }
-    }
-    if !(0.0..0.5).contains(&config.arrival_margin_share) {
-        return Err(ExecutiveError::Config(format!(
-            "arrival_margin_share is {}; give a share in 0..0.5 of the time to the task",
-            config.arrival_margin_share
-        )));
-    }
-    if !(config.arrival_margin_min_s.is_finite() && config.arrival_margin_min_s >= 0.0) {
-        return Err(ExecutiveError::Config(format!(
-            "arrival_margin_min_s is {}; give 0 or more seconds",
-            config.arrival_margin_min_s
-        )));
-    }
-    if config.slack_s.is_nan() || config.slack_s <= 0.0 {
-        return Err(ExecutiveError::Config(format!(
-            "slack_s is {}; give a positive number of seconds (.inf turns the slack rule off)",
-            config.slack_s
-        )));
-    }
-    Ok(())
-}
-
 /// How often the loop ticks: the watch's clock rules (give up, lost mission), the plan
 /// retries and the end of the task.
 const TICK: Duration = Duration::from_millis(20);
@@ -257,22 +126,26 @@ struct Executive<'a> {
     session: &'a zenoh::Session,
     root: &'a str,
     config: &'a ExecutiveConfig,
-    planner: PlannerClient,
+    planner: Arc<PlannerClient>,
     inputs: Inputs,
     /// The robot's last good estimate.
     position: Option<[f64; 2]>,
-    /// The robot's time model, fitted as it drives.
+    /// The robot's time calibration, fitted as it drives.
     calibration: Calibration,
     /// Wall seconds the recent curious plans took (request to reply), the slowest.
     plan_wall_s: Option<f64>,
-    /// What the last window handed the next (the arrival margin, the mission count, the
-    /// next window's plan).
+    /// What the last window handed the next (the arrival margin, the mission and ask
+    /// counts, the next window's plan).
     handover: Handover,
     /// This executive's own tag in its mission ids (from its Zenoh session id), so a
     /// restarted executive never reuses an id its predecessor sent: the controller's
     /// statuses on an old mission are not taken for a new one's.
     tag: String,
 }
+
+/// A plan request's answer as the loop gets it back: the ask's id, whether it was
+/// curious, the wall seconds it took, and the reply.
+type Answered = (u64, bool, f64, Result<Plan, ClientError>);
 
 impl Executive<'_> {
     fn now(&self) -> f64 {
@@ -288,67 +161,71 @@ impl Executive<'_> {
         }
     }
 
-    /// What a curious plan costs on the mission clock: the wall time the last ones
-    /// took (with a margin; the deadline until one was measured) at the clock's rate.
-    /// Charging the whole deadline would waste it whenever the GA ends sooner (its
-    /// generations, on a small map): at a sim running 20x, a 1 s deadline is 20 s of
-    /// downtime the robot would wait through.
+    /// What a curious plan costs on the mission clock: the config's fixed figure when
+    /// it sets one, else the wall time the last ones took (with a margin; the deadline
+    /// until one was measured) at the clock's rate. Charging the whole deadline would
+    /// waste it whenever the GA ends sooner (its generations, on a small map).
     fn planning_cost_s(&self) -> f64 {
+        if let Some(cost) = self.config.planning_cost_s {
+            return cost;
+        }
         let wall = self.plan_wall_s.map_or(self.config.plan_deadline_s, |w| {
             (w * PLAN_WALL_MARGIN + PLAN_WALL_SLACK_S).min(self.config.plan_deadline_s)
         });
         wall * lock(&self.inputs.clock).rate()
     }
 
-    /// The machine's time: the mission clock, wall seconds since `began`, and what a
-    /// plan costs now.
+    /// The machine's time: the mission clock, wall seconds since `began`, what a plan
+    /// costs now, and the clock's rate.
     fn moment(&self, began: Instant) -> Now {
         Now {
             mission_s: self.now(),
             wall_s: began.elapsed().as_secs_f64(),
             planning_cost_s: self.planning_cost_s(),
+            clock_rate: lock(&self.inputs.clock).rate(),
         }
     }
 
-    /// One request for the plan `ask` describes, with the shortest path as its fallback
-    /// and attached ([`crate::window`]'s one-request rule).
-    async fn plan(&mut self, ask: &PlanAsk) -> Result<Plan, ClientError> {
-        let request = PlanRequest {
-            request_id: None,
-            cancel_token: None,
-            start: ask.from,
-            goal: ask.to,
-            t_exec_s: ask.t_exec_s,
-            deadline_s: self.config.plan_deadline_s,
-            model: if ask.curious {
-                self.config.model
-            } else {
-                PlannerModel::Shortest
-            },
-            params: GaOverrides {
-                max_generations: self.config.max_generations,
-                w_loc: self.config.w_loc,
-                ..self.time_model().overrides()
-            },
-            seed: self.config.seed,
-            map_version: None,
-            shortest: ShortestPathUse::Fallback,
-        };
-        let asked = Instant::now();
-        let plan = self.planner.plan(&request).await?;
+    /// Sends the request `ask` describes ([`plan_request`]) without waiting: its answer
+    /// joins `in_flight`.
+    fn ask(&self, ask: &PlanAsk, in_flight: &mut JoinSet<Answered>) {
+        let request = plan_request(self.config, ask, self.time_model());
+        let planner = self.planner.clone();
+        let (id, curious) = (ask.id, ask.curious);
+        in_flight.spawn(async move {
+            let asked = Instant::now();
+            let reply = planner.plan(&request).await;
+            (id, curious, asked.elapsed().as_secs_f64(), reply)
+        });
+    }
+
+    /// Learns what a curious plan costs from one that came back.
+    fn took(&mut self, plan: &Plan, took_s: f64) {
         // Only what the GA took says what a curious plan costs (a fallback to the
         // shortest path is answered at once).
         if plan.model != PlannerModel::Shortest {
-            let took = asked.elapsed().as_secs_f64();
             // The slowest of the recent plans, forgetting slowly.
-            self.plan_wall_s = Some(self.plan_wall_s.map_or(took, |w| took.max(0.8 * w)));
+            self.plan_wall_s = Some(self.plan_wall_s.map_or(took_s, |w| took_s.max(0.8 * w)));
         }
-        Ok(plan)
     }
 
     fn publish(&self, mission: &Mission) {
         let key = keys::robot_mission(self.root, &self.config.robot);
         roam_runtime::publish_wait(self.session, &key, mission, Delivery::Reliable);
+    }
+
+    /// What the executive is doing, for operators and for lock-step drivers: the
+    /// mission time of the last event it handled and the plans in flight.
+    fn publish_status(&self, window: usize, heard_s: f64, status_s: Option<f64>, asks: usize) {
+        let key = keys::robot_executive(self.root, &self.config.robot);
+        let status = ExecutiveStatus {
+            robot: self.config.robot.clone(),
+            window,
+            heard_s,
+            status_s,
+            plans_in_flight: asks as u32,
+        };
+        roam_runtime::publish_wait(self.session, &key, &status, Delivery::Latest);
     }
 
     /// Waits briefly for the sim's clock, so that an executive restarted mid-mission
@@ -445,6 +322,7 @@ impl Executive<'_> {
             from,
             time_model: self.time_model(),
             watch: self.config.watch_params(self.time_model()),
+            rules: WindowRules::of(self.config),
             give_up_after_s: self.config.give_up_after_s,
             waypoint_spacing_m: self.config.waypoint_spacing_m,
             scale,
@@ -452,43 +330,38 @@ impl Executive<'_> {
         let handover = std::mem::replace(&mut self.handover, Handover::first(self.config.margin()));
         let (mut machine, actions) = DowntimeWindow::begin(setup, handover, self.moment(began));
         let mut pending = VecDeque::from(actions);
+        // Dropping a request's future cancels it at the planner (PlannerClient::plan).
+        let mut in_flight: JoinSet<Answered> = JoinSet::new();
         let mut tick = tokio::time::interval(TICK);
         tick.set_missed_tick_behavior(MissedTickBehavior::Delay);
         let name = || task.name.clone();
         loop {
             while let Some(action) = pending.pop_front() {
                 match action {
-                    WindowAction::Drive(mission) | WindowAction::Hold(mission) => {
-                        self.publish(&mission)
-                    }
-                    WindowAction::RequestPlan(ask) => {
-                        let event = tokio::select! {
-                            _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
-                            reply = self.plan(&ask) => match reply {
-                                Ok(plan) => WindowEvent::PlanReply(Box::new(plan)),
-                                Err(e) => {
-                                    tracing::warn!(task = %task.name, curious = ask.curious, "the plan request failed: {e}");
-                                    WindowEvent::PlanFailed
-                                }
-                            },
-                        };
-                        pending.extend(machine.handle(event, self.moment(began)));
-                    }
+                    WindowAction::Drive(mission) => self.publish(&mission),
+                    WindowAction::RequestPlan(ask) => self.ask(&ask, &mut in_flight),
+                    // The answer is dropped by the machine when it comes.
+                    WindowAction::Forget(_) => {}
                     WindowAction::Planned {
                         budget_s,
                         eta_s,
                         curious,
+                        late_probability,
                     } => progress(Progress::Planned {
                         window,
                         task: name(),
                         budget_s,
                         eta_s,
                         curious,
+                        late_probability,
                     }),
                     WindowAction::Replanned { reason } => progress(Progress::Replanned {
                         window,
                         reason: reason.as_str().to_owned(),
                     }),
+                    WindowAction::Recovering { held_s } => {
+                        progress(Progress::Recovering { window, held_s })
+                    }
                     WindowAction::Arrived { at_s, drive } => {
                         progress(Progress::Arrived {
                             window,
@@ -515,9 +388,23 @@ impl Executive<'_> {
                     }
                 }
             }
+            let mut status_s = None;
             let event = tokio::select! {
                 _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
                 _ = tick.tick() => WindowEvent::Tick,
+                Some(answered) = in_flight.join_next(), if !in_flight.is_empty() => {
+                    let Ok((id, curious, took_s, reply)) = answered else { continue };
+                    match reply {
+                        Ok(plan) => {
+                            self.took(&plan, took_s);
+                            WindowEvent::PlanReply { id, plan: Box::new(plan) }
+                        }
+                        Err(e) => {
+                            tracing::warn!(task = %task.name, curious, "the plan request failed: {e}");
+                            WindowEvent::PlanFailed { id }
+                        }
+                    }
+                }
                 sample = self.inputs.estimates.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
                     let Some(e) = self.inputs.estimate(&sample) else { continue };
@@ -526,10 +413,21 @@ impl Executive<'_> {
                 sample = self.inputs.statuses.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
                     let Some(s) = self.inputs.status(&sample) else { continue };
+                    status_s = s.estimate_step.map(|_| self.now());
                     WindowEvent::Status(s)
                 }
             };
-            pending.extend(machine.handle(event, self.moment(began)));
+            let tick_only = matches!(event, WindowEvent::Tick);
+            let now = self.moment(began);
+            pending.extend(machine.handle(event, now));
+            if !tick_only
+                && pending
+                    .iter()
+                    .all(|a| !matches!(a, WindowAction::RequestPlan(_)))
+            {
+                let asks = machine.asks_in_flight();
+                self.publish_status(window, now.mission_s, status_s, asks);
+            }
         }
     }
 }
@@ -563,9 +461,12 @@ pub async fn run(
     progress: &(dyn Fn(Progress) + Sync),
     on_window: &(dyn Fn(&WindowOutcome) + Sync),
 ) -> Result<Vec<WindowOutcome>, ExecutiveError> {
-    check(config)?;
+    config.check()?;
     let requester = Requester::new(session.clone(), Duration::from_secs(10));
     let world = wait_for_world(&requester, root, cancel).await?;
+    // A day whose tasks are in walls or cannot be reached from each other in time is
+    // refused before the robot moves, naming the tasks and the seconds missing.
+    crate::day_check::check_day(&config.tasks, &world, config.time_model_prior, None)?;
     let params = GaParams::default();
     // The report's information is measured on the static map, as the driven path's: a
     // planner on the change coupling reports its own figure on the coupled map, which
@@ -579,7 +480,7 @@ pub async fn run(
         session,
         root,
         config,
-        planner: PlannerClient::new(session.clone(), root),
+        planner: Arc::new(PlannerClient::new(session.clone(), root)),
         inputs,
         position: None,
         calibration: load_calibration(config)?,

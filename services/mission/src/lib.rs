@@ -9,7 +9,11 @@
 //! reports each window: the information gathered, the arrival against the task's start,
 //! the PEB along the way.
 //!
+//! - [`config`]: [`config::ExecutiveConfig`], the one configuration of the live
+//!   executive and the batch; [`request`]: the planner request of a window's ask.
 //! - [`tasks`]: the task sequence and its checks; the built-in world's day.
+//! - [`day_check`]: a day checked against a map: every place free, every task
+//!   reachable in time from the previous one (paper 000's fastest path).
 //! - [`calibration`]: paper 000's time model (Eq. 2's v_lin, v_ang) fitted to what the
 //!   robot drove, with Table I as the prior, kept per robot in a small file.
 //! - [`path`]: a planned path's waypoints (every turn kept); off-path distance; ETA slip.
@@ -20,9 +24,8 @@
 //!   during the task; the report): events in, actions out.
 //! - [`information`]: the information a path gathers, on the planner's own scale.
 //! - `roam_experiments::reproduce::mission`: `roam reproduce mission`, the couplings
-//!   compared in batch, and with `--days N` the executive's whole day in batch
-//!   (today's, the new one, each coupling left out, the shortest path) against issue
-//!   14's goals.
+//!   compared in batch, and with `--days N` the executive's whole day in batch: the
+//!   same window machine driven in process, once per configuration compared.
 //! - [`executive`]: the executive on Zenoh (a client of the planner, the controller,
 //!   localization and the sim clock), a thin loop that feeds the window's machine and
 //!   performs its actions; `inputs`: what it hears (clock, estimates, controller
@@ -30,6 +33,8 @@
 //! - [`service`]: `roam mission`, the executive as a service that publishes its reports.
 
 pub mod calibration;
+pub mod config;
+pub mod day_check;
 #[cfg(feature = "zenoh")]
 pub mod executive;
 pub mod information;
@@ -37,6 +42,7 @@ pub mod information;
 mod inputs;
 pub mod margin;
 pub mod path;
+pub mod request;
 #[cfg(feature = "zenoh")]
 pub mod service;
 pub mod tasks;

@@ -67,10 +67,18 @@ fn log(p: Progress) {
             budget_s,
             eta_s,
             curious,
+            late_probability,
         } => tracing::info!(
-            window, %task, budget_s, eta_s, curious, "planned"
+            window, %task, budget_s, eta_s, curious, late_probability, "planned"
         ),
         Progress::Replanned { window, reason } => tracing::info!(window, %reason, "replanned"),
+        Progress::Recovering { window, held_s } => {
+            tracing::warn!(
+                window,
+                held_s,
+                "held for the PEB: driving back to the last fix"
+            )
+        }
         Progress::Arrived {
             window,
             task,

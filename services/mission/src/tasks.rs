@@ -32,6 +32,61 @@ pub enum TaskError {
     TooMany { count: usize, max: usize },
     #[error("task {name:?}: {what}")]
     Bad { name: String, what: String },
+    /// Checked against a map ([`crate::day_check`]): the task's place is off the map,
+    /// in a wall, its inflation or unknown space, or in a pocket no planning cell
+    /// reaches; `why` says which.
+    #[error("task {name:?}: its place {at:?} {why}")]
+    Blocked {
+        name: String,
+        at: [f64; 2],
+        why: String,
+    },
+    /// Checked against a map: the robot's start position is where no plan can begin.
+    #[error("the start {at:?} {why}")]
+    StartBlocked { at: [f64; 2], why: String },
+    /// Checked against a map: no path at all joins the task's place to the previous
+    /// one (or to the start).
+    #[error("task {name:?}: its place {at:?} cannot be reached from {from}: no path joins them on this map (walls or their inflation enclose one of them)")]
+    NoPath {
+        name: String,
+        at: [f64; 2],
+        from: LegFrom,
+    },
+    /// Checked against a map: the fastest path (paper 000 Eq. 2, turns counted, with
+    /// the robot's time model) from the end of the previous task (or from the start,
+    /// at 0 s) takes longer than the gap to this task's start.
+    #[error("task {name:?}: its place {at:?} cannot be reached from {from} in time: the fastest path takes {fastest_s:.1} s, the gap is {gap_s:.1} s ({missing_s:.1} s missing)")]
+    Unreachable {
+        name: String,
+        at: [f64; 2],
+        from: LegFrom,
+        fastest_s: f64,
+        gap_s: f64,
+        missing_s: f64,
+    },
+    /// Checked against a map: the time model is one the planner refuses.
+    #[error("the time model (v_lin {v_lin} s/m, v_ang {v_ang} s/rad) cannot time the day's drives: {what}")]
+    TimeModel {
+        v_lin: f64,
+        v_ang: f64,
+        what: String,
+    },
+}
+
+/// Where a leg of the day begins: the previous task, or the robot's start position.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LegFrom {
+    Start { at: [f64; 2] },
+    Task { name: String },
+}
+
+impl std::fmt::Display for LegFrom {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LegFrom::Start { at } => write!(f, "the start {at:?}"),
+            LegFrom::Task { name } => write!(f, "{name:?}"),
+        }
+    }
 }
 
 /// Checks a task list: finite places, start times that increase with room for each

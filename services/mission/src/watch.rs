@@ -25,8 +25,11 @@
 //!   before), beyond what a replan costs on the mission clock (the time model overestimated the drive, or a replan
 //!   was cheap): replan a curious path from where it is with the time left, the mirror
 //!   of the late rule. At most once per `slack_interval_s`, and never after the window
-//!   slipped. The executive holds the robot while it plans (the slack pays for it), so
-//!   the new path starts where the robot is.
+//!   slipped. The robot drives on while the plan is made; the window
+//!   ([`crate::window`]) plans from where it will be when the plan comes.
+//!
+//! Slack and behind replans need `min_replan_window_s` left to the task: the late
+//! arrivals of issue 26 came from short replans near a window's end.
 //!
 //! Replans other than resending a lost mission count toward `max_replans`.
 
@@ -48,7 +51,9 @@ pub struct WatchParams {
     pub slack_s: f64,
     /// Mission seconds between two slack replans at least (and two behind ones).
     pub slack_interval_s: f64,
-    /// The behind rule is on (off: today's executive before it, in the batch of days).
+    /// Slack and behind replans only with at least this much time left to the task.
+    pub min_replan_window_s: f64,
+    /// The behind rule is on.
     pub behind: bool,
 }
 
@@ -61,9 +66,48 @@ pub enum Reason {
     PushedOffPath,
     Slack,
     Behind,
+    /// The time left, less the margin, reached the fastest path's time: straight there.
+    LastSafeMoment,
+    /// The robot was held for its PEB and driven back to where it had a fix.
+    Recovered,
+    /// No planner answered: the fastest path the executive computes itself.
+    NoPlanner,
 }
 
 impl Reason {
+    /// Every reason, in the order [`Reason::name`] lists them.
+    pub const ALL: [Reason; 9] = [
+        Reason::ControllerSilent,
+        Reason::Stuck,
+        Reason::EtaSlipped,
+        Reason::PushedOffPath,
+        Reason::Slack,
+        Reason::Behind,
+        Reason::LastSafeMoment,
+        Reason::Recovered,
+        Reason::NoPlanner,
+    ];
+
+    /// The reason's token, as reports and tables name it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Reason::ControllerSilent => "silent",
+            Reason::Stuck => "stuck",
+            Reason::EtaSlipped => "late",
+            Reason::PushedOffPath => "off_path",
+            Reason::Slack => "slack",
+            Reason::Behind => "behind",
+            Reason::LastSafeMoment => "last_safe_moment",
+            Reason::Recovered => "recovered",
+            Reason::NoPlanner => "no_planner",
+        }
+    }
+
+    /// The reason whose sentence ([`Reason::as_str`]) is `sentence`.
+    pub fn of_sentence(sentence: &str) -> Option<Reason> {
+        Reason::ALL.into_iter().find(|r| r.as_str() == sentence)
+    }
+
     /// The sentence the window's report gives for the replan.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -73,6 +117,9 @@ impl Reason {
             Reason::PushedOffPath => "pushed off the path",
             Reason::Slack => "slack: arriving early, a curious path with the time left",
             Reason::Behind => "behind the plan: a curious path with the time left",
+            Reason::LastSafeMoment => "the last safe moment: the fastest path now, or late",
+            Reason::Recovered => "recovered from a PEB hold: a new path from where it has a fix",
+            Reason::NoPlanner => "no planner answered: the fastest path the executive computes",
         }
     }
 }
@@ -98,9 +145,13 @@ pub enum Decision {
 /// What the controller said about the current mission.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Status {
-    Active { distance_left_m: f64 },
+    Active {
+        distance_left_m: f64,
+    },
     Completed,
     Stuck,
+    /// Held by the PEB guard (the window acts on it, [`crate::window`]).
+    Halted,
     Other,
 }
 
@@ -214,7 +265,10 @@ impl Watch {
                     self.slipped = true;
                     return self.replan(Reason::EtaSlipped, false);
                 }
-                let spaced = now_s - self.planned_at_s >= self.params.slack_interval_s;
+                // A replan near the window's end is the one a time model gets most
+                // wrong: none with less than `min_replan_window_s` left.
+                let spaced = now_s - self.planned_at_s >= self.params.slack_interval_s
+                    && self.task_start_s - now_s >= self.params.min_replan_window_s;
                 if let (Some(pace), true) = (progress, self.params.behind) {
                     if spaced && eta_slips(now_s, distance_left_m, pace, self.task_start_s) {
                         return self.replan(Reason::Behind, true);
@@ -228,7 +282,7 @@ impl Watch {
                 }
                 Decision::Keep
             }
-            Status::Active { .. } | Status::Other => Decision::Keep,
+            Status::Active { .. } | Status::Halted | Status::Other => Decision::Keep,
         }
     }
 
@@ -244,6 +298,19 @@ impl Watch {
         } else {
             self.replans += 1;
         }
+    }
+
+    /// The window sent the robot straight to the task (the last safe moment): never
+    /// curious again, as after the ETA slipped.
+    pub fn straight(&mut self, path: Vec<[f64; 2]>, now_s: f64, wall_s: f64) {
+        self.slipped = true;
+        self.replanned(path, true, now_s, wall_s);
+    }
+
+    /// Whether the robot was sent the shortest way for good (the ETA slipped, or the
+    /// last safe moment came).
+    pub fn slipped(&self) -> bool {
+        self.slipped
     }
 
     fn replan(&self, reason: Reason, curious: bool) -> Decision {
@@ -272,6 +339,7 @@ mod tests {
             controller_silence_s: 3.0,
             slack_s: 10.0,
             slack_interval_s: 5.0,
+            min_replan_window_s: 0.0,
             behind: true,
         }
     }

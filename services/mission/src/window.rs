@@ -1,42 +1,54 @@
 //! One downtime window of the executive as a plain state machine: the bookkeeping and
 //! the sequencing around the replan policy ([`crate::watch`]). No Zenoh, no tokio, no
-//! clock of its own: the executive ([`crate::executive`]) feeds it [`WindowEvent`]s, each
-//! with the time it happened ([`Now`]), and performs the [`WindowAction`]s it returns, in
-//! order; the tests feed it events directly.
+//! clock of its own: the live executive ([`crate::executive`]) and the batch of days
+//! (`roam_experiments::reproduce::mission::days`) feed it [`WindowEvent`]s, each with
+//! the time it happened ([`Now`]), and perform the [`WindowAction`]s it returns, in
+//! order; the tests feed it events directly. This is the one window loop roam has.
 //!
 //! The window, in order:
 //! 1. **Begin** where the robot is. A task already over is skipped (the executive was
-//!    down through it). The plan made for the window during the previous task is used
-//!    when it starts within [`PREPLAN_FROM_M`] of the robot; otherwise a plan is asked
-//!    for, and asked again every [`PLAN_RETRY_S`] (wall) after a failure, until the
-//!    window is given up.
+//!    down through it). The plan made for the window ahead of time is used when it
+//!    starts within [`PREPLAN_FROM_M`] of the robot and the window begins when that
+//!    plan assumed; otherwise a plan is asked for, and asked again every
+//!    [`PLAN_RETRY_S`] (wall) after a failure. After [`FALLBACK_AFTER_FAILURES`]
+//!    failures the robot drives the fastest path the window computes itself (no
+//!    planner: degrade, don't stop) and curiosity comes back through the slack rule.
 //! 2. **Drive**: the plan's route is sent as a mission and the watch starts. Every good
-//!    estimate is recorded (the driven path, its PEB) and fed to the watch, as are the
-//!    controller's statuses on the current mission and the ticks.
-//! 3. **Replan** when the watch says so: one plan request from where the robot is, with
-//!    the time left; slack holds the robot first. A curious request that fails is
-//!    followed by one for the shortest path; when that fails too, nothing changes (a
-//!    held robot is sent back on the path it had) and the watch decides again.
-//! 4. **Arrive**: the time model's prediction is scored, the arrival margin learns, and
-//!    the next window is planned from the task's place while the robot is at it (a plan
-//!    that comes after the task ended is dropped); the window is done when the task
-//!    ends. **Give up**: done at once.
+//!    estimate is recorded (the driven path, its PEB, the last point with a fix) and
+//!    fed to the watch, as are the controller's statuses on the current mission and
+//!    the ticks. With `plan_ahead` the next window's plan is asked for at once, from
+//!    this task's place, so that it is ready when this task ends.
+//! 3. **Replan** when the watch says so: one plan request with the time left. The
+//!    robot drives on while the plan is made: a slack or behind replan starts where the
+//!    robot will be when the plan comes (the point that far along its route), so
+//!    planning costs the window nothing. A curious request that fails is followed by
+//!    one for the shortest path; when that fails too, the window's own fastest path.
+//! 4. **The last safe moment.** At most every [`SAFE_CHECK_S`] on a curious route, the
+//!    window computes the fastest path from where the robot is; when the budget the
+//!    arrival margin leaves of the time left no longer exceeds that path's time, the
+//!    robot goes straight, at once, without the planner, and never curious again in
+//!    the window. A late ETA does the same.
+//! 5. **Holds.** When the controller's PEB guard holds the robot for
+//!    `hold_patience_s`, the window sends a recovery mission back along the robot's own
+//!    track to the last estimate with a fix (PEB at most `fix_peb_m`), which the guard
+//!    lets through, then replans from there with the time left.
+//! 6. **Arrive**: the time model's prediction is scored, the arrival margin learns, and
+//!    the window is done when the task ends (and the next window's plan is in, or
+//!    failed). **Give up**: done at once.
 //!
-//! **One planner request per plan.** The executive asks every plan with the shortest
-//! path as its fallback (`shortest: fallback`, [`roam_proto::planner::ShortestPathUse`]):
-//! the reply carries the shortest path (the report's comparison, and the route when the
-//! curious plan does not reach the goal within its budget), and a budget the shortest
-//! path does not fit is answered with the shortest path rather than refused. A window
-//! with no time left asks for the shortest path directly.
-//!
-//! While a request is in flight the machine only records estimates: the executive awaits
-//! each request before it reads the next input, so the watch decides on a path the robot
-//! has been given.
+//! **Plan budgets and deadlines.** Each plan's deadline is the configured one cut to
+//! `replan_time_share` of the time left at the clock's rate, and its budget is what the
+//! arrival margin ([`crate::margin`]) leaves of the time to the task after the plan's
+//! expected cost: the plan's probability of arriving late is bounded, and reported with
+//! it. One planner request per plan (`shortest: fallback`): the reply carries the
+//! shortest path, and a budget it does not fit is answered with it.
 
 mod ending;
 mod events;
 mod handover;
+mod holds;
 mod routes;
+mod straight;
 
 pub use events::{DrivenMission, Now, PlanAsk, WindowAction, WindowEvent};
 pub use handover::{Handover, WindowEnd, WindowOutcome};
@@ -46,6 +58,7 @@ use roam_planner::plan::MAX_T_EXEC_S;
 use roam_proto::controller::{ControllerStatus, Mission, MissionState};
 
 use crate::calibration::TimeModel;
+use crate::config::ExecutiveConfig;
 use crate::information::InformationScale;
 use crate::margin::ArrivalMargin;
 use crate::path::{distance, mission_waypoints};
@@ -56,9 +69,23 @@ use crate::watch::{Decision, Reason, Status, Watch, WatchParams};
 /// where it starts, metres.
 pub const PREPLAN_FROM_M: f64 = 0.5;
 
+/// A plan made ahead is used when its window begins at most this long after the time
+/// it assumed the robot would set off, mission seconds (a sim step and a bit).
+pub const PREPLAN_LATE_S: f64 = 1.0;
+
 /// Wall seconds between two requests for a window's first plan (or the next window's)
 /// when none came: an outage costs downtime, not the mission.
 pub const PLAN_RETRY_S: f64 = 1.0;
+
+/// Failed first-plan requests after which the robot drives the window's own fastest
+/// path rather than wait on.
+pub const FALLBACK_AFTER_FAILURES: u32 = 2;
+
+/// Mission seconds between two last-safe-moment checks at most.
+pub const SAFE_CHECK_S: f64 = 1.0;
+
+/// The least deadline a plan request carries, wall seconds.
+pub const MIN_DEADLINE_S: f64 = 0.05;
 
 /// The least driving budget a request carries: the planner takes only positive ones. A
 /// window with no time left asks for the shortest path, for which the budget only says
@@ -67,6 +94,36 @@ const LEAST_T_EXEC_S: f64 = 1e-3;
 
 /// The report's reason for a window given up before any plan came.
 pub const NO_PLAN_REASON: &str = "no planner answered before the window was given up";
+
+/// The executive's rules a window follows (from [`ExecutiveConfig`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindowRules {
+    /// Ask for curious plans at all (`false`: the fastest path in every window).
+    pub curious: bool,
+    pub plan_ahead: bool,
+    pub recover: bool,
+    pub hold_patience_s: f64,
+    /// An estimate with a PEB at most this is a fix a recovery may go back to, metres.
+    pub fix_peb_m: f64,
+    pub replan_time_share: f64,
+    /// The configured deadline, wall seconds.
+    pub plan_deadline_s: f64,
+}
+
+impl WindowRules {
+    /// The rules `config` sets.
+    pub fn of(config: &ExecutiveConfig) -> WindowRules {
+        WindowRules {
+            curious: config.curious(),
+            plan_ahead: config.plan_ahead,
+            recover: config.recover,
+            hold_patience_s: config.hold_patience_s,
+            fix_peb_m: config.fix_peb_m,
+            replan_time_share: config.replan_time_share,
+            plan_deadline_s: config.plan_deadline_s,
+        }
+    }
+}
 
 /// What a window is about and the executive's settings for it.
 #[derive(Debug, Clone)]
@@ -85,9 +142,11 @@ pub struct WindowSetup<'a> {
     /// The time model the window's plans are made with (paper 000 Eq. 2).
     pub time_model: TimeModel,
     pub watch: WatchParams,
+    pub rules: WindowRules,
     pub give_up_after_s: f64,
     pub waypoint_spacing_m: f64,
-    /// The map the report measures information on.
+    /// The map the report measures information on, and the window's own fastest paths
+    /// are found on.
     pub scale: InformationScale<'a>,
 }
 
@@ -101,7 +160,7 @@ struct MissionIds {
 }
 
 impl MissionIds {
-    fn next(&mut self, waypoints: Vec<[f64; 2]>) -> Mission {
+    fn next(&mut self, waypoints: Vec<[f64; 2]>, recovery: bool) -> Mission {
         self.sent += 1;
         Mission {
             robot: self.robot.clone(),
@@ -110,46 +169,63 @@ impl MissionIds {
                 self.robot, self.tag, self.window, self.sent
             ),
             waypoints,
+            recovery,
         }
     }
 }
 
-/// The request in flight and what its reply is for.
+/// The drive's request in flight and what its reply is for.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Asked {
+enum DriveAsk {
     FirstPlan {
         budget_s: f64,
+        time_left_s: f64,
     },
     Replan {
         reason: Reason,
         resend: bool,
-        held: bool,
         ask: PlanAsk,
-    },
-    NextWindow {
-        budget_s: f64,
     },
 }
 
-/// The robot on its way: what today's window loop kept in its locals.
+/// The next window's request in flight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct AheadAsk {
+    budget_s: f64,
+    time_left_s: f64,
+    leave_at_s: f64,
+}
+
+/// The robot on its way.
 #[derive(Debug, Clone)]
 struct Drive {
     budget_s: f64,
     shortest: Vec<[f64; 2]>,
     /// Of the window's first route.
     planned_information: f64,
+    late_probability: f64,
     /// Every route sent, in order.
     plans: Vec<Vec<[f64; 2]>>,
-    /// The current route's waypoints (sent again after a slack hold that found no plan).
+    /// The current route's waypoints.
     waypoints: Vec<[f64; 2]>,
     /// The current mission's id: statuses on any other are not about this route.
     mission: String,
+    /// The current route is a curious one (the last-safe-moment rule watches it).
+    route_curious: bool,
     first_sent_at_s: f64,
     sent_at_s: f64,
     /// The current route from where it was sent.
     path: Vec<[f64; 2]>,
     watch: Watch,
     reasons: Vec<String>,
+    safe_checked_at_s: f64,
+    /// The current mission is a recovery back to the last fix.
+    recovering: bool,
+    /// Since when the PEB guard holds the robot, if it does.
+    held_since_s: Option<f64>,
+    holds: u32,
+    held_s: f64,
+    recoveries: u32,
 }
 
 #[derive(Debug, Clone)]
@@ -158,9 +234,10 @@ enum Phase {
     /// failure.
     FirstPlan {
         retry_at_wall_s: Option<f64>,
+        failures: u32,
     },
     Driving(Box<Drive>),
-    /// Arrived; at the task until `leave_at_s`, planning the next window meanwhile.
+    /// Arrived; at the task until `leave_at_s`.
     AtTask {
         outcome: Box<WindowOutcome>,
         leave_at_s: f64,
@@ -175,6 +252,7 @@ pub struct DowntimeWindow<'a> {
     setup: WindowSetup<'a>,
     margin: ArrivalMargin,
     ids: MissionIds,
+    asks_made: u64,
     /// The next window's plan, once made.
     planned_ahead: Option<PlannedAhead>,
     began_s: f64,
@@ -182,8 +260,11 @@ pub struct DowntimeWindow<'a> {
     here: [f64; 2],
     /// Where the window began, then every good estimate until the robot arrived.
     driven: Vec<[f64; 2]>,
+    /// The index in `driven` of the last estimate with a fix.
+    last_fix: usize,
     pebs: Vec<f64>,
-    asked: Option<Asked>,
+    drive_ask: Option<(u64, DriveAsk)>,
+    ahead_ask: Option<(u64, AheadAsk)>,
     phase: Phase,
 }
 
@@ -203,15 +284,19 @@ impl<'a> DowntimeWindow<'a> {
                 window: setup.window,
                 sent: handover.missions_sent,
             },
+            asks_made: handover.asks_made,
             margin: handover.margin,
             planned_ahead: None,
             began_s: now.mission_s,
             here: from,
             driven: vec![from],
+            last_fix: 0,
             pebs: Vec::new(),
-            asked: None,
+            drive_ask: None,
+            ahead_ask: None,
             phase: Phase::FirstPlan {
                 retry_at_wall_s: None,
+                failures: 0,
             },
             setup,
         };
@@ -221,11 +306,13 @@ impl<'a> DowntimeWindow<'a> {
             return (w, vec![WindowAction::Skipped, done]);
         }
         let window = w.setup.window;
-        let ahead = handover
-            .planned_ahead
-            .filter(|p| p.window == window && distance(p.from, from) <= PREPLAN_FROM_M);
+        let ahead = handover.planned_ahead.filter(|p| {
+            p.window == window
+                && distance(p.from, from) <= PREPLAN_FROM_M
+                && now.mission_s <= p.leave_at_s + PREPLAN_LATE_S
+        });
         let actions = match ahead {
-            Some(p) => w.start_driving(p.route, p.shortest, p.budget_s, now),
+            Some(p) => w.start_driving(p.route, p.shortest, p.budget_s, p.time_left_s, now),
             None => vec![w.ask_first_plan(now)],
         };
         (w, actions)
@@ -241,45 +328,88 @@ impl<'a> DowntimeWindow<'a> {
             } => self.on_estimate(position, peb_m, degraded, now),
             WindowEvent::Status(status) => self.on_status(&status, now),
             WindowEvent::Tick => self.on_tick(now),
-            WindowEvent::PlanReply(plan) => match (self.asked.take(), routes(*plan)) {
-                (Some(asked), Some((route, shortest))) => self.on_plan(asked, route, shortest, now),
-                (Some(asked), None) => self.on_plan_failed(asked, now),
-                (None, _) => Vec::new(),
-            },
-            WindowEvent::PlanFailed => match self.asked.take() {
-                Some(asked) => self.on_plan_failed(asked, now),
-                None => Vec::new(),
-            },
+            WindowEvent::PlanReply { id, plan } => self.on_reply(id, Some(*plan), now),
+            WindowEvent::PlanFailed { id } => self.on_reply(id, None, now),
         }
     }
 
-    /// The budget for a plan to a task starting at `task_start_s`, the robot leaving at
-    /// `leave_at_s` at the earliest (now when `None`) and the plan costing what it costs.
-    fn budget_to(&self, task_start_s: f64, leave_at_s: Option<f64>, now: Now) -> f64 {
-        let earliest = now.mission_s + now.planning_cost_s;
+    /// The requests in flight (for the executive's status).
+    pub fn asks_in_flight(&self) -> usize {
+        usize::from(self.drive_ask.is_some()) + usize::from(self.ahead_ask.is_some())
+    }
+
+    /// A request from `from` to `to` for a task starting at `task_start_s`, the robot
+    /// leaving at `leave_at_s` at the earliest (now when `None`): its deadline cut to
+    /// what the time left affords, its budget what the margin leaves after the plan's
+    /// expected cost; with the time left that budget was made from.
+    fn ask(
+        &mut self,
+        from: [f64; 2],
+        to: [f64; 2],
+        task_start_s: f64,
+        leave_at_s: Option<f64>,
+        curious: bool,
+        now: Now,
+    ) -> (PlanAsk, f64, f64) {
+        let rules = self.setup.rules;
+        let set_off = leave_at_s.map_or(now.mission_s, |at| at.max(now.mission_s));
+        let time_left = (task_start_s - set_off).max(0.0);
+        let rate = now.clock_rate.max(1e-9);
+        let deadline_s = rules
+            .plan_deadline_s
+            .min(rules.replan_time_share * time_left / rate)
+            .max(MIN_DEADLINE_S);
+        let curious = curious && rules.curious;
+        let cost = if curious {
+            now.planning_cost_s.min(deadline_s * rate)
+        } else {
+            0.0
+        };
+        let earliest = now.mission_s + cost;
         let time_left = task_start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
-        self.margin.budget(time_left)
+        let budget_s = self.margin.budget(time_left);
+        self.asks_made += 1;
+        let ask = PlanAsk {
+            id: self.asks_made,
+            from,
+            to,
+            t_exec_s: budget_s.clamp(LEAST_T_EXEC_S, MAX_T_EXEC_S),
+            deadline_s,
+            curious: curious && budget_s > 0.0,
+        };
+        (ask, budget_s, time_left)
     }
 
     fn ask_first_plan(&mut self, now: Now) -> WindowAction {
-        let budget_s = self.budget_to(self.setup.task.start_s, None, now);
-        self.asked = Some(Asked::FirstPlan { budget_s });
-        WindowAction::RequestPlan(ask(self.setup.from, self.setup.task.at, budget_s, true))
+        let (from, to, start) = (self.setup.from, self.setup.task.at, self.setup.task.start_s);
+        let (ask, budget_s, time_left_s) = self.ask(from, to, start, None, true, now);
+        self.drive_ask = Some((
+            ask.id,
+            DriveAsk::FirstPlan {
+                budget_s,
+                time_left_s,
+            },
+        ));
+        WindowAction::RequestPlan(ask)
     }
 
-    fn ask_next_window(&mut self, now: Now, leave_at_s: f64) -> Vec<WindowAction> {
+    fn ask_next_window(&mut self, now: Now) -> Vec<WindowAction> {
         let Some(next) = &self.setup.next else {
             return Vec::new();
         };
         let (start_s, to) = (next.start_s, next.at);
-        let budget_s = self.budget_to(start_s, Some(leave_at_s), now);
-        self.asked = Some(Asked::NextWindow { budget_s });
-        vec![WindowAction::RequestPlan(ask(
-            self.setup.task.at,
-            to,
-            budget_s,
-            true,
-        ))]
+        let task = &self.setup.task;
+        let (from, leave_at_s) = (task.at, task.start_s + task.duration_s);
+        let (ask, budget_s, time_left_s) = self.ask(from, to, start_s, Some(leave_at_s), true, now);
+        self.ahead_ask = Some((
+            ask.id,
+            AheadAsk {
+                budget_s,
+                time_left_s,
+                leave_at_s,
+            },
+        ));
+        vec![WindowAction::RequestPlan(ask)]
     }
 
     fn start_driving(
@@ -287,10 +417,11 @@ impl<'a> DowntimeWindow<'a> {
         route: Route,
         shortest: Vec<[f64; 2]>,
         budget_s: f64,
+        time_left_s: f64,
         now: Now,
     ) -> Vec<WindowAction> {
         let waypoints = mission_waypoints(&route.points, self.setup.waypoint_spacing_m);
-        let mission = self.ids.next(waypoints.clone());
+        let mission = self.ids.next(waypoints.clone(), false);
         let watch = Watch::new(
             self.setup.watch,
             self.setup.task.start_s,
@@ -298,18 +429,22 @@ impl<'a> DowntimeWindow<'a> {
             now.mission_s,
             now.wall_s,
         );
+        let late_probability = self.margin.late_probability(route.t_eta_s, time_left_s);
         let planned = WindowAction::Planned {
             budget_s,
             eta_s: route.t_eta_s,
             curious: route.curious,
+            late_probability,
         };
         self.phase = Phase::Driving(Box::new(Drive {
             budget_s,
             shortest,
             planned_information: self.setup.scale.of(&route.points),
+            late_probability,
             path: std::iter::once(self.setup.from)
                 .chain(route.points.iter().copied())
                 .collect(),
+            route_curious: route.curious,
             plans: vec![route.points],
             waypoints,
             mission: mission.id.clone(),
@@ -317,8 +452,20 @@ impl<'a> DowntimeWindow<'a> {
             sent_at_s: now.mission_s,
             watch,
             reasons: Vec::new(),
+            safe_checked_at_s: f64::NEG_INFINITY,
+            recovering: false,
+            held_since_s: None,
+            holds: 0,
+            held_s: 0.0,
+            recoveries: 0,
         }));
-        vec![planned, WindowAction::Drive(mission)]
+        let mut actions = vec![planned, WindowAction::Drive(mission)];
+        let ahead_due =
+            self.setup.rules.plan_ahead && self.planned_ahead.is_none() && self.ahead_ask.is_none();
+        if ahead_due {
+            actions.extend(self.ask_next_window(now));
+        }
+        actions
     }
 
     fn on_estimate(
@@ -336,20 +483,25 @@ impl<'a> DowntimeWindow<'a> {
         self.here = position;
         self.driven.push(position);
         self.pebs.extend(peb_m);
-        match &mut self.phase {
-            Phase::Driving(drive) if self.asked.is_none() => {
+        if peb_m.is_some_and(|p| p <= self.setup.rules.fix_peb_m) {
+            self.last_fix = self.driven.len() - 1;
+        }
+        let mut actions = match &mut self.phase {
+            Phase::Driving(drive) if self.drive_ask.is_none() && !drive.recovering => {
                 let decision = drive.watch.on_estimate(position);
                 self.decide(decision, now)
             }
             _ => Vec::new(),
-        }
+        };
+        actions.extend(self.check_safe(now));
+        actions
     }
 
     fn on_status(&mut self, s: &ControllerStatus, now: Now) -> Vec<WindowAction> {
         let Phase::Driving(drive) = &mut self.phase else {
             return Vec::new();
         };
-        if self.asked.is_some() || s.mission.as_deref() != Some(drive.mission.as_str()) {
+        if s.mission.as_deref() != Some(drive.mission.as_str()) {
             return Vec::new();
         }
         let status = match s.state {
@@ -358,19 +510,50 @@ impl<'a> DowntimeWindow<'a> {
             MissionState::Active => Status::Active {
                 distance_left_m: s.distance_left_m.unwrap_or(0.0),
             },
+            MissionState::HaltedPeb => Status::Halted,
             _ => Status::Other,
         };
+        if status == Status::Halted {
+            return self.on_held(now);
+        }
+        if let Some(since) = drive.held_since_s.take() {
+            drive.held_s += now.mission_s - since;
+        }
+        if drive.recovering {
+            return match status {
+                // Back at the fix (or stuck on the way): a new plan from there.
+                Status::Completed | Status::Stuck => {
+                    drive.recovering = false;
+                    let curious = !drive.watch.slipped();
+                    self.replan(Reason::Recovered, curious, true, now)
+                }
+                _ => Vec::new(),
+            };
+        }
+        if status == Status::Completed {
+            // Arrived: a replan in flight is no longer wanted.
+            let mut actions: Vec<WindowAction> = self
+                .drive_ask
+                .take()
+                .map(|(id, _)| WindowAction::Forget(id))
+                .into_iter()
+                .collect();
+            actions.extend(self.arrive(now.mission_s, now));
+            return actions;
+        }
+        if self.drive_ask.is_some() {
+            return self.check_safe(now);
+        }
         let decision =
             drive
                 .watch
                 .on_status(status, now.mission_s, now.wall_s, now.planning_cost_s);
-        self.decide(decision, now)
+        let mut actions = self.decide(decision, now);
+        actions.extend(self.check_safe(now));
+        actions
     }
 
     fn on_tick(&mut self, now: Now) -> Vec<WindowAction> {
-        if self.asked.is_some() {
-            return Vec::new();
-        }
         let due = |retry: &mut Option<f64>| {
             let due = retry.is_some_and(|at| now.wall_s >= at);
             if due {
@@ -379,16 +562,28 @@ impl<'a> DowntimeWindow<'a> {
             due
         };
         match &mut self.phase {
-            Phase::FirstPlan { retry_at_wall_s } => {
-                if due(retry_at_wall_s) {
+            Phase::FirstPlan {
+                retry_at_wall_s, ..
+            } => {
+                if self.drive_ask.is_none() && due(retry_at_wall_s) {
                     vec![self.ask_first_plan(now)]
                 } else {
                     Vec::new()
                 }
             }
             Phase::Driving(drive) => {
+                let give_up = now.mission_s > self.setup.task.start_s + self.setup.give_up_after_s;
+                if self.drive_ask.is_some() || drive.recovering {
+                    return if give_up {
+                        self.give_up()
+                    } else {
+                        self.check_safe(now)
+                    };
+                }
                 let decision = drive.watch.on_tick(now.mission_s, now.wall_s);
-                self.decide(decision, now)
+                let mut actions = self.decide(decision, now);
+                actions.extend(self.check_safe(now));
+                actions
             }
             Phase::AtTask {
                 leave_at_s,
@@ -396,8 +591,8 @@ impl<'a> DowntimeWindow<'a> {
                 ..
             } => {
                 let leave_at_s = *leave_at_s;
-                if now.mission_s < leave_at_s && due(retry_at_wall_s) {
-                    self.ask_next_window(now, leave_at_s)
+                if self.ahead_ask.is_none() && now.mission_s < leave_at_s && due(retry_at_wall_s) {
+                    self.ask_next_window(now)
                 } else {
                     self.finish_at_task_end(now)
                 }
@@ -419,6 +614,63 @@ impl<'a> DowntimeWindow<'a> {
         }
     }
 
+    /// The last-safe-moment rule (module doc).
+    fn check_safe(&mut self, now: Now) -> Vec<WindowAction> {
+        let Phase::Driving(drive) = &mut self.phase else {
+            return Vec::new();
+        };
+        let watched = drive.route_curious && !drive.recovering && !drive.watch.slipped();
+        if !watched || now.mission_s - drive.safe_checked_at_s < SAFE_CHECK_S {
+            return Vec::new();
+        }
+        drive.safe_checked_at_s = now.mission_s;
+        let time_left = self.setup.task.start_s - now.mission_s;
+        let Some(fastest) = self.fastest_from_here() else {
+            return Vec::new();
+        };
+        if self.margin.budget(time_left) > fastest.t_eta_s {
+            return Vec::new();
+        }
+        self.go_straight(fastest, Reason::LastSafeMoment, now)
+    }
+
+    /// The window's own fastest path from where the robot is to the task.
+    fn fastest_from_here(&self) -> Option<Route> {
+        let s = &self.setup;
+        straight::fastest_route(&s.scale, s.time_model, self.here, s.task.at)
+    }
+
+    /// Sends the robot along `route` (the window's own fastest path) at once, for
+    /// `reason`; curious no more in this window.
+    fn go_straight(&mut self, route: Route, reason: Reason, now: Now) -> Vec<WindowAction> {
+        let Phase::Driving(drive) = &mut self.phase else {
+            return Vec::new();
+        };
+        let mut actions: Vec<WindowAction> = self
+            .drive_ask
+            .take()
+            .map(|(id, _)| WindowAction::Forget(id))
+            .into_iter()
+            .collect();
+        let path: Vec<[f64; 2]> = std::iter::once(self.here)
+            .chain(route.points.iter().copied())
+            .collect();
+        drive.reasons.push(reason.as_str().to_owned());
+        drive
+            .watch
+            .straight(path.clone(), now.mission_s, now.wall_s);
+        drive.waypoints = mission_waypoints(&route.points, self.setup.waypoint_spacing_m);
+        drive.plans.push(route.points);
+        drive.route_curious = false;
+        let mission = self.ids.next(drive.waypoints.clone(), false);
+        drive.mission = mission.id.clone();
+        drive.sent_at_s = now.mission_s;
+        drive.path = path;
+        actions.push(WindowAction::Replanned { reason });
+        actions.push(WindowAction::Drive(mission));
+        actions
+    }
+
     fn replan(
         &mut self,
         reason: Reason,
@@ -426,49 +678,86 @@ impl<'a> DowntimeWindow<'a> {
         resend: bool,
         now: Now,
     ) -> Vec<WindowAction> {
-        let budget_s = self.budget_to(self.setup.task.start_s, None, now);
-        let ask = ask(self.here, self.setup.task.at, budget_s, curious);
-        let Phase::Driving(drive) = &mut self.phase else {
+        // Late: straight to the task at once, on the window's own fastest path.
+        if reason == Reason::EtaSlipped {
+            if let Some(route) = self.fastest_from_here() {
+                return self.go_straight(route, reason, now);
+            }
+        }
+        let Phase::Driving(drive) = &self.phase else {
             return Vec::new();
         };
-        let mut actions = Vec::new();
-        // Slack pays for the robot waiting while it plans, so the new route starts where
-        // the robot is rather than where it was.
-        let held = reason == Reason::Slack;
-        if held {
-            let hold = self.ids.next(Vec::new());
-            drive.mission = hold.id.clone();
-            actions.push(WindowAction::Hold(hold));
-        }
-        self.asked = Some(Asked::Replan {
-            reason,
-            resend,
-            held,
-            ask,
-        });
-        actions.push(WindowAction::RequestPlan(ask));
-        actions
+        // A slack or behind replan is made while the robot drives on: it starts where
+        // the robot will be when the plan comes.
+        let from = match reason {
+            Reason::Slack | Reason::Behind => {
+                let lead_m = now.planning_cost_s * self.setup.watch.expected_speed_m_per_s;
+                straight::point_ahead(&drive.path, self.here, lead_m)
+            }
+            _ => self.here,
+        };
+        let (to, start) = (self.setup.task.at, self.setup.task.start_s);
+        let (ask, _, _) = self.ask(from, to, start, None, curious, now);
+        self.drive_ask = Some((
+            ask.id,
+            DriveAsk::Replan {
+                reason,
+                resend,
+                ask,
+            },
+        ));
+        vec![WindowAction::RequestPlan(ask)]
     }
 
-    fn on_plan(
+    fn on_reply(
         &mut self,
-        asked: Asked,
+        id: u64,
+        plan: Option<roam_proto::planner::Plan>,
+        now: Now,
+    ) -> Vec<WindowAction> {
+        if self.drive_ask.is_some_and(|(asked, _)| asked == id) {
+            let Some((_, asked)) = self.drive_ask.take() else {
+                return Vec::new();
+            };
+            return match plan.and_then(routes) {
+                Some((route, shortest)) => self.on_drive_plan(asked, route, shortest, now),
+                None => self.on_drive_failed(asked, now),
+            };
+        }
+        if self.ahead_ask.is_some_and(|(asked, _)| asked == id) {
+            let Some((_, asked)) = self.ahead_ask.take() else {
+                return Vec::new();
+            };
+            return match plan.and_then(routes) {
+                Some((route, shortest)) => self.on_ahead_plan(asked, route, shortest, now),
+                None => self.on_ahead_failed(now),
+            };
+        }
+        // A reply nobody waits for any more (forgotten, or an earlier window's).
+        Vec::new()
+    }
+
+    fn on_drive_plan(
+        &mut self,
+        asked: DriveAsk,
         route: Route,
         shortest: Vec<[f64; 2]>,
         now: Now,
     ) -> Vec<WindowAction> {
         match asked {
-            Asked::FirstPlan { budget_s } => {
+            DriveAsk::FirstPlan {
+                budget_s,
+                time_left_s,
+            } => {
                 if !matches!(self.phase, Phase::FirstPlan { .. }) {
                     return Vec::new();
                 }
-                self.start_driving(route, shortest, budget_s, now)
+                self.start_driving(route, shortest, budget_s, time_left_s, now)
             }
-            Asked::Replan {
+            DriveAsk::Replan {
                 reason,
                 resend,
                 ask,
-                ..
             } => {
                 let Phase::Driving(drive) = &mut self.phase else {
                     return Vec::new();
@@ -481,8 +770,9 @@ impl<'a> DowntimeWindow<'a> {
                     .watch
                     .replanned(path.clone(), resend, now.mission_s, now.wall_s);
                 drive.waypoints = mission_waypoints(&route.points, self.setup.waypoint_spacing_m);
+                drive.route_curious = route.curious;
                 drive.plans.push(route.points);
-                let mission = self.ids.next(drive.waypoints.clone());
+                let mission = self.ids.next(drive.waypoints.clone(), false);
                 drive.mission = mission.id.clone();
                 drive.sent_at_s = now.mission_s;
                 drive.path = path;
@@ -491,101 +781,123 @@ impl<'a> DowntimeWindow<'a> {
                     WindowAction::Drive(mission),
                 ]
             }
-            Asked::NextWindow { budget_s } => {
-                let Phase::AtTask { leave_at_s, .. } = self.phase else {
-                    return Vec::new();
-                };
-                // A plan for a window that has begun would start from a place the robot
-                // may have left: dropped.
-                if now.mission_s <= leave_at_s {
-                    self.planned_ahead = Some(PlannedAhead {
-                        window: self.setup.window + 1,
-                        from: self.setup.task.at,
-                        route,
-                        shortest,
-                        budget_s,
-                    });
-                }
-                self.finish_at_task_end(now)
-            }
         }
     }
 
-    fn on_plan_failed(&mut self, asked: Asked, now: Now) -> Vec<WindowAction> {
+    fn on_drive_failed(&mut self, asked: DriveAsk, now: Now) -> Vec<WindowAction> {
         let task = &self.setup.task;
         match asked {
-            Asked::FirstPlan { .. } => {
+            DriveAsk::FirstPlan { .. } => {
+                let Phase::FirstPlan { failures, .. } = self.phase else {
+                    return Vec::new();
+                };
                 if now.mission_s > task.start_s + self.setup.give_up_after_s {
                     return self.give_up_without_a_plan();
                 }
+                let failures = failures + 1;
+                if failures >= FALLBACK_AFTER_FAILURES {
+                    if let Some(route) = self.fastest_from_here() {
+                        return self.drive_without_a_planner(route, now);
+                    }
+                }
                 self.phase = Phase::FirstPlan {
                     retry_at_wall_s: Some(now.wall_s + PLAN_RETRY_S),
+                    failures,
                 };
                 Vec::new()
             }
             // A curious plan that fails (busy, an outage) leaves the shortest way.
-            Asked::Replan {
+            DriveAsk::Replan {
                 reason,
                 resend,
-                held,
                 ask,
             } if ask.curious => {
+                self.asks_made += 1;
                 let ask = PlanAsk {
+                    id: self.asks_made,
                     curious: false,
                     ..ask
                 };
-                self.asked = Some(Asked::Replan {
-                    reason,
-                    resend,
-                    held,
-                    ask,
-                });
+                self.drive_ask = Some((
+                    ask.id,
+                    DriveAsk::Replan {
+                        reason,
+                        resend,
+                        ask,
+                    },
+                ));
                 vec![WindowAction::RequestPlan(ask)]
             }
-            Asked::Replan { held, .. } => {
-                let Phase::Driving(drive) = &mut self.phase else {
-                    return Vec::new();
-                };
-                if !held {
-                    return Vec::new();
-                }
-                // Held for nothing: back on the path it had.
-                let mission = self.ids.next(drive.waypoints.clone());
-                drive.mission = mission.id.clone();
-                vec![WindowAction::Drive(mission)]
-            }
-            Asked::NextWindow { .. } => {
-                let Phase::AtTask {
-                    leave_at_s,
-                    retry_at_wall_s,
-                    ..
-                } = &mut self.phase
-                else {
-                    return Vec::new();
-                };
-                let next_given_up = self
-                    .setup
-                    .next
-                    .as_ref()
-                    .is_none_or(|n| now.mission_s > n.start_s + self.setup.give_up_after_s);
-                if now.mission_s < *leave_at_s && !next_given_up {
-                    *retry_at_wall_s = Some(now.wall_s + PLAN_RETRY_S);
-                    return Vec::new();
-                }
-                self.finish_at_task_end(now)
-            }
+            // No planner at all: the window's own fastest path, or the path it had.
+            DriveAsk::Replan { .. } => match self.fastest_from_here() {
+                Some(route) => self.go_straight(route, Reason::NoPlanner, now),
+                None => Vec::new(),
+            },
         }
     }
-}
 
-/// A request for `budget_s`: curious only when there is time to be curious in, and the
-/// budget within the planner's range (the report keeps the budget as computed).
-fn ask(from: [f64; 2], to: [f64; 2], budget_s: f64, curious: bool) -> PlanAsk {
-    PlanAsk {
-        from,
-        to,
-        t_exec_s: budget_s.clamp(LEAST_T_EXEC_S, MAX_T_EXEC_S),
-        curious: curious && budget_s > 0.0,
+    /// No planner answered the window's first plan: the robot drives the window's own
+    /// fastest path (the report says so), and the slack rule may replan a curious one.
+    fn drive_without_a_planner(&mut self, route: Route, now: Now) -> Vec<WindowAction> {
+        let time_left = self.setup.task.start_s - now.mission_s;
+        let budget = self.margin.budget(time_left);
+        let shortest = route.points.clone();
+        let mut actions = self.start_driving(route, shortest, budget, time_left, now);
+        if let Phase::Driving(drive) = &mut self.phase {
+            drive.reasons.push(Reason::NoPlanner.as_str().to_owned());
+        }
+        actions.insert(
+            0,
+            WindowAction::Replanned {
+                reason: Reason::NoPlanner,
+            },
+        );
+        actions
+    }
+
+    fn on_ahead_plan(
+        &mut self,
+        asked: AheadAsk,
+        route: Route,
+        shortest: Vec<[f64; 2]>,
+        now: Now,
+    ) -> Vec<WindowAction> {
+        // A plan for a window that has begun would start from a place the robot may
+        // have left: dropped.
+        if now.mission_s <= asked.leave_at_s {
+            self.planned_ahead = Some(PlannedAhead {
+                window: self.setup.window + 1,
+                from: self.setup.task.at,
+                route,
+                shortest,
+                budget_s: asked.budget_s,
+                time_left_s: asked.time_left_s,
+                leave_at_s: asked.leave_at_s,
+            });
+        }
+        self.finish_at_task_end(now)
+    }
+
+    fn on_ahead_failed(&mut self, now: Now) -> Vec<WindowAction> {
+        let Phase::AtTask {
+            leave_at_s,
+            retry_at_wall_s,
+            ..
+        } = &mut self.phase
+        else {
+            // While driving: asked again at the arrival.
+            return Vec::new();
+        };
+        let next_given_up = self
+            .setup
+            .next
+            .as_ref()
+            .is_none_or(|n| now.mission_s > n.start_s + self.setup.give_up_after_s);
+        if now.mission_s < *leave_at_s && !next_given_up {
+            *retry_at_wall_s = Some(now.wall_s + PLAN_RETRY_S);
+            return Vec::new();
+        }
+        self.finish_at_task_end(now)
     }
 }
 

@@ -27,6 +27,7 @@
 //! ids, cancel tokens, who may cancel); bounded logs and echoes of untrusted input come
 //! from `roam_runtime::warn_limit` and `roam_proto::excerpt`, shared by every service.
 
+pub mod answer;
 pub mod best;
 #[cfg(feature = "zenoh")]
 pub mod budget;

@@ -278,28 +278,55 @@ pub fn check_spec(spec: &PlanSpec) -> Result<(), PlanError> {
     Ok(())
 }
 
-/// The work of a plan, for the service's queue: its GA's cost ([`crate::limits`]; for
-/// `greedy` its evaluations of a longest path; 0 for the baseline), or the limit it
-/// exceeds.
-pub fn work(world: &World, spec: &PlanSpec) -> Result<u64, PlanError> {
-    let cost = match Model::of(spec.model) {
+/// The work of a plan, for the service's queue ([`work`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Work {
+    /// Its GA's cost ([`crate::limits`], counting the generations that can start before
+    /// its deadline; for `greedy` its evaluations of a longest path; 0 for the baseline).
+    pub cost: u64,
+    /// The generations `cost` counts: the request's max_generations, or the fewer that
+    /// can start before the deadline ([`limits::generations_before_deadline`]). The
+    /// request's for `greedy` and the baseline.
+    pub generations: u32,
+}
+
+/// The work of a plan, for the service's queue, or the limit it exceeds.
+pub fn work(world: &World, spec: &PlanSpec) -> Result<Work, PlanError> {
+    let requested = spec.params.max_generations;
+    let work = match Model::of(spec.model) {
         Some(_) => {
-            let size = limits::check(
-                &sized_params(spec),
-                world.meta.resolution,
-                spec.t_exec_s,
-                world.cell_count(),
-                &spec.limits,
-            )?;
+            let size = size(world, spec)?;
             if spec.model == PlannerModel::Greedy {
-                (size.path_cells as u64).saturating_mul(greedy::WORK_EVALUATIONS)
+                Work {
+                    cost: (size.path_cells as u64).saturating_mul(greedy::WORK_EVALUATIONS),
+                    generations: requested,
+                }
             } else {
-                size.cost
+                Work {
+                    cost: size.cost,
+                    generations: size.generations,
+                }
             }
         }
-        None => 0,
+        None => Work {
+            cost: 0,
+            generations: requested,
+        },
     };
-    Ok(cost)
+    Ok(work)
+}
+
+/// The GA's size ([`limits::check`]): the work that can be done before the deadline
+/// on the spec's evaluation threads.
+fn size(world: &World, spec: &PlanSpec) -> Result<PlanSize, LimitError> {
+    limits::check(
+        &sized_params(spec),
+        world.meta.resolution,
+        spec.t_exec_s,
+        world.cell_count(),
+        spec.deadline_s * spec.threads.max(1) as f64,
+        &spec.limits,
+    )
 }
 
 /// The parameters a plan is sized by ([`crate::limits`]): the request's, except that
@@ -364,13 +391,7 @@ fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
     let params = &spec.params;
     // The GA's size, before any search: the baseline has no population to bound.
     let size = match Model::of(spec.model) {
-        Some(_) => Some(limits::check(
-            &sized_params(spec),
-            world.meta.resolution,
-            spec.t_exec_s,
-            world.cell_count(),
-            &spec.limits,
-        )?),
+        Some(_) => Some(size(world, spec)?),
         None => None,
     };
     if start == goal && size.is_some() && (0..MOVES.len()).all(|d| world.step(start, d).is_none()) {

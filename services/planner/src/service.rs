@@ -357,6 +357,9 @@ struct Prepared<'a> {
     spec: PlanSpec,
     /// Its work for the queue ([`crate::queue::units`]).
     units: f64,
+    /// The generations `units` counts ([`crate::plan::Work::generations`]): the share of
+    /// them a plan ran is the share of its units it did.
+    sized_generations: u32,
 }
 
 /// Admits a request to the queue or refuses it at once, waits for its turn, plans.
@@ -399,6 +402,7 @@ async fn serve_plan(
         map_version,
         world,
         mut spec,
+        sized_generations,
         ..
     } = prepared;
     // The deadline counts from the request's arrival: the wait was part of it.
@@ -423,6 +427,7 @@ async fn serve_plan(
                 map_version,
                 &world,
                 spec,
+                sized_generations,
                 &stop,
             );
             (result, request)
@@ -527,7 +532,10 @@ fn prepare(state: &PlannerInstance, request: PlanRequest) -> Result<Prepared<'_>
     // The numbers and the plan's size, before it is queued: what is refused for its
     // content is refused at once, not after a wait.
     check_spec(&spec).map_err(|e| e.to_reply())?;
-    let units = crate::queue::units(crate::plan::work(&world, &spec).map_err(|e| e.to_reply())?);
+    // A plan is sized by the generations that can start before its deadline: the GA
+    // stops there, so what it could only do later is neither refused nor queued for.
+    let work = crate::plan::work(&world, &spec).map_err(|e| e.to_reply())?;
+    let units = crate::queue::units(work.cost);
     Ok(Prepared {
         request,
         request_id,
@@ -538,6 +546,7 @@ fn prepare(state: &PlannerInstance, request: PlanRequest) -> Result<Prepared<'_>
         world,
         spec,
         units,
+        sized_generations: work.generations,
     })
 }
 
@@ -614,7 +623,8 @@ fn exhausted(state: &PlannerInstance, e: Exhausted) -> ErrorReply {
 
 /// Plans a request whose turn has come (or the floor of one cancelled in the queue),
 /// within the CPU budget, and builds the reply; with the share of its generations it
-/// ran, for the queue's rate.
+/// ran (of the `sized_generations` its queue units count), for the queue's rate.
+#[allow(clippy::too_many_arguments)]
 fn plan_now(
     state: &PlannerInstance,
     request: &PlanRequest,
@@ -622,6 +632,7 @@ fn plan_now(
     map_version: roam_proto::planner::MapVersion,
     world: &World,
     mut spec: PlanSpec,
+    sized_generations: u32,
     stop: &AtomicBool,
 ) -> Result<(Plan, f64), ErrorReply> {
     let grant = state
@@ -658,10 +669,10 @@ fn plan_now(
         outcome.stop_reason = StopReason::Budget;
         granted_s
     });
-    let share = if spec.params.max_generations == 0 || outcome.generations == 0 {
+    let share = if sized_generations == 0 || outcome.generations == 0 {
         1.0
     } else {
-        f64::from(outcome.generations) / f64::from(spec.params.max_generations)
+        f64::from(outcome.generations) / f64::from(sized_generations)
     };
     let mut plan = to_message(
         world,

@@ -412,3 +412,82 @@ fn the_fastest_path_floor_admits_a_budget_the_distance_shortest_path_would_refus
         other => panic!("{other:?}"),
     }
 }
+
+/// Issue 26 item 5: a deadline bounds the work. Model I with 100,000 generations and a
+/// 2 s deadline on the built-in world (an 80 s budget: paths of at most 201 cells) would
+/// cost 200 × 100,000 × 201 = 4.02e9, over `max_plan_cost`; the GA stops at its
+/// deadline, so only the generations that can start before it count, and the request is
+/// admitted and planned: cut at the deadline, its best path so far. One whose deadline
+/// lets the whole cost run is still refused, the limit named.
+#[test]
+fn a_deadline_bounds_the_work_a_plan_is_sized_by() {
+    let world = common::builtin_world();
+    let mut curious = PlanSpec::batch(
+        [-8.0, -8.0],
+        [6.0, -7.0],
+        80.0,
+        PlannerModel::Model1,
+        100_000,
+        3,
+    );
+    curious.threads = 4;
+    curious.deadline_s = 2.0;
+    let work = roam_planner::plan::work(&world, &curious).expect("admitted: no LimitError");
+    // 2 s × 4 threads × 2.5e8 cells per thread-second / (200 × 201), and one more.
+    assert_eq!(work.generations, 49_752);
+    assert_eq!(work.cost, 200 * 49_752 * 201);
+
+    // The batch deadline (600 s) lets all 100,000 generations run: over the cap.
+    let batch = PlanSpec {
+        deadline_s: roam_planner::plan::MAX_DEADLINE_S,
+        ..curious.clone()
+    };
+    match roam_planner::plan::work(&world, &batch) {
+        Err(PlanError::Limit(limit)) => {
+            assert_eq!(limit.name(), "max_plan_cost");
+            assert_eq!(limit.max_actual(), (4_000_000_000, 200 * 100_000 * 201));
+        }
+        other => panic!("expected max_plan_cost, got {other:?}"),
+    }
+    // Population 2000 with a 10 s deadline: 24,876 generations fit, still 1e10 cells.
+    let wide = PlanSpec {
+        deadline_s: 10.0,
+        params: roam_planner::params::GaParams {
+            population: 2000,
+            ..curious.params.clone()
+        },
+        ..curious.clone()
+    };
+    match plan(&world, &wide, &AtomicBool::new(false), |_, _| {}) {
+        Err(PlanError::Limit(limit)) => {
+            assert_eq!(limit.name(), "max_plan_cost");
+            assert_eq!(limit.max_actual().1, 2000 * 24_876 * 201);
+            let reply = PlanError::Limit(limit).to_reply();
+            assert_eq!(
+                reply.limit.map(|l| l.name),
+                Some("max_plan_cost".to_owned())
+            );
+        }
+        other => panic!("expected max_plan_cost, got {other:?}"),
+    }
+
+    // Planned, not refused, and cut at the deadline (here 1 s, less work still).
+    let quick = PlanSpec {
+        deadline_s: 1.0,
+        ..curious
+    };
+    let started = std::time::Instant::now();
+    let outcome = run(&world, &quick);
+    assert!(
+        started.elapsed().as_secs_f64() < 3.0,
+        "{:?}",
+        started.elapsed()
+    );
+    assert_eq!(outcome.stop_reason, StopReason::Deadline);
+    assert!(
+        (1..100_000).contains(&outcome.generations),
+        "{}",
+        outcome.generations
+    );
+    assert!(outcome.reaches_goal && outcome.within_budget);
+}

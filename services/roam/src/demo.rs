@@ -261,21 +261,27 @@ async fn drive(
         w_loc: Some(DEMO_W_LOC),
         ..ExecutiveConfig::default()
     };
-    let say = |p: Progress| match p {
+    let say = |p: Progress| {
+        match p {
         Progress::Planned {
             window,
             task,
             budget_s,
             eta_s,
             curious,
+            late_probability,
         } => progress(&format!(
-            "window {} -> {task}: {} path, downtime budget {budget_s:.1} s, ETA {eta_s:.1} s",
+            "window {} -> {task}: {} path, downtime budget {budget_s:.1} s, ETA {eta_s:.1} s, P(late) {late_probability:.0e}",
             window + 1,
-            if curious { "curious" } else { "shortest" },
+            if curious { "curious" } else { "fastest" },
         )),
         Progress::Replanned { window, reason } => {
             progress(&format!("window {}: replanned ({reason})", window + 1))
         }
+        Progress::Recovering { window, held_s } => progress(&format!(
+            "window {}: held {held_s:.1} s for its PEB, driving back to its last fix",
+            window + 1
+        )),
         Progress::Arrived {
             window,
             task,
@@ -293,6 +299,7 @@ async fn drive(
             "window {}: {task} was over before the window began",
             window + 1
         )),
+    }
     };
     let cancel = CancellationToken::new();
     let outcomes = executive::run(&session, &root, &config, &cancel, &say, &|_| {}).await?;

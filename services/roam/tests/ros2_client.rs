@@ -98,6 +98,7 @@ async fn a_ros2_client_reads_the_map_and_plans_and_calls_the_planner() {
         robot: "r1".into(),
         id: "ros2-test".into(),
         waypoints: waypoints.clone(),
+        recovery: false,
     };
     session
         .put(

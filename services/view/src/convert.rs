@@ -637,6 +637,7 @@ mod tests {
             robot: "r1".into(),
             id: "w1".into(),
             waypoints: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 2.0]],
+            recovery: false,
         };
         let update = mission(&m, stamp());
         let e = &update.entities[0];
@@ -661,6 +662,7 @@ mod tests {
             robot: "r1".into(),
             id: "x".repeat(1 << 20),
             waypoints: (0..MAX_WAYPOINTS + 5).map(|i| [i as f64, 0.0]).collect(),
+            recovery: false,
         };
         let e = &mission(&m, stamp()).entities[0];
         assert_eq!(e.lines[0].points.len(), MAX_WAYPOINTS);
@@ -703,6 +705,7 @@ mod tests {
             robot: evil.clone(),
             id: evil.clone(),
             waypoints: vec![[0.0, 0.0]],
+            recovery: false,
         };
         let a = anchors(
             &[NamedPoint {

@@ -185,6 +185,7 @@ mod tests {
             robot: "r".repeat(roam_proto::keys::MAX_SEGMENT_LEN),
             id: "i".repeat(roam_proto::controller::MAX_MISSION_ID_BYTES),
             waypoints: vec![[extreme, extreme]; MAX_WAYPOINTS],
+            recovery: false,
         };
         let bytes = encode(&mission);
         assert!(bytes.len() <= MAX_MISSION_BYTES, "{}", bytes.len());

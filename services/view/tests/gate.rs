@@ -31,6 +31,7 @@ async fn view_with_a_mission(access: Access) -> (Stack, ViewHandle, Cancellation
         robot: "r1".into(),
         id: "m-gate".into(),
         waypoints: vec![[0.0, 0.0], [1.0, 2.0]],
+        recovery: false,
     };
     within(
         "put mission",

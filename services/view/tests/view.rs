@@ -162,6 +162,7 @@ async fn an_mcap_recording_of_a_short_run_holds_the_map_robots_and_anchors() {
         robot: "robot".into(),
         id: "m1".into(),
         waypoints: vec![[-8.0, -8.0], [-6.0, -8.0]],
+        recovery: false,
     };
     within(
         "put mission",

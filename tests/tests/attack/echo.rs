@@ -64,6 +64,7 @@ pub(crate) async fn logs(harness: &Harness, client: &Requester, log: &Captured) 
         robot: "robot".into(),
         id: "i".repeat(1_000_000),
         waypoints: vec![[1.0, 1.0]],
+        recovery: false,
     };
     for _ in 0..20 {
         for leaf in ["mission", "ranges", "observation", "estimate"] {
@@ -85,6 +86,7 @@ pub(crate) async fn logs(harness: &Harness, client: &Requester, log: &Captured) 
         robot: format!("robot\n{FORGED_LINE}\u{1b}[31m"),
         id: format!("id\n{FORGED_LINE}"),
         waypoints: vec![],
+        recovery: false,
     };
     within(
         "put",

@@ -49,6 +49,7 @@ pub(crate) async fn keys_decide(harness: &Harness, client: &Requester) {
         robot: "robot".into(),
         id: "forged".into(),
         waypoints: vec![[9.0, 9.0]],
+        recovery: false,
     };
     put(client, &keys::robot_mission(&root, "AAA"), &forged).await;
     // 2. Scans whose bodies name key syntax, on the real robot's key and on a wildcard.

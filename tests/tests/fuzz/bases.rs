@@ -394,6 +394,7 @@ pub(crate) fn mission_bases() -> Vec<Vec<u8>> {
             robot: robot.into(),
             id: "fuzz".into(),
             waypoints,
+            recovery: false,
         })
     };
     vec![

@@ -464,6 +464,7 @@ async fn every_queryable_and_subscriber_survives_random_and_mutated_payloads() {
         robot: "robot".into(),
         id: "after-the-storm".into(),
         waypoints: vec![[60.0, 16.0]],
+        recovery: false,
     };
     within(
         "mission",

@@ -263,6 +263,7 @@ async fn run(
             robot: name.clone(),
             id: format!("bench-{k}"),
             waypoints: vec![places[(k + robots / 2) % robots], at],
+            recovery: false,
         };
         session
             .put(keys::robot_mission(root, &name), encode(&mission))

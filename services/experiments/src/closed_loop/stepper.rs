@@ -107,18 +107,33 @@ impl Stepper {
         robot: &str,
         waypoints: Vec<[f64; 2]>,
     ) -> Result<(), EpisodeError> {
+        self.controller_of(robot)?.set_mission(waypoints);
+        Ok(())
+    }
+
+    /// Gives `robot` a recovery mission ([`Controller::set_recovery`]: the PEB guard
+    /// does not hold it), as a mission with `recovery: true` to the controller service.
+    pub fn set_recovery(
+        &mut self,
+        robot: &str,
+        waypoints: Vec<[f64; 2]>,
+    ) -> Result<(), EpisodeError> {
+        self.controller_of(robot)?.set_recovery(waypoints);
+        Ok(())
+    }
+
+    fn controller_of(&mut self, robot: &str) -> Result<&mut Controller, EpisodeError> {
         if self.sim.robot(robot).is_none() {
             return Err(EpisodeError::UnknownRobot(robot.to_owned()));
         }
-        let controller = self.controllers.entry(robot.to_owned()).or_insert_with(|| {
+        let (params, setup) = (&self.params, &self.setup);
+        Ok(self.controllers.entry(robot.to_owned()).or_insert_with(|| {
             Controller::new(
-                self.params.clone(),
-                self.setup.obstacles.clone(),
-                self.setup.information.clone(),
+                params.clone(),
+                setup.obstacles.clone(),
+                setup.information.clone(),
             )
-        });
-        controller.set_mission(waypoints);
-        Ok(())
+        }))
     }
 
     /// Takes `robot`'s controller away: it is updated no more and gets no commands

@@ -16,6 +16,10 @@ impl DowntimeWindow<'_> {
         let Phase::Driving(drive) = std::mem::replace(&mut self.phase, Phase::Done) else {
             return Vec::new();
         };
+        let mut drive = drive;
+        if let Some(since) = drive.held_since_s.take() {
+            drive.held_s += at_s - since;
+        }
         let model = self.setup.time_model;
         let took_s = at_s - drive.sent_at_s;
         let (d, theta) = path_measure(&drive.path);
@@ -44,8 +48,12 @@ impl DowntimeWindow<'_> {
             retry_at_wall_s: None,
         };
         let mut actions = vec![arrived];
-        if self.setup.next.is_some() {
-            actions.extend(self.ask_next_window(now, leave_at_s));
+        let ask_now = self.setup.next.is_some()
+            && self.planned_ahead.is_none()
+            && self.ahead_ask.is_none()
+            && now.mission_s < leave_at_s;
+        if ask_now {
+            actions.extend(self.ask_next_window(now));
         } else {
             actions.extend(self.finish_at_task_end(now));
         }
@@ -88,6 +96,10 @@ impl DowntimeWindow<'_> {
             replans: 0,
             replan_reasons: vec![NO_PLAN_REASON.into()],
             time_model: None,
+            late_probability: None,
+            holds: 0,
+            held_s: 0.0,
+            recoveries: 0,
         };
         let outcome = WindowOutcome {
             report,
@@ -134,6 +146,10 @@ impl DowntimeWindow<'_> {
             replans: drive.reasons.len() as u32,
             replan_reasons: drive.reasons,
             time_model: Some(time_model),
+            late_probability: Some(drive.late_probability),
+            holds: drive.holds,
+            held_s: drive.held_s,
+            recoveries: drive.recoveries,
         };
         WindowOutcome {
             report,
@@ -148,7 +164,7 @@ impl DowntimeWindow<'_> {
         let Phase::AtTask { leave_at_s, .. } = self.phase else {
             return Vec::new();
         };
-        if self.asked.is_some() || now.mission_s < leave_at_s {
+        if self.ahead_ask.is_some() || now.mission_s < leave_at_s {
             return Vec::new();
         }
         let Phase::AtTask { outcome, .. } = std::mem::replace(&mut self.phase, Phase::Done) else {
@@ -159,12 +175,14 @@ impl DowntimeWindow<'_> {
 
     pub(super) fn finish(&mut self, outcome: Option<WindowOutcome>) -> WindowAction {
         self.phase = Phase::Done;
-        self.asked = None;
+        self.drive_ask = None;
+        self.ahead_ask = None;
         WindowAction::Done(Box::new(WindowEnd {
             outcome,
             handover: Handover {
-                margin: self.margin,
+                margin: self.margin.clone(),
                 missions_sent: self.ids.sent,
+                asks_made: self.asks_made,
                 planned_ahead: self.planned_ahead.take(),
             },
             position: self.here,

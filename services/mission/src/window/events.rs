@@ -14,9 +14,11 @@ pub struct Now {
     /// Wall seconds from any fixed origin: the lost-mission rule's clock, and the plan
     /// retries'.
     pub wall_s: f64,
-    /// What a curious plan asked now costs on the mission clock, seconds (the executive
-    /// measures it).
+    /// What a curious plan asked now is expected to cost on the mission clock, seconds
+    /// (the executive measures it, or its config fixes it).
     pub planning_cost_s: f64,
+    /// Mission seconds per wall second (the sim's real-time factor; 1 on wall time).
+    pub clock_rate: f64,
 }
 
 /// What the executive hears.
@@ -32,19 +34,24 @@ pub enum WindowEvent {
     Status(ControllerStatus),
     /// Time passed.
     Tick,
-    /// The planner's reply to the request in flight.
-    PlanReply(Box<Plan>),
-    /// The request in flight failed: no planner answered, or it refused.
-    PlanFailed,
+    /// The planner's reply to request `id`.
+    PlanReply { id: u64, plan: Box<Plan> },
+    /// Request `id` failed: no planner answered, or it refused.
+    PlanFailed { id: u64 },
 }
 
 /// A plan to ask the planner for.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanAsk {
+    /// Names the request's reply ([`WindowEvent::PlanReply`]); unique over the day.
+    pub id: u64,
     pub from: [f64; 2],
     pub to: [f64; 2],
     /// The driving budget t_exec, within the planner's range.
     pub t_exec_s: f64,
+    /// The planner's deadline, wall seconds: the configured one, cut to what the time
+    /// left can afford at the clock's rate.
+    pub deadline_s: f64,
     /// A curious path (the executive's model); `false`: the shortest path.
     pub curious: bool,
 }
@@ -54,20 +61,24 @@ pub struct PlanAsk {
 pub enum WindowAction {
     /// Send the robot this mission; it replaces the one the robot drives.
     Drive(Mission),
-    /// Hold the robot where it is (a mission with no waypoints) while a slack replan is
-    /// made.
-    Hold(Mission),
-    /// Ask the planner, then answer with [`WindowEvent::PlanReply`] or
-    /// [`WindowEvent::PlanFailed`] before any other event.
+    /// Ask the planner, without waiting: its answer comes back as
+    /// [`WindowEvent::PlanReply`] or [`WindowEvent::PlanFailed`] with the ask's id,
+    /// whenever it comes. At most two are in flight (the drive's, the next window's).
     RequestPlan(PlanAsk),
+    /// Forget request `id`: its answer, if it comes, is not wanted (the executive may
+    /// cancel it).
+    Forget(u64),
     /// The window's first route, for a progress display.
     Planned {
         budget_s: f64,
         eta_s: f64,
         curious: bool,
+        late_probability: f64,
     },
-    /// A replan was sent.
+    /// A replan was sent (or the robot sent straight, or recovered).
     Replanned { reason: Reason },
+    /// The PEB guard held the robot too long: it is driven back to where it had a fix.
+    Recovering { held_s: f64 },
     /// The robot reached the task's place; the time model's calibration learns from
     /// `drive`.
     Arrived { at_s: f64, drive: DrivenMission },

@@ -24,7 +24,9 @@ pub struct Handover {
     pub margin: ArrivalMargin,
     /// Missions sent so far: their ids go on counting, so none is sent twice.
     pub missions_sent: u64,
-    /// The next window's plan, made during this window's task.
+    /// Plan requests made so far: their ids go on counting too.
+    pub asks_made: u64,
+    /// The next window's plan, made during this window.
     pub planned_ahead: Option<PlannedAhead>,
 }
 
@@ -34,6 +36,7 @@ impl Handover {
         Handover {
             margin,
             missions_sent: 0,
+            asks_made: 0,
             planned_ahead: None,
         }
     }

@@ -20,6 +20,11 @@ pub struct PlannedAhead {
     pub route: Route,
     pub shortest: Vec<[f64; 2]>,
     pub budget_s: f64,
+    /// The time to the task the budget was made from, seconds.
+    pub time_left_s: f64,
+    /// When the plan assumed the robot sets off (the previous task's end), mission
+    /// seconds: a window that begins later takes a fresh plan instead.
+    pub leave_at_s: f64,
 }
 
 /// The route a plan reply gives the robot, and the shortest path it carries: the curious

@@ -49,7 +49,7 @@ fn task(name: &str, at: [f64; 2], start_s: f64) -> Task {
 }
 
 fn margin() -> ArrivalMargin {
-    ArrivalMargin::new(0.08, 2.0)
+    ArrivalMargin::new(0.05, 2.0, 1e-3)
 }
 
 fn watch_params() -> WatchParams {
@@ -62,7 +62,20 @@ fn watch_params() -> WatchParams {
         controller_silence_s: 3.0,
         slack_s: 10.0,
         slack_interval_s: 5.0,
+        min_replan_window_s: 0.0,
         behind: true,
+    }
+}
+
+fn rules() -> WindowRules {
+    WindowRules {
+        curious: true,
+        plan_ahead: false,
+        recover: true,
+        hold_patience_s: 4.0,
+        fix_peb_m: 2.0,
+        replan_time_share: 1.0,
+        plan_deadline_s: 1.0,
     }
 }
 
@@ -91,6 +104,7 @@ impl Fixture {
             from,
             time_model: TimeModel::table_i(),
             watch: watch_params(),
+            rules: rules(),
             give_up_after_s: 60.0,
             waypoint_spacing_m: 1.0,
             scale: self.scale(),
@@ -109,7 +123,7 @@ impl Fixture {
     /// The first window with its curious plan sent at 1 s (wall 0 s).
     fn driving(&self, next: bool) -> (DowntimeWindow<'_>, Mission) {
         let (mut w, _) = self.begin(next);
-        let actions = w.handle(curious_reply(true), at(1.0, 0.0));
+        let actions = answer(&mut w, curious_reply(true), at(1.0, 0.0));
         (w, sent(&actions))
     }
 }
@@ -120,7 +134,37 @@ fn at(mission_s: f64, wall_s: f64) -> Now {
         mission_s,
         wall_s,
         planning_cost_s: 1.0,
+        clock_rate: 1.0,
     }
+}
+
+/// A reply; [`answer`] gives it the id of the request in flight.
+fn reply(plan: Plan) -> WindowEvent {
+    WindowEvent::PlanReply {
+        id: 0,
+        plan: Box::new(plan),
+    }
+}
+
+/// A failure; [`answer`] gives it the id of the request in flight.
+fn failed() -> WindowEvent {
+    WindowEvent::PlanFailed { id: 0 }
+}
+
+/// `event` as the answer to the request in flight (the drive's, else the next
+/// window's).
+fn answer(w: &mut DowntimeWindow<'_>, event: WindowEvent, now: Now) -> Vec<WindowAction> {
+    let id = w
+        .drive_ask
+        .map(|(id, _)| id)
+        .or(w.ahead_ask.map(|(id, _)| id))
+        .expect("a request in flight");
+    let event = match event {
+        WindowEvent::PlanReply { plan, .. } => WindowEvent::PlanReply { id, plan },
+        WindowEvent::PlanFailed { .. } => WindowEvent::PlanFailed { id },
+        other => other,
+    };
+    w.handle(event, now)
 }
 
 /// Cell centres from `a` to `b` along x or y, 0.2 m apart, both ends included.
@@ -199,23 +243,23 @@ fn attached(points: Vec<[f64; 2]>) -> Option<ShortestPath> {
 
 /// A curious plan with the shortest path attached, within its budget or not.
 fn curious_reply(within_budget: bool) -> WindowEvent {
-    WindowEvent::PlanReply(Box::new(Plan {
+    reply(Plan {
         within_budget,
         shortest: attached(shortest_points(FROM)),
         ..plan(PlannerModel::Model1, curious_points(), CURIOUS_ETA_S)
-    }))
+    })
 }
 
 /// The shortest path from `from`, as the planner answers `model: shortest` (or the
 /// fallback).
 fn shortest_reply(from: [f64; 2]) -> WindowEvent {
     let points = shortest_points(from);
-    WindowEvent::PlanReply(Box::new(Plan {
+    reply(Plan {
         within_budget: false,
         stop_reason: StopReason::Complete,
         shortest: attached(points.clone()),
         ..plan(PlannerModel::Shortest, points, SHORTEST_ETA_S)
-    }))
+    })
 }
 
 fn estimate(position: [f64; 2], peb_m: f64) -> WindowEvent {
@@ -281,6 +325,16 @@ fn report(actions: &[WindowAction]) -> WindowReport {
     ended(actions).outcome.expect("an outcome").report
 }
 
+/// The controller's status `state` on `mission`.
+fn answer_status(
+    w: &mut DowntimeWindow<'_>,
+    mission: &Mission,
+    state: MissionState,
+    now: Now,
+) -> Vec<WindowAction> {
+    w.handle(status(&mission.id, state, 0.0), now)
+}
+
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 1e-9
 }
@@ -289,18 +343,19 @@ fn close(a: f64, b: f64) -> bool {
 fn the_first_plan_is_asked_for_then_sent_as_a_mission() {
     let f = fixture();
     let (mut w, actions) = f.begin(false);
-    // 100 s to the task, minus the plan's 1 s, minus the margin (8%).
+    // 100 s to the task, minus the plan's 1 s, minus the margin.
     let ask = asked(&actions);
     assert_eq!(actions.len(), 1);
     assert_eq!((ask.from, ask.to, ask.curious), (FROM, GOAL, true));
     assert!(close(ask.t_exec_s, margin().budget(99.0)), "{ask:?}");
-    let actions = w.handle(curious_reply(true), at(1.0, 0.0));
+    let actions = answer(&mut w, curious_reply(true), at(1.0, 0.0));
     assert_eq!(
         actions[0],
         WindowAction::Planned {
             budget_s: margin().budget(99.0),
             eta_s: CURIOUS_ETA_S,
-            curious: true
+            curious: true,
+            late_probability: margin().late_probability(CURIOUS_ETA_S, 99.0),
         }
     );
     let mission = sent(&actions);
@@ -319,7 +374,7 @@ fn a_plan_that_does_not_fit_drives_the_shortest_path_it_carries() {
     let f = fixture();
     // The GA's path over its budget: the attached shortest path is driven.
     let (mut w, _) = f.begin(false);
-    let actions = w.handle(curious_reply(false), at(1.0, 0.0));
+    let actions = answer(&mut w, curious_reply(false), at(1.0, 0.0));
     assert!(matches!(
         actions[0],
         WindowAction::Planned { curious: false, eta_s, .. } if eta_s == SHORTEST_ETA_S
@@ -330,7 +385,7 @@ fn a_plan_that_does_not_fit_drives_the_shortest_path_it_carries() {
     );
     // The planner's fallback for a budget the shortest path does not fit.
     let (mut w, _) = f.begin(false);
-    let actions = w.handle(shortest_reply(FROM), at(1.0, 0.0));
+    let actions = answer(&mut w, shortest_reply(FROM), at(1.0, 0.0));
     assert!(matches!(
         actions[0],
         WindowAction::Planned { curious: false, .. }
@@ -338,12 +393,8 @@ fn a_plan_that_does_not_fit_drives_the_shortest_path_it_carries() {
     // A curious reply without the shortest path (a planner that did not attach it)
     // cannot be compared or fallen back from: asked again, as a failure.
     let (mut w, _) = f.begin(false);
-    let bare = WindowEvent::PlanReply(Box::new(plan(
-        PlannerModel::Model1,
-        curious_points(),
-        CURIOUS_ETA_S,
-    )));
-    assert!(w.handle(bare, at(1.0, 0.0)).is_empty());
+    let bare = reply(plan(PlannerModel::Model1, curious_points(), CURIOUS_ETA_S));
+    assert!(answer(&mut w, bare, at(1.0, 0.0)).is_empty());
     let again = w.handle(WindowEvent::Tick, at(1.2, PLAN_RETRY_S));
     assert!(asked(&again).curious);
 }
@@ -388,11 +439,11 @@ fn estimates_are_recorded_and_fed_to_the_watch() {
     assert!(w.handle(estimate(waiting, 0.6), at(3.1, 0.3)).is_empty());
     assert!(w.handle(WindowEvent::Tick, at(3.2, 9.0)).is_empty());
     let route = line(pushed, [2.0, 0.1]);
-    let reply = WindowEvent::PlanReply(Box::new(Plan {
+    let reply = reply(Plan {
         shortest: attached(route.clone()),
         ..plan(PlannerModel::Model1, route, 10.0)
-    }));
-    let actions = w.handle(reply, at(4.0, 0.4));
+    });
+    let actions = answer(&mut w, reply, at(4.0, 0.4));
     assert_eq!(
         actions[0],
         WindowAction::Replanned {
@@ -473,7 +524,15 @@ fn arrival_ends_the_window_with_its_report_when_the_task_ends() {
 fn a_window_is_given_up_past_its_task_start() {
     let f = fixture();
     let (mut w, _) = f.driving(true);
-    // 60 s after the task's start, not before.
+    // Late (past the task's start): the last safe moment sends it straight...
+    let straight = w.handle(WindowEvent::Tick, at(159.5, 1.0));
+    assert_eq!(
+        straight[0],
+        WindowAction::Replanned {
+            reason: Reason::LastSafeMoment
+        }
+    );
+    // ...and 60 s after the task's start, not before, the window is given up.
     assert!(w.handle(WindowEvent::Tick, at(160.0, 1.0)).is_empty());
     let actions = w.handle(WindowEvent::Tick, at(160.5, 1.0));
     assert_eq!(actions[0], WindowAction::GaveUp);
@@ -499,7 +558,7 @@ fn stuck_replans_the_shortest_way_and_the_report_counts_it() {
     let actions = w.handle(status(&first.id, MissionState::Stuck, 8.0), at(6.0, 0.2));
     let ask = asked(&actions);
     assert_eq!((ask.from, ask.curious), (here, false));
-    let actions = w.handle(shortest_reply(here), at(6.0, 0.3));
+    let actions = answer(&mut w, shortest_reply(here), at(6.0, 0.3));
     assert_eq!(
         actions[0],
         WindowAction::Replanned {
@@ -547,51 +606,70 @@ fn slack(w: &mut DowntimeWindow<'_>, mission: &Mission) -> Vec<WindowAction> {
 }
 
 #[test]
-fn slack_holds_the_robot_then_replans_from_where_it_is() {
+fn slack_replans_from_where_the_robot_will_be_while_it_drives_on() {
     let f = fixture();
     let (mut w, first) = f.driving(false);
     let actions = slack(&mut w, &first);
-    let WindowAction::Hold(hold) = &actions[0] else {
-        panic!("{actions:?}");
-    };
-    assert!(hold.waypoints.is_empty());
-    assert_eq!(hold.id, "robot-tag-w0-m2");
+    // No hold: the robot drives on, and the plan starts 0.5 m (1 s at 0.5 m/s) further
+    // along its route than where it is: 0.2 m north to the corner, 0.3 m east.
+    assert!(!actions.iter().any(|a| matches!(a, WindowAction::Drive(_))));
     let ask = asked(&actions);
-    assert_eq!((ask.from, ask.curious), ([0.1, 0.9], true));
+    assert!(ask.curious);
+    assert!(distance(ask.from, [0.4, 1.1]) < 1e-9, "{ask:?}");
     assert!(close(ask.t_exec_s, margin().budget(92.0)));
-    let actions = w.handle(curious_reply(true), at(8.0, 0.3));
+    let actions = answer(&mut w, curious_reply(true), at(8.0, 0.3));
     assert_eq!(
         actions[0],
         WindowAction::Replanned {
             reason: Reason::Slack
         }
     );
-    assert_eq!(sent(&actions).id, "robot-tag-w0-m3");
+    assert_eq!(sent(&actions).id, "robot-tag-w0-m2");
 }
 
 #[test]
-fn a_failed_replan_after_a_slack_hold_resends_the_old_path() {
+fn no_slack_replan_near_the_windows_end() {
+    let f = fixture();
+    let mut setup = f.setup(0, FROM, false);
+    setup.watch.min_replan_window_s = 95.0;
+    let (mut w, actions) = DowntimeWindow::begin(setup, Handover::first(margin()), at(0.0, 0.0));
+    assert!(asked(&actions).curious);
+    let first = sent(&answer(&mut w, curious_reply(true), at(1.0, 0.0)));
+    // 93 s left at 7 s: less than the 95 s a slack replan needs.
+    assert!(slack(&mut w, &first).is_empty());
+}
+
+#[test]
+fn a_failed_slack_replan_leaves_the_robot_on_its_path_then_the_fastest_path() {
     let f = fixture();
     let (mut w, first) = f.driving(false);
     slack(&mut w, &first);
     // The curious request fails: the shortest path is asked for, from the same place.
-    let actions = w.handle(WindowEvent::PlanFailed, at(8.0, 0.3));
+    let actions = answer(&mut w, failed(), at(8.0, 0.3));
     let ask = asked(&actions);
-    assert_eq!((ask.from, ask.curious), ([0.1, 0.9], false));
-    // That fails too: back on the path it had, as a new mission.
-    let actions = w.handle(WindowEvent::PlanFailed, at(8.1, 0.4));
-    let resent = sent(&actions);
-    assert_eq!(actions.len(), 1);
-    assert_eq!(resent.id, "robot-tag-w0-m3");
-    assert_eq!(resent.waypoints, first.waypoints);
-    // Its statuses are heard; nothing was replanned.
-    let actions = w.handle(
-        status(&resent.id, MissionState::Completed, 0.0),
-        at(50.0, 0.5),
+    assert!(!ask.curious);
+    // That fails too: the window's own fastest path from where the robot is.
+    let actions = answer(&mut w, failed(), at(8.1, 0.4));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::NoPlanner
+        }
     );
+    let straight = sent(&actions);
+    assert_eq!(straight.id, "robot-tag-w0-m2");
+    assert_eq!(
+        straight.waypoints.last().copied(),
+        Some(GOAL),
+        "{straight:?}"
+    );
+    let actions = answer_status(&mut w, &straight, MissionState::Completed, at(50.0, 0.5));
     assert!(matches!(actions[0], WindowAction::Arrived { .. }));
     let r = report(&w.handle(WindowEvent::Tick, at(105.0, 0.6)));
-    assert_eq!(r.replans, 0);
+    assert_eq!(
+        r.replan_reasons,
+        vec![Reason::NoPlanner.as_str().to_owned()]
+    );
 }
 
 #[test]
@@ -601,14 +679,10 @@ fn a_failed_curious_replan_falls_back_to_the_shortest_path() {
     let pushed = [2.0, 2.5];
     let actions = w.handle(estimate(pushed, 0.1), at(3.0, 0.1));
     assert!(asked(&actions).curious);
-    assert!(
-        !actions.iter().any(|a| matches!(a, WindowAction::Hold(_))),
-        "only slack holds the robot"
-    );
-    let actions = w.handle(WindowEvent::PlanFailed, at(3.5, 0.2));
+    let actions = answer(&mut w, failed(), at(3.5, 0.2));
     let ask = asked(&actions);
     assert_eq!((ask.from, ask.curious), (pushed, false));
-    let actions = w.handle(shortest_reply(pushed), at(3.6, 0.3));
+    let actions = answer(&mut w, shortest_reply(pushed), at(3.6, 0.3));
     assert_eq!(
         actions[0],
         WindowAction::Replanned {
@@ -622,18 +696,17 @@ fn a_failed_curious_replan_falls_back_to_the_shortest_path() {
 }
 
 #[test]
-fn a_failed_shortest_replan_changes_nothing() {
+fn a_failed_shortest_replan_drives_the_windows_own_fastest_path() {
     let f = fixture();
     let (mut w, first) = f.driving(false);
     let actions = w.handle(status(&first.id, MissionState::Stuck, 5.0), at(4.0, 0.1));
     assert!(!asked(&actions).curious);
-    assert!(w.handle(WindowEvent::PlanFailed, at(4.1, 0.2)).is_empty());
-    // The first mission is still the one watched.
-    let actions = w.handle(
-        status(&first.id, MissionState::Completed, 0.0),
-        at(40.0, 0.3),
-    );
-    assert!(matches!(actions[0], WindowAction::Arrived { .. }));
+    let actions = answer(&mut w, failed(), at(4.1, 0.2));
+    let straight = sent(&actions);
+    assert_ne!(straight.id, first.id);
+    // The first mission is watched no more.
+    let stale = status(&first.id, MissionState::Completed, 0.0);
+    assert!(w.handle(stale, at(40.0, 0.3)).is_empty());
 }
 
 #[test]
@@ -645,7 +718,7 @@ fn a_lost_mission_is_sent_again_from_where_the_robot_is() {
     let actions = w.handle(WindowEvent::Tick, at(2.2, 3.0));
     let ask = asked(&actions);
     assert_eq!((ask.from, ask.curious), (FROM, true));
-    let actions = w.handle(curious_reply(true), at(2.5, 3.1));
+    let actions = answer(&mut w, curious_reply(true), at(2.5, 3.1));
     assert_eq!(
         actions[0],
         WindowAction::Replanned {
@@ -696,12 +769,12 @@ fn the_next_window_is_planned_during_the_task() {
     let budget_s = learnt_margin().budget(95.0);
     assert!(close(ask.t_exec_s, budget_s), "{ask:?} {budget_s}");
     let next_route = line(GOAL, NEXT);
-    let reply = WindowEvent::PlanReply(Box::new(Plan {
+    let reply = reply(Plan {
         shortest: attached(next_route.clone()),
         ..plan(PlannerModel::Model1, next_route.clone(), 50.0)
-    }));
+    });
     assert!(
-        w.handle(reply, at(81.0, 1.5)).is_empty(),
+        answer(&mut w, reply, at(81.0, 1.5)).is_empty(),
         "at the task still"
     );
     let end = ended(&w.handle(WindowEvent::Tick, at(105.0, 2.0)));
@@ -721,7 +794,8 @@ fn the_next_window_is_planned_during_the_task() {
         WindowAction::Planned {
             budget_s,
             eta_s: 50.0,
-            curious: true
+            curious: true,
+            late_probability: learnt_margin().late_probability(50.0, 95.0),
         }
     );
     let mission = sent(&actions);
@@ -739,16 +813,16 @@ fn a_plan_for_the_next_window_after_the_task_ended_is_dropped() {
     let (mut w, mission) = f.driving(true);
     arrived(&mut w, &mission);
     // No planner answered: asked again a second later (wall), while the task lasts.
-    assert!(w.handle(WindowEvent::PlanFailed, at(81.0, 2.0)).is_empty());
+    assert!(answer(&mut w, failed(), at(81.0, 2.0)).is_empty());
     assert!(w.handle(WindowEvent::Tick, at(82.0, 2.5)).is_empty());
     let actions = w.handle(WindowEvent::Tick, at(83.0, 3.0));
     assert_eq!(asked(&actions).from, GOAL);
     // The answer comes after the task ended: the window is done without it.
-    let late = WindowEvent::PlanReply(Box::new(Plan {
+    let late = reply(Plan {
         shortest: attached(line(GOAL, NEXT)),
         ..plan(PlannerModel::Model1, line(GOAL, NEXT), 50.0)
-    }));
-    let end = ended(&w.handle(late, at(106.0, 4.0)));
+    });
+    let end = ended(&answer(&mut w, late, at(106.0, 4.0)));
     assert!(end.handover.planned_ahead.is_none());
 }
 
@@ -756,7 +830,7 @@ fn a_plan_for_the_next_window_after_the_task_ended_is_dropped() {
 fn the_first_plan_is_asked_again_until_the_window_is_given_up() {
     let f = fixture();
     let (mut w, _) = f.begin(false);
-    assert!(w.handle(WindowEvent::PlanFailed, at(1.0, 0.5)).is_empty());
+    assert!(answer(&mut w, failed(), at(1.0, 0.5)).is_empty());
     assert!(w.handle(WindowEvent::Tick, at(1.2, 1.0)).is_empty());
     let actions = w.handle(WindowEvent::Tick, at(2.0, 1.5));
     let ask = asked(&actions);
@@ -765,7 +839,7 @@ fn the_first_plan_is_asked_again_until_the_window_is_given_up() {
         "asked anew: {ask:?}"
     );
     // Past the give-up time (60 s after the task's start) the window is given up.
-    let actions = w.handle(WindowEvent::PlanFailed, at(161.0, 2.0));
+    let actions = answer(&mut w, failed(), at(161.0, 2.0));
     assert_eq!(actions[0], WindowAction::GaveUp);
     let end = ended(&actions);
     let outcome = end.outcome.expect("outcome");
@@ -789,4 +863,154 @@ fn a_task_over_before_its_window_is_skipped() {
     assert!(end.outcome.is_none());
     assert_eq!(end.handover.missions_sent, 4);
     assert!(w.handle(WindowEvent::Tick, at(106.0, 1.0)).is_empty());
+}
+
+#[test]
+fn at_the_last_safe_moment_the_robot_goes_straight_and_stays_straight() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    // On its curious route at 95 s, 5 s before the task: the fastest path from here
+    // takes longer than what the margin leaves of 5 s.
+    let here = [0.1, 1.1];
+    let actions = w.handle(estimate(here, 0.1), at(95.0, 0.5));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::LastSafeMoment
+        }
+    );
+    let straight = sent(&actions);
+    assert_ne!(straight.id, first.id);
+    assert_eq!(straight.waypoints.last().copied(), Some(GOAL));
+    assert!(
+        !actions
+            .iter()
+            .any(|a| matches!(a, WindowAction::RequestPlan(_))),
+        "no planner"
+    );
+    // Curious no more: far early on the new route is not slack.
+    let again = w.handle(
+        status(&straight.id, MissionState::Active, 0.5),
+        at(97.0, 0.6),
+    );
+    assert!(again.is_empty(), "{again:?}");
+    let r = report(&{
+        w.handle(
+            status(&straight.id, MissionState::Completed, 0.0),
+            at(99.0, 0.7),
+        );
+        w.handle(WindowEvent::Tick, at(105.0, 0.8))
+    });
+    assert_eq!(r.on_time, true);
+    assert_eq!(
+        r.replan_reasons,
+        vec![Reason::LastSafeMoment.as_str().to_owned()]
+    );
+}
+
+#[test]
+fn a_robot_held_for_its_peb_is_driven_back_to_its_last_fix_then_replanned() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    for (p, peb) in [
+        ([0.1, 0.3], 0.3),
+        ([0.1, 0.5], 0.4),
+        ([0.1, 0.7], 3.0),
+        ([0.1, 0.9], 9.0),
+    ] {
+        assert!(w.handle(estimate(p, peb), at(5.0, 0.1)).is_empty());
+    }
+    let held = |w: &mut DowntimeWindow<'_>, t: f64| {
+        w.handle(status(&first.id, MissionState::HaltedPeb, 2.0), at(t, 0.2))
+    };
+    assert!(held(&mut w, 10.0).is_empty());
+    assert!(held(&mut w, 13.9).is_empty(), "within its patience");
+    let actions = held(&mut w, 14.1);
+    assert!(matches!(actions[0], WindowAction::Recovering { held_s } if close(held_s, 4.1)));
+    let back = sent(&actions);
+    assert!(back.recovery, "the guard lets a recovery through");
+    assert_eq!(back.waypoints.last().copied(), Some([0.1, 0.5]), "{back:?}");
+    // Back at the fix: a curious plan from there with the time left.
+    let actions = answer_status(&mut w, &back, MissionState::Completed, at(20.0, 0.3));
+    let ask = asked(&actions);
+    assert!(ask.curious);
+    let actions = answer(&mut w, curious_reply(true), at(21.0, 0.4));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::Recovered
+        }
+    );
+    let onward = sent(&actions);
+    assert!(!onward.recovery);
+    answer_status(&mut w, &onward, MissionState::Completed, at(70.0, 0.5));
+    let r = report(&w.handle(WindowEvent::Tick, at(105.0, 0.6)));
+    assert_eq!((r.holds, r.recoveries), (1, 1));
+    assert!(close(r.held_s, 4.1), "{r:?}");
+    assert!(r.on_time);
+}
+
+#[test]
+fn with_plan_ahead_the_next_window_is_asked_while_driving_beside_a_replan() {
+    let f = fixture();
+    let mut setup = f.setup(0, FROM, true);
+    setup.rules.plan_ahead = true;
+    let (mut w, actions) = DowntimeWindow::begin(setup, Handover::first(margin()), at(0.0, 0.0));
+    let first_id = asked(&actions).id;
+    let actions = w.handle(
+        WindowEvent::PlanReply {
+            id: first_id,
+            plan: Box::new(Plan {
+                shortest: attached(shortest_points(FROM)),
+                ..plan(PlannerModel::Model1, curious_points(), CURIOUS_ETA_S)
+            }),
+        },
+        at(1.0, 0.0),
+    );
+    let mission = sent(&actions);
+    let ahead = asked(&actions);
+    assert_eq!(
+        (ahead.from, ahead.to),
+        (GOAL, NEXT),
+        "the next window, from this task"
+    );
+    // A replan while the next window's plan is made: two in flight.
+    let pushed = [2.0, 2.5];
+    let replan = asked(&w.handle(estimate(pushed, 0.1), at(3.0, 0.1)));
+    assert_ne!(replan.id, ahead.id);
+    assert_eq!(w.asks_in_flight(), 2);
+    let next_route = line(GOAL, NEXT);
+    let ahead_reply = WindowEvent::PlanReply {
+        id: ahead.id,
+        plan: Box::new(Plan {
+            shortest: attached(next_route.clone()),
+            ..plan(PlannerModel::Model1, next_route, 50.0)
+        }),
+    };
+    assert!(w.handle(ahead_reply, at(3.5, 0.2)).is_empty());
+    // Arriving forgets the replan; nothing more is asked at the task.
+    let actions = w.handle(
+        status(&mission.id, MissionState::Completed, 0.0),
+        at(60.0, 0.3),
+    );
+    assert_eq!(actions[0], WindowAction::Forget(replan.id));
+    assert!(!actions
+        .iter()
+        .any(|a| matches!(a, WindowAction::RequestPlan(_))));
+    // Its late answer changes nothing.
+    let late = WindowEvent::PlanFailed { id: replan.id };
+    assert!(w.handle(late, at(61.0, 0.4)).is_empty());
+    let end = ended(&w.handle(WindowEvent::Tick, at(105.0, 0.5)));
+    let planned = end.handover.planned_ahead.expect("planned while driving");
+    assert_eq!((planned.window, planned.leave_at_s), (1, 105.0));
+    // A window that begins well after the plan assumed takes a fresh one.
+    let handover = Handover {
+        planned_ahead: Some(planned),
+        ..end.handover
+    };
+    let (_, actions) = DowntimeWindow::begin(f.setup(1, GOAL, false), handover, at(110.0, 0.0));
+    assert!(
+        matches!(actions[0], WindowAction::RequestPlan(_)),
+        "{actions:?}"
+    );
 }

@@ -10,8 +10,9 @@ pub(crate) enum ReproduceCommand {
     /// The papers joined: seeded downtime missions in the built-in world, planned on the
     /// static information map, with the PEB localizability cost, and the shortest path.
     /// With --days N: the executive's whole day (tasks::day() on the day world) N times
-    /// per variant (today's executive, the new one, the new one without each coupling,
-    /// the shortest path) against issue 14's goals.
+    /// per variant (the shipped executive, without each coupling, the paper's planner
+    /// alone, the fastest path), driven by the executive's own window machine, against
+    /// the goals.
     Mission {
         /// Print {"missions", "variants": [{"variant", "information", "on_time_share", "peb_mean_m"}]};
         /// with --days, the days' report (variants, goals with verdicts, every window).
@@ -23,16 +24,20 @@ pub(crate) enum ReproduceCommand {
         #[arg(long)]
         days: Option<usize>,
         /// With --days: the variants to run, comma-separated (default all:
-        /// today,new,new_no_change,new_no_peb,shortest).
+        /// plain,executive,no_change,no_peb,fastest_path).
         #[arg(long, value_delimiter = ',')]
         variants: Vec<String>,
         /// With --days: threads the days run on (default: the machine's cores; the
         /// report does not depend on it).
         #[arg(long)]
         jobs: Option<usize>,
-        /// With --days: what a curious plan costs on the mission clock, seconds.
-        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
-        plan_cost: f64,
+        /// With --days: what a curious plan costs, wall seconds, before its deadline
+        /// cuts it (the demo's, measured).
+        #[arg(long, default_value_t = 0.4, allow_negative_numbers = true)]
+        plan_wall: f64,
+        /// With --days: the clock's rate, mission seconds per wall second (the demo's).
+        #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
+        rate: f64,
         #[arg(long, default_value_t = 0)]
         seed: u64,
         /// GA generations per plan.
@@ -120,7 +125,8 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             days: Some(days),
             variants,
             jobs,
-            plan_cost,
+            plan_wall,
+            rate,
             seed,
             generations,
             w_loc,
@@ -131,7 +137,8 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 days,
                 &variants,
                 jobs,
-                plan_cost,
+                plan_wall,
+                rate,
                 seed,
                 generations,
                 w_loc,
@@ -321,7 +328,8 @@ async fn reproduce_days(
     days: usize,
     variants: &[String],
     jobs: Option<usize>,
-    plan_cost: f64,
+    plan_wall: f64,
+    rate: f64,
     seed: u64,
     generations: u32,
     w_loc: f64,
@@ -332,7 +340,8 @@ async fn reproduce_days(
         seed,
         generations,
         w_loc,
-        plan_cost_s: plan_cost,
+        plan_wall_s: plan_wall,
+        rate,
         ..DaysOptions::default()
     };
     if !variants.is_empty() {

@@ -16,6 +16,7 @@ pub(crate) async fn attack(session: &zenoh::Session, root: &str) -> usize {
         robot: "robot".into(),
         id: "huge".into(),
         waypoints: vec![[1.234_567_890_123, -9.876_543_210_987]; 10_000_000],
+        recovery: false,
     });
     for _ in 0..HUGE_MISSIONS {
         session
@@ -30,6 +31,7 @@ pub(crate) async fn attack(session: &zenoh::Session, root: &str) -> usize {
             robot: ghost.clone(),
             id: format!("ghost-mission-{i}"),
             waypoints: vec![[1.0, 1.0]],
+            recovery: false,
         };
         session
             .put(keys::robot_mission(root, &ghost), encode(&mission))
@@ -40,6 +42,7 @@ pub(crate) async fn attack(session: &zenoh::Session, root: &str) -> usize {
         robot: "robot".into(),
         id: "i".repeat(1_000_000),
         waypoints: vec![[1.0, 1.0]],
+        recovery: false,
     };
     session
         .put(keys::robot_mission(root, "robot"), encode(&long_id))

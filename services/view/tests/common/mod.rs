@@ -406,6 +406,7 @@ pub fn mission(robot: &str, id: &str, waypoints: usize) -> roam_proto::controlle
         robot: robot.into(),
         id: id.into(),
         waypoints: (0..waypoints).map(|i| [i as f64 * 0.5, 1.5]).collect(),
+        recovery: false,
     }
 }
 

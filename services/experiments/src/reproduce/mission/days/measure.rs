@@ -31,8 +31,13 @@ pub struct WindowResult {
     pub share: f64,
     /// From the window's beginning to its first mission: the robot waited for the plan.
     pub waited_for_plan_s: f64,
-    /// Held still while a slack replan was made, in all.
+    /// Held by the controller's PEB guard, in all (the executive's count), seconds;
+    /// how many holds it acted on and how many recoveries it sent.
     pub held_s: f64,
+    pub holds: u32,
+    pub recoveries: u32,
+    /// The first plan's probability of arriving late, as its margin bounds it.
+    pub late_probability: Option<f64>,
     /// Waiting at the task's place before its start (arrived early), seconds.
     pub early_s: Option<f64>,
     /// The driving budget of the first plan (t_exec), seconds.
@@ -62,7 +67,7 @@ pub struct WindowResult {
     pub halted_steps: u64,
     /// RMS of the estimates' error along the drive (degraded estimates left out), metres.
     pub estimate_rms_m: Option<f64>,
-    /// Each replan's reason, in order (`slack`, `stuck`, `late`, `off_path`, `silent`).
+    /// Each replan's reason, in order ([`roam_mission::watch::Reason::name`]).
     pub replans: Vec<&'static str>,
     /// The time model's prediction of the arrived mission.
     pub time_model: Option<TimeModelUse>,
@@ -101,8 +106,8 @@ impl Track {
                 self.peb_n += 1;
             }
         }
-        if let Some(e) = step.estimate {
-            self.error2_sum += distance(e, step.truth).powi(2);
+        if let Some(e) = step.estimate.as_ref().filter(|e| !e.degraded) {
+            self.error2_sum += distance(e.position, step.truth).powi(2);
             self.error_n += 1;
         }
         if step

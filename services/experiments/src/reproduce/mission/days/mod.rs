@@ -1,33 +1,31 @@
-//! `roam reproduce mission --days N`: issue 14's item 7 measured in batch. The
-//! executive's day ([`roam_mission::tasks::day`] on [`roam_mission::tasks::DAY_SCENARIO`]: four
+//! `roam reproduce mission --days N`: the executive's day in batch. The demo's day
+//! ([`roam_mission::tasks::day`] on [`roam_mission::tasks::DAY_SCENARIO`]: four
 //! windows, one a round trip, a cart on the docks, a north-east room no anchor covers)
-//! is run N times per variant with the services' own code and no network:
+//! is run N times per variant with the shipped code and no network:
 //!
-//! - **planning**: the planner's batch [`roam_planner::plan::plan`] with the request the
-//!   executive sends (Model I, `max_generations`, the time model, W_loc), on the map the
-//!   planner service holds ([`planning`]); a curious plan costs a fixed `plan_cost_s`
-//!   of mission time (the services' 1 s deadline at 1× real time), never wall time;
+//! - **the executive**: its own window machine ([`roam_mission::window`]), each
+//!   variant a configuration of it ([`Variant`], [`roam_mission::config::ExecutiveConfig`]),
+//!   driven as the live executive drives it ([`day`]);
+//! - **planning**: the very request the executive sends, answered by the planner's own
+//!   code on the map the planner service holds ([`planning`]); an answer reaches the
+//!   window `plan_wall_s` (cut to the plan's deadline) at the clock's `rate` later, while
+//!   the robot drives on, as in the demo;
 //! - **driving**: the sim, localization's tracker and the APF controller one step at a
 //!   time ([`crate::closed_loop::stepper::Stepper`]), the mapper's change map fed the
-//!   robot's observation every step ([`robot`]); mission time is sim time;
-//! - **watching**: the executive's replan policy ([`roam_mission::watch::Watch`]) on every
-//!   step's estimate and status, its replans, its time model learning from each arrived
-//!   mission ([`roam_mission::calibration::Calibration::add_planned`]) and the next window
-//!   planned during the task ([`window`], [`day`]).
+//!   robot's observation every step ([`robot`]); mission time is sim time.
 //!
-//! The variants ([`Variant`]) are today's executive, the new one, the new one without
-//! each coupling, and the shortest path. **Common random numbers**: a day's sim seed and
-//! its plans' seeds depend on the day (and the window and the plan's rank in it), never
-//! on the variant, so every variant of a day meets the same range and motion noise step
-//! by step and its first plan of each window draws the same GA stream. Days are
-//! independent: each starts from Table I and an empty change map. The same options give
-//! the same report bit for bit, whatever the number of threads (`jobs`).
+//! **Common random numbers**: a day's sim seed and its plans' seed depend on the day,
+//! never on the variant, so every variant of a day meets the same range and motion
+//! noise step by step. Days are independent: each starts from the time model's prior
+//! and an empty change map. The same options give the same report bit for bit,
+//! whatever the number of threads (`jobs`).
 //!
 //! Measured per window ([`measure::WindowResult`]): the share of the window driven, late
 //! arrivals, the information driven (paper 000's distinct cells on the static map,
-//! along the true path) and planned, the change seen, the PEB, and the time model's
-//! prediction error; then per variant and window of the day ([`summary`]), against the
-//! goals with verdicts computed from the figures ([`goals`]), as a table ([`table`]).
+//! along the true path) and planned, the change seen, the PEB, holds and recoveries, and
+//! the time model's prediction error; then per variant and window of the day
+//! ([`summary`]), against the goals with verdicts computed from the figures ([`goals`]),
+//! as a table ([`table`]).
 
 pub mod day;
 pub mod goals;
@@ -37,9 +35,7 @@ pub mod robot;
 pub mod stats;
 pub mod summary;
 pub mod table;
-pub mod thin;
 pub mod variant;
-pub mod window;
 pub mod world;
 
 #[cfg(test)]
@@ -60,8 +56,11 @@ use roam_mission::calibration::CalibrationError;
 /// The most days one batch runs.
 pub const MAX_DAYS: usize = 10_000;
 
-/// The most a curious plan may cost on the mission clock, seconds (a window is minutes).
-pub const MAX_PLAN_COST_S: f64 = 600.0;
+/// The most wall seconds a curious plan may cost (the planner's longest deadline).
+pub const MAX_PLAN_WALL_S: f64 = 600.0;
+
+/// The fastest clock a batch may assume, mission seconds per wall second.
+pub const MAX_RATE: f64 = 1000.0;
 
 /// What to run.
 #[derive(Debug, Clone, PartialEq)]
@@ -72,9 +71,11 @@ pub struct DaysOptions {
     pub generations: u32,
     /// W_loc of the PEB cost (as `roam reproduce mission`: 2000).
     pub w_loc: f64,
-    /// What a curious plan costs on the mission clock, seconds (the services' default
-    /// deadline, 1 s, at 1× real time).
-    pub plan_cost_s: f64,
+    /// What a curious plan costs, wall seconds, before its deadline cuts it (measured
+    /// in the demo: see services/mission/README.md).
+    pub plan_wall_s: f64,
+    /// The clock's rate, mission seconds per wall second (the demo's 20×).
+    pub rate: f64,
     pub variants: Vec<Variant>,
     /// Threads the days run on (the report does not depend on it).
     pub jobs: usize,
@@ -87,7 +88,8 @@ impl Default for DaysOptions {
             seed: 0,
             generations: 1000,
             w_loc: 2000.0,
-            plan_cost_s: 1.0,
+            plan_wall_s: 0.4,
+            rate: 20.0,
             variants: Variant::ALL.to_vec(),
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
         }
@@ -121,12 +123,13 @@ pub struct DaysReport {
     pub seed: u64,
     pub generations: u32,
     pub w_loc: f64,
-    pub plan_cost_s: f64,
+    pub plan_wall_s: f64,
+    pub rate: f64,
     /// Cells the day's cart covers at some step.
     pub changing_cells: usize,
     pub variants: Vec<VariantSummary>,
     pub information_vs_shortest: Option<Paired>,
-    pub information_vs_today: Option<Paired>,
+    pub information_vs_plain: Option<Paired>,
     pub effects: Vec<Effect>,
     pub goals: Vec<Goal>,
     pub results: Vec<DayResult>,
@@ -155,12 +158,15 @@ fn check(o: &DaysOptions) -> Result<(), DaysError> {
     if !(o.w_loc.is_finite() && o.w_loc >= 0.0) {
         return invalid("w_loc", &o.w_loc, "a finite 0 or more".into());
     }
-    if !(o.plan_cost_s.is_finite() && (0.0..=MAX_PLAN_COST_S).contains(&o.plan_cost_s)) {
+    if !(o.plan_wall_s.is_finite() && (0.0..=MAX_PLAN_WALL_S).contains(&o.plan_wall_s)) {
         return invalid(
-            "plan_cost_s",
-            &o.plan_cost_s,
-            format!("0 to {MAX_PLAN_COST_S} seconds"),
+            "plan_wall_s",
+            &o.plan_wall_s,
+            format!("0 to {MAX_PLAN_WALL_S} seconds"),
         );
+    }
+    if !(o.rate.is_finite() && o.rate >= 1.0 && o.rate <= MAX_RATE) {
+        return invalid("rate", &o.rate, format!("1 to {MAX_RATE} (MAX_RATE)"));
     }
     if o.variants.is_empty() {
         return invalid("variants", &"empty", "at least one".into());
@@ -207,23 +213,24 @@ pub fn report(options: &DaysOptions, world: &DayWorld, results: Vec<DayResult>) 
         .iter()
         .filter_map(|&v| summary::variant_summary(&results, v))
         .collect();
-    let vs_shortest = summary::paired(&results, Variant::New, Variant::Shortest);
-    let vs_today = summary::paired(&results, Variant::New, Variant::Today);
-    let effects = [("change", Variant::NewNoChange), ("peb", Variant::NewNoPeb)]
+    let vs_shortest = summary::paired(&results, Variant::Executive, Variant::FastestPath);
+    let vs_plain = summary::paired(&results, Variant::Executive, Variant::Plain);
+    let effects = [("change", Variant::NoChange), ("peb", Variant::NoPeb)]
         .into_iter()
         .filter_map(|(c, without)| summary::effect(&results, c, without))
         .collect();
-    let goals = goals::goals(&summaries, vs_shortest.as_ref(), vs_today.as_ref());
+    let goals = goals::goals(&summaries, vs_shortest.as_ref(), vs_plain.as_ref());
     DaysReport {
         days: options.days,
         seed: options.seed,
         generations: options.generations,
         w_loc: options.w_loc,
-        plan_cost_s: options.plan_cost_s,
+        plan_wall_s: options.plan_wall_s,
+        rate: options.rate,
         changing_cells: world.changing_cells,
         variants: summaries,
         information_vs_shortest: vs_shortest,
-        information_vs_today: vs_today,
+        information_vs_plain: vs_plain,
         effects,
         goals,
         results,

@@ -4,40 +4,28 @@
 
 use crate::closed_loop::stepper::Stepper;
 use crate::closed_loop::PositionSource;
-use roam_controller::controller::{Decision, MissionStatus};
+use roam_controller::controller::Decision;
 use roam_controller::params::ApfParams;
 use roam_mapper::change_map::{ChangeMap, MapParams, ObservationWindow};
 use roam_proto::cells::Cells;
 
 use super::world::DayWorld;
 use super::DaysError;
-use roam_mission::watch::Status;
+use roam_proto::controller::Mission;
+use roam_proto::localization::PositionEstimate;
 
 /// What one step showed of the robot.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Step {
     /// Sim time at the end of the step, seconds.
     pub time_s: f64,
     /// Its true position.
     pub truth: [f64; 2],
-    /// The localization's estimate when it is not degraded (what the executive hears).
-    pub estimate: Option<[f64; 2]>,
+    /// The localization's estimate (what the executive hears); `None` when the scan
+    /// was refused.
+    pub estimate: Option<PositionEstimate>,
     /// The controller's decision on this step.
     pub decision: Option<Decision>,
-}
-
-impl Step {
-    /// The controller's status as the executive reads it (`MissionState` on the wire).
-    pub fn status(&self) -> Option<Status> {
-        self.decision.map(|d| match d.status {
-            MissionStatus::Completed => Status::Completed,
-            MissionStatus::Stuck | MissionStatus::StepLimit => Status::Stuck,
-            MissionStatus::Active => Status::Active {
-                distance_left_m: d.distance_left_m,
-            },
-            MissionStatus::Idle | MissionStatus::HaltedPeb => Status::Other,
-        })
-    }
 }
 
 /// One robot through its day.
@@ -99,9 +87,17 @@ impl Robot {
         &self.first_ranges
     }
 
-    /// Sends the controller a mission (an empty one holds the robot).
-    pub fn send(&mut self, waypoints: Vec<[f64; 2]>) -> Result<(), DaysError> {
-        Ok(self.stepper.set_mission(&self.name, waypoints)?)
+    /// Sends the controller a mission (an empty one holds the robot), as the
+    /// executive's `mission` message does.
+    pub fn send(&mut self, mission: &Mission) -> Result<(), DaysError> {
+        if mission.recovery {
+            self.stepper
+                .set_recovery(&self.name, mission.waypoints.clone())?;
+        } else {
+            self.stepper
+                .set_mission(&self.name, mission.waypoints.clone())?;
+        }
+        Ok(())
     }
 
     /// One sim step: the sim moves the robot by the last command, localization
@@ -132,18 +128,13 @@ impl Robot {
                     .map_err(|e| DaysError::Mapper(e.to_string()))?;
             }
         }
-        let estimate = r
-            .estimate
-            .as_ref()
-            .filter(|e| !e.degraded)
-            .map(|e| e.position);
-        if estimate.is_some() {
-            self.position = estimate;
+        if let Some(e) = r.estimate.as_ref().filter(|e| !e.degraded) {
+            self.position = Some(e.position);
         }
         Ok(Step {
             time_s: out.time_s,
             truth: r.messages.truth.at,
-            estimate,
+            estimate: r.estimate,
             decision: r.decision,
         })
     }

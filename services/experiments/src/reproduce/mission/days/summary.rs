@@ -246,7 +246,7 @@ pub fn paired(results: &[DayResult], of: Variant, against: Variant) -> Option<Pa
 
 /// A coupling's effect: `new` against `without`.
 pub fn effect(results: &[DayResult], coupling: &'static str, without: Variant) -> Option<Effect> {
-    let days = pairs(results, Variant::New, without);
+    let days = pairs(results, Variant::Executive, without);
     if days.is_empty() {
         return None;
     }
@@ -287,7 +287,7 @@ pub fn effect(results: &[DayResult], coupling: &'static str, without: Variant) -
     }
     Some(Effect {
         coupling,
-        with: Variant::New,
+        with: Variant::Executive,
         without,
         figures,
     })
@@ -301,14 +301,14 @@ mod tests {
     #[test]
     fn figures_come_from_the_windows_and_pairs_from_the_same_days() {
         let results = vec![
-            day(Variant::New, 0, 200.0, false),
-            day(Variant::New, 1, 300.0, true),
-            day(Variant::Shortest, 0, 100.0, false),
-            day(Variant::Shortest, 1, 100.0, false),
+            day(Variant::Executive, 0, 200.0, false),
+            day(Variant::Executive, 1, 300.0, true),
+            day(Variant::FastestPath, 0, 100.0, false),
+            day(Variant::FastestPath, 1, 100.0, false),
             // A day only one of them ran is not paired.
-            day(Variant::Shortest, 2, 1.0, false),
+            day(Variant::FastestPath, 2, 1.0, false),
         ];
-        let new = variant_summary(&results, Variant::New).expect("ran");
+        let new = variant_summary(&results, Variant::Executive).expect("ran");
         assert_eq!((new.days, new.windows, new.late), (2, 4, 1));
         assert_eq!(new.share_median, Some(0.7));
         assert_eq!(new.information_per_day_median, Some(500.0));
@@ -316,12 +316,12 @@ mod tests {
         assert_eq!(new.by_window.len(), 2);
         assert_eq!(new.by_window[1].late, 1);
         assert_eq!(new.by_window[1].never_arrived, 1);
-        assert!(variant_summary(&results, Variant::Today).is_none());
-        let p = paired(&results, Variant::New, Variant::Shortest).expect("paired");
+        assert!(variant_summary(&results, Variant::Plain).is_none());
+        let p = paired(&results, Variant::Executive, Variant::FastestPath).expect("paired");
         assert_eq!(p.days, 2);
         // Day 0: 400 / 200 − 1 = 1; day 1: 600 / 200 − 1 = 2.
         assert_eq!(p.median_gain, Some(1.5));
         assert_eq!(p.total_gain, Some(1.5));
-        assert!(paired(&results, Variant::New, Variant::Today).is_none());
+        assert!(paired(&results, Variant::Executive, Variant::Plain).is_none());
     }
 }

@@ -1,5 +1,5 @@
 //! The batch's report as terminal text: the variants, the goals with their verdicts and
-//! shortfalls, each coupling's effect, and the new and today's executives window by
+//! shortfalls, each coupling's effect, and the executive and the plain planner window by
 //! window.
 
 use std::fmt::Write;
@@ -109,14 +109,14 @@ fn by_window(out: &mut String, v: &VariantSummary) {
 /// The report as text.
 pub fn table(r: &DaysReport) -> String {
     let mut out = format!(
-        "issue 14 item 7, measured in batch: {} days of tasks::day() on the day world (config/scenarios/day.yaml; {} cells the cart covers), seed {}, Model I with {} generations, a curious plan costs {:.1} s of mission time, W_loc {}\n",
-        r.days, r.changing_cells, r.seed, r.generations, r.plan_cost_s, r.w_loc
+        "the executive's day in batch (its own window machine): {} days of tasks::day() on the day world (config/scenarios/day.yaml; {} cells the cart covers), seed {}, Model I with {} generations, a curious plan costs {:.2} s of wall time (cut to its deadline) at {}x, W_loc {}\n",
+        r.days, r.changing_cells, r.seed, r.generations, r.plan_wall_s, r.rate, r.w_loc
     );
     variants(&mut out, r);
     out.push_str(
         "(share, drv/pln: medians over windows; info, plan, chg (changing cells seen), halt: per day, medians over days; model err: (predicted - took) / took)\n\n",
     );
-    let _ = writeln!(out, "goals (the new executive):");
+    let _ = writeln!(out, "goals (the shipped executive):");
     for g in &r.goals {
         let target = match g.target {
             Target::AtLeast => ">=",
@@ -150,7 +150,7 @@ pub fn table(r: &DaysReport) -> String {
         }
     }
     if !r.effects.is_empty() {
-        out.push_str("\neach coupling alone on the changing world (new against new without it, the same days):\n");
+        out.push_str("\neach coupling alone on the changing world (the executive against itself without it, the same days):\n");
         for e in &r.effects {
             let _ = writeln!(
                 out,
@@ -171,7 +171,7 @@ pub fn table(r: &DaysReport) -> String {
             }
         }
     }
-    for variant in [Variant::New, Variant::Today] {
+    for variant in [Variant::Executive, Variant::Plain] {
         if let Some(v) = r.variants.iter().find(|s| s.variant == variant) {
             out.push('\n');
             by_window(&mut out, v);

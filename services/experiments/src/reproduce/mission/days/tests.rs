@@ -7,18 +7,17 @@ use std::sync::OnceLock;
 use super::day::{day_seed, DayResult};
 use super::goals::{goals, Verdict};
 use super::measure::WindowResult;
-use super::planning::plan_seed;
 use super::summary::{paired, variant_summary};
 use super::*;
 
-/// A small batch that stays fast in debug builds: two days, three variants (today's,
-/// the new one, the shortest path), a few GA generations.
+/// A small batch that stays fast in debug builds: two days, three variants (plain, the
+/// executive, the fastest path), a few GA generations.
 fn small(jobs: usize) -> DaysOptions {
     DaysOptions {
         days: 2,
         seed: 3,
         generations: 20,
-        variants: vec![Variant::Today, Variant::New, Variant::Shortest],
+        variants: vec![Variant::Plain, Variant::Executive, Variant::FastestPath],
         jobs,
         ..DaysOptions::default()
     }
@@ -50,7 +49,7 @@ fn the_same_options_give_the_same_report_bit_for_bit_on_one_or_two_threads() {
     // Every (variant, day) is in the report, in order, and the day was driven.
     let units: Vec<(usize, Variant)> = once.results.iter().map(|d| (d.day, d.variant)).collect();
     let expected: Vec<(usize, Variant)> = (0..2)
-        .flat_map(|d| [Variant::Today, Variant::New, Variant::Shortest].map(|v| (d, v)))
+        .flat_map(|d| [Variant::Plain, Variant::Executive, Variant::FastestPath].map(|v| (d, v)))
         .collect();
     assert_eq!(units, expected);
     for d in &once.results {
@@ -85,22 +84,22 @@ fn a_days_noise_and_seeds_do_not_depend_on_the_variant() {
             .first_ranges
     };
     assert_ne!(first(0), first(1), "days differ in their noise");
-    // The seeds are functions of the batch's seed, the day, the window and the rank
-    // only: there is no variant to give them.
+    // The seeds are functions of the batch's seed and the day only: there is no
+    // variant to give them.
     assert_eq!(day_seed(3, 1), day_seed(3, 1));
     assert_ne!(day_seed(3, 0), day_seed(3, 1));
     assert_ne!(day_seed(3, 0), day_seed(4, 0));
-    assert_eq!(
-        plan_seed(day_seed(3, 1), 2, 0),
-        plan_seed(day_seed(3, 1), 2, 0)
-    );
 }
 
 #[test]
 fn the_report_has_every_goal_with_a_verdict_computed_from_its_figure() {
     let report = one_thread();
-    assert_eq!(report.goals.len(), 5);
+    assert_eq!(report.goals.len(), 6);
     for g in &report.goals {
+        if g.goal.starts_with("no_peb") {
+            assert_eq!(g.verdict, Verdict::NotMeasured, "no_peb did not run: {g:?}");
+            continue;
+        }
         assert_ne!(g.verdict, Verdict::NotMeasured, "{g:?}");
         assert_eq!(
             g.verdict,
@@ -110,7 +109,7 @@ fn the_report_has_every_goal_with_a_verdict_computed_from_its_figure() {
         assert_eq!(g.shortfall.is_some(), g.verdict == Verdict::DoesNotHold);
     }
     let table = table::table(report);
-    assert!(table.contains("goals (the new executive):"), "{table}");
+    assert!(table.contains("goals (the shipped executive):"), "{table}");
 }
 
 /// A window with the figures a test gives.
@@ -127,6 +126,9 @@ pub(super) fn window(i: usize, share: f64, info: f64, late: bool) -> WindowResul
         share,
         waited_for_plan_s: 1.0,
         held_s: 0.0,
+        holds: 0,
+        recoveries: 0,
+        late_probability: Some(1e-3),
         early_s: (!late).then_some(100.0 - 100.0 * share),
         budget_s: 99.0,
         curious: true,
@@ -152,6 +154,7 @@ pub(super) fn day(variant: Variant, day: usize, info: f64, late: bool) -> DayRes
         variant,
         windows: vec![window(0, 0.5, info, false), window(1, 0.9, info, late)],
         first_ranges: Vec::new(),
+        asks: Vec::new(),
         truth: Vec::new(),
     }
 }
@@ -161,9 +164,9 @@ fn judged(results: &[DayResult]) -> Vec<(&'static str, Verdict)> {
         .iter()
         .filter_map(|&v| variant_summary(results, v))
         .collect();
-    let vs_shortest = paired(results, Variant::New, Variant::Shortest);
-    let vs_today = paired(results, Variant::New, Variant::Today);
-    goals(&summaries, vs_shortest.as_ref(), vs_today.as_ref())
+    let vs_shortest = paired(results, Variant::Executive, Variant::FastestPath);
+    let vs_plain = paired(results, Variant::Executive, Variant::Plain);
+    goals(&summaries, vs_shortest.as_ref(), vs_plain.as_ref())
         .into_iter()
         .map(|g| (g.goal, g.verdict))
         .collect()
@@ -171,42 +174,47 @@ fn judged(results: &[DayResult]) -> Vec<(&'static str, Verdict)> {
 
 #[test]
 fn synthetic_figures_short_of_every_goal_do_not_hold_and_good_ones_hold() {
-    // Share 0.7, a late window, driven/planned 0.8, +10% on the shortest and today's.
+    // Share 0.7, a late window, driven/planned 0.8, +10% on the fastest path and plain,
+    // no_peb halted 100 steps a day.
+    let mut held = day(Variant::NoPeb, 0, 100.0, false);
+    held.windows[0].halted_steps = 100;
     let poor = [
-        day(Variant::New, 0, 110.0, true),
-        day(Variant::Shortest, 0, 100.0, false),
-        day(Variant::Today, 0, 100.0, false),
+        day(Variant::Executive, 0, 110.0, true),
+        day(Variant::FastestPath, 0, 100.0, false),
+        day(Variant::Plain, 0, 100.0, false),
+        held,
     ];
     let verdicts = judged(&poor);
-    assert_eq!(verdicts.len(), 5);
+    assert_eq!(verdicts.len(), 6);
     assert!(
         verdicts.iter().all(|(_, v)| *v == Verdict::DoesNotHold),
         "{verdicts:?}"
     );
     // Share 0.95, none late, driven/planned 0.97, +100% and +50%.
-    let mut new = day(Variant::New, 0, 300.0, false);
+    let mut new = day(Variant::Executive, 0, 300.0, false);
     for w in &mut new.windows {
         w.share = 0.95;
         w.driven_over_planned = Some(0.97);
     }
     let good = [
         new,
-        day(Variant::Shortest, 0, 150.0, false),
-        day(Variant::Today, 0, 200.0, false),
+        day(Variant::FastestPath, 0, 150.0, false),
+        day(Variant::Plain, 0, 200.0, false),
+        day(Variant::NoPeb, 0, 200.0, false),
     ];
     let verdicts = judged(&good);
     assert!(
         verdicts.iter().all(|(_, v)| *v == Verdict::Holds),
         "{verdicts:?}"
     );
-    // The same good day without the baselines: those two goals are not measured.
+    // The same good day without the baselines: those three goals are not measured.
     let verdicts = judged(&good[..1]);
     assert_eq!(
         verdicts
             .iter()
             .filter(|(_, v)| *v == Verdict::NotMeasured)
             .count(),
-        2,
+        3,
         "{verdicts:?}"
     );
 }
@@ -232,13 +240,16 @@ fn bad_options_are_refused_naming_the_field_and_its_limit() {
         .0,
         "days"
     );
-    for cost in [-1.0, f64::NAN, f64::INFINITY, MAX_PLAN_COST_S + 1.0] {
+    for cost in [-1.0, f64::NAN, f64::INFINITY, MAX_PLAN_WALL_S + 1.0] {
         let (field, limit) = refused(DaysOptions {
-            plan_cost_s: cost,
+            plan_wall_s: cost,
             ..ok.clone()
         });
-        assert_eq!(field, "plan_cost_s", "{cost}");
+        assert_eq!(field, "plan_wall_s", "{cost}");
         assert!(limit.contains("seconds"), "{limit}");
+    }
+    for rate in [0.5, f64::NAN, MAX_RATE * 2.0] {
+        assert_eq!(refused(DaysOptions { rate, ..ok.clone() }).0, "rate");
     }
     assert_eq!(
         refused(DaysOptions {

@@ -1,0 +1,303 @@
+//! How the executive plans and watches: [`ExecutiveConfig`], the one configuration the
+//! live executive (`roam mission --config`) and the batch of days
+//! (`roam_experiments::reproduce::mission::days`) both run. Every variant a batch
+//! compares is a value of it, so a report's "variant" is a configuration a user can
+//! run, never a second program.
+
+use std::path::PathBuf;
+
+use roam_proto::keys;
+use roam_proto::planner::PlannerModel;
+use serde::Deserialize;
+
+use crate::calibration::TimeModel;
+use crate::margin::ArrivalMargin;
+use crate::tasks::{self, Task, TaskError};
+use crate::watch::WatchParams;
+
+/// How the executive plans and watches.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ExecutiveConfig {
+    /// The robot this executive drives.
+    pub robot: String,
+    pub tasks: Vec<Task>,
+    /// The curiosity model for downtime paths (paper 000); `shortest` drives the
+    /// fastest path in every window (the baseline).
+    pub model: PlannerModel,
+    /// The planner's deadline, wall seconds (paper 000's t_plan), at most: a replan's
+    /// is cut to what the window can afford ([`ExecutiveConfig::replan_time_share`]).
+    pub plan_deadline_s: f64,
+    /// Generations the GA may run at most (it stops at the deadline anyway).
+    pub max_generations: Option<u32>,
+    /// The planner's localizability cost W_loc (paper 002's PEB in paper 000's fitness;
+    /// see the planner's `w_loc`). `None`: the planner's default, off.
+    pub w_loc: Option<f64>,
+    pub seed: u64,
+    /// Waypoints are at most this far apart along the planned path, metres.
+    pub waypoint_spacing_m: f64,
+    /// An estimate farther than this from the planned path means the robot was pushed
+    /// off it: replan from where it is, metres.
+    pub off_path_m: f64,
+    /// The robot's top speed for the ETA-slip check, m/s.
+    pub speed_m_per_s: f64,
+    /// Replans per window at most.
+    pub max_replans: u32,
+    /// A window is given up this long after its task's start, seconds.
+    pub give_up_after_s: f64,
+    /// No status from the controller on the current mission for this long (wall
+    /// seconds) means the controller lost it (it restarted, or the robot's link was
+    /// down when the mission was sent): replan from where the robot is and send again.
+    pub controller_silence_s: f64,
+    /// Arriving this much earlier than the task's start is slack: the executive replans
+    /// a curious path with the time left (the mirror of the ETA slip rule), seconds.
+    /// Infinity turns the rule off.
+    pub slack_s: f64,
+    /// Mission seconds between two slack replans at least.
+    pub slack_interval_s: f64,
+    /// A slack or behind replan is made only when at least this much of the window is
+    /// left after it, seconds: a short replan near a window's end is the one a time
+    /// model gets most wrong (issue 26: the late windows came from them).
+    pub min_replan_window_s: f64,
+    /// The behind rule ([`crate::watch`]): replan a curious path when the robot's own
+    /// pace says it would arrive late though its top speed would not.
+    pub behind: bool,
+    /// Plan the next window while the robot drives toward (and works at) this task, so
+    /// that planning costs the next window nothing.
+    pub plan_ahead: bool,
+    /// The largest share of the time left that a plan may cost on the mission clock:
+    /// its deadline is cut to `replan_time_share × time left / clock rate` (at the
+    /// demo's 20×, a minute left gives a replan 0.3 s of wall time).
+    pub replan_time_share: f64,
+    /// The arrival margin's floor share of the time to the task, and floor seconds
+    /// ([`crate::margin`]); `0` and `0` with `late_probability` 1 leave no margin.
+    pub arrival_margin_share: f64,
+    pub arrival_margin_min_s: f64,
+    /// The probability of arriving late that each plan's margin is sized for, from the
+    /// robot's own prediction errors ([`crate::margin`]); in (0, 1].
+    pub late_probability: f64,
+    /// Recover a robot that the controller's PEB guard holds: after `hold_patience_s`
+    /// of mission time held, drive it back along its own path to where it had a fix,
+    /// then replan with the time left.
+    pub recover: bool,
+    pub hold_patience_s: f64,
+    /// An estimate whose PEB is at most this is a fix a recovery may go back to: the
+    /// controller's guard (`max_peb_m`, 2 m by default), metres.
+    pub fix_peb_m: f64,
+    /// What a curious plan costs on the mission clock, seconds, fixed (a lock-step sim,
+    /// whose clock stands while the planner works: 0); absent: measured, the wall time
+    /// recent plans took at the clock's rate.
+    pub planning_cost_s: Option<f64>,
+    /// Plan with paper 000 Eq. 2's v_lin and v_ang fitted to what this robot drove
+    /// (Table I as the prior; see [`crate::calibration`]); `false`: Table I throughout.
+    pub calibrate: bool,
+    /// Where the robot's fit is kept across restarts; absent: in memory only.
+    pub calibration_file: Option<PathBuf>,
+    /// The time model before anything was driven (the calibration's prior): Table I's
+    /// v_lin 2.0 s/m and v_ang 1.0 s/rad by default; a robot's datasheet figures where
+    /// they are known. Bounded as the calibration's fits are.
+    pub time_model_prior: TimeModel,
+}
+
+impl ExecutiveConfig {
+    /// The replan policy's parameters for plans made with `model`.
+    pub fn watch_params(&self, model: TimeModel) -> WatchParams {
+        let expected = 1.0 / model.v_lin;
+        WatchParams {
+            off_path_m: self.off_path_m,
+            speed_m_per_s: self.speed_m_per_s.min(expected),
+            expected_speed_m_per_s: expected,
+            max_replans: self.max_replans,
+            give_up_after_s: self.give_up_after_s,
+            controller_silence_s: self.controller_silence_s,
+            slack_s: self.slack_s,
+            slack_interval_s: self.slack_interval_s,
+            min_replan_window_s: self.min_replan_window_s,
+            behind: self.behind,
+        }
+    }
+
+    /// The arrival margin this config asks for ([`crate::margin`]).
+    pub fn margin(&self) -> ArrivalMargin {
+        ArrivalMargin::new(
+            self.arrival_margin_share,
+            self.arrival_margin_min_s,
+            self.late_probability,
+        )
+    }
+
+    /// Plans are curious (the model is not the shortest path).
+    pub fn curious(&self) -> bool {
+        self.model != PlannerModel::Shortest
+    }
+
+    /// The paper's planner alone, as an executive without roam's rules would use it:
+    /// Table I's time model throughout, one plan at each window's start, no slack, no
+    /// behind rule, no arrival margin, no recovery, no PEB cost. What the batch calls
+    /// `plain`.
+    pub fn plain(self) -> ExecutiveConfig {
+        ExecutiveConfig {
+            calibrate: false,
+            slack_s: f64::INFINITY,
+            behind: false,
+            plan_ahead: false,
+            arrival_margin_share: 0.0,
+            arrival_margin_min_s: 0.0,
+            late_probability: 1.0,
+            recover: false,
+            w_loc: None,
+            ..self
+        }
+    }
+
+    /// The fastest path in every window: the baseline a user would drive without roam.
+    pub fn fastest_path_only(self) -> ExecutiveConfig {
+        ExecutiveConfig {
+            model: PlannerModel::Shortest,
+            ..self.plain()
+        }
+    }
+
+    /// Checks every field, naming the first that is out of range.
+    pub fn check(&self) -> Result<(), ConfigError> {
+        tasks::check(&self.tasks)?;
+        keys::check_name("robot", &self.robot).map_err(|e| ConfigError::Field(e.to_string()))?;
+        for (name, value) in [
+            ("plan_deadline_s", self.plan_deadline_s),
+            ("waypoint_spacing_m", self.waypoint_spacing_m),
+            ("off_path_m", self.off_path_m),
+            ("speed_m_per_s", self.speed_m_per_s),
+            ("give_up_after_s", self.give_up_after_s),
+            ("controller_silence_s", self.controller_silence_s),
+            ("slack_interval_s", self.slack_interval_s),
+            ("hold_patience_s", self.hold_patience_s),
+            ("fix_peb_m", self.fix_peb_m),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(ConfigError::Field(format!(
+                    "{name} is {value}; give a positive number"
+                )));
+            }
+        }
+        if !(0.0..0.5).contains(&self.arrival_margin_share) {
+            return Err(ConfigError::Field(format!(
+                "arrival_margin_share is {}; give a share in 0..0.5 of the time to the task",
+                self.arrival_margin_share
+            )));
+        }
+        for (name, value) in [
+            ("arrival_margin_min_s", self.arrival_margin_min_s),
+            ("min_replan_window_s", self.min_replan_window_s),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(ConfigError::Field(format!(
+                    "{name} is {value}; give 0 or more seconds"
+                )));
+            }
+        }
+        if !(self.late_probability > 0.0 && self.late_probability <= 1.0) {
+            return Err(ConfigError::Field(format!(
+                "late_probability is {}; give a probability in (0, 1], e.g. 0.001",
+                self.late_probability
+            )));
+        }
+        if !(self.replan_time_share > 0.0 && self.replan_time_share <= 1.0) {
+            return Err(ConfigError::Field(format!(
+                "replan_time_share is {}; give a share in (0, 1] of the time left",
+                self.replan_time_share
+            )));
+        }
+        if let Some(cost) = self.planning_cost_s {
+            if !(cost.is_finite() && cost >= 0.0) {
+                return Err(ConfigError::Field(format!(
+                    "planning_cost_s is {cost}; give 0 or more seconds, or leave it out to measure it"
+                )));
+            }
+        }
+        if self.slack_s.is_nan() || self.slack_s <= 0.0 {
+            return Err(ConfigError::Field(format!(
+                "slack_s is {}; give a positive number of seconds (.inf turns the slack rule off)",
+                self.slack_s
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl Default for ExecutiveConfig {
+    fn default() -> Self {
+        ExecutiveConfig {
+            robot: "robot".to_owned(),
+            tasks: tasks::builtin(),
+            model: PlannerModel::Model1,
+            plan_deadline_s: 1.0,
+            max_generations: Some(1000),
+            w_loc: None,
+            seed: 0,
+            waypoint_spacing_m: 1.0,
+            off_path_m: 1.5,
+            speed_m_per_s: 0.5,
+            max_replans: 5,
+            give_up_after_s: 60.0,
+            controller_silence_s: 3.0,
+            slack_s: 10.0,
+            slack_interval_s: 10.0,
+            min_replan_window_s: 20.0,
+            behind: true,
+            plan_ahead: true,
+            replan_time_share: 0.1,
+            arrival_margin_share: 0.05,
+            arrival_margin_min_s: 2.0,
+            late_probability: 1e-3,
+            recover: true,
+            hold_patience_s: 4.0,
+            fix_peb_m: 2.0,
+            planning_cost_s: None,
+            calibrate: true,
+            calibration_file: None,
+            time_model_prior: TimeModel::table_i(),
+        }
+    }
+}
+
+/// Why a configuration is refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConfigError {
+    #[error(transparent)]
+    Tasks(#[from] TaskError),
+    #[error("invalid config: {0}")]
+    Field(String),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_is_valid_and_each_bad_field_is_named() {
+        assert_eq!(ExecutiveConfig::default().check(), Ok(()));
+        assert_eq!(ExecutiveConfig::default().plain().check(), Ok(()));
+        let bad = |c: ExecutiveConfig| c.check().expect_err("refused").to_string();
+        let c = ExecutiveConfig::default;
+        assert!(bad(ExecutiveConfig {
+            late_probability: 0.0,
+            ..c()
+        })
+        .contains("late_probability"));
+        assert!(bad(ExecutiveConfig {
+            replan_time_share: 2.0,
+            ..c()
+        })
+        .contains("replan_time_share"));
+        assert!(bad(ExecutiveConfig {
+            hold_patience_s: f64::NAN,
+            ..c()
+        })
+        .contains("hold_patience_s"));
+        assert!(bad(ExecutiveConfig {
+            min_replan_window_s: -1.0,
+            ..c()
+        })
+        .contains("min_replan_window_s"));
+    }
+}
