@@ -52,6 +52,32 @@ pub struct WindowReport {
     pub held_s: f64,
     #[serde(default)]
     pub recoveries: u32,
+    /// The window's plan requests in order (at most [`MAX_REPORTED_ASKS`]; `asks_made`
+    /// counts them all).
+    #[serde(
+        default,
+        skip_serializing_if = "Vec::is_empty",
+        deserialize_with = "crate::bounded::vec::<_, MAX_REPORTED_ASKS, _>"
+    )]
+    pub asks: Vec<AskReport>,
+    #[serde(default)]
+    pub asks_made: u32,
+}
+
+/// The most plan requests a window report lists.
+pub const MAX_REPORTED_ASKS: usize = 64;
+
+/// One plan request of a window, as its report lists it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AskReport {
+    /// When it was asked, mission seconds.
+    pub at_s: f64,
+    pub from: [f64; 2],
+    pub t_exec_s: f64,
+    pub curious: bool,
+    /// For the next window (made ahead), not this one's drive.
+    pub ahead: bool,
 }
 
 /// A window's time model and its prediction error.
@@ -84,12 +110,12 @@ pub struct ExecutiveStatus {
     pub robot: String,
     /// The window it is in (0 for the first).
     pub window: usize,
-    /// The mission time of the last event it handled, seconds.
-    pub heard_s: f64,
-    /// The mission time when it handled the controller's last status, if that was the
-    /// last event, seconds.
+    /// The sim step of the last estimate it handled, and of the estimate the
+    /// controller's last status it handled answered (`None` before the first).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub status_s: Option<f64>,
+    pub estimate_step: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub status_step: Option<u64>,
     /// Plan requests it waits on.
     pub plans_in_flight: u32,
 }

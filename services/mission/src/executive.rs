@@ -141,6 +141,15 @@ struct Executive<'a> {
     /// restarted executive never reuses an id its predecessor sent: the controller's
     /// statuses on an old mission are not taken for a new one's.
     tag: String,
+    /// What it heard last, for its status.
+    heard: Heard,
+}
+
+/// The sim steps of the last estimate and controller status the loop handled.
+#[derive(Debug, Clone, Copy, Default)]
+struct Heard {
+    estimate_step: Option<u64>,
+    status_step: Option<u64>,
 }
 
 /// A plan request's answer as the loop gets it back: the ask's id, whether it was
@@ -214,15 +223,17 @@ impl Executive<'_> {
         roam_runtime::publish_wait(self.session, &key, mission, Delivery::Reliable);
     }
 
-    /// What the executive is doing, for operators and for lock-step drivers: the
-    /// mission time of the last event it handled and the plans in flight.
-    fn publish_status(&self, window: usize, heard_s: f64, status_s: Option<f64>, asks: usize) {
+    /// What the executive is doing, for operators and for lock-step drivers: the sim
+    /// steps of the last estimate and controller status it handled, and the plans in
+    /// flight.
+    fn publish_status(&self, window: usize, asks: usize) {
+        let heard = self.heard;
         let key = keys::robot_executive(self.root, &self.config.robot);
         let status = ExecutiveStatus {
             robot: self.config.robot.clone(),
             window,
-            heard_s,
-            status_s,
+            estimate_step: heard.estimate_step,
+            status_step: heard.status_step,
             plans_in_flight: asks as u32,
         };
         roam_runtime::publish_wait(self.session, &key, &status, Delivery::Latest);
@@ -261,6 +272,7 @@ impl Executive<'_> {
                 sample = self.inputs.estimates.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
                     if let Some(e) = self.inputs.estimate(&sample) {
+                        self.heard.estimate_step = Some(e.step);
                         if !e.degraded {
                             self.position = Some(e.position);
                             return Ok(e.position);
@@ -332,6 +344,7 @@ impl Executive<'_> {
         let mut pending = VecDeque::from(actions);
         // Dropping a request's future cancels it at the planner (PlannerClient::plan).
         let mut in_flight: JoinSet<Answered> = JoinSet::new();
+        self.publish_status(window, machine.asks_in_flight());
         let mut tick = tokio::time::interval(TICK);
         tick.set_missed_tick_behavior(MissedTickBehavior::Delay);
         let name = || task.name.clone();
@@ -388,7 +401,6 @@ impl Executive<'_> {
                     }
                 }
             }
-            let mut status_s = None;
             let event = tokio::select! {
                 _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
                 _ = tick.tick() => WindowEvent::Tick,
@@ -408,25 +420,23 @@ impl Executive<'_> {
                 sample = self.inputs.estimates.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
                     let Some(e) = self.inputs.estimate(&sample) else { continue };
+                    self.heard.estimate_step = Some(e.step);
                     WindowEvent::Estimate { position: e.position, peb_m: e.peb_m, degraded: e.degraded }
                 }
                 sample = self.inputs.statuses.recv_async() => {
                     let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
                     let Some(s) = self.inputs.status(&sample) else { continue };
-                    status_s = s.estimate_step.map(|_| self.now());
+                    self.heard.status_step = s.estimate_step.or(self.heard.status_step);
                     WindowEvent::Status(s)
                 }
             };
             let tick_only = matches!(event, WindowEvent::Tick);
-            let now = self.moment(began);
-            pending.extend(machine.handle(event, now));
-            if !tick_only
-                && pending
-                    .iter()
-                    .all(|a| !matches!(a, WindowAction::RequestPlan(_)))
-            {
-                let asks = machine.asks_in_flight();
-                self.publish_status(window, now.mission_s, status_s, asks);
+            pending.extend(machine.handle(event, self.moment(began)));
+            if !tick_only {
+                // A tick after every event: what the time decides (the task's end, the
+                // last safe moment) is decided at the event's mission time, as in batch.
+                pending.extend(machine.handle(WindowEvent::Tick, self.moment(began)));
+                self.publish_status(window, machine.asks_in_flight());
             }
         }
     }
@@ -487,6 +497,7 @@ pub async fn run(
         plan_wall_s: None,
         handover: Handover::first(config.margin()),
         tag: session.zid().to_string().chars().take(8).collect(),
+        heard: Heard::default(),
     };
     executive.hear_the_clock(cancel).await?;
     let mut outcomes = Vec::with_capacity(config.tasks.len());

@@ -45,6 +45,17 @@ impl Clock {
         }
     }
 
+    /// An input stamped `time_s` on the sim's clock came: the clock is at least there
+    /// (the estimate of a step can overtake the step's clock on its way through the
+    /// router). Without a sim clock heard, nothing changes.
+    pub(crate) fn heard_at(&mut self, time_s: f64) {
+        if let Some((_, latest)) = self.latest {
+            if time_s.is_finite() && time_s > latest {
+                self.latest = Some((Instant::now(), time_s));
+            }
+        }
+    }
+
     /// Mission seconds per wall second, measured; 1 until half a second was seen.
     pub(crate) fn rate(&self) -> f64 {
         match (self.first, self.latest) {
@@ -149,7 +160,11 @@ impl Inputs {
     /// the robot in its body. Anything else is ignored.
     pub(crate) fn estimate(&self, sample: &Sample) -> Option<PositionEstimate> {
         let e: PositionEstimate = own(sample, &self.estimate_key)?;
-        (e.robot == self.robot).then_some(e)
+        if e.robot != self.robot {
+            return None;
+        }
+        lock(&self.clock).heard_at(e.time_s);
+        Some(e)
     }
 
     /// The controller's status in `sample` when it is on this robot, as

@@ -31,7 +31,8 @@
 //! 5. **Holds.** When the controller's PEB guard holds the robot for
 //!    `hold_patience_s`, the window sends a recovery mission back along the robot's own
 //!    track to the last estimate with a fix (PEB at most `fix_peb_m`), which the guard
-//!    lets through, then replans from there with the time left.
+//!    lets through, then sends it straight to the task from there (a curious route would
+//!    lead back into the gap). At most [`MAX_RECOVERIES`] a window.
 //! 6. **Arrive**: the time model's prediction is scored, the arrival margin learns, and
 //!    the window is done when the task ends (and the next window's plan is in, or
 //!    failed). **Give up**: done at once.
@@ -56,6 +57,7 @@ pub use routes::{routes, PlannedAhead, Route};
 
 use roam_planner::plan::MAX_T_EXEC_S;
 use roam_proto::controller::{ControllerStatus, Mission, MissionState};
+use roam_proto::mission::{AskReport, MAX_REPORTED_ASKS};
 
 use crate::calibration::TimeModel;
 use crate::config::ExecutiveConfig;
@@ -83,6 +85,10 @@ pub const FALLBACK_AFTER_FAILURES: u32 = 2;
 
 /// Mission seconds between two last-safe-moment checks at most.
 pub const SAFE_CHECK_S: f64 = 1.0;
+
+/// Recoveries from PEB holds one window sends at most: a robot held again after them
+/// stays held (and the window is given up in time), rather than shuttle.
+pub const MAX_RECOVERIES: u32 = 3;
 
 /// The least deadline a plan request carries, wall seconds.
 pub const MIN_DEADLINE_S: f64 = 0.05;
@@ -265,6 +271,10 @@ pub struct DowntimeWindow<'a> {
     pebs: Vec<f64>,
     drive_ask: Option<(u64, DriveAsk)>,
     ahead_ask: Option<(u64, AheadAsk)>,
+    /// The window's requests, for its report (at most [`MAX_REPORTED_ASKS`]), and how
+    /// many it made.
+    asks: Vec<AskReport>,
+    asks_in_window: u32,
     phase: Phase,
 }
 
@@ -294,6 +304,8 @@ impl<'a> DowntimeWindow<'a> {
             pebs: Vec::new(),
             drive_ask: None,
             ahead_ask: None,
+            asks: Vec::new(),
+            asks_in_window: 0,
             phase: Phase::FirstPlan {
                 retry_at_wall_s: None,
                 failures: 0,
@@ -368,16 +380,35 @@ impl<'a> DowntimeWindow<'a> {
         let earliest = now.mission_s + cost;
         let time_left = task_start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
         let budget_s = self.margin.budget(time_left);
-        self.asks_made += 1;
         let ask = PlanAsk {
-            id: self.asks_made,
+            id: self.next_ask_id(),
             from,
             to,
             t_exec_s: budget_s.clamp(LEAST_T_EXEC_S, MAX_T_EXEC_S),
             deadline_s,
             curious: curious && budget_s > 0.0,
         };
+        self.record(&ask, leave_at_s.is_some(), now);
         (ask, budget_s, time_left)
+    }
+
+    fn next_ask_id(&mut self) -> u64 {
+        self.asks_made += 1;
+        self.asks_made
+    }
+
+    /// Keeps `ask` for the window's report.
+    fn record(&mut self, ask: &PlanAsk, ahead: bool, now: Now) {
+        self.asks_in_window += 1;
+        if self.asks.len() < MAX_REPORTED_ASKS {
+            self.asks.push(AskReport {
+                at_s: now.mission_s,
+                from: ask.from,
+                t_exec_s: ask.t_exec_s,
+                curious: ask.curious,
+                ahead,
+            });
+        }
     }
 
     fn ask_first_plan(&mut self, now: Now) -> WindowAction {
@@ -507,8 +538,12 @@ impl<'a> DowntimeWindow<'a> {
         let status = match s.state {
             MissionState::Completed => Status::Completed,
             MissionState::Stuck | MissionState::StepLimit => Status::Stuck,
-            MissionState::Active => Status::Active {
-                distance_left_m: s.distance_left_m.unwrap_or(0.0),
+            // The controller's acknowledgement of a new mission carries no distance yet:
+            // heard, but no progress to measure (taking it as 0 m left would spoil the
+            // robot's pace for the whole mission).
+            MissionState::Active => match s.distance_left_m {
+                Some(distance_left_m) => Status::Active { distance_left_m },
+                None => Status::Other,
             },
             MissionState::HaltedPeb => Status::Halted,
             _ => Status::Other,
@@ -521,11 +556,15 @@ impl<'a> DowntimeWindow<'a> {
         }
         if drive.recovering {
             return match status {
-                // Back at the fix (or stuck on the way): a new plan from there.
+                // Back at the fix (or stuck on the way): straight to the task from
+                // there. A curious route would lead back into the coverage gap it was
+                // held in (the planner does not know where the guard holds robots).
                 Status::Completed | Status::Stuck => {
                     drive.recovering = false;
-                    let curious = !drive.watch.slipped();
-                    self.replan(Reason::Recovered, curious, true, now)
+                    match self.fastest_from_here() {
+                        Some(route) => self.go_straight(route, Reason::Recovered, now),
+                        None => self.replan(Reason::Recovered, false, true, now),
+                    }
                 }
                 _ => Vec::new(),
             };
@@ -812,12 +851,12 @@ impl<'a> DowntimeWindow<'a> {
                 resend,
                 ask,
             } if ask.curious => {
-                self.asks_made += 1;
                 let ask = PlanAsk {
-                    id: self.asks_made,
+                    id: self.next_ask_id(),
                     curious: false,
                     ..ask
                 };
+                self.record(&ask, false, now);
                 self.drive_ask = Some((
                     ask.id,
                     DriveAsk::Replan {

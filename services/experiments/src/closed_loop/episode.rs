@@ -1,5 +1,6 @@
 //! One batch run of the controller in the sim world, without any network: the loop the
-//! experiments repeat and that the services reproduce step for step.
+//! experiments repeat and that the services reproduce step for step. It is the one
+//! closed loop roam has, [`Stepper`], driven to the end ([`run_episode`]).
 //!
 //! The structure is kept literally like the services' (sim → ranges → localization →
 //! controller → commands → sim):
@@ -29,13 +30,14 @@ use std::sync::Arc;
 
 use roam_localization::fim::FimOptions;
 use roam_localization::model::RangingModel;
-use roam_localization::{LocalizationError, Tracker};
-use roam_sim::messages::robot_messages;
-use roam_sim::{Command, Sim, SimError, SimParams};
+use roam_localization::LocalizationError;
+use roam_sim::{SimError, SimParams};
 use roam_world::scenario::Scenario;
 use serde::Serialize;
 
-use roam_controller::controller::{Controller, Decision, MissionStatus};
+use roam_controller::controller::{Decision, MissionStatus};
+
+use crate::closed_loop::stepper::Stepper;
 use roam_controller::information::InformationField;
 use roam_controller::obstacle_field::ObstacleField;
 use roam_controller::params::{ApfParams, ParamError};
@@ -189,14 +191,8 @@ impl Episode {
     }
 }
 
-struct EpisodeRobot {
-    index: usize,
-    controller: Controller,
-    track: RobotTrack,
-    done: bool,
-}
-
-/// Runs one episode (module doc) of `setup`'s scenario with seed `seed`.
+/// Runs `missions` (at most one per robot) from the scenario's start to the end (module
+/// doc) with the scenario's sim parameters: a [`Stepper`] driven to the end.
 pub fn run_episode(
     setup: &Setup,
     params: &ApfParams,
@@ -204,89 +200,80 @@ pub fn run_episode(
     missions: &[RobotMission],
     seed: u64,
 ) -> Result<Episode, EpisodeError> {
-    params.check()?;
-    let mut sim = Sim::with_params(&setup.scenario, setup.sim_params, seed)?;
-    let mut tracker = Tracker::new(setup.scenario.file.sensing, FimOptions::default());
-    let mut driven: BTreeMap<&str, EpisodeRobot> = BTreeMap::new();
+    run_episode_with(setup, setup.sim_params, params, source, missions, seed)
+}
+
+/// [`run_episode`] with the sim's parameters `sim_params` (e.g. with its observation
+/// on, [`Stepper::observing`]: the tracks do not change).
+pub fn run_episode_with(
+    setup: &Setup,
+    sim_params: SimParams,
+    params: &ApfParams,
+    source: PositionSource,
+    missions: &[RobotMission],
+    seed: u64,
+) -> Result<Episode, EpisodeError> {
+    let mut stepper = Stepper::new(setup, sim_params, params, source, seed)?;
+    // Each robot's track, whether it is done, and its mission's rank.
+    let mut tracks: BTreeMap<String, (RobotTrack, bool, usize)> = BTreeMap::new();
     for (index, m) in missions.iter().enumerate() {
-        if sim.robot(&m.robot).is_none() {
-            return Err(EpisodeError::UnknownRobot(m.robot.clone()));
+        stepper.set_mission(&m.robot, m.waypoints.clone())?;
+        let done = m.waypoints.is_empty();
+        if done {
+            stepper.retire(&m.robot);
         }
-        let mut controller = Controller::new(
-            params.clone(),
-            setup.obstacles.clone(),
-            setup.information.clone(),
-        );
-        controller.set_mission(m.waypoints.clone());
-        let d = EpisodeRobot {
-            index,
-            done: !controller.is_active(),
-            controller,
-            track: RobotTrack {
-                robot: m.robot.clone(),
-                waypoints: m.waypoints.clone(),
-                status: MissionStatus::Idle,
-                success: m.waypoints.is_empty(),
-                steps: 0,
-                distance_m: 0.0,
-                truth: Vec::new(),
-                estimate: Vec::new(),
-                error_m: Vec::new(),
-                held_updates: 0,
-            },
+        let track = RobotTrack {
+            robot: m.robot.clone(),
+            waypoints: m.waypoints.clone(),
+            status: MissionStatus::Idle,
+            success: done,
+            steps: 0,
+            distance_m: 0.0,
+            truth: Vec::new(),
+            estimate: Vec::new(),
+            error_m: Vec::new(),
+            held_updates: 0,
         };
-        if driven.insert(m.robot.as_str(), d).is_some() {
+        if tracks
+            .insert(m.robot.clone(), (track, done, index))
+            .is_some()
+        {
             return Err(EpisodeError::DuplicateMission(m.robot.clone()));
         }
     }
     let max_sim_steps = params.max_steps.saturating_add(1);
-    let mut report = sim.step(&[])?;
     loop {
-        let mut commands = Vec::new();
-        for r in &report.robots {
-            let messages = robot_messages(&sim, report.step, report.time_s, r);
-            // The localization service ignores a scan it refuses; so does the episode.
-            let Ok(estimate) = tracker.on_scan(&messages.ranges) else {
+        let out = stepper.step()?;
+        for r in &out.robots {
+            // A refused scan updates no controller, as the localization service
+            // publishes nothing for it.
+            let (Some(e), Some(d)) = (&r.estimate, r.decision) else {
                 continue;
             };
-            let Some(d) = driven.get_mut(r.name.as_str()) else {
+            let Some((track, done, _)) = tracks.get_mut(&r.robot) else {
                 continue;
             };
-            if d.done {
-                continue;
-            }
-            let truth = r.readings.truth;
-            let (position, peb) = match source {
-                PositionSource::Estimate => (estimate.position, estimate.peb_m),
-                PositionSource::Truth => (truth, setup.information.peb_m(truth)),
-            };
-            let decision = d.controller.update(position, peb);
-            d.done = d.track.record(
-                truth,
-                estimate.position,
-                &decision,
+            *done = track.record(
+                r.messages.truth.at,
+                e.position,
+                &d,
                 params.stuck_window_steps,
             );
-            if decision.status == MissionStatus::Active {
-                commands.push(Command {
-                    robot: r.name.clone(),
-                    u: decision.u,
-                });
+            if *done {
+                stepper.retire(&r.robot);
             }
         }
-        if driven.values().all(|d| d.done) || sim.steps() >= max_sim_steps {
+        if tracks.values().all(|(_, done, _)| *done) || stepper.sim().steps() >= max_sim_steps {
             break;
         }
-        report = sim.step(&commands)?;
     }
-    let sim_steps = sim.steps();
     let mut robots: Vec<(usize, RobotTrack)> =
-        driven.into_values().map(|d| (d.index, d.track)).collect();
+        tracks.into_values().map(|(t, _, i)| (i, t)).collect();
     robots.sort_by_key(|(i, _)| *i);
     Ok(Episode {
         seed,
         source,
-        sim_steps,
+        sim_steps: stepper.sim().steps(),
         robots: robots.into_iter().map(|(_, t)| t).collect(),
     })
 }

@@ -197,9 +197,12 @@ mod tests {
 
     use super::*;
     use crate::closed_loop::episode::{
-        load_scenario, mission_from_waypoints, run_episode, Episode, RobotMission, RobotTrack,
+        load_scenario, mission_from_waypoints, run_episode, run_episode_with, Episode,
+        RobotMission, RobotTrack,
     };
     use roam_controller::params::Follow;
+    use roam_sim::messages::robot_messages;
+    use roam_sim::Sim;
 
     fn scenario(file: &str) -> Setup {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -208,79 +211,112 @@ mod tests {
         Setup::new(&load_scenario(&path).expect("scenario")).expect("setup")
     }
 
-    /// `run_episode` rebuilt on a stepper: one mission per robot, a robot retired when
-    /// it is done, the run over when all are or after `max_steps` + 1 sim steps.
-    fn stepped(
+    struct EpisodeRobot {
+        index: usize,
+        controller: Controller,
+        track: RobotTrack,
+        done: bool,
+    }
+
+    /// The episode loop as paper 002's experiments were first written here, on the sim,
+    /// tracker and controllers directly: the reference [`run_episode`] (now a stepper
+    /// driven to the end) must match bit for bit.
+    fn loop_episode(
         setup: &Setup,
-        sim_params: SimParams,
         params: &ApfParams,
         source: PositionSource,
         missions: &[RobotMission],
         seed: u64,
-    ) -> Episode {
-        let mut s = Stepper::new(setup, sim_params, params, source, seed).expect("stepper");
-        let mut tracks: BTreeMap<String, (RobotTrack, bool)> = BTreeMap::new();
-        for m in missions {
-            s.set_mission(&m.robot, m.waypoints.clone())
-                .expect("mission");
-            let track = RobotTrack {
-                robot: m.robot.clone(),
-                waypoints: m.waypoints.clone(),
-                status: MissionStatus::Idle,
-                success: m.waypoints.is_empty(),
-                steps: 0,
-                distance_m: 0.0,
-                truth: Vec::new(),
-                estimate: Vec::new(),
-                error_m: Vec::new(),
-                held_updates: 0,
-            };
-            let done = m.waypoints.is_empty();
-            if done {
-                s.retire(&m.robot);
+    ) -> Result<Episode, EpisodeError> {
+        params.check()?;
+        let mut sim = Sim::with_params(&setup.scenario, setup.sim_params, seed)?;
+        let mut tracker = Tracker::new(setup.scenario.file.sensing, FimOptions::default());
+        let mut driven: BTreeMap<&str, EpisodeRobot> = BTreeMap::new();
+        for (index, m) in missions.iter().enumerate() {
+            if sim.robot(&m.robot).is_none() {
+                return Err(EpisodeError::UnknownRobot(m.robot.clone()));
             }
-            tracks.insert(m.robot.clone(), (track, done));
+            let mut controller = Controller::new(
+                params.clone(),
+                setup.obstacles.clone(),
+                setup.information.clone(),
+            );
+            controller.set_mission(m.waypoints.clone());
+            let d = EpisodeRobot {
+                index,
+                done: !controller.is_active(),
+                controller,
+                track: RobotTrack {
+                    robot: m.robot.clone(),
+                    waypoints: m.waypoints.clone(),
+                    status: MissionStatus::Idle,
+                    success: m.waypoints.is_empty(),
+                    steps: 0,
+                    distance_m: 0.0,
+                    truth: Vec::new(),
+                    estimate: Vec::new(),
+                    error_m: Vec::new(),
+                    held_updates: 0,
+                },
+            };
+            if driven.insert(m.robot.as_str(), d).is_some() {
+                return Err(EpisodeError::DuplicateMission(m.robot.clone()));
+            }
         }
-        let max = params.max_steps.saturating_add(1);
+        let max_sim_steps = params.max_steps.saturating_add(1);
+        let mut report = sim.step(&[])?;
         loop {
-            let out = s.step().expect("step");
-            for r in &out.robots {
-                let (Some(e), Some(d)) = (&r.estimate, r.decision) else {
+            let mut commands = Vec::new();
+            for r in &report.robots {
+                let messages = robot_messages(&sim, report.step, report.time_s, r);
+                // The localization service ignores a scan it refuses; so does the episode.
+                let Ok(estimate) = tracker.on_scan(&messages.ranges) else {
                     continue;
                 };
-                let Some((t, done)) = tracks.get_mut(&r.robot) else {
+                let Some(d) = driven.get_mut(r.name.as_str()) else {
                     continue;
                 };
-                *done = t.record(
-                    r.messages.truth.at,
-                    e.position,
-                    &d,
+                if d.done {
+                    continue;
+                }
+                let truth = r.readings.truth;
+                let (position, peb) = match source {
+                    PositionSource::Estimate => (estimate.position, estimate.peb_m),
+                    PositionSource::Truth => (truth, setup.information.peb_m(truth)),
+                };
+                let decision = d.controller.update(position, peb);
+                d.done = d.track.record(
+                    truth,
+                    estimate.position,
+                    &decision,
                     params.stuck_window_steps,
                 );
-                if *done {
-                    s.retire(&r.robot);
+                if decision.status == MissionStatus::Active {
+                    commands.push(Command {
+                        robot: r.name.clone(),
+                        u: decision.u,
+                    });
                 }
             }
-            if tracks.values().all(|(_, done)| *done) || s.sim().steps() >= max {
+            if driven.values().all(|d| d.done) || sim.steps() >= max_sim_steps {
                 break;
             }
+            report = sim.step(&commands)?;
         }
-        let mut robots: Vec<RobotTrack> = Vec::new();
-        for m in missions {
-            if let Some((t, _)) = tracks.remove(&m.robot) {
-                robots.push(t);
-            }
-        }
-        Episode {
+        let sim_steps = sim.steps();
+        let mut robots: Vec<(usize, RobotTrack)> =
+            driven.into_values().map(|d| (d.index, d.track)).collect();
+        robots.sort_by_key(|(i, _)| *i);
+        Ok(Episode {
             seed,
             source,
-            sim_steps: s.sim().steps(),
-            robots,
-        }
+            sim_steps,
+            robots: robots.into_iter().map(|(_, t)| t).collect(),
+        })
     }
 
     #[test]
-    fn a_stepper_driven_like_run_episode_gives_its_tracks_bit_for_bit() {
+    fn run_episode_on_a_stepper_gives_the_first_loops_tracks_bit_for_bit() {
         let es1 = scenario("es1.yaml");
         let paper = ApfParams {
             max_steps: 600,
@@ -294,15 +330,8 @@ mod tests {
         ] {
             let a =
                 run_episode(&es1, &paper, source, std::slice::from_ref(&m), seed).expect("episode");
-            let b = stepped(
-                &es1,
-                es1.sim_params,
-                &paper,
-                source,
-                std::slice::from_ref(&m),
-                seed,
-            );
-            assert_eq!(a, b, "ES1, seed {seed}");
+            let b = loop_episode(&es1, &paper, source, std::slice::from_ref(&m), seed);
+            assert_eq!(a, b.expect("episode"), "ES1, seed {seed}");
             assert!(a.robots[0].steps > 50, "it drove");
         }
         // The built-in world's robot along a U (indoor, path following) and along the
@@ -325,15 +354,14 @@ mod tests {
                 7,
             )
             .expect("episode");
-            let b = stepped(
+            let b = loop_episode(
                 &downtime,
-                downtime.sim_params,
                 &indoor,
                 PositionSource::Estimate,
                 std::slice::from_ref(&u),
                 7,
             );
-            assert_eq!(a, b, "{follow:?}");
+            assert_eq!(a, b.expect("episode"), "{follow:?}");
             assert!(a.success(), "{follow:?}");
         }
     }
@@ -346,27 +374,28 @@ mod tests {
             robot: "robot".into(),
             waypoints: vec![[-8.0, -4.0], [-4.0, -4.0]],
         };
-        let quiet = stepped(
+        let quiet = run_episode(
             &day,
-            day.sim_params,
             &indoor,
             PositionSource::Estimate,
             std::slice::from_ref(&to),
             3,
-        );
+        )
+        .expect("episode");
         let watched = Stepper::observing(&day);
         assert!(
             watched.sensing.observation_radius_m > 0.0,
             "day.yaml observes"
         );
-        let seen = stepped(
+        let seen = run_episode_with(
             &day,
             watched,
             &indoor,
             PositionSource::Estimate,
             std::slice::from_ref(&to),
             3,
-        );
+        )
+        .expect("episode");
         assert_eq!(quiet, seen);
 
         // Midway, a new mission back to the start: the robot turns around.

@@ -3,7 +3,7 @@
 //! (with or without a plan), and the outcome: the window's report with the paths
 //! planned, driven and the shortest.
 
-use roam_proto::mission::{TimeModelReport, WindowReport};
+use roam_proto::mission::{TimeModelReport, WindowReport, MAX_REPORTED_ASKS};
 
 use super::{
     DowntimeWindow, Drive, DrivenMission, Handover, Now, Phase, WindowAction, WindowEnd,
@@ -100,6 +100,8 @@ impl DowntimeWindow<'_> {
             holds: 0,
             held_s: 0.0,
             recoveries: 0,
+            asks: std::mem::take(&mut self.asks),
+            asks_made: self.asks_in_window,
         };
         let outcome = WindowOutcome {
             report,
@@ -150,6 +152,8 @@ impl DowntimeWindow<'_> {
             holds: drive.holds,
             held_s: drive.held_s,
             recoveries: drive.recoveries,
+            asks: std::mem::take(&mut self.asks),
+            asks_made: self.asks_in_window,
         };
         WindowOutcome {
             report,
@@ -167,9 +171,15 @@ impl DowntimeWindow<'_> {
         if self.ahead_ask.is_some() || now.mission_s < leave_at_s {
             return Vec::new();
         }
-        let Phase::AtTask { outcome, .. } = std::mem::replace(&mut self.phase, Phase::Done) else {
+        let Phase::AtTask { mut outcome, .. } = std::mem::replace(&mut self.phase, Phase::Done)
+        else {
             return Vec::new();
         };
+        // The requests made at the task (the next window's) belong to this window too.
+        let report = &mut outcome.report;
+        let room = MAX_REPORTED_ASKS.saturating_sub(report.asks.len());
+        report.asks.extend(self.asks.drain(..).take(room));
+        report.asks_made = self.asks_in_window;
         vec![self.finish(Some(*outcome))]
     }
 

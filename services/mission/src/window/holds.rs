@@ -19,7 +19,8 @@ impl DowntimeWindow<'_> {
             now.mission_s
         });
         let held_s = now.mission_s - since;
-        if !rules.recover || drive.recovering || held_s < rules.hold_patience_s {
+        let spent = drive.recoveries >= super::MAX_RECOVERIES;
+        if !rules.recover || drive.recovering || spent || held_s < rules.hold_patience_s {
             return Vec::new();
         }
         let back = straight::back_along(&self.driven, self.last_fix);

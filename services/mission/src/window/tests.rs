@@ -930,11 +930,11 @@ fn a_robot_held_for_its_peb_is_driven_back_to_its_last_fix_then_replanned() {
     let back = sent(&actions);
     assert!(back.recovery, "the guard lets a recovery through");
     assert_eq!(back.waypoints.last().copied(), Some([0.1, 0.5]), "{back:?}");
-    // Back at the fix: a curious plan from there with the time left.
+    // Back at the fix: straight to the task from there, without the planner.
     let actions = answer_status(&mut w, &back, MissionState::Completed, at(20.0, 0.3));
-    let ask = asked(&actions);
-    assert!(ask.curious);
-    let actions = answer(&mut w, curious_reply(true), at(21.0, 0.4));
+    assert!(!actions
+        .iter()
+        .any(|a| matches!(a, WindowAction::RequestPlan(_))));
     assert_eq!(
         actions[0],
         WindowAction::Replanned {

@@ -12,8 +12,9 @@
 //!
 //! and its events heard in the same order: every sim step, localization's estimate,
 //! the controller's status on the current mission (the controller service's own
-//! message, [`roam_controller::status::controller_status`]), the plan answers that are
-//! due, then a tick. Wall time is mission time over the clock's rate (the demo's 20×),
+//! message, [`roam_controller::status::controller_status`]), each followed by a tick
+//! (the live executive ticks after every event), the plan answers that are due, then a
+//! tick. Wall time is mission time over the clock's rate (the demo's 20×),
 //! so the wall-clock rules (plan retries, a silent controller) behave as they do in the
 //! demo.
 
@@ -31,6 +32,7 @@ use roam_mission::window::{
     DowntimeWindow, Handover, Now, WindowAction, WindowEnd, WindowEvent, WindowOutcome,
     WindowRules, WindowSetup,
 };
+use roam_proto::mission::WindowReport;
 use roam_proto::planner::Plan;
 use roam_world::seed::splitmix64;
 use serde::Serialize;
@@ -60,24 +62,14 @@ pub struct DayResult {
     /// The ranges of the day's first scan: the same in every variant of a day (the
     /// sim's noise depends on the day, not on the variant).
     pub first_ranges: Vec<f64>,
-    /// Every plan request of the day in order, as (ask id, curious, from, t_exec_s):
-    /// what the equivalence test holds the live executive to.
+    /// The executive's own window reports, as the live executive publishes them:
+    /// what the equivalence test holds the live executive to (not in the JSON: the
+    /// windows above carry their figures).
     #[serde(skip)]
-    pub asks: Vec<AskRecord>,
+    pub reports: Vec<WindowReport>,
     /// The robot's true path through the whole day (not in the JSON: large).
     #[serde(skip)]
     pub truth: Vec<[f64; 2]>,
-}
-
-/// A plan request the day made.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AskRecord {
-    pub window: usize,
-    pub curious: bool,
-    pub from: [f64; 2],
-    pub t_exec_s: f64,
-    /// Mission time it was asked at, seconds.
-    pub at_s: f64,
 }
 
 /// The seed of day `day` in a batch seeded `seed`.
@@ -104,6 +96,11 @@ pub fn day_config(
     variant.config(base, options.w_loc)
 }
 
+/// The sim's seed on a day seeded `day_seed` (the same for every variant).
+pub fn sim_seed(day_seed: u64) -> u64 {
+    splitmix64(day_seed ^ SIM_STREAM)
+}
+
 /// Runs day `day` of `variant`.
 pub fn run_day(
     world: &DayWorld,
@@ -113,21 +110,48 @@ pub fn run_day(
 ) -> Result<DayResult, DaysError> {
     let seed = day_seed(options.seed, day);
     let config = day_config(world, variant, options, seed);
-    let planner = Planner {
+    let (windows, first_ranges, reports, truth) = drive(
         world,
-        change: variant.change_coupling(),
-    };
-    let robot = Robot::new(world, &ApfParams::indoor(), splitmix64(seed ^ SIM_STREAM))?;
-    let mut day_run = DayRun::new(world, &config, planner, robot, options)?;
-    let windows = day_run.drive_day()?;
+        &config,
+        variant.change_coupling(),
+        sim_seed(seed),
+        options,
+    )?;
     Ok(DayResult {
         day,
         variant,
         windows,
-        first_ranges: day_run.robot.first_ranges().to_vec(),
-        asks: day_run.asks,
-        truth: day_run.truth,
+        first_ranges,
+        reports,
+        truth,
     })
+}
+
+/// What [`drive`] returns: the windows' measures, the first scan's ranges, the
+/// executive's window reports and the robot's true path.
+pub type Driven = (
+    Vec<WindowResult>,
+    Vec<f64>,
+    Vec<WindowReport>,
+    Vec<[f64; 2]>,
+);
+
+/// The executive configured by `config` through its day, the planner coupling the
+/// change layer when `change`, the sim seeded `sim_seed`, with the controller the demo
+/// runs ([`ApfParams::indoor`]).
+pub fn drive(
+    world: &DayWorld,
+    config: &ExecutiveConfig,
+    change: bool,
+    sim_seed: u64,
+    options: &DaysOptions,
+) -> Result<Driven, DaysError> {
+    let planner = Planner { world, change };
+    let robot = Robot::new(world, &ApfParams::indoor(), sim_seed)?;
+    let mut day_run = DayRun::new(world, config, planner, robot, options)?;
+    let windows = day_run.drive_day()?;
+    let first_ranges = day_run.robot.first_ranges().to_vec();
+    Ok((windows, first_ranges, day_run.reports, day_run.truth))
 }
 
 /// The executive through one variant's day, and the robot it drives.
@@ -138,13 +162,15 @@ pub struct DayRun<'a> {
     pub planner: Planner<'a>,
     pub robot: Robot,
     pub calibration: Calibration,
-    /// What the last window handed the next.
+    /// What the last window handed the next, and where it left the robot (its last good
+    /// estimate, as the live executive keeps it).
     handover: Handover,
+    position: Option<[f64; 2]>,
     /// The clock's rate: wall time is mission time over it.
     rate: f64,
     /// What a curious plan costs at most, wall seconds (its deadline may cut it).
     plan_wall_s: f64,
-    pub asks: Vec<AskRecord>,
+    pub reports: Vec<WindowReport>,
     /// The whole day's true path.
     pub truth: Vec<[f64; 2]>,
 }
@@ -179,9 +205,10 @@ impl<'a> DayRun<'a> {
             robot,
             calibration: Calibration::new(config.time_model_prior, CalibrationConfig::default())?,
             handover: Handover::first(config.margin()),
+            position: None,
             rate: options.rate,
             plan_wall_s: options.plan_wall_s,
-            asks: Vec::new(),
+            reports: Vec::new(),
             truth: Vec::new(),
         })
     }
@@ -240,7 +267,10 @@ impl<'a> DayRun<'a> {
         next: Option<&Task>,
     ) -> Result<Option<WindowResult>, DaysError> {
         let began = self.robot.now_s();
-        let from = self.robot.position().unwrap_or([f64::NAN, f64::NAN]);
+        let from = self
+            .position
+            .or(self.robot.position())
+            .unwrap_or([f64::NAN, f64::NAN]);
         let model = self.time_model();
         let world = self.world;
         let setup = WindowSetup {
@@ -266,24 +296,25 @@ impl<'a> DayRun<'a> {
         if let Some(&at) = self.truth.last() {
             log.track.truth.push(at);
         }
-        let mut ended = self.perform(w, &mut machine, &mut log, actions)?;
+        let mut ended = self.perform(&mut machine, &mut log, actions)?;
         while ended.is_none() {
-            ended = self.step_window(w, &mut machine, &mut log)?;
+            ended = self.step_window(&mut machine, &mut log)?;
         }
         let Some(end) = ended else {
             return Ok(None);
         };
         self.handover = end.handover;
-        Ok(end
-            .outcome
-            .map(|outcome| self.result(w, task, began, outcome, log)))
+        self.position = Some(end.position);
+        Ok(end.outcome.map(|outcome| {
+            self.reports.push(outcome.report.clone());
+            self.result(w, task, began, outcome, log)
+        }))
     }
 
     /// One sim step of the window: its estimate, the controller's status, the answers
     /// due, a tick; the window's end if it came.
     fn step_window(
         &mut self,
-        w: usize,
         machine: &mut DowntimeWindow<'_>,
         log: &mut WindowLog,
     ) -> Result<Option<WindowEnd>, DaysError> {
@@ -313,21 +344,23 @@ impl<'a> DayRun<'a> {
             );
             events.push(WindowEvent::Status(status));
         }
+        // Each event is followed by a tick, as the live executive ticks after each.
         for event in events {
-            let actions = machine.handle(event, self.now());
-            if let Some(end) = self.perform(w, machine, log, actions)? {
-                return Ok(Some(end));
+            for event in [event, WindowEvent::Tick] {
+                let actions = machine.handle(event, self.now());
+                if let Some(end) = self.perform(machine, log, actions)? {
+                    return Ok(Some(end));
+                }
             }
         }
         let actions = machine.handle(WindowEvent::Tick, self.now());
-        self.perform(w, machine, log, actions)
+        self.perform(machine, log, actions)
     }
 
     /// Performs `actions` in order, then hands the machine every answer that is due
     /// (and performs what it asks in turn); the window's end if it came.
     fn perform(
         &mut self,
-        w: usize,
         machine: &mut DowntimeWindow<'_>,
         log: &mut WindowLog,
         actions: Vec<WindowAction>,
@@ -358,13 +391,6 @@ impl<'a> DayRun<'a> {
                         } else {
                             0.0
                         };
-                        self.asks.push(AskRecord {
-                            window: w,
-                            curious: ask.curious,
-                            from: ask.from,
-                            t_exec_s: ask.t_exec_s,
-                            at_s: now,
-                        });
                         log.answers.push((now + cost_s, ask.id, answer));
                     }
                     WindowAction::Forget(id) => log.answers.retain(|a| a.1 != id),

@@ -154,7 +154,7 @@ pub(super) fn day(variant: Variant, day: usize, info: f64, late: bool) -> DayRes
         variant,
         windows: vec![window(0, 0.5, info, false), window(1, 0.9, info, late)],
         first_ranges: Vec::new(),
-        asks: Vec::new(),
+        reports: Vec::new(),
         truth: Vec::new(),
     }
 }

@@ -17,6 +17,7 @@ use roam_world::scenario::{self, Scenario};
 use roam_world::DEFAULT_MAX_CELLS;
 
 use super::DaysError;
+use roam_mission::calibration::TimeModel;
 use roam_mission::tasks::{self, Task, DAY_SCENARIO};
 
 /// The inflated map's occupied value (the map server's `inflated` layer).
@@ -86,6 +87,9 @@ impl DayWorld {
         let setup = Setup::new(&scenario).map_err(|e| world(&e))?;
         let sim_params = Stepper::observing(&setup);
         let tasks = tasks::day();
+        let start = scenario.file.robots.first().map(|r| r.at);
+        roam_mission::day_check::check_day(&tasks, &planning, TimeModel::table_i(), start)
+            .map_err(|e| world(&e))?;
         let step_s = scenario.file.time.step_s;
         let day_s = tasks.last().map_or(0.0, |t| t.start_s + t.duration_s);
         let moving = changing_cells(&setup, sim_params, day_s, step_s)?;
