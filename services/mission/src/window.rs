@@ -30,7 +30,8 @@
 //!    the window. A late ETA does the same.
 //! 5. **Holds.** When the controller's PEB guard holds the robot for
 //!    `hold_patience_s`, the window sends a recovery mission back along the robot's own
-//!    track to the last estimate with a fix (PEB at most `fix_peb_m`), which the guard
+//!    track to the last estimate with a fix (PEB at most `fix_peb_m`) and at least
+//!    [`RECOVERY_BACK_M`] back (where the fix is lost the estimate freezes), which the guard
 //!    lets through, then sends it straight to the task from there (a curious route would
 //!    lead back into the gap). At most [`MAX_RECOVERIES`] a window.
 //! 6. **Arrive**: the time model's prediction is scored, the arrival margin learns, and
@@ -89,6 +90,11 @@ pub const SAFE_CHECK_S: f64 = 1.0;
 /// Recoveries from PEB holds one window sends at most: a robot held again after them
 /// stays held (and the window is given up in time), rather than shuttle.
 pub const MAX_RECOVERIES: u32 = 3;
+
+/// A recovery drives back along the robot's track at least this far, metres, past its
+/// last fix: where the fix is lost, localization's estimate freezes at the last fix, so
+/// a way back to that point alone would be done before the robot moved.
+pub const RECOVERY_BACK_M: f64 = 1.5;
 
 /// The least deadline a plan request carries, wall seconds.
 pub const MIN_DEADLINE_S: f64 = 0.05;
@@ -614,7 +620,7 @@ impl<'a> DowntimeWindow<'a> {
                 let give_up = now.mission_s > self.setup.task.start_s + self.setup.give_up_after_s;
                 if self.drive_ask.is_some() || drive.recovering {
                     return if give_up {
-                        self.give_up()
+                        self.give_up(now)
                     } else {
                         self.check_safe(now)
                     };
@@ -644,7 +650,7 @@ impl<'a> DowntimeWindow<'a> {
         match decision {
             Decision::Keep => Vec::new(),
             Decision::Arrived { at_s } => self.arrive(at_s, now),
-            Decision::GiveUp => self.give_up(),
+            Decision::GiveUp => self.give_up(now),
             Decision::Replan {
                 reason,
                 curious,

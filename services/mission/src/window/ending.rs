@@ -60,10 +60,13 @@ impl DowntimeWindow<'_> {
         actions
     }
 
-    pub(super) fn give_up(&mut self) -> Vec<WindowAction> {
-        let Phase::Driving(drive) = std::mem::replace(&mut self.phase, Phase::Done) else {
+    pub(super) fn give_up(&mut self, now: Now) -> Vec<WindowAction> {
+        let Phase::Driving(mut drive) = std::mem::replace(&mut self.phase, Phase::Done) else {
             return Vec::new();
         };
+        if let Some(since) = drive.held_since_s.take() {
+            drive.held_s += now.mission_s - since;
+        }
         let model = self.setup.time_model;
         let time_model = TimeModelReport {
             v_lin: model.v_lin,

@@ -23,7 +23,7 @@ impl DowntimeWindow<'_> {
         if !rules.recover || drive.recovering || spent || held_s < rules.hold_patience_s {
             return Vec::new();
         }
-        let back = straight::back_along(&self.driven, self.last_fix);
+        let back = straight::back_along(&self.driven, self.last_fix, super::RECOVERY_BACK_M);
         let waypoints = mission_waypoints(&back, spacing);
         let mut actions: Vec<WindowAction> = self
             .drive_ask

@@ -59,14 +59,22 @@ pub(super) fn point_ahead(path: &[[f64; 2]], here: [f64; 2], lead_m: f64) -> [f6
     at
 }
 
-/// The way back along `driven` (oldest first) from its end to its point `to_index`: the
-/// points in reverse, the robot's own track to where it last had a fix.
-pub(super) fn back_along(driven: &[[f64; 2]], to_index: usize) -> Vec<[f64; 2]> {
-    driven[to_index.min(driven.len())..]
-        .iter()
-        .rev()
-        .copied()
-        .collect()
+/// The way back along `driven` (oldest first) from its end past its point `fix` (the
+/// last with a fix) until at least `back_m` metres were covered: the robot's own track
+/// in reverse, to where it last had a fix and a little beyond.
+pub(super) fn back_along(driven: &[[f64; 2]], fix: usize, back_m: f64) -> Vec<[f64; 2]> {
+    let mut out: Vec<[f64; 2]> = Vec::new();
+    let mut covered = 0.0;
+    for (i, &p) in driven.iter().enumerate().rev() {
+        if let Some(&last) = out.last() {
+            covered += distance(last, p);
+        }
+        out.push(p);
+        if i <= fix && covered >= back_m {
+            break;
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -83,12 +91,23 @@ mod tests {
     }
 
     #[test]
-    fn the_way_back_is_the_track_reversed_to_the_fix() {
+    fn the_way_back_is_the_track_reversed_past_the_fix() {
         let driven = [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0]];
         assert_eq!(
-            back_along(&driven, 1),
+            back_along(&driven, 2, 0.5),
+            vec![[3.0, 0.0], [2.0, 0.0]],
+            "to the fix, far enough already"
+        );
+        // The fix is where the track ends (the estimate froze there): back 1.5 m more.
+        assert_eq!(
+            back_along(&driven, 3, 1.5),
             vec![[3.0, 0.0], [2.0, 0.0], [1.0, 0.0]]
         );
-        assert!(back_along(&driven, 9).is_empty());
+        assert_eq!(
+            back_along(&driven, 3, 10.0).len(),
+            4,
+            "at most the whole track"
+        );
+        assert!(back_along(&[], 0, 1.0).is_empty());
     }
 }
