@@ -20,9 +20,7 @@ use std::time::{Duration, Instant};
 
 use roam_proto::excerpt;
 use roam_proto::map::Layer;
-use roam_proto::planner::{
-    CancelPlan, Plan, PlanProgress, PlanRequest, PlannerModel, ShortestPath, StopReason,
-};
+use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, PlannerModel, StopReason};
 use roam_proto::{keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{reply, Requester, Service, ServiceError};
@@ -35,7 +33,7 @@ use crate::inflight::{CancelVerdict, InFlight};
 use crate::limits::PlanLimits;
 use crate::maps::MapCache;
 use crate::params::GaParams;
-use crate::plan::{check_spec, plan, PlanOutcome, PlanSpec};
+use crate::plan::{check_spec, plan, PlanSpec};
 use crate::queue::{PlanQueue, QueueConfig, Refusal, Turn, MAX_QUEUED_PLANS};
 use crate::token;
 use crate::world::World;
@@ -674,7 +672,7 @@ fn plan_now(
     } else {
         f64::from(outcome.generations) / f64::from(sized_generations)
     };
-    let mut plan = to_message(
+    let mut plan = crate::answer::to_message(
         world,
         request,
         request_id.clone(),
@@ -684,45 +682,4 @@ fn plan_now(
     );
     plan.budget_s = budget_s;
     Ok((plan, share))
-}
-
-/// The reply message of an outcome.
-pub fn to_message(
-    world: &World,
-    request: &PlanRequest,
-    request_id: String,
-    map_version: roam_proto::planner::MapVersion,
-    instance: &str,
-    outcome: PlanOutcome,
-) -> Plan {
-    // Only when the request asked ([`plan`] measures it only then): a client from
-    // before the field never sees it. The fastest path, as driven (map cells).
-    let shortest = outcome.shortest.as_ref().map(|s| ShortestPath {
-        cells: s.cells.clone(),
-        points: s.points.clone(),
-        t_eta_s: s.t_eta_s,
-        distinct_information: s.metrics.distinct_information,
-    });
-    Plan {
-        request_id,
-        model: outcome.model,
-        cells: outcome.cells,
-        points: outcome.points,
-        planning_resolution_m: Some(world.meta.resolution),
-        t_eta_s: outcome.t_eta_s,
-        reaches_goal: outcome.reaches_goal,
-        within_budget: outcome.within_budget,
-        fitness: outcome.fitness,
-        u_ges: outcome.metrics.u_ges,
-        density: outcome.metrics.density,
-        distinct_information: outcome.metrics.distinct_information,
-        generations: outcome.generations,
-        planning_ms: outcome.planning.as_secs_f64() * 1000.0,
-        stop_reason: outcome.stop_reason,
-        budget_s: None,
-        seed: request.seed,
-        map_version,
-        instance: instance.to_owned(),
-        shortest,
-    }
 }
