@@ -5,6 +5,8 @@
 //! key root, so tests run in parallel without seeing each other. Services are awaited
 //! by liveliness, never by sleeping, and every await has a timeout.
 
+pub mod lockstep;
+
 use std::future::IntoFuture;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};

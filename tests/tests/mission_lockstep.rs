@@ -11,23 +11,11 @@
 //! (`planning_cost_s: 0`: the clock stands while the planner works), and the GA runs a
 //! few generations, far inside its deadline, so the planner's answers are the batch's.
 
-use std::time::{Duration, Instant};
-
-use roam_controller::service::ControllerConfig;
 use roam_experiments::reproduce::mission::days::day::{day_seed, drive, sim_seed};
 use roam_experiments::reproduce::mission::days::{DayWorld, DaysOptions};
 use roam_mission::config::ExecutiveConfig;
-use roam_mission::service::MissionConfig;
-use roam_proto::controller::{ControllerStatus, MissionState};
-use roam_proto::mission::{ExecutiveStatus, WindowReport};
-use roam_proto::sim::{RobotCommand, SimControl, SimStatus};
-use roam_proto::{decode, keys, Message};
-use roam_tests::{repo_path, within, Harness};
-use zenoh::handlers::FifoChannelHandler;
-use zenoh::pubsub::Subscriber;
-use zenoh::sample::Sample;
-
-type Sub = Subscriber<FifoChannelHandler<Sample>>;
+use roam_proto::mission::WindowReport;
+use roam_tests::lockstep::LockstepDay;
 
 const SCENARIO: &str = "config/scenarios/day.yaml";
 const DAY: usize = 1;
@@ -54,23 +42,6 @@ fn config(seed: u64) -> ExecutiveConfig {
     }
 }
 
-async fn subscribe(client: &roam_runtime::Requester, key: String) -> Sub {
-    within("subscribe", client.session().declare_subscriber(key))
-        .await
-        .expect("subscriber")
-}
-
-/// Every message waiting on `sub`, decoded.
-fn drain<T: Message>(sub: &Sub) -> Vec<T> {
-    let mut out = Vec::new();
-    while let Ok(Some(sample)) = sub.try_recv() {
-        if let Ok(m) = decode(&sample.payload().to_bytes()) {
-            out.push(m);
-        }
-    }
-    out
-}
-
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn the_live_executive_and_the_batch_make_the_same_day() {
     let seed = day_seed(BATCH_SEED, DAY);
@@ -86,108 +57,16 @@ async fn the_live_executive_and_the_batch_make_the_same_day() {
     assert_eq!(batch.len(), 4, "{batch:?}");
 
     // Live.
-    let harness = Harness::start().await;
-    let _map_server = harness
-        .start_role(roam_map_server::MapServerConfig {
-            map: Some(repo_path(SCENARIO)),
-            ..harness.map_server_config()
-        })
-        .await;
-    let _planner = harness
-        .start_role(harness.planner_config("planner-0"))
-        .await;
-    let mut sim = harness.sim_config(Some(SCENARIO));
-    sim.seed = sim_seed(seed);
-    let _sim = harness.start_role(sim).await;
-    let _localization = harness
-        .start_role(harness.localization_config(Some(SCENARIO)))
-        .await;
-    let _controller = harness
-        .start_role(ControllerConfig {
-            scenario: Some(repo_path(SCENARIO)),
-            // Lock-step waits on this test, not on the clock: no stale halts.
-            stale_after_s: 600.0,
-            apf: roam_controller::params::ApfParams::indoor(),
-            ..harness.controller_config()
-        })
-        .await;
-    let client = harness.client().await;
-    let root = harness.root.clone();
-    let reports = subscribe(&client, keys::robot_mission_report(&root, "robot")).await;
-    let executive = subscribe(&client, keys::robot_executive(&root, "robot")).await;
-    let statuses = subscribe(&client, keys::robot_controller(&root, "robot")).await;
-    let commands = subscribe(&client, keys::robot_command(&root, "robot")).await;
-    let _mission = harness
-        .start_role(MissionConfig {
-            root: root.clone(),
-            executive: config.clone(),
-            scenario: Some(repo_path(SCENARIO)),
-            ..MissionConfig::default()
-        })
-        .await;
-    // The executive listens before it waits 2 s for a clock the paused sim has not
-    // published yet.
-    tokio::time::sleep(Duration::from_secs(3)).await;
-
+    let mut day = LockstepDay::start(SCENARIO, sim_seed(seed), config).await;
     let mut live: Vec<WindowReport> = Vec::new();
-    let mut heard = ExecutiveStatus {
-        robot: "robot".into(),
-        window: 0,
-        estimate_step: None,
-        status_step: None,
-        plans_in_flight: 0,
-    };
-    let mut last_status: Option<ControllerStatus> = None;
-    let mut step = 0;
-    while live.len() < 4 && step < MAX_STEPS {
-        step += 1;
-        let stepped: SimStatus = within(
-            "step",
-            client.request(&keys::sim_control(&root), Some(&SimControl::Step { n: 1 })),
-        )
-        .await
-        .unwrap_or_else(|e| panic!("step {step}: {e}; last status {last_status:?}"));
-        let driving = last_status.as_ref().is_some_and(|s| s.mission.is_some());
-        let waited = Instant::now();
-        loop {
-            for s in drain::<ExecutiveStatus>(&executive) {
-                heard = s;
-            }
-            for s in drain::<ControllerStatus>(&statuses) {
-                last_status = Some(s);
-            }
-            let estimate_heard = heard.estimate_step.is_some_and(|e| e >= stepped.step);
-            let status_heard = !driving || heard.status_step.is_some_and(|e| e >= stepped.step);
-            if estimate_heard && status_heard && heard.plans_in_flight == 0 {
-                break;
-            }
-            // A refused scan gives no estimate: after a while the step goes on.
-            if waited.elapsed() > Duration::from_secs(3) {
-                eprintln!("step {step}: waited out, heard {heard:?}, driving {driving}");
-                break;
-            }
-            tokio::time::sleep(Duration::from_millis(1)).await;
-        }
-        // The command for this step has left the controller; the next step takes it.
-        if last_status.as_ref().is_some_and(|s| {
-            s.state == MissionState::Active && s.estimate_step == Some(stepped.step)
-        }) {
-            let until = Instant::now() + Duration::from_secs(10);
-            'command: while Instant::now() < until {
-                for c in drain::<RobotCommand>(&commands) {
-                    if c.step == Some(stepped.step) {
-                        break 'command;
-                    }
-                }
-                tokio::time::sleep(Duration::from_millis(1)).await;
-            }
-        }
-        live.extend(drain::<WindowReport>(&reports));
+    while live.len() < 4 && day.steps < MAX_STEPS {
+        live.extend(day.step().await.reports);
     }
     assert_eq!(
         live.len(),
         4,
-        "the live day ended after {step} steps: {live:?}"
+        "the live day ended after {} steps: {live:?}",
+        day.steps
     );
 
     for (l, b) in live.iter().zip(&batch) {
@@ -226,5 +105,5 @@ async fn the_live_executive_and_the_batch_make_the_same_day() {
             (a, c) => assert_eq!(a, c, "window {w}"),
         }
     }
-    harness.close().await;
+    day.close().await;
 }

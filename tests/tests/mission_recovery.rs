@@ -17,24 +17,15 @@
 //! task missed.
 
 use std::collections::BTreeMap;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
-use roam_controller::service::ControllerConfig;
 use roam_experiments::reproduce::mission::days::day::{day_seed, sim_seed};
 use roam_mission::config::ExecutiveConfig;
-use roam_mission::service::MissionConfig;
 use roam_mission::tasks::Task;
 use roam_mission::watch::Reason;
 use roam_proto::controller::{ControllerStatus, Mission, MissionState};
-use roam_proto::mission::{ExecutiveStatus, WindowReport};
-use roam_proto::sim::{RobotCommand, SimControl, SimStatus};
-use roam_proto::{decode, keys, Message};
-use roam_tests::{repo_path, within, Harness};
-use zenoh::handlers::FifoChannelHandler;
-use zenoh::pubsub::Subscriber;
-use zenoh::sample::Sample;
-
-type Sub = Subscriber<FifoChannelHandler<Sample>>;
+use roam_proto::mission::WindowReport;
+use roam_tests::lockstep::{LockstepDay, Seen};
 
 const SCENARIO: &str = "config/scenarios/day.yaml";
 /// Free floor south of the north-east room, three or more anchors in range (PEB about
@@ -75,23 +66,6 @@ fn config(recover: bool) -> ExecutiveConfig {
     }
 }
 
-async fn subscribe(client: &roam_runtime::Requester, key: String) -> Sub {
-    within("subscribe", client.session().declare_subscriber(key))
-        .await
-        .expect("subscriber")
-}
-
-/// Every message waiting on `sub`, decoded.
-fn drain<T: Message>(sub: &Sub) -> Vec<T> {
-    let mut out = Vec::new();
-    while let Ok(Some(sample)) = sub.try_recv() {
-        if let Ok(m) = decode(&sample.payload().to_bytes()) {
-            out.push(m);
-        }
-    }
-    out
-}
-
 /// What one live day showed.
 #[derive(Debug, Default)]
 struct Day {
@@ -116,148 +90,48 @@ struct Day {
 /// The day of [`config`]`(recover)` live, the sim stepped at most [`MAX_STEPS`] times.
 async fn live_day(recover: bool) -> Day {
     let config = config(recover);
-    let harness = Harness::start().await;
-    let _map_server = harness
-        .start_role(roam_map_server::MapServerConfig {
-            map: Some(repo_path(SCENARIO)),
-            ..harness.map_server_config()
-        })
-        .await;
-    let _planner = harness
-        .start_role(harness.planner_config("planner-0"))
-        .await;
-    let mut sim = harness.sim_config(Some(SCENARIO));
-    sim.seed = sim_seed(config.seed);
-    let _sim = harness.start_role(sim).await;
-    let _localization = harness
-        .start_role(harness.localization_config(Some(SCENARIO)))
-        .await;
-    let _controller = harness
-        .start_role(ControllerConfig {
-            scenario: Some(repo_path(SCENARIO)),
-            // Lock-step waits on this test, not on the clock: no stale halts.
-            stale_after_s: 600.0,
-            apf: roam_controller::params::ApfParams::indoor(),
-            ..harness.controller_config()
-        })
-        .await;
-    let client = harness.client().await;
-    let root = harness.root.clone();
-    let reports = subscribe(&client, keys::robot_mission_report(&root, "robot")).await;
-    let executive = subscribe(&client, keys::robot_executive(&root, "robot")).await;
-    let statuses = subscribe(&client, keys::robot_controller(&root, "robot")).await;
-    let commands = subscribe(&client, keys::robot_command(&root, "robot")).await;
-    let missions = subscribe(&client, keys::robot_mission(&root, "robot")).await;
-    let _mission = harness
-        .start_role(MissionConfig {
-            root: root.clone(),
-            executive: config.clone(),
-            scenario: Some(repo_path(SCENARIO)),
-            ..MissionConfig::default()
-        })
-        .await;
-    // The executive listens before it waits 2 s for a clock the paused sim has not
-    // published yet.
-    tokio::time::sleep(Duration::from_secs(3)).await;
-
+    let mut stack = LockstepDay::start(SCENARIO, sim_seed(config.seed), config).await;
     let mut day = Day {
         peb_min_m: f64::INFINITY,
         peb_max_m: f64::NEG_INFINITY,
         ..Day::default()
     };
-    let mut heard = ExecutiveStatus {
-        robot: "robot".into(),
-        window: 0,
-        estimate_step: None,
-        status_step: None,
-        plans_in_flight: 0,
-    };
-    let mut last_status: Option<ControllerStatus> = None;
-    let note = |day: &mut Day, s: &ControllerStatus| {
-        *day.states.entry(format!("{:?}", s.state)).or_default() += 1;
-        if let Some(p) = s.peb_m {
-            day.peb_min_m = day.peb_min_m.min(p);
-            day.peb_max_m = day.peb_max_m.max(p);
-        }
-        if s.state == MissionState::HaltedPeb {
-            match s.peb_m {
-                Some(_) => day.held_bounded += 1,
-                None => day.held_unbounded += 1,
+    let note = |day: &mut Day, seen: Seen| {
+        day.recoveries
+            .extend(seen.missions.into_iter().filter(|m| m.recovery));
+        for s in seen.statuses {
+            *day.states.entry(format!("{:?}", s.state)).or_default() += 1;
+            if let Some(p) = s.peb_m {
+                day.peb_min_m = day.peb_min_m.min(p);
+                day.peb_max_m = day.peb_max_m.max(p);
             }
-            day.first_held.get_or_insert_with(|| s.clone());
-        }
-        let on_recovery = s
-            .mission
-            .as_ref()
-            .filter(|id| day.recoveries.iter().any(|m| &m.id == *id));
-        if let Some(id) = on_recovery {
-            day.on_recoveries.insert(id.clone(), s.clone());
-        }
-    };
-    while day.reports.is_empty() && day.steps < MAX_STEPS {
-        day.steps += 1;
-        let step = day.steps;
-        let stepped: SimStatus = within(
-            "step",
-            client.request(&keys::sim_control(&root), Some(&SimControl::Step { n: 1 })),
-        )
-        .await
-        .unwrap_or_else(|e| panic!("step {step}: {e}; last status {last_status:?}"));
-        let driving = last_status.as_ref().is_some_and(|s| s.mission.is_some());
-        let waited = Instant::now();
-        loop {
-            for s in drain::<ExecutiveStatus>(&executive) {
-                heard = s;
-            }
-            for m in drain::<Mission>(&missions) {
-                if m.recovery {
-                    day.recoveries.push(m);
+            if s.state == MissionState::HaltedPeb {
+                match s.peb_m {
+                    Some(_) => day.held_bounded += 1,
+                    None => day.held_unbounded += 1,
                 }
+                day.first_held.get_or_insert_with(|| s.clone());
             }
-            for s in drain::<ControllerStatus>(&statuses) {
-                note(&mut day, &s);
-                last_status = Some(s);
-            }
-            let estimate_heard = heard.estimate_step.is_some_and(|e| e >= stepped.step);
-            let status_heard = !driving || heard.status_step.is_some_and(|e| e >= stepped.step);
-            if estimate_heard && status_heard && heard.plans_in_flight == 0 {
-                break;
-            }
-            // A refused scan gives no estimate: after a while the step goes on.
-            if waited.elapsed() > Duration::from_secs(3) {
-                eprintln!("step {step}: waited out, heard {heard:?}, driving {driving}");
-                break;
-            }
-            tokio::time::sleep(Duration::from_millis(1)).await;
-        }
-        // The command for this step has left the controller; the next step takes it.
-        if last_status.as_ref().is_some_and(|s| {
-            s.state == MissionState::Active && s.estimate_step == Some(stepped.step)
-        }) {
-            let until = Instant::now() + Duration::from_secs(10);
-            'command: while Instant::now() < until {
-                for c in drain::<RobotCommand>(&commands) {
-                    if c.step == Some(stepped.step) {
-                        break 'command;
-                    }
-                }
-                tokio::time::sleep(Duration::from_millis(1)).await;
+            let on_recovery = s
+                .mission
+                .as_ref()
+                .filter(|id| day.recoveries.iter().any(|m| &m.id == *id))
+                .cloned();
+            if let Some(id) = on_recovery {
+                day.on_recoveries.insert(id, s);
             }
         }
-        day.reports.extend(drain::<WindowReport>(&reports));
+        day.reports.extend(seen.reports);
+    };
+    while day.reports.is_empty() && stack.steps < MAX_STEPS {
+        let seen = stack.step().await;
+        note(&mut day, seen);
     }
     // What came with the last step.
-    tokio::time::sleep(Duration::from_millis(200)).await;
-    for m in drain::<Mission>(&missions) {
-        if m.recovery {
-            day.recoveries.push(m);
-        }
-    }
-    for s in drain::<ControllerStatus>(&statuses) {
-        note(&mut day, &s);
-    }
-    day.reports.extend(drain::<WindowReport>(&reports));
-    harness.close().await;
+    let seen = stack.settle().await;
+    note(&mut day, seen);
+    day.steps = stack.steps;
+    stack.close().await;
     eprintln!(
         "recover {recover}: {} steps; controller states {:?}; bounded PEB {:.3}–{:.3} m; \
          held with PEB unbounded {} times, bounded {} times; first held {:?}",

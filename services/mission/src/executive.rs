@@ -275,6 +275,10 @@ impl Executive<'_> {
                         self.heard.estimate_step = Some(e.step);
                         if !e.degraded {
                             self.position = Some(e.position);
+                            // A sim that stepped for this estimate published its clock
+                            // too: the window begins on the sim's time, not on wall time.
+                            self.hear_the_clock(cancel).await?;
+                            lock(&self.inputs.clock).heard_at(e.time_s);
                             return Ok(e.position);
                         }
                     }
