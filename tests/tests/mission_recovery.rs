@@ -1,4 +1,4 @@
-//! A held robot gets out (issue 26, item 3), through Zenoh: the map server, the planner,
+//! A held robot gets out, through Zenoh: the map server, the planner,
 //! the sim in lock-step (this test stepping it), localization, the controller
 //! (`ApfParams::indoor()`, its PEB guard on at 2 m) and the executive as `roam mission`,
 //! on the demo's day world, as `mission_lockstep.rs` runs them.

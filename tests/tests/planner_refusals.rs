@@ -289,7 +289,7 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
     running.stop().await;
 }
 
-/// Issue 26 item 5: a deadline bounds the work, so a request is not refused for work it
+/// A deadline bounds the work, so a request is not refused for work it
 /// could only do after its deadline. Model I at Table I's population with 100,000
 /// generations and an 80 s budget (paths of at most 201 cells) would cost 4.02e9, over
 /// `max_plan_cost`; with a 2 s deadline only the generations that can start before it

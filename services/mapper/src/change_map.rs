@@ -433,6 +433,12 @@ impl ChangeMap {
         self.layer(|c| c.rate())
     }
 
+    /// The `change_information` layer at `t_now`: round(100 · P_c(E > 0)) of every cell
+    /// (Eq. 2), as paper 000's information scores (0–100), what the planner couples in.
+    pub fn change_scores(&self, t_now: f64) -> Vec<u8> {
+        scores(&self.probability_layer(t_now).cells)
+    }
+
     /// P_c(E > 0) at `t_now` of every cell (Eq. 2).
     pub fn probability_layer(&self, t_now: f64) -> Grid<f64> {
         let t = self.now(t_now);
@@ -492,6 +498,14 @@ impl ChangeMap {
             0.0
         }
     }
+}
+
+/// Probabilities as paper 000's information scores: round(100 · p), p clamped to 0..1.
+pub fn scores(probabilities: &[f64]) -> Vec<u8> {
+    probabilities
+        .iter()
+        .map(|p| (p.clamp(0.0, 1.0) * 100.0).round() as u8)
+        .collect()
 }
 
 #[cfg(test)]

@@ -313,10 +313,7 @@ fn layers_to_send(state: &MapperShared) -> Option<[(&'static str, Cells); 4]> {
     m.dirty = false;
     let now = m.now_s;
     let probability = m.map.probability_layer(now).cells;
-    let scores = probability
-        .iter()
-        .map(|p| (p.clamp(0.0, 1.0) * 100.0).round() as u8)
-        .collect();
+    let scores = crate::change_map::scores(&probability);
     Some([
         (
             CHANGE_RATE_LAYER,

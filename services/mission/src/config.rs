@@ -57,7 +57,7 @@ pub struct ExecutiveConfig {
     pub slack_interval_s: f64,
     /// A slack or behind replan is made only when at least this much of the window is
     /// left after it, seconds: a short replan near a window's end is the one a time
-    /// model gets most wrong (issue 26: the late windows came from them).
+    /// model gets most wrong, and where the batch's late arrivals came from.
     pub min_replan_window_s: f64,
     /// The behind rule ([`crate::watch`]): replan a curious path when the robot's own
     /// pace says it would arrive late though its top speed would not.

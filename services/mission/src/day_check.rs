@@ -1,4 +1,4 @@
-//! A day of tasks checked against a map, before anything is driven (issue 26): every
+//! A day of tasks checked against a map, before anything is driven: every
 //! task's place must be where the robot can stand, and every task must be reachable in
 //! time from the previous one.
 //!

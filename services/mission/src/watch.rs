@@ -28,8 +28,8 @@
 //!   slipped. The robot drives on while the plan is made; the window
 //!   ([`crate::window`]) plans from where it will be when the plan comes.
 //!
-//! Slack and behind replans need `min_replan_window_s` left to the task: the late
-//! arrivals of issue 26 came from short replans near a window's end.
+//! Slack and behind replans need `min_replan_window_s` left to the task: a short
+//! replan near a window's end is the one a time model gets most wrong.
 //!
 //! Replans other than resending a lost mission count toward `max_replans`.
 

@@ -45,10 +45,12 @@
 //! it. One planner request per plan (`shortest: fallback`): the reply carries the
 //! shortest path, and a budget it does not fit is answered with it.
 
+mod asks;
 mod ending;
 mod events;
 mod handover;
 mod holds;
+mod replies;
 mod routes;
 mod straight;
 
@@ -56,11 +58,10 @@ pub use events::{DrivenMission, Now, PlanAsk, WindowAction, WindowEvent};
 pub use handover::{Handover, WindowEnd, WindowOutcome};
 pub use routes::{routes, PlannedAhead, Route};
 
-use roam_planner::plan::MAX_T_EXEC_S;
 use roam_proto::controller::{ControllerStatus, Mission, MissionState};
-use roam_proto::mission::{AskReport, MAX_REPORTED_ASKS};
+use roam_proto::mission::AskReport;
 
-use crate::calibration::TimeModel;
+use crate::calibration::{path_measure, TimeModel};
 use crate::config::ExecutiveConfig;
 use crate::information::InformationScale;
 use crate::margin::ArrivalMargin;
@@ -198,6 +199,15 @@ enum DriveAsk {
         resend: bool,
         ask: PlanAsk,
     },
+}
+
+/// How the watch takes a new route.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Follows {
+    /// A replan (`resend`: a lost mission sent again, not counted).
+    Replan { resend: bool },
+    /// Straight to the task, curious no more.
+    Straight,
 }
 
 /// The next window's request in flight.
@@ -356,99 +366,6 @@ impl<'a> DowntimeWindow<'a> {
         usize::from(self.drive_ask.is_some()) + usize::from(self.ahead_ask.is_some())
     }
 
-    /// A request from `from` to `to` for a task starting at `task_start_s`, the robot
-    /// leaving at `leave_at_s` at the earliest (now when `None`): its deadline cut to
-    /// what the time left affords, its budget what the margin leaves after the plan's
-    /// expected cost; with the time left that budget was made from.
-    fn ask(
-        &mut self,
-        from: [f64; 2],
-        to: [f64; 2],
-        task_start_s: f64,
-        leave_at_s: Option<f64>,
-        curious: bool,
-        now: Now,
-    ) -> (PlanAsk, f64, f64) {
-        let rules = self.setup.rules;
-        let set_off = leave_at_s.map_or(now.mission_s, |at| at.max(now.mission_s));
-        let time_left = (task_start_s - set_off).max(0.0);
-        let rate = now.clock_rate.max(1e-9);
-        let deadline_s = rules
-            .plan_deadline_s
-            .min(rules.replan_time_share * time_left / rate)
-            .max(MIN_DEADLINE_S);
-        let curious = curious && rules.curious;
-        let cost = if curious {
-            now.planning_cost_s.min(deadline_s * rate)
-        } else {
-            0.0
-        };
-        let earliest = now.mission_s + cost;
-        let time_left = task_start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
-        let budget_s = self.margin.budget(time_left);
-        let ask = PlanAsk {
-            id: self.next_ask_id(),
-            from,
-            to,
-            t_exec_s: budget_s.clamp(LEAST_T_EXEC_S, MAX_T_EXEC_S),
-            deadline_s,
-            curious: curious && budget_s > 0.0,
-        };
-        self.record(&ask, leave_at_s.is_some(), now);
-        (ask, budget_s, time_left)
-    }
-
-    fn next_ask_id(&mut self) -> u64 {
-        self.asks_made += 1;
-        self.asks_made
-    }
-
-    /// Keeps `ask` for the window's report.
-    fn record(&mut self, ask: &PlanAsk, ahead: bool, now: Now) {
-        self.asks_in_window += 1;
-        if self.asks.len() < MAX_REPORTED_ASKS {
-            self.asks.push(AskReport {
-                at_s: now.mission_s,
-                from: ask.from,
-                t_exec_s: ask.t_exec_s,
-                curious: ask.curious,
-                ahead,
-            });
-        }
-    }
-
-    fn ask_first_plan(&mut self, now: Now) -> WindowAction {
-        let (from, to, start) = (self.setup.from, self.setup.task.at, self.setup.task.start_s);
-        let (ask, budget_s, time_left_s) = self.ask(from, to, start, None, true, now);
-        self.drive_ask = Some((
-            ask.id,
-            DriveAsk::FirstPlan {
-                budget_s,
-                time_left_s,
-            },
-        ));
-        WindowAction::RequestPlan(ask)
-    }
-
-    fn ask_next_window(&mut self, now: Now) -> Vec<WindowAction> {
-        let Some(next) = &self.setup.next else {
-            return Vec::new();
-        };
-        let (start_s, to) = (next.start_s, next.at);
-        let task = &self.setup.task;
-        let (from, leave_at_s) = (task.at, task.start_s + task.duration_s);
-        let (ask, budget_s, time_left_s) = self.ask(from, to, start_s, Some(leave_at_s), true, now);
-        self.ahead_ask = Some((
-            ask.id,
-            AheadAsk {
-                budget_s,
-                time_left_s,
-                leave_at_s,
-            },
-        ));
-        vec![WindowAction::RequestPlan(ask)]
-    }
-
     fn start_driving(
         &mut self,
         route: Route,
@@ -577,12 +494,7 @@ impl<'a> DowntimeWindow<'a> {
         }
         if status == Status::Completed {
             // Arrived: a replan in flight is no longer wanted.
-            let mut actions: Vec<WindowAction> = self
-                .drive_ask
-                .take()
-                .map(|(id, _)| WindowAction::Forget(id))
-                .into_iter()
-                .collect();
+            let mut actions = self.forget_drive_ask();
             actions.extend(self.arrive(now.mission_s, now));
             return actions;
         }
@@ -670,10 +582,18 @@ impl<'a> DowntimeWindow<'a> {
         }
         drive.safe_checked_at_s = now.mission_s;
         let time_left = self.setup.task.start_s - now.mission_s;
+        let budget = self.margin.budget(time_left);
+        // What is left of the route is a way to the task, so the fastest path takes no
+        // longer: while the budget covers the route left, no search is needed (on a
+        // large map the search is the expensive part; this keeps it to the window's end).
+        let (d, theta) = path_measure(&straight::route_left(&drive.path, self.here));
+        if budget > self.setup.time_model.eta(d, theta) {
+            return Vec::new();
+        }
         let Some(fastest) = self.fastest_from_here() else {
             return Vec::new();
         };
-        if self.margin.budget(time_left) > fastest.t_eta_s {
+        if budget > fastest.t_eta_s {
             return Vec::new();
         }
         self.go_straight(fastest, Reason::LastSafeMoment, now)
@@ -688,32 +608,55 @@ impl<'a> DowntimeWindow<'a> {
     /// Sends the robot along `route` (the window's own fastest path) at once, for
     /// `reason`; curious no more in this window.
     fn go_straight(&mut self, route: Route, reason: Reason, now: Now) -> Vec<WindowAction> {
+        let mut actions = self.forget_drive_ask();
+        let here = self.here;
+        actions.extend(self.send_route(here, route, reason, Follows::Straight, now));
+        actions
+    }
+
+    /// The robot now drives `route` from `from`, for `reason`: the watch follows it, the
+    /// drive keeps it, and its mission is sent.
+    fn send_route(
+        &mut self,
+        from: [f64; 2],
+        route: Route,
+        reason: Reason,
+        follows: Follows,
+        now: Now,
+    ) -> Vec<WindowAction> {
+        let spacing = self.setup.waypoint_spacing_m;
         let Phase::Driving(drive) = &mut self.phase else {
             return Vec::new();
         };
-        let mut actions: Vec<WindowAction> = self
-            .drive_ask
+        let path: Vec<[f64; 2]> = std::iter::once(from)
+            .chain(route.points.iter().copied())
+            .collect();
+        let (t, wall) = (now.mission_s, now.wall_s);
+        match follows {
+            Follows::Straight => drive.watch.straight(path.clone(), t, wall),
+            Follows::Replan { resend } => drive.watch.replanned(path.clone(), resend, t, wall),
+        }
+        drive.reasons.push(reason.as_str().to_owned());
+        drive.waypoints = mission_waypoints(&route.points, spacing);
+        drive.route_curious = route.curious && follows != Follows::Straight;
+        drive.plans.push(route.points);
+        let mission = self.ids.next(drive.waypoints.clone(), false);
+        drive.mission = mission.id.clone();
+        drive.sent_at_s = t;
+        drive.path = path;
+        vec![
+            WindowAction::Replanned { reason },
+            WindowAction::Drive(mission),
+        ]
+    }
+
+    /// The drive's request in flight is forgotten (its answer will be dropped).
+    fn forget_drive_ask(&mut self) -> Vec<WindowAction> {
+        self.drive_ask
             .take()
             .map(|(id, _)| WindowAction::Forget(id))
             .into_iter()
-            .collect();
-        let path: Vec<[f64; 2]> = std::iter::once(self.here)
-            .chain(route.points.iter().copied())
-            .collect();
-        drive.reasons.push(reason.as_str().to_owned());
-        drive
-            .watch
-            .straight(path.clone(), now.mission_s, now.wall_s);
-        drive.waypoints = mission_waypoints(&route.points, self.setup.waypoint_spacing_m);
-        drive.plans.push(route.points);
-        drive.route_curious = false;
-        let mission = self.ids.next(drive.waypoints.clone(), false);
-        drive.mission = mission.id.clone();
-        drive.sent_at_s = now.mission_s;
-        drive.path = path;
-        actions.push(WindowAction::Replanned { reason });
-        actions.push(WindowAction::Drive(mission));
-        actions
+            .collect()
     }
 
     fn replan(
@@ -743,206 +686,7 @@ impl<'a> DowntimeWindow<'a> {
         };
         let (to, start) = (self.setup.task.at, self.setup.task.start_s);
         let (ask, _, _) = self.ask(from, to, start, None, curious, now);
-        self.drive_ask = Some((
-            ask.id,
-            DriveAsk::Replan {
-                reason,
-                resend,
-                ask,
-            },
-        ));
-        vec![WindowAction::RequestPlan(ask)]
-    }
-
-    fn on_reply(
-        &mut self,
-        id: u64,
-        plan: Option<roam_proto::planner::Plan>,
-        now: Now,
-    ) -> Vec<WindowAction> {
-        if self.drive_ask.is_some_and(|(asked, _)| asked == id) {
-            let Some((_, asked)) = self.drive_ask.take() else {
-                return Vec::new();
-            };
-            return match plan.and_then(routes) {
-                Some((route, shortest)) => self.on_drive_plan(asked, route, shortest, now),
-                None => self.on_drive_failed(asked, now),
-            };
-        }
-        if self.ahead_ask.is_some_and(|(asked, _)| asked == id) {
-            let Some((_, asked)) = self.ahead_ask.take() else {
-                return Vec::new();
-            };
-            return match plan.and_then(routes) {
-                Some((route, shortest)) => self.on_ahead_plan(asked, route, shortest, now),
-                None => self.on_ahead_failed(now),
-            };
-        }
-        // A reply nobody waits for any more (forgotten, or an earlier window's).
-        Vec::new()
-    }
-
-    fn on_drive_plan(
-        &mut self,
-        asked: DriveAsk,
-        route: Route,
-        shortest: Vec<[f64; 2]>,
-        now: Now,
-    ) -> Vec<WindowAction> {
-        match asked {
-            DriveAsk::FirstPlan {
-                budget_s,
-                time_left_s,
-            } => {
-                if !matches!(self.phase, Phase::FirstPlan { .. }) {
-                    return Vec::new();
-                }
-                self.start_driving(route, shortest, budget_s, time_left_s, now)
-            }
-            DriveAsk::Replan {
-                reason,
-                resend,
-                ask,
-            } => {
-                let Phase::Driving(drive) = &mut self.phase else {
-                    return Vec::new();
-                };
-                let path: Vec<[f64; 2]> = std::iter::once(ask.from)
-                    .chain(route.points.iter().copied())
-                    .collect();
-                drive.reasons.push(reason.as_str().to_owned());
-                drive
-                    .watch
-                    .replanned(path.clone(), resend, now.mission_s, now.wall_s);
-                drive.waypoints = mission_waypoints(&route.points, self.setup.waypoint_spacing_m);
-                drive.route_curious = route.curious;
-                drive.plans.push(route.points);
-                let mission = self.ids.next(drive.waypoints.clone(), false);
-                drive.mission = mission.id.clone();
-                drive.sent_at_s = now.mission_s;
-                drive.path = path;
-                vec![
-                    WindowAction::Replanned { reason },
-                    WindowAction::Drive(mission),
-                ]
-            }
-        }
-    }
-
-    fn on_drive_failed(&mut self, asked: DriveAsk, now: Now) -> Vec<WindowAction> {
-        let task = &self.setup.task;
-        match asked {
-            DriveAsk::FirstPlan { .. } => {
-                let Phase::FirstPlan { failures, .. } = self.phase else {
-                    return Vec::new();
-                };
-                if now.mission_s > task.start_s + self.setup.give_up_after_s {
-                    return self.give_up_without_a_plan();
-                }
-                let failures = failures + 1;
-                if failures >= FALLBACK_AFTER_FAILURES {
-                    if let Some(route) = self.fastest_from_here() {
-                        return self.drive_without_a_planner(route, now);
-                    }
-                }
-                self.phase = Phase::FirstPlan {
-                    retry_at_wall_s: Some(now.wall_s + PLAN_RETRY_S),
-                    failures,
-                };
-                Vec::new()
-            }
-            // A curious plan that fails (busy, an outage) leaves the shortest way.
-            DriveAsk::Replan {
-                reason,
-                resend,
-                ask,
-            } if ask.curious => {
-                let ask = PlanAsk {
-                    id: self.next_ask_id(),
-                    curious: false,
-                    ..ask
-                };
-                self.record(&ask, false, now);
-                self.drive_ask = Some((
-                    ask.id,
-                    DriveAsk::Replan {
-                        reason,
-                        resend,
-                        ask,
-                    },
-                ));
-                vec![WindowAction::RequestPlan(ask)]
-            }
-            // No planner at all: the window's own fastest path, or the path it had.
-            DriveAsk::Replan { .. } => match self.fastest_from_here() {
-                Some(route) => self.go_straight(route, Reason::NoPlanner, now),
-                None => Vec::new(),
-            },
-        }
-    }
-
-    /// No planner answered the window's first plan: the robot drives the window's own
-    /// fastest path (the report says so), and the slack rule may replan a curious one.
-    fn drive_without_a_planner(&mut self, route: Route, now: Now) -> Vec<WindowAction> {
-        let time_left = self.setup.task.start_s - now.mission_s;
-        let budget = self.margin.budget(time_left);
-        let shortest = route.points.clone();
-        let mut actions = self.start_driving(route, shortest, budget, time_left, now);
-        if let Phase::Driving(drive) = &mut self.phase {
-            drive.reasons.push(Reason::NoPlanner.as_str().to_owned());
-        }
-        actions.insert(
-            0,
-            WindowAction::Replanned {
-                reason: Reason::NoPlanner,
-            },
-        );
-        actions
-    }
-
-    fn on_ahead_plan(
-        &mut self,
-        asked: AheadAsk,
-        route: Route,
-        shortest: Vec<[f64; 2]>,
-        now: Now,
-    ) -> Vec<WindowAction> {
-        // A plan for a window that has begun would start from a place the robot may
-        // have left: dropped.
-        if now.mission_s <= asked.leave_at_s {
-            self.planned_ahead = Some(PlannedAhead {
-                window: self.setup.window + 1,
-                from: self.setup.task.at,
-                route,
-                shortest,
-                budget_s: asked.budget_s,
-                time_left_s: asked.time_left_s,
-                leave_at_s: asked.leave_at_s,
-            });
-        }
-        self.finish_at_task_end(now)
-    }
-
-    fn on_ahead_failed(&mut self, now: Now) -> Vec<WindowAction> {
-        let Phase::AtTask {
-            leave_at_s,
-            retry_at_wall_s,
-            ..
-        } = &mut self.phase
-        else {
-            // While driving: asked again at the arrival.
-            return Vec::new();
-        };
-        let next_given_up = self
-            .setup
-            .next
-            .as_ref()
-            .is_none_or(|n| now.mission_s > n.start_s + self.setup.give_up_after_s);
-        if now.mission_s < *leave_at_s && !next_given_up {
-            *retry_at_wall_s = Some(now.wall_s + PLAN_RETRY_S);
-            return Vec::new();
-        }
-        self.finish_at_task_end(now)
+        self.ask_replan(reason, resend, ask)
     }
 }
 

@@ -413,7 +413,7 @@ fn the_fastest_path_floor_admits_a_budget_the_distance_shortest_path_would_refus
     }
 }
 
-/// Issue 26 item 5: a deadline bounds the work. Model I with 100,000 generations and a
+/// A deadline bounds the work. Model I with 100,000 generations and a
 /// 2 s deadline on the built-in world (an 80 s budget: paths of at most 201 cells) would
 /// cost 200 × 100,000 × 201 = 4.02e9, over `max_plan_cost`; the GA stops at its
 /// deadline, so only the generations that can start before it count, and the request is

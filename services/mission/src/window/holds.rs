@@ -1,7 +1,7 @@
 //! A robot the controller's PEB guard holds (paper 002's uncertainty, roam's guard): the
 //! window counts the hold and, after `hold_patience_s`, drives the robot back along its
-//! own track to its last fix with a recovery mission (which the guard lets through),
-//! then replans from there ([`super::DowntimeWindow::on_status`]).
+//! own track past its last fix with a recovery mission (which the guard lets through),
+//! then goes straight to the task from there ([`super::DowntimeWindow::on_status`]).
 
 use super::{straight, DowntimeWindow, Now, Phase, WindowAction};
 use crate::path::mission_waypoints;
@@ -25,12 +25,10 @@ impl DowntimeWindow<'_> {
         }
         let back = straight::back_along(&self.driven, self.last_fix, super::RECOVERY_BACK_M);
         let waypoints = mission_waypoints(&back, spacing);
-        let mut actions: Vec<WindowAction> = self
-            .drive_ask
-            .take()
-            .map(|(id, _)| WindowAction::Forget(id))
-            .into_iter()
-            .collect();
+        let mut actions = self.forget_drive_ask();
+        let Phase::Driving(drive) = &mut self.phase else {
+            return actions;
+        };
         drive.recovering = true;
         drive.recoveries += 1;
         drive.held_s += held_s;

@@ -40,9 +40,7 @@ pub(super) fn fastest_route(
 /// (its last point when the path is shorter): where the robot will be when a plan asked
 /// now comes, if it drives on.
 pub(super) fn point_ahead(path: &[[f64; 2]], here: [f64; 2], lead_m: f64) -> [f64; 2] {
-    let Some(nearest) = (0..path.len())
-        .min_by(|&a, &b| distance(path[a], here).total_cmp(&distance(path[b], here)))
-    else {
+    let Some(nearest) = nearest(path, here) else {
         return here;
     };
     let mut left = lead_m.max(0.0);
@@ -57,6 +55,20 @@ pub(super) fn point_ahead(path: &[[f64; 2]], here: [f64; 2], lead_m: f64) -> [f6
         at = *next;
     }
     at
+}
+
+/// The index of `path`'s point nearest to `here`.
+fn nearest(path: &[[f64; 2]], here: [f64; 2]) -> Option<usize> {
+    (0..path.len()).min_by(|&a, &b| distance(path[a], here).total_cmp(&distance(path[b], here)))
+}
+
+/// What is left of `path` from `here`: `here`, then the path from its point nearest to
+/// `here` on.
+pub(super) fn route_left(path: &[[f64; 2]], here: [f64; 2]) -> Vec<[f64; 2]> {
+    let from = nearest(path, here).unwrap_or(path.len());
+    std::iter::once(here)
+        .chain(path[from..].iter().copied())
+        .collect()
 }
 
 /// The way back along `driven` (oldest first) from its end past its point `fix` (the

@@ -146,12 +146,7 @@ fn change_information(
         map.observe(&window, f64::from(t))
             .map_err(|e| MissionExperimentError::World(e.to_string()))?;
     }
-    Ok(map
-        .probability_layer(f64::from(seconds))
-        .cells
-        .iter()
-        .map(|p| (p.clamp(0.0, 1.0) * 100.0).round() as u8)
-        .collect())
+    Ok(map.change_scores(f64::from(seconds)))
 }
 
 /// Runs the comparison; `progress(done, total)` after each mission.

@@ -1,4 +1,4 @@
-//! The goals for the shipped executive (issues 14 and 26), each judged from the
+//! The goals for the shipped executive, each judged from the
 //! figures, and what falls short explained by the figures that account for it.
 
 use std::fmt::Write;
@@ -203,8 +203,8 @@ fn information_shortfall(new: &VariantSummary, other: &VariantSummary, p: &Paire
     )
 }
 
-/// The halted steps a day of `no_peb` had before the executive recovered holds (issue
-/// 26: 762 a day, the robot held in the two-anchor room for the rest of the day).
+/// The halted steps of a day whose robot the PEB guard holds in the north-east room for
+/// the rest of the day: `no_peb` with `recover: false` (762 a day over 50 days).
 pub const HALTED_STEPS_BEFORE_RECOVERY: f64 = 762.0;
 
 /// The share of [`HALTED_STEPS_BEFORE_RECOVERY`] a day of `no_peb` may keep.
@@ -231,7 +231,7 @@ fn halted_shortfall(no_peb: &VariantSummary) -> String {
     )
 }
 
-/// The goals of issues 14 and 26, judged on the shipped executive (the holds on
+/// The goals, judged on the shipped executive (the holds on
 /// `no_peb`, where the PEB cost does not keep the robot out of poor coverage).
 pub fn goals(
     summaries: &[VariantSummary],

@@ -32,16 +32,6 @@ pub struct Planner<'a> {
     pub change: bool,
 }
 
-/// The mapper's `change_information` scores of `change` at `now_s`.
-pub fn change_scores(change: &ChangeMap, now_s: f64) -> Vec<u8> {
-    change
-        .probability_layer(now_s)
-        .cells
-        .iter()
-        .map(|p| (p.clamp(0.0, 1.0) * 100.0).round() as u8)
-        .collect()
-}
-
 impl Planner<'_> {
     /// The information map a plan made now uses: the static one, or coupled with the
     /// change layer at `now_s` (module doc).
@@ -50,7 +40,7 @@ impl Planner<'_> {
             return None;
         }
         let mut world = self.world.planning.clone();
-        world.information = couple(&world.information, &change_scores(change, now_s));
+        world.information = couple(&world.information, &change.change_scores(now_s));
         // Model II's block sums follow the information map.
         world.set_heuristic_compression(world.heuristic_compression);
         Some(world)

@@ -1,0 +1,124 @@
+//! The window's plan requests: their budgets and deadlines (the arrival margin after
+//! the plan's expected cost, the deadline cut to what the time left affords), their ids,
+//! and the record the window's report lists.
+
+use roam_planner::plan::MAX_T_EXEC_S;
+use roam_proto::mission::{AskReport, MAX_REPORTED_ASKS};
+
+use super::{
+    AheadAsk, DowntimeWindow, DriveAsk, Now, PlanAsk, WindowAction, LEAST_T_EXEC_S, MIN_DEADLINE_S,
+};
+use crate::watch::Reason;
+
+impl DowntimeWindow<'_> {
+    /// A request from `from` to `to` for a task starting at `task_start_s`, the robot
+    /// leaving at `leave_at_s` at the earliest (now when `None`): its deadline cut to
+    /// what the time left affords, its budget what the margin leaves after the plan's
+    /// expected cost; with the time left that budget was made from.
+    pub(super) fn ask(
+        &mut self,
+        from: [f64; 2],
+        to: [f64; 2],
+        task_start_s: f64,
+        leave_at_s: Option<f64>,
+        curious: bool,
+        now: Now,
+    ) -> (PlanAsk, f64, f64) {
+        let rules = self.setup.rules;
+        let set_off = leave_at_s.map_or(now.mission_s, |at| at.max(now.mission_s));
+        let time_left = (task_start_s - set_off).max(0.0);
+        let rate = now.clock_rate.max(1e-9);
+        let deadline_s = rules
+            .plan_deadline_s
+            .min(rules.replan_time_share * time_left / rate)
+            .max(MIN_DEADLINE_S);
+        let curious = curious && rules.curious;
+        let cost = if curious {
+            now.planning_cost_s.min(deadline_s * rate)
+        } else {
+            0.0
+        };
+        let earliest = now.mission_s + cost;
+        let time_left = task_start_s - leave_at_s.map_or(earliest, |at| at.max(earliest));
+        let budget_s = self.margin.budget(time_left);
+        let ask = PlanAsk {
+            id: self.next_ask_id(),
+            from,
+            to,
+            t_exec_s: budget_s.clamp(LEAST_T_EXEC_S, MAX_T_EXEC_S),
+            deadline_s,
+            curious: curious && budget_s > 0.0,
+        };
+        self.record(&ask, leave_at_s.is_some(), now);
+        (ask, budget_s, time_left)
+    }
+
+    pub(super) fn next_ask_id(&mut self) -> u64 {
+        self.asks_made += 1;
+        self.asks_made
+    }
+
+    /// Keeps `ask` for the window's report.
+    pub(super) fn record(&mut self, ask: &PlanAsk, ahead: bool, now: Now) {
+        self.asks_in_window += 1;
+        if self.asks.len() < MAX_REPORTED_ASKS {
+            self.asks.push(AskReport {
+                at_s: now.mission_s,
+                from: ask.from,
+                t_exec_s: ask.t_exec_s,
+                curious: ask.curious,
+                ahead,
+            });
+        }
+    }
+
+    pub(super) fn ask_first_plan(&mut self, now: Now) -> WindowAction {
+        let (from, to, start) = (self.setup.from, self.setup.task.at, self.setup.task.start_s);
+        let (ask, budget_s, time_left_s) = self.ask(from, to, start, None, true, now);
+        self.drive_ask = Some((
+            ask.id,
+            DriveAsk::FirstPlan {
+                budget_s,
+                time_left_s,
+            },
+        ));
+        WindowAction::RequestPlan(ask)
+    }
+
+    pub(super) fn ask_next_window(&mut self, now: Now) -> Vec<WindowAction> {
+        let Some(next) = &self.setup.next else {
+            return Vec::new();
+        };
+        let (start_s, to) = (next.start_s, next.at);
+        let task = &self.setup.task;
+        let (from, leave_at_s) = (task.at, task.start_s + task.duration_s);
+        let (ask, budget_s, time_left_s) = self.ask(from, to, start_s, Some(leave_at_s), true, now);
+        self.ahead_ask = Some((
+            ask.id,
+            AheadAsk {
+                budget_s,
+                time_left_s,
+                leave_at_s,
+            },
+        ));
+        vec![WindowAction::RequestPlan(ask)]
+    }
+
+    /// Asks `ask` as the drive's replan for `reason`.
+    pub(super) fn ask_replan(
+        &mut self,
+        reason: Reason,
+        resend: bool,
+        ask: PlanAsk,
+    ) -> Vec<WindowAction> {
+        self.drive_ask = Some((
+            ask.id,
+            DriveAsk::Replan {
+                reason,
+                resend,
+                ask,
+            },
+        ));
+        vec![WindowAction::RequestPlan(ask)]
+    }
+}

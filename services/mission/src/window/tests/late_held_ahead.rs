@@ -1,0 +1,155 @@
+//! The rules that keep the robot on time and free: the last safe moment, a PEB hold
+//! recovered, and the next window planned while driving beside a replan.
+
+use super::*;
+
+#[test]
+fn at_the_last_safe_moment_the_robot_goes_straight_and_stays_straight() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    // On its curious route at 95 s, 5 s before the task: the fastest path from here
+    // takes longer than what the margin leaves of 5 s.
+    let here = [0.1, 1.1];
+    let actions = w.handle(estimate(here, 0.1), at(95.0, 0.5));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::LastSafeMoment
+        }
+    );
+    let straight = sent(&actions);
+    assert_ne!(straight.id, first.id);
+    assert_eq!(straight.waypoints.last().copied(), Some(GOAL));
+    assert!(
+        !actions
+            .iter()
+            .any(|a| matches!(a, WindowAction::RequestPlan(_))),
+        "no planner"
+    );
+    // Curious no more: far early on the new route is not slack.
+    let again = w.handle(
+        status(&straight.id, MissionState::Active, 0.5),
+        at(97.0, 0.6),
+    );
+    assert!(again.is_empty(), "{again:?}");
+    let r = report(&{
+        w.handle(
+            status(&straight.id, MissionState::Completed, 0.0),
+            at(99.0, 0.7),
+        );
+        w.handle(WindowEvent::Tick, at(105.0, 0.8))
+    });
+    assert!(r.on_time);
+    assert_eq!(
+        r.replan_reasons,
+        vec![Reason::LastSafeMoment.as_str().to_owned()]
+    );
+}
+
+#[test]
+fn a_robot_held_for_its_peb_is_driven_back_to_its_last_fix_then_replanned() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    for (p, peb) in [
+        ([0.1, 0.3], 0.3),
+        ([0.1, 0.5], 0.4),
+        ([0.1, 0.7], 3.0),
+        ([0.1, 0.9], 9.0),
+    ] {
+        assert!(w.handle(estimate(p, peb), at(5.0, 0.1)).is_empty());
+    }
+    let held = |w: &mut DowntimeWindow<'_>, t: f64| {
+        w.handle(status(&first.id, MissionState::HaltedPeb, 2.0), at(t, 0.2))
+    };
+    assert!(held(&mut w, 10.0).is_empty());
+    assert!(held(&mut w, 13.9).is_empty(), "within its patience");
+    let actions = held(&mut w, 14.1);
+    assert!(matches!(actions[0], WindowAction::Recovering { held_s } if close(held_s, 4.1)));
+    let back = sent(&actions);
+    assert!(back.recovery, "the guard lets a recovery through");
+    // Back past the last fix ([0.1, 0.5]) by RECOVERY_BACK_M, here to the track's start.
+    assert_eq!(back.waypoints.last().copied(), Some(FROM), "{back:?}");
+    // Back at the fix: straight to the task from there, without the planner.
+    let actions = answer_status(&mut w, &back, MissionState::Completed, at(20.0, 0.3));
+    assert!(!actions
+        .iter()
+        .any(|a| matches!(a, WindowAction::RequestPlan(_))));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::Recovered
+        }
+    );
+    let onward = sent(&actions);
+    assert!(!onward.recovery);
+    answer_status(&mut w, &onward, MissionState::Completed, at(70.0, 0.5));
+    let r = report(&w.handle(WindowEvent::Tick, at(105.0, 0.6)));
+    assert_eq!((r.holds, r.recoveries), (1, 1));
+    assert!(close(r.held_s, 4.1), "{r:?}");
+    assert!(r.on_time);
+}
+
+#[test]
+fn with_plan_ahead_the_next_window_is_asked_while_driving_beside_a_replan() {
+    let f = fixture();
+    let mut setup = f.setup(0, FROM, true);
+    setup.rules.plan_ahead = true;
+    let (mut w, actions) = DowntimeWindow::begin(setup, Handover::first(margin()), at(0.0, 0.0));
+    let first_id = asked(&actions).id;
+    let actions = w.handle(
+        WindowEvent::PlanReply {
+            id: first_id,
+            plan: Box::new(Plan {
+                shortest: attached(shortest_points(FROM)),
+                ..plan(PlannerModel::Model1, curious_points(), CURIOUS_ETA_S)
+            }),
+        },
+        at(1.0, 0.0),
+    );
+    let mission = sent(&actions);
+    let ahead = asked(&actions);
+    assert_eq!(
+        (ahead.from, ahead.to),
+        (GOAL, NEXT),
+        "the next window, from this task"
+    );
+    // A replan while the next window's plan is made: two in flight.
+    let pushed = [2.0, 2.5];
+    let replan = asked(&w.handle(estimate(pushed, 0.1), at(3.0, 0.1)));
+    assert_ne!(replan.id, ahead.id);
+    assert_eq!(w.asks_in_flight(), 2);
+    let next_route = line(GOAL, NEXT);
+    let ahead_reply = WindowEvent::PlanReply {
+        id: ahead.id,
+        plan: Box::new(Plan {
+            shortest: attached(next_route.clone()),
+            ..plan(PlannerModel::Model1, next_route, 50.0)
+        }),
+    };
+    assert!(w.handle(ahead_reply, at(3.5, 0.2)).is_empty());
+    // Arriving forgets the replan; nothing more is asked at the task.
+    let actions = w.handle(
+        status(&mission.id, MissionState::Completed, 0.0),
+        at(60.0, 0.3),
+    );
+    assert_eq!(actions[0], WindowAction::Forget(replan.id));
+    assert!(!actions
+        .iter()
+        .any(|a| matches!(a, WindowAction::RequestPlan(_))));
+    // Its late answer changes nothing.
+    let late = WindowEvent::PlanFailed { id: replan.id };
+    assert!(w.handle(late, at(61.0, 0.4)).is_empty());
+    let end = ended(&w.handle(WindowEvent::Tick, at(105.0, 0.5)));
+    let planned = end.handover.planned_ahead.expect("planned while driving");
+    assert_eq!((planned.window, planned.leave_at_s), (1, 105.0));
+    // A window that begins well after the plan assumed takes a fresh one.
+    let handover = Handover {
+        planned_ahead: Some(planned),
+        ..end.handover
+    };
+    let (_, actions) = DowntimeWindow::begin(f.setup(1, GOAL, false), handover, at(110.0, 0.0));
+    assert!(
+        matches!(actions[0], WindowAction::RequestPlan(_)),
+        "{actions:?}"
+    );
+}
