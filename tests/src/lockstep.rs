@@ -219,6 +219,24 @@ impl LockstepDay {
                 self.take(&mut seen);
             }
         }
+        // This step's controller status reaches this driver too (the executive may have
+        // heard it first): without it, whether a command is due cannot be told.
+        let active_before = self
+            .last_status
+            .as_ref()
+            .is_some_and(|s| s.state == MissionState::Active);
+        if active_before {
+            let until = Instant::now() + STEP_PATIENCE;
+            let heard = |seen: &Seen| {
+                seen.statuses
+                    .iter()
+                    .any(|s| s.estimate_step >= Some(stepped.step))
+            };
+            while Instant::now() < until && !heard(&seen) {
+                tokio::time::sleep(Duration::from_millis(1)).await;
+                self.take(&mut seen);
+            }
+        }
         // The command for this step has left the controller; the next step takes it.
         let active = self.last_status.as_ref().is_some_and(|s| {
             s.state == MissionState::Active && s.estimate_step == Some(stepped.step)

@@ -13,6 +13,10 @@
 //! the holder of the token can cancel the plan ([`PlannerClient::cancel`]). A plan whose
 //! future is dropped before its reply (the caller gave up) is cancelled with its token,
 //! so the planner does not keep computing a path nobody waits for.
+//!
+//! Every request names its client (`?client=<name>` on the key, by default this
+//! session's Zenoh id), so that each planner instance gives each client its fair share
+//! of its queue ([`crate::queue`]).
 
 use roam_runtime::Delivery;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -31,6 +35,8 @@ pub const REPLY_MARGIN: Duration = Duration::from_secs(10);
 pub struct PlannerClient {
     session: zenoh::Session,
     root: String,
+    /// The name sent for the queue's fair share.
+    client: String,
     next: AtomicUsize,
 }
 
@@ -105,12 +111,19 @@ impl Drop for CancelOnDrop<'_> {
 }
 
 impl PlannerClient {
+    /// A client named by its session's Zenoh id.
     pub fn new(session: zenoh::Session, root: &str) -> Self {
         PlannerClient {
+            client: session.zid().to_string(),
             session,
             root: root.to_owned(),
             next: AtomicUsize::new(0),
         }
+    }
+
+    /// The key `key` with this client's name as its `client` parameter.
+    fn named(&self, key: String) -> String {
+        format!("{key}?{}={}", crate::service::CLIENT_PARAMETER, self.client)
     }
 
     /// The instances that hold a liveliness token now, sorted by name.
@@ -177,7 +190,7 @@ impl PlannerClient {
         if instances.is_empty() {
             // No token seen (yet): fall back to the shared key.
             return requester
-                .request(&keys::planner_plan(&self.root), Some(request))
+                .request(&self.named(keys::planner_plan(&self.root)), Some(request))
                 .await;
         }
         let first = self.next.fetch_add(1, Ordering::Relaxed);
@@ -185,7 +198,10 @@ impl PlannerClient {
         for k in 0..instances.len() {
             let instance = &instances[(first + k) % instances.len()];
             match requester
-                .request(&keys::planner_plan_at(&self.root, instance), Some(request))
+                .request(
+                    &self.named(keys::planner_plan_at(&self.root, instance)),
+                    Some(request),
+                )
                 .await
             {
                 Ok(plan) => return Ok(plan),

@@ -1,7 +1,20 @@
-//! The instance's plan queue: a burst is served in order, or refused at once.
+//! The instance's plan queue: each client gets its share, a burst is served in order, or
+//! refused at once.
 //!
 //! An instance plans `max_concurrent_plans` requests at a time; the next ones wait in a
-//! bounded FIFO queue of `max_queued_plans`. A request is admitted when its *expected
+//! bounded queue of `max_queued_plans`. **Each client has a fair share** (start-time fair
+//! queuing, one round per request): a request's round is the later of the round being
+//! served and the round after its client's previous request, and the queue serves
+//! rounds in order (arrival order within a round and within a client). A client that
+//! queued 10,000 requests holds rounds far ahead; a newcomer's request is served next,
+//! after the requests of the round being served. When the queue is full, a request whose
+//! round comes before the last queued one takes that one's place (the displaced request
+//! is refused `busy`), so a flood fills the queue only with itself. A client is who the
+//! request says it is ([`ClientId`]: the query's `client` parameter; roam's own
+//! clients send their Zenoh session's id): a share against a runaway client, not
+//! against a stranger who invents names.
+//!
+//! A request is admitted when its *expected
 //! wait* plus its *expected planning time* fits its `deadline_s` (which counts from its
 //! arrival: the wait is part of it); otherwise it is refused `busy` at once, with the
 //! expected wait in the error (`expected_wait_s`) so that a client can choose another
@@ -24,8 +37,8 @@
 //! before it is queued. A queued request can be cancelled by its requester like a
 //! running one ([`crate::inflight`]); it then leaves the queue at once.
 
-use std::collections::VecDeque;
-use std::sync::Mutex;
+use std::collections::{HashMap, HashSet, VecDeque};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use tokio_util::sync::CancellationToken;
@@ -41,6 +54,33 @@ pub const OVERHEAD_UNITS: f64 = 2.0e6;
 pub const PRIOR_SECONDS_PER_UNIT: f64 = 1.0e-8;
 /// The weight of the newest measurement in the rate's average.
 pub const RATE_WEIGHT: f64 = 0.3;
+/// The longest client name kept; a longer one is cut there.
+pub const MAX_CLIENT_ID_BYTES: usize = 64;
+
+/// Who a request is from, for its fair share: the name the client gives (clipped to
+/// [`MAX_CLIENT_ID_BYTES`]), or one shared name for every client that gives none.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct ClientId(Arc<str>);
+
+impl ClientId {
+    /// The share of the requests that name no client.
+    pub fn anonymous() -> ClientId {
+        ClientId(Arc::from(""))
+    }
+
+    /// The client named `name` (empty: [`ClientId::anonymous`]).
+    pub fn named(name: &str) -> ClientId {
+        let mut end = name.len().min(MAX_CLIENT_ID_BYTES);
+        while !name.is_char_boundary(end) {
+            end -= 1;
+        }
+        ClientId(Arc::from(&name[..end]))
+    }
+
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+}
 
 /// The queue's settings (see [`crate::PlannerConfig`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -87,10 +127,13 @@ pub fn units(cost: u64) -> f64 {
     OVERHEAD_UNITS + cost as f64
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct Job {
     id: u64,
-    /// Arrival order: the queue is served in it.
+    client: ClientId,
+    /// Its fair-share round: the queue serves rounds in order.
+    round: u64,
+    /// Arrival order, within a round.
     seq: u64,
     /// Expected seconds of planning.
     expected_s: f64,
@@ -98,12 +141,92 @@ struct Job {
     since: Instant,
 }
 
+impl Job {
+    fn order(&self) -> (u64, u64) {
+        (self.round, self.seq)
+    }
+}
+
+/// A client's place in the rounds.
+#[derive(Debug, Clone, Copy, Default)]
+struct Share {
+    /// The round its next request takes at the earliest.
+    next_round: u64,
+    /// Its requests running or waiting (the entry goes at 0).
+    jobs: usize,
+}
+
 #[derive(Debug, Default)]
 struct Inner {
     running: Vec<Job>,
+    /// In `(round, seq)` order.
     waiting: VecDeque<Job>,
+    /// The round of the request that started last.
+    round: u64,
+    clients: HashMap<ClientId, Share>,
+    /// Requests that lost their place to a request of an earlier round.
+    displaced: HashSet<u64>,
     rate: Rate,
     next_id: u64,
+}
+
+impl Inner {
+    /// Forgets a request (running or waiting) and its client's share when it was the
+    /// client's last.
+    fn remove(&mut self, id: u64) {
+        let gone = if let Some(at) = self.running.iter().position(|j| j.id == id) {
+            Some(self.running.swap_remove(at))
+        } else if let Some(at) = self.waiting.iter().position(|j| j.id == id) {
+            self.waiting.remove(at)
+        } else {
+            None
+        };
+        self.displaced.remove(&id);
+        if let Some(job) = gone {
+            if let Some(share) = self.clients.get_mut(&job.client) {
+                share.jobs = share.jobs.saturating_sub(1);
+                if share.jobs == 0 {
+                    self.clients.remove(&job.client);
+                }
+            }
+        }
+    }
+
+    /// Queues `job` in its place. A request that reached the queue after a later one
+    /// of the same client (requests are checked concurrently) takes that one's round,
+    /// and the client's later requests move one round on.
+    fn insert(&mut self, mut job: Job) {
+        let later_of_client = self
+            .waiting
+            .iter()
+            .any(|j| j.client == job.client && j.seq > job.seq);
+        if later_of_client {
+            let mut rounds: Vec<u64> = self
+                .waiting
+                .iter()
+                .filter(|j| j.client == job.client)
+                .map(|j| j.round)
+                .chain([job.round])
+                .collect();
+            rounds.sort_unstable();
+            let client = job.client.clone();
+            let mut mine: Vec<&mut Job> = self
+                .waiting
+                .iter_mut()
+                .filter(|j| j.client == client)
+                .chain([&mut job])
+                .collect();
+            mine.sort_by_key(|j| j.seq);
+            for (j, round) in mine.into_iter().zip(rounds) {
+                j.round = round;
+            }
+            self.waiting.push_back(job);
+            self.waiting.make_contiguous().sort_by_key(Job::order);
+        } else {
+            let at = self.waiting.partition_point(|j| j.order() < job.order());
+            self.waiting.insert(at, job);
+        }
+    }
 }
 
 /// Why a request was not admitted.
@@ -156,6 +279,8 @@ pub enum Turn {
     Plan,
     /// The requester cancelled (or the instance is stopping) while it was queued.
     Cancelled,
+    /// The queue was full and a request of an earlier round took this one's place.
+    Displaced,
 }
 
 /// The queue of one instance.
@@ -227,31 +352,46 @@ impl PlanQueue {
         free_at.get(earliest(&free_at)).copied().unwrap_or(0.0)
     }
 
-    /// Admits the request that arrived `seq`-th at `now` (the queue serves arrival
-    /// order: requests are checked concurrently, so one may reach the queue after a
-    /// later one), of `units` of work ([`units`]), with `deadline_s` from `now` and its
-    /// planning at most `max_plan_s` (the CPU budget's `max_plan_seconds`); or refuses
-    /// it.
+    /// Admits the request that arrived `seq`-th at `now` from `client`, of `units` of
+    /// work ([`units`]), with `deadline_s` from `now` and its planning at most
+    /// `max_plan_s` (the CPU budget's `max_plan_seconds`); or refuses it. Its place is
+    /// its client's fair share (see the module doc).
     pub fn admit(
         &self,
         seq: u64,
+        client: &ClientId,
         units: f64,
         deadline_s: f64,
         max_plan_s: f64,
         now: Instant,
     ) -> Result<Ticket<'_>, Refusal> {
         let mut inner = self.lock();
-        let ahead = inner.waiting.partition_point(|j| j.seq < seq);
+        let share = inner.clients.get(client).copied().unwrap_or_default();
+        // The round the client's newest request takes; this one's place is the round
+        // of the client's first request that arrived after it, if one is queued.
+        let round = share.next_round.max(inner.round);
+        let place = inner
+            .waiting
+            .iter()
+            .filter(|j| j.client == *client && j.seq > seq)
+            .map(|j| j.round)
+            .min()
+            .unwrap_or(round);
+        let order = (place, seq);
+        let ahead = inner.waiting.partition_point(|j| j.order() < order);
         let wait = self.expected_wait(&inner, now, ahead);
         let plan = (units * inner.rate.seconds_per_unit).min(max_plan_s);
         let queued = inner.waiting.len();
         let slot_free = inner.running.len() < self.config.max_concurrent_plans && ahead == 0;
         if !slot_free {
             if queued >= self.config.max_queued_plans {
-                return Err(Refusal::Full {
-                    queued,
-                    expected_wait_s: wait,
-                });
+                let last_is_later = inner.waiting.back().is_some_and(|j| j.order() > order);
+                if !last_is_later {
+                    return Err(Refusal::Full {
+                        queued,
+                        expected_wait_s: wait,
+                    });
+                }
             }
             if wait + plan > deadline_s {
                 return Err(Refusal::Late {
@@ -261,18 +401,27 @@ impl PlanQueue {
                     queued,
                 });
             }
+            if queued >= self.config.max_queued_plans {
+                if let Some(last) = inner.waiting.back().map(|j| j.id) {
+                    inner.remove(last);
+                    inner.displaced.insert(last);
+                    self.changed.notify_waiters();
+                }
+            }
         }
         let id = inner.next_id;
         inner.next_id += 1;
-        inner.waiting.insert(
-            ahead,
-            Job {
-                id,
-                seq,
-                expected_s: plan.min(deadline_s),
-                since: now,
-            },
-        );
+        let entry = inner.clients.entry(client.clone()).or_default();
+        entry.next_round = round + 1;
+        entry.jobs += 1;
+        inner.insert(Job {
+            id,
+            client: client.clone(),
+            round,
+            seq,
+            expected_s: plan.min(deadline_s),
+            since: now,
+        });
         Ok(Ticket {
             queue: self,
             id,
@@ -289,30 +438,35 @@ impl PlanQueue {
 impl Ticket<'_> {
     /// Moves this request from the queue to a slot if it is first in line and a slot
     /// is free.
-    fn try_start(&mut self, now: Instant) -> bool {
+    fn try_start(&mut self, now: Instant) -> Option<Turn> {
         let queue = self.queue;
         let mut inner = queue.lock();
+        if inner.displaced.remove(&self.id) {
+            return Some(Turn::Displaced);
+        }
         let first = inner.waiting.front().is_some_and(|j| j.id == self.id);
         if !first || inner.running.len() >= queue.config.max_concurrent_plans {
-            return false;
+            return None;
         }
         if let Some(mut job) = inner.waiting.pop_front() {
             job.since = now;
+            inner.round = inner.round.max(job.round);
             inner.running.push(job);
             self.started = Some(now);
         }
-        true
+        Some(Turn::Plan)
     }
 
-    /// Waits until a slot is this request's, in arrival order, or until `cancel`.
+    /// Waits until a slot is this request's, in its client's fair turn, or until
+    /// `cancel`, or until it is displaced.
     pub async fn wait_turn(&mut self, cancel: &CancellationToken) -> Turn {
         loop {
             let changed = self.queue.changed.notified();
             tokio::pin!(changed);
             // Registered before the check, so no wake-up between them is lost.
             changed.as_mut().enable();
-            if self.try_start(Instant::now()) {
-                return Turn::Plan;
+            if let Some(turn) = self.try_start(Instant::now()) {
+                return turn;
             }
             tokio::select! {
                 _ = &mut changed => {}
@@ -356,8 +510,7 @@ impl Ticket<'_> {
 impl Drop for Ticket<'_> {
     fn drop(&mut self) {
         let mut inner = self.queue.lock();
-        inner.running.retain(|j| j.id != self.id);
-        inner.waiting.retain(|j| j.id != self.id);
+        inner.remove(self.id);
         drop(inner);
         self.queue.changed.notify_waiters();
     }
@@ -366,6 +519,11 @@ impl Drop for Ticket<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The client of the tests that have one.
+    fn one() -> ClientId {
+        ClientId::named("one")
+    }
 
     fn queue(concurrent: usize, queued: usize) -> PlanQueue {
         PlanQueue::new(QueueConfig {
@@ -384,15 +542,15 @@ mod tests {
         // Two slots share the cores: the prior rate is twice one plan's.
         const ONE_S: f64 = super::tests::ONE_S / 2.0;
         let now = Instant::now();
-        let mut a = q.admit(1, 2.0 * ONE_S, 30.0, 30.0, now).expect("a");
-        assert!(a.try_start(now));
-        let mut b = q.admit(2, ONE_S, 30.0, 30.0, now).expect("b");
-        assert!(b.try_start(now));
+        let mut a = q.admit(1, &one(), 2.0 * ONE_S, 30.0, 30.0, now).expect("a");
+        assert_eq!(a.try_start(now), Some(Turn::Plan));
+        let mut b = q.admit(2, &one(), ONE_S, 30.0, 30.0, now).expect("b");
+        assert_eq!(b.try_start(now), Some(Turn::Plan));
         // Both slots busy: free in 1 s (b) and 2 s (a).
-        let c = q.admit(3, 3.0 * ONE_S, 30.0, 30.0, now).expect("c");
+        let c = q.admit(3, &one(), 3.0 * ONE_S, 30.0, 30.0, now).expect("c");
         assert!((c.expected_wait_s - 1.0).abs() < 1e-9);
         // c takes b's slot at 1 s and ends at 4 s; d gets a's at 2 s.
-        let d = q.admit(4, ONE_S, 30.0, 30.0, now).expect("d");
+        let d = q.admit(4, &one(), ONE_S, 30.0, 30.0, now).expect("d");
         assert!(
             (d.expected_wait_s - 2.0).abs() < 1e-9,
             "{}",
@@ -400,7 +558,7 @@ mod tests {
         );
         // 1 s later the running plans have 0 and 1 s left.
         let later = now + Duration::from_secs(1);
-        let e = q.admit(5, ONE_S, 30.0, 30.0, later).expect("e");
+        let e = q.admit(5, &one(), ONE_S, 30.0, 30.0, later).expect("e");
         // Slots free at 0 and 1; c takes 0 → 3, d takes 1 → 2: e waits 2 s.
         assert!(
             (e.expected_wait_s - 2.0).abs() < 1e-9,
@@ -415,10 +573,12 @@ mod tests {
     fn a_request_that_cannot_make_its_deadline_is_refused_with_the_wait() {
         let q = queue(1, 10);
         let now = Instant::now();
-        let mut a = q.admit(6, 10.0 * ONE_S, 30.0, 30.0, now).expect("a");
-        assert!(a.try_start(now));
+        let mut a = q
+            .admit(6, &one(), 10.0 * ONE_S, 30.0, 30.0, now)
+            .expect("a");
+        assert_eq!(a.try_start(now), Some(Turn::Plan));
         // 10 s wait + 1 s plan > 5 s.
-        match q.admit(7, ONE_S, 5.0, 30.0, now) {
+        match q.admit(7, &one(), ONE_S, 5.0, 30.0, now) {
             Err(Refusal::Late {
                 expected_wait_s,
                 expected_plan_s,
@@ -432,21 +592,21 @@ mod tests {
             other => panic!("{other:?}"),
         }
         // 10 s + 1 s fits 30 s; a free slot admits anything.
-        assert!(q.admit(8, ONE_S, 30.0, 30.0, now).is_ok());
+        assert!(q.admit(8, &one(), ONE_S, 30.0, 30.0, now).is_ok());
         drop(a);
         let q = queue(1, 10);
-        assert!(q.admit(9, 100.0 * ONE_S, 1.0, 30.0, now).is_ok());
+        assert!(q.admit(9, &one(), 100.0 * ONE_S, 1.0, 30.0, now).is_ok());
     }
 
     #[test]
     fn the_queue_is_bounded() {
         let q = queue(1, 2);
         let now = Instant::now();
-        let mut a = q.admit(10, ONE_S, 60.0, 60.0, now).expect("a");
-        assert!(a.try_start(now));
-        let _b = q.admit(11, ONE_S, 60.0, 60.0, now).expect("b");
-        let _c = q.admit(12, ONE_S, 60.0, 60.0, now).expect("c");
-        match q.admit(13, ONE_S, 60.0, 60.0, now) {
+        let mut a = q.admit(10, &one(), ONE_S, 60.0, 60.0, now).expect("a");
+        assert_eq!(a.try_start(now), Some(Turn::Plan));
+        let _b = q.admit(11, &one(), ONE_S, 60.0, 60.0, now).expect("b");
+        let _c = q.admit(12, &one(), ONE_S, 60.0, 60.0, now).expect("c");
+        match q.admit(13, &one(), ONE_S, 60.0, 60.0, now) {
             Err(Refusal::Full {
                 queued,
                 expected_wait_s,
@@ -463,10 +623,10 @@ mod tests {
         let q = queue(1, 10);
         let now = Instant::now();
         let never = CancellationToken::new();
-        let mut a = q.admit(14, ONE_S, 60.0, 60.0, now).expect("a");
+        let mut a = q.admit(14, &one(), ONE_S, 60.0, 60.0, now).expect("a");
         assert_eq!(a.wait_turn(&never).await, Turn::Plan);
-        let mut b = q.admit(15, ONE_S, 60.0, 60.0, now).expect("b");
-        let mut c = q.admit(16, ONE_S, 60.0, 60.0, now).expect("c");
+        let mut b = q.admit(15, &one(), ONE_S, 60.0, 60.0, now).expect("b");
+        let mut c = q.admit(16, &one(), ONE_S, 60.0, 60.0, now).expect("c");
         let cancel_b = CancellationToken::new();
         cancel_b.cancel();
         assert_eq!(b.wait_turn(&cancel_b).await, Turn::Cancelled);
@@ -487,17 +647,102 @@ mod tests {
     fn the_queue_serves_arrival_order_whatever_order_requests_reach_it() {
         let q = queue(1, 10);
         let now = Instant::now();
-        let mut a = q.admit(0, ONE_S, 60.0, 60.0, now).expect("a");
-        assert!(a.try_start(now));
-        let mut late = q.admit(9, ONE_S, 60.0, 60.0, now).expect("9th");
-        let mut early = q.admit(5, 2.0 * ONE_S, 60.0, 60.0, now).expect("5th");
+        let mut a = q.admit(0, &one(), ONE_S, 60.0, 60.0, now).expect("a");
+        assert_eq!(a.try_start(now), Some(Turn::Plan));
+        let mut late = q.admit(9, &one(), ONE_S, 60.0, 60.0, now).expect("9th");
+        let mut early = q
+            .admit(5, &one(), 2.0 * ONE_S, 60.0, 60.0, now)
+            .expect("5th");
         // The 5th goes first: its wait is a's 1 s, the 9th's is 1 + 2.
         assert!((early.expected_wait_s - 1.0).abs() < 1e-9);
         drop(a);
-        assert!(!late.try_start(now));
-        assert!(early.try_start(now));
+        assert_eq!(late.try_start(now), None);
+        assert_eq!(early.try_start(now), Some(Turn::Plan));
         drop(early);
-        assert!(late.try_start(now));
+        assert_eq!(late.try_start(now), Some(Turn::Plan));
+    }
+
+    #[test]
+    fn a_newcomer_is_served_before_a_flooding_client_s_backlog() {
+        let q = queue(1, 100);
+        let now = Instant::now();
+        let flood = ClientId::named("flood");
+        let mut running = q.admit(0, &flood, ONE_S, 1e6, 1e6, now).expect("first");
+        assert_eq!(running.try_start(now), Some(Turn::Plan));
+        let backlog: Vec<_> = (1..=50)
+            .map(|i| q.admit(i, &flood, ONE_S, 1e6, 1e6, now).expect("backlog"))
+            .collect();
+        // Another client's request waits only for the plan running, not the backlog.
+        let mut other = q
+            .admit(51, &ClientId::named("other"), ONE_S, 3.0, 1e6, now)
+            .expect("a fair share");
+        assert!(
+            (other.expected_wait_s - 1.0).abs() < 1e-9,
+            "{}",
+            other.expected_wait_s
+        );
+        drop(running);
+        assert_eq!(other.try_start(now), Some(Turn::Plan));
+        // A client with one request at a time is always next. With two queued, its
+        // second shares round 1 with the flood's next, which arrived first.
+        drop(other);
+        let mut third = q
+            .admit(52, &ClientId::named("other"), ONE_S, 1e6, 1e6, now)
+            .expect("third");
+        let mut fourth = q
+            .admit(53, &ClientId::named("other"), ONE_S, 1e6, 1e6, now)
+            .expect("fourth");
+        assert_eq!(third.try_start(now), Some(Turn::Plan));
+        drop(third);
+        let mut backlog = backlog.into_iter();
+        let mut next = backlog.next().expect("the flood's next");
+        assert_eq!(
+            fourth.try_start(now),
+            None,
+            "round 1: the flood's arrived first"
+        );
+        assert_eq!(next.try_start(now), Some(Turn::Plan));
+        drop(next);
+        assert_eq!(fourth.try_start(now), Some(Turn::Plan));
+        let again = fourth;
+        drop((again, backlog));
+        assert_eq!(q.load(), (0, 0));
+        assert!(
+            q.lock().clients.is_empty(),
+            "no client is kept after its last request"
+        );
+    }
+
+    #[test]
+    fn a_full_queue_gives_the_flood_s_last_place_to_another_client() {
+        let q = queue(1, 3);
+        let now = Instant::now();
+        let flood = ClientId::named("flood");
+        let mut running = q.admit(0, &flood, ONE_S, 1e6, 1e6, now).expect("first");
+        assert_eq!(running.try_start(now), Some(Turn::Plan));
+        let mut backlog: Vec<_> = (1..=3)
+            .map(|i| q.admit(i, &flood, ONE_S, 1e6, 1e6, now).expect("backlog"))
+            .collect();
+        assert!(matches!(
+            q.admit(4, &flood, ONE_S, 1e6, 1e6, now),
+            Err(Refusal::Full { .. })
+        ));
+        let mut other = q
+            .admit(5, &ClientId::named("other"), ONE_S, 1e6, 1e6, now)
+            .expect("a place");
+        assert_eq!(backlog[2].try_start(now), Some(Turn::Displaced));
+        assert_eq!(q.load(), (1, 3));
+        drop(running);
+        assert_eq!(other.try_start(now), Some(Turn::Plan));
+        drop(backlog.remove(2));
+        assert_eq!(q.load(), (1, 2));
+    }
+
+    #[test]
+    fn client_names_are_clipped() {
+        let long = "é".repeat(100);
+        assert!(ClientId::named(&long).as_str().len() <= MAX_CLIENT_ID_BYTES);
+        assert_eq!(ClientId::named(""), ClientId::anonymous());
     }
 
     #[test]

@@ -34,7 +34,7 @@ use crate::limits::PlanLimits;
 use crate::maps::MapCache;
 use crate::params::GaParams;
 use crate::plan::{check_spec, plan, PlanSpec};
-use crate::queue::{PlanQueue, QueueConfig, Refusal, Turn, MAX_QUEUED_PLANS};
+use crate::queue::{ClientId, PlanQueue, QueueConfig, Refusal, Turn, MAX_QUEUED_PLANS};
 use crate::token;
 use crate::world::World;
 
@@ -45,6 +45,9 @@ pub const SERVICE_NAME: &str = "planner";
 
 /// Largest plan request accepted, in bytes.
 pub const MAX_REQUEST_BYTES: usize = 64 * 1024;
+/// The query parameter that names the client for its fair share of the queue
+/// (`<root>/planner/plan?client=<name>`; [`crate::queue::ClientId`]).
+pub const CLIENT_PARAMETER: &str = "client";
 
 /// How often progress is published at most.
 pub const PROGRESS_PERIOD: Duration = Duration::from_millis(50);
@@ -338,7 +341,11 @@ async fn answer_plan(state: Arc<PlannerInstance>, query: Query, seq: u64, arrive
         // The codec's refusals quote the payload only as a bounded excerpt.
         Err(e) => return reply::send_error(&query, &e).await,
     };
-    let result = serve_plan(&state, request, seq, arrived).await;
+    let client = query
+        .parameters()
+        .get(CLIENT_PARAMETER)
+        .map_or_else(ClientId::anonymous, ClientId::named);
+    let result = serve_plan(&state, request, &client, seq, arrived).await;
     reply::send_result(&query, result).await;
 }
 
@@ -364,6 +371,7 @@ struct Prepared<'a> {
 async fn serve_plan(
     state: &Arc<PlannerInstance>,
     request: PlanRequest,
+    client: &ClientId,
     seq: u64,
     arrived: Instant,
 ) -> Result<Plan, ErrorReply> {
@@ -375,6 +383,7 @@ async fn serve_plan(
         .queue
         .admit(
             seq,
+            client,
             prepared.units,
             prepared.spec.deadline_s - margin,
             max_plan_s,
@@ -392,6 +401,16 @@ async fn serve_plan(
         roam_runtime::publish(&state.session, &key, &message, Delivery::Latest).await;
     }
     let turn = ticket.wait_turn(&prepared.wake).await;
+    if turn == Turn::Displaced {
+        let (running, queued) = state.queue.load();
+        return Err(ErrorReply::new(
+            ErrorCode::Busy,
+            format!(
+                "planner {}'s queue is full ({queued} queued, {running} planning) and another client's request took this one's place: this client has the most requests queued; ask another instance or retry",
+                state.instance
+            ),
+        ));
+    }
     let Prepared {
         request,
         request_id,

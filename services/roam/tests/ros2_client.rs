@@ -146,6 +146,12 @@ async fn a_ros2_client_reads_the_map_and_plans_and_calls_the_planner() {
         "the map differs from the layer"
     );
     assert_eq!(out["plan_poses"], 3);
+    // 1,000 GetPlan calls at once: every one answered (the script checks), an empty path
+    // for those beyond the node's capacity.
+    let storm = &out["get_plan_storm"];
+    eprintln!("GetPlan storm: {storm}");
+    assert_eq!(storm["answered"], storm["calls"], "{storm}");
+    assert_eq!(storm["calls"], 1000, "{storm}");
     for refusal in ["nan", "short_budget", "model", "truncated"] {
         assert!(
             out["refusals"][refusal]

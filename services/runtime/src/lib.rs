@@ -15,7 +15,8 @@
 //!   the session);
 //! - [`lock`]: shared state under a mutex, usable after a panicked holder;
 //! - [`liveliness`]: waiting until a service's token is seen;
-//! - [`world_check`]: a service's check that its world is the map server's.
+//! - [`world_check`]: a service's check that its world is the map server's;
+//! - [`zenoh_threads`]: Zenoh's process-wide thread pools, sized for many sessions.
 
 pub mod client;
 pub mod config_file;
@@ -31,6 +32,7 @@ pub mod subscribe;
 pub mod telemetry;
 pub mod warn_limit;
 pub mod world_check;
+pub mod zenoh_threads;
 
 pub use client::{ClientError, Requester};
 pub use liveliness::{wait_for_liveliness, LivelinessWait};

@@ -6,8 +6,16 @@
 //! [`HEAD_TIMEOUT`]), lets [`Access::check`] decide, and then either answers with a short
 //! HTTP refusal (403, 401, …, logged as one bounded, escaped, throttled line) or forwards
 //! the connection to the SDK's server: the head as checked, the bytes read after it, and
-//! then everything both ways (`copy_bidirectional`). At most [`MAX_CONNECTIONS`] are
-//! served at once (a 503 beyond).
+//! then everything both ways (`copy_bidirectional`).
+//!
+//! **Two pools, so that half-open connections cannot lock clients out** (slowloris).
+//! A connection still sending its head holds one of [`MAX_HALF_OPEN`] places; when they
+//! are all taken, a newcomer takes the place of the connection that has been sending
+//! its head the longest (answered 503 and closed). A real client sends its head in one
+//! packet, so it is never the oldest for long: any number of trickling connections
+//! delays it by nothing. Only a connection whose head was admitted takes one of the
+//! [`MAX_CONNECTIONS`] served slots (a 503 beyond), so the served slots are held by
+//! clients the gate let in, never by strangers still talking.
 //!
 //! Clients that offer only the protocol's older name, `foxglove.websocket.v1`
 //! (`@foxglove/ws-protocol`, Lichtblick), get it translated: the gate offers the SDK
@@ -18,8 +26,9 @@
 //! client offering that is passed through untouched), and the subprotocol is not part of
 //! the WebSocket key exchange, so nothing after the heads changes.
 
+use std::collections::VecDeque;
 use std::net::SocketAddr;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use tokio::io::{AsyncRead, AsyncReadExt, AsyncWriteExt};
@@ -34,8 +43,10 @@ use crate::wire::{clipped, Throttle};
 
 /// How long a client has to send its request head.
 pub const HEAD_TIMEOUT: Duration = Duration::from_secs(5);
-/// Connections served at once (being checked or forwarded).
+/// Connections forwarded to the SDK's server at once (their heads admitted).
 pub const MAX_CONNECTIONS: usize = 32;
+/// Connections sending their request head at once; beyond, the oldest is dropped.
+pub const MAX_HALF_OPEN: usize = 256;
 /// How long connecting to the SDK's server, reading its answer or writing a refusal may take.
 const INNER_TIMEOUT: Duration = Duration::from_secs(2);
 /// How long a stop waits for the forwarded connections to end.
@@ -76,6 +87,7 @@ impl Gate {
             access,
             inner,
             slots: Arc::new(Semaphore::new(MAX_CONNECTIONS)),
+            half_open: HalfOpen::default(),
             refused: Throttle::default(),
             cancel: cancel.clone(),
         });
@@ -100,8 +112,64 @@ struct Shared {
     access: Access,
     inner: SocketAddr,
     slots: Arc<Semaphore>,
+    half_open: HalfOpen,
     refused: Throttle,
     cancel: CancellationToken,
+}
+
+/// The connections sending their head, oldest first (see the module doc).
+#[derive(Default)]
+struct HalfOpen {
+    inner: Mutex<HalfOpenInner>,
+}
+
+#[derive(Default)]
+struct HalfOpenInner {
+    next_id: u64,
+    /// (id, woken when the place is taken by a newcomer), oldest first.
+    open: VecDeque<(u64, CancellationToken)>,
+}
+
+/// A connection's place among the half-open ones; given back when dropped.
+struct Place<'a> {
+    pool: &'a HalfOpen,
+    id: u64,
+    evicted: CancellationToken,
+}
+
+impl HalfOpen {
+    /// A place for a new connection, taken from the oldest when all are held.
+    fn enter(&self) -> Place<'_> {
+        let mut inner = roam_runtime::lock(&self.inner);
+        if inner.open.len() >= MAX_HALF_OPEN {
+            if let Some((_, oldest)) = inner.open.pop_front() {
+                oldest.cancel();
+            }
+        }
+        let id = inner.next_id;
+        inner.next_id += 1;
+        let evicted = CancellationToken::new();
+        inner.open.push_back((id, evicted.clone()));
+        Place {
+            pool: self,
+            id,
+            evicted,
+        }
+    }
+
+    #[cfg(test)]
+    fn len(&self) -> usize {
+        roam_runtime::lock(&self.inner).open.len()
+    }
+}
+
+impl Drop for Place<'_> {
+    fn drop(&mut self) {
+        let mut inner = roam_runtime::lock(&self.pool.inner);
+        if let Some(at) = inner.open.iter().position(|(id, _)| *id == self.id) {
+            inner.open.remove(at);
+        }
+    }
 }
 
 async fn accept_loop(listener: TcpListener, shared: Arc<Shared>, tracker: TaskTracker) {
@@ -125,39 +193,48 @@ async fn accept_loop(listener: TcpListener, shared: Arc<Shared>, tracker: TaskTr
         let shared = shared.clone();
         tracker.spawn(async move {
             let _ = stream.set_nodelay(true);
-            let Ok(slot) = shared.slots.clone().try_acquire_owned() else {
-                let full = Refusal {
-                    status: Status::Unavailable,
-                    why: format!("{MAX_CONNECTIONS} connections are open"),
-                };
-                return refuse(stream, peer, &full, &shared.refused).await;
-            };
             tokio::select! {
                 _ = shared.cancel.cancelled() => {}
                 _ = serve(stream, peer, &shared) => {}
             }
-            drop(slot);
         });
     }
 }
 
-/// Checks one connection and forwards it, or refuses it.
+/// Reads a connection's head among the half-open ones, checks it, and forwards it in a
+/// served slot, or refuses it.
 async fn serve(mut client: TcpStream, peer: SocketAddr, shared: &Shared) {
     let mut buf = Vec::with_capacity(1024);
-    let checked = match tokio::time::timeout(HEAD_TIMEOUT, read_head(&mut client, &mut buf)).await {
-        Ok(Ok(len)) => admit(&buf[..len], &shared.access).map(|(head, a)| (head, a, len)),
-        Ok(Err(outcome)) => Err(outcome),
-        Err(_) => Err(Outcome::Refused(Refusal {
-            status: Status::RequestTimeout,
-            why: format!("no request head within {HEAD_TIMEOUT:?}"),
+    let place = shared.half_open.enter();
+    let read = tokio::time::timeout(HEAD_TIMEOUT, read_head(&mut client, &mut buf));
+    let checked = tokio::select! {
+        _ = place.evicted.cancelled() => Err(Outcome::Refused(Refusal {
+            status: Status::Unavailable,
+            why: format!("{MAX_HALF_OPEN} connections are sending their head; this one the longest"),
         })),
+        read = read => match read {
+            Ok(Ok(len)) => admit(&buf[..len], &shared.access).map(|(head, a)| (head, a, len)),
+            Ok(Err(outcome)) => Err(outcome),
+            Err(_) => Err(Outcome::Refused(Refusal {
+                status: Status::RequestTimeout,
+                why: format!("no request head within {HEAD_TIMEOUT:?}"),
+            })),
+        },
     };
+    drop(place);
     let (head, admitted, len) = match checked {
         Ok(checked) => checked,
         Err(Outcome::Refused(refusal)) => {
             return refuse(client, peer, &refusal, &shared.refused).await
         }
         Err(Outcome::Gone) => return,
+    };
+    let Ok(_slot) = shared.slots.clone().try_acquire_owned() else {
+        let full = Refusal {
+            status: Status::Unavailable,
+            why: format!("{MAX_CONNECTIONS} connections are open"),
+        };
+        return refuse(client, peer, &full, &shared.refused).await;
     };
     if let Err(why) = forward(&mut client, head, admitted, &buf[len..], shared.inner).await {
         let refusal = Refusal {
@@ -332,6 +409,21 @@ mod tests {
         assert!(buf.len() <= MAX_HEAD_BYTES + 3, "{} bytes read", buf.len());
         let (result, _) = read_from(b"GET / HTTP/1.1\r\n").await;
         assert!(matches!(result, Err(Outcome::Gone)), "{result:?}");
+    }
+
+    #[test]
+    fn a_newcomer_takes_the_place_of_the_oldest_half_open_connection() {
+        let pool = HalfOpen::default();
+        let places: Vec<Place<'_>> = (0..MAX_HALF_OPEN).map(|_| pool.enter()).collect();
+        assert!(places.iter().all(|p| !p.evicted.is_cancelled()));
+        let newcomer = pool.enter();
+        assert!(places[0].evicted.is_cancelled(), "the oldest is dropped");
+        assert!(places[1..].iter().all(|p| !p.evicted.is_cancelled()));
+        assert_eq!(pool.len(), MAX_HALF_OPEN);
+        drop(places);
+        assert_eq!(pool.len(), 1, "only the newcomer is left");
+        drop(newcomer);
+        assert_eq!(pool.len(), 0);
     }
 
     #[test]

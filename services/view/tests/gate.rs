@@ -232,18 +232,29 @@ async fn malformed_oversized_and_silent_clients_are_refused_within_bounds() {
     endless.extend(std::iter::repeat_n(b'a', 64 * 1024));
     assert_eq!(raw_status(addr, &endless).await, 431);
 
-    // Every slot taken by clients that send nothing: the next is turned away at once,
-    // and the silent ones are answered when their time is up.
+    // Slowloris: more connections than the half-open places, each sending half a head
+    // and then nothing. The oldest are dropped (503) as newcomers arrive, a real client
+    // still gets its upgrade at once, and the rest are answered when their time is up.
+    let half = b"GET / HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\n";
     let mut silent = Vec::new();
-    for _ in 0..roam_view::MAX_CONNECTIONS {
-        silent.push(TcpStream::connect(addr).await.expect("connect"));
+    for _ in 0..roam_view::MAX_HALF_OPEN + 8 {
+        let mut stream = TcpStream::connect(addr).await.expect("connect");
+        stream.write_all(half).await.expect("half a head");
+        silent.push(stream);
     }
     tokio::time::sleep(Duration::from_millis(200)).await;
-    assert_eq!(raw_status(addr, b"").await, 503);
-    let mut first = silent.swap_remove(0);
+    let mut oldest = silent.remove(0);
+    let mut answer = Vec::new();
+    within("the evicted one's answer", oldest.read_to_end(&mut answer))
+        .await
+        .expect("read");
+    assert!(answer.starts_with(b"HTTP/1.1 503 "), "{answer:?}");
+    let client = FoxgloveClient::connect(addr).await;
+    drop(client);
+    let mut last = silent.pop().expect("a silent one");
     let mut answer = Vec::new();
     let waited = tokio::time::Instant::now();
-    within("the head timeout", first.read_to_end(&mut answer))
+    within("the head timeout", last.read_to_end(&mut answer))
         .await
         .expect("read");
     assert!(answer.starts_with(b"HTTP/1.1 408 "), "{answer:?}");

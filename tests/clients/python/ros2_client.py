@@ -136,6 +136,43 @@ class Caller:
         return STORE.deserialize_cdr(data, resp_type)
 
 
+STORM_CALLS = 1000
+STORM_WITHIN_S = 60.0
+
+
+def storm(session, key, gid, payload):
+    """STORM_CALLS GetPlan calls sent at once, the rmw_zenoh way; waits up to
+    STORM_WITHIN_S for their responses and counts them (and the empty paths)."""
+    import threading
+    cond = threading.Condition()
+    seen = {'answered': 0, 'empty': 0, 'errors': 0}
+
+    def on_reply(reply):
+        with cond:
+            if reply.ok is None:
+                seen['errors'] += 1
+            else:
+                r = STORE.deserialize_cdr(reply.ok.payload.to_bytes(),
+                                          'nav_msgs/msg/GetPlan_Response')
+                seen['answered'] += 1
+                seen['empty'] += len(r.plan.poses) == 0
+            cond.notify_all()
+
+    start = time.time()
+    for seq in range(1, STORM_CALLS + 1):
+        session.get(key, payload=payload, attachment=attachment(100000 + seq, gid),
+                    target=zenoh.QueryTarget.ALL_COMPLETE,
+                    consolidation=zenoh.ConsolidationMode.NONE, timeout=STORM_WITHIN_S,
+                    handler=on_reply)
+    with cond:
+        cond.wait_for(lambda: seen['answered'] + seen['errors'] >= STORM_CALLS,
+                      timeout=STORM_WITHIN_S)
+        result = dict(seen, calls=STORM_CALLS, seconds=round(time.time() - start, 2))
+    check(result['errors'] == 0, f'no get_plan call in the storm is an error: {result}')
+    check(result['answered'] == STORM_CALLS, f'every get_plan call in the storm is answered: {result}')
+    return result
+
+
 def live(args):
     register_services()
     domain = args.domain
@@ -245,6 +282,11 @@ def live(args):
                 'nav_msgs/msg/GetPlan_Request', 'nav_msgs/msg/GetPlan_Response')
     check(len(r.plan.poses) == 0, 'a get_plan to an infinite goal is an empty path')
     out['get_plan_poses'] = True
+
+    # A storm: every call gets a response (an empty path at worst), none hangs.
+    request = bytes(STORE.serialize_cdr(GReq(start=pose(-8.0, -8.0), goal=pose(6.0, -7.0),
+                                             tolerance=0.0), 'nav_msgs/msg/GetPlan_Request'))
+    out['get_plan_storm'] = storm(session, gp.key, gid, request)
     session.close()
     print(json.dumps(out))
 

@@ -11,7 +11,13 @@
 //!   [`echo::MAX_ECHO_REPLY_BYTES`], a flood of bad puts grows the log by at most
 //!   [`echo::MAX_FLOOD_LOG_BYTES`], and names with newlines or terminal escapes forge no
 //!   log line ([`echo`]);
-//! - the live view refuses a page from a foreign Origin ([`view`]).
+//! - a client flooding the planner's queue leaves another its fair share
+//!   ([`planner_flood`]);
+//! - the live view refuses a page from a foreign Origin and lets a real client in past
+//!   hundreds of half-open connections ([`view`]).
+//!
+//! Oversized payloads, sent by a stranger's Python client to a `roam stack`, are in
+//! `services/roam/tests/oversized.rs`.
 //!
 //! The phases run one after another in one test, because the log is the process's and
 //! its growth is measured. The secure site's version of the file attack (the operator
@@ -20,6 +26,7 @@
 mod echo;
 mod files;
 mod logs;
+mod planner_flood;
 mod routing;
 mod view;
 
@@ -42,7 +49,10 @@ async fn attacks_on_a_running_stack_find_nothing() {
     echo::replies(&harness, &client).await;
     echo::logs(&harness, &client, &log).await;
 
+    planner_flood::second_client(&harness).await;
+
     view::origins(&harness).await;
+    view::half_open(&harness).await;
 
     harness.close().await;
 }

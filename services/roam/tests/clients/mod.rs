@@ -27,7 +27,20 @@ impl RoamProcess {
     /// contains `ready`; the rest of stderr keeps being drained so the process never
     /// blocks on a full pipe.
     pub fn start(args: &[&str], root: &str, ready: &str) -> RoamProcess {
-        let mut child = Command::new(ROAM)
+        Self::start_in(Command::new(ROAM), args, root, ready)
+    }
+
+    /// [`RoamProcess::start`] in the environment a user's shell gives it: without the
+    /// `ZENOH_RUNTIME` that `.cargo/config.toml` sets for the tests, so that the
+    /// binary's own setting is what runs.
+    pub fn start_as_installed(args: &[&str], root: &str, ready: &str) -> RoamProcess {
+        let mut command = Command::new(ROAM);
+        command.env_remove(roam_runtime::zenoh_threads::ZENOH_RUNTIME_ENV);
+        Self::start_in(command, args, root, ready)
+    }
+
+    fn start_in(mut command: Command, args: &[&str], root: &str, ready: &str) -> RoamProcess {
+        let mut child = command
             .args(args)
             .env("ROAM_ROOT", root)
             .stdin(Stdio::null())

@@ -12,6 +12,14 @@
 //!   an empty path (nav_msgs' own convention for "no plan") and a logged line with the
 //!   reason; `tolerance` is ignored (roam plans to the goal cell).
 //!
+//! **Every call is answered.** A ROS 2 client waits for its response with no timeout of
+//! its own, so the node never leaves a call unanswered: at most
+//! [`MAX_CONCURRENT_CALLS`] calls of each service are planned at once, a call beyond
+//! them is answered at once (an empty path for GetPlan, `busy` for PlanDowntime), and a
+//! GetPlan call has [`GET_PLAN_ANSWER_S`] for its two plans before it is answered with
+//! an empty path. Up to [`MAX_WAITING_CALLS`] calls are taken from Zenoh at once, so
+//! that the ones beyond capacity get their answer instead of waiting in Zenoh's channel.
+//!
 //! Both call roam's planner through Zenoh ([`roam_planner::client::PlannerClient`]), as
 //! any client would. A request that is not valid CDR gets `malformed` (PlanDowntime) or an
 //! empty path (GetPlan), a NaN or a frame other than `map` `invalid_request`; a query
@@ -40,6 +48,12 @@ pub const GET_PLAN_BUDGET_FACTOR: f64 = 1.5;
 pub const GET_PLAN_PROBE_BUDGET_S: f64 = 3600.0;
 /// The largest request read: two poses, a few numbers and a model name.
 pub const MAX_REQUEST_BYTES: usize = 16 * 1024;
+/// Calls of one service planned at once; the next are answered at once.
+pub const MAX_CONCURRENT_CALLS: usize = 16;
+/// Calls of one service taken from Zenoh at once (planned or being refused).
+pub const MAX_WAITING_CALLS: usize = 1024;
+/// The seconds a GetPlan call has for its shortest-path probe and its plan.
+pub const GET_PLAN_ANSWER_S: f64 = 2.0 * crate::convert::DEFAULT_DEADLINE_S + 2.0;
 
 pub const PLAN_DOWNTIME: &str = "roam/plan_downtime";
 pub const GET_PLAN: &str = "roam/get_plan";
@@ -48,6 +62,20 @@ pub const GET_PLAN: &str = "roam/get_plan";
 struct State {
     out: Arc<Output>,
     planner: Arc<PlannerClient>,
+    /// One permit per call being planned ([`MAX_CONCURRENT_CALLS`]).
+    calls: Arc<tokio::sync::Semaphore>,
+}
+
+impl State {
+    /// A permit to plan a call now, or the refusal that answers it at once.
+    fn take_call(&self) -> Result<tokio::sync::OwnedSemaphorePermit, ErrorReply> {
+        self.calls.clone().try_acquire_owned().map_err(|_| {
+            ErrorReply::new(
+                ErrorCode::Busy,
+                format!("{MAX_CONCURRENT_CALLS} calls are being planned; retry in a moment"),
+            )
+        })
+    }
 }
 
 pub(super) async fn declare(
@@ -55,9 +83,10 @@ pub(super) async fn declare(
     out: Arc<Output>,
     root: &str,
 ) -> Result<(), Ros2Error> {
-    let state = State {
+    let fresh_state = || State {
         planner: Arc::new(PlannerClient::new(out.session().clone(), root)),
         out: out.clone(),
+        calls: Arc::new(tokio::sync::Semaphore::new(MAX_CONCURRENT_CALLS)),
     };
     let mut tokens = Vec::new();
     for (name, ros_type) in [
@@ -75,12 +104,12 @@ pub(super) async fn declare(
         tokens.push(out.token(&endpoint.token).await?);
         let key = endpoint.key.clone();
         if name == PLAN_DOWNTIME {
-            service.serve(queryable, state.clone(), move |s, q| {
+            service.serve_up_to(queryable, MAX_WAITING_CALLS, fresh_state(), move |s, q| {
                 let key = key.clone();
                 async move { plan_downtime(s, q, key).await }
             });
         } else {
-            service.serve(queryable, state.clone(), move |s, q| {
+            service.serve_up_to(queryable, MAX_WAITING_CALLS, fresh_state(), move |s, q| {
                 let key = key.clone();
                 async move { get_plan(s, q, key).await }
             });
@@ -170,9 +199,9 @@ async fn plan_downtime(state: State, query: Query, key: String) {
         MAX_REQUEST_BYTES,
     ) {
         Err(e) => Err(ErrorReply::new(ErrorCode::Malformed, e.to_string())),
-        Ok(request) => match convert::plan_downtime_request(&request) {
-            Err(refusal) => Err(refusal),
-            Ok(plan_request) => state
+        Ok(request) => match (convert::plan_downtime_request(&request), state.take_call()) {
+            (Err(refusal), _) | (Ok(_), Err(refusal)) => Err(refusal),
+            (Ok(plan_request), Ok(_call)) => state
                 .planner
                 .plan(&plan_request)
                 .await
@@ -235,7 +264,20 @@ async fn get_plan(state: State, query: Query, key: String) {
         MAX_REQUEST_BYTES,
     ) {
         Err(e) => Err(ErrorReply::new(ErrorCode::Malformed, e.to_string())),
-        Ok(request) => get_plan_path(&state, &request).await,
+        Ok(request) => match state.take_call() {
+            Err(busy) => Err(busy),
+            Ok(_call) => {
+                let within = std::time::Duration::from_secs_f64(GET_PLAN_ANSWER_S);
+                tokio::time::timeout(within, get_plan_path(&state, &request))
+                    .await
+                    .unwrap_or_else(|_| {
+                        Err(ErrorReply::new(
+                            ErrorCode::Unavailable,
+                            format!("roam's planner gave no plan within {GET_PLAN_ANSWER_S} s"),
+                        ))
+                    })
+            }
+        },
     };
     let points = points.unwrap_or_else(|refusal| {
         out.refuse(
