@@ -7,8 +7,9 @@
 //! 4. each `--cfg KEY:VALUE` (a Zenoh config path and a JSON5 value), in order.
 //!
 //! Layers 1 and 2 are merged as JSON objects (a key set in 2 replaces the same key in
-//! 1, other keys of 1 stay), then handed to Zenoh, which validates the result and fills
-//! in its defaults; layers 3 and 4 are inserted into that config one key at a time.
+//! 1, other keys of 1 stay) over roam's [transport defaults](transport_defaults), then
+//! handed to Zenoh, which validates the result and fills in its defaults; layers 3 and 4
+//! are inserted into that config one key at a time.
 
 use std::path::{Path, PathBuf};
 
@@ -16,6 +17,37 @@ use serde_json::Value;
 
 /// The environment variable naming a Zenoh config file (Zenoh's own convention).
 pub const ZENOH_CONFIG_ENV: &str = "ZENOH_CONFIG";
+
+/// The largest Zenoh message a roam session receives, in bytes (Zenoh's
+/// `transport/link/rx/max_message_size`, 1 GiB by default). Above the largest request
+/// any roam service accepts (the map server's `max_request_bytes`, 96 MiB) and the
+/// largest layer it serves, so every message roam itself sends arrives and a service
+/// sees, and refuses by name, any request up to this size; a larger one is dropped by
+/// Zenoh where it arrives (the sender's query times out) instead of being reassembled.
+pub const MAX_MESSAGE_BYTES: u64 = 128 * 1024 * 1024;
+
+/// How long, in microseconds, Zenoh may wait to queue one blocking message (a query, a
+/// reply, a `Block` put) on a link before it closes that link's transport (Zenoh's
+/// `transport/link/tx/queue/congestion_control/block/wait_before_close`, 5 s by
+/// default). Zenoh sets this deadline once for the whole message, at its first wait, not
+/// per fragment: a 48 MB query routed to a service on a loaded 2-core machine could take
+/// longer than 5 s to drain, and the router then closed *the service's* transport with
+/// every query in flight. 30 s lets [`MAX_MESSAGE_BYTES`] cross at 4.5 MB/s; a peer that
+/// has gone away is dropped sooner by its lease (10 s).
+pub const WAIT_BEFORE_CLOSE_US: u64 = 30_000_000;
+
+/// roam's own defaults for every session it opens, under every other layer (a file,
+/// `ZENOH_CONFIG`, a flag or `--cfg` set the same keys over them).
+pub fn transport_defaults() -> Value {
+    serde_json::json!({
+        "transport": {"link": {
+            "rx": {"max_message_size": MAX_MESSAGE_BYTES},
+            "tx": {"queue": {"congestion_control": {"block": {
+                "wait_before_close": WAIT_BEFORE_CLOSE_US
+            }}}}
+        }}
+    })
+}
 
 /// Zenoh session flags shared by every role of the `roam` binary.
 #[derive(Debug, Clone, Default, clap::Args)]
@@ -96,9 +128,10 @@ impl SessionArgs {
         file_section: Option<&Value>,
         env_file: Option<&Path>,
     ) -> Result<zenoh::Config, SessionError> {
-        let mut merged = file_section
-            .cloned()
-            .unwrap_or(Value::Object(Default::default()));
+        let mut merged = transport_defaults();
+        if let Some(section) = file_section {
+            merge(&mut merged, section.clone());
+        }
         if let Some(path) = env_file {
             merge(&mut merged, read_zenoh_file(path)?);
         }
@@ -239,6 +272,33 @@ mod tests {
             .expect("config");
         assert_eq!(get(&env_only, "mode"), serde_json::json!("client"));
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn transport_defaults_apply_under_every_layer() {
+        let config = SessionArgs::default()
+            .zenoh_config_with(None, None)
+            .expect("config");
+        assert_eq!(
+            get(&config, "transport/link/rx/max_message_size"),
+            serde_json::json!(MAX_MESSAGE_BYTES)
+        );
+        let wait = "transport/link/tx/queue/congestion_control/block/wait_before_close";
+        assert_eq!(get(&config, wait), serde_json::json!(WAIT_BEFORE_CLOSE_US));
+        let file_section =
+            serde_json::json!({"transport": {"link": {"rx": {"max_message_size": 1000}}}});
+        let args = SessionArgs {
+            cfg: vec![format!("{wait}:7")],
+            ..SessionArgs::default()
+        };
+        let config = args
+            .zenoh_config_with(Some(&file_section), None)
+            .expect("config");
+        assert_eq!(
+            get(&config, "transport/link/rx/max_message_size"),
+            serde_json::json!(1000)
+        );
+        assert_eq!(get(&config, wait), serde_json::json!(7));
     }
 
     #[test]

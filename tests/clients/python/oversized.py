@@ -2,20 +2,23 @@
 """A stranger's oversized queries against a running roam stack (eclipse-zenoh only).
 
 For each key given, sends AT_ONCE queries of BYTES bytes at once from one session, waits
-for their replies, then sends one small query to see that the service still answers.
-Prints one JSON object: for each key, how many of the big queries were answered (with
-the refusals' messages) and whether the small query after them was.
+for their replies, then asks the service a small query from a new session (a client that
+did nothing wrong), again until it answers or AFTER_S have passed. Prints one JSON
+object: for each key, how many of the big queries were answered (with the refusals'
+messages), whether the small query was answered and after how many seconds.
 
     python3 oversized.py --connect tcp/127.0.0.1:7447 --bytes 48000000 KEY...
 """
 import argparse
 import json
 import threading
+import time
 
 import zenoh
 
 AT_ONCE = 4
-TIMEOUT_S = 30.0
+TIMEOUT_S = 60.0
+AFTER_S = 5.0
 
 
 def ask(session, key, payload):
@@ -26,17 +29,36 @@ def ask(session, key, payload):
     return None
 
 
+def open_session(endpoint):
+    conf = zenoh.Config()
+    conf.insert_json5('mode', '"client"')
+    conf.insert_json5('connect/endpoints', json.dumps([endpoint]))
+    conf.insert_json5('scouting/multicast/enabled', 'false')
+    return zenoh.open(conf)
+
+
+def answered_after(endpoint, key):
+    """Seconds until a new session's small query to KEY is answered, or None."""
+    started = time.monotonic()
+    bystander = open_session(endpoint)
+    try:
+        while time.monotonic() - started < AFTER_S:
+            remaining = AFTER_S - (time.monotonic() - started)
+            for _ in bystander.get(key, payload=b'{}', timeout=max(0.5, min(2.0, remaining))):
+                return round(time.monotonic() - started, 3)
+            time.sleep(0.1)
+        return None
+    finally:
+        bystander.close()
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument('--connect', required=True)
     parser.add_argument('--bytes', type=int, default=48_000_000)
     parser.add_argument('keys', nargs='+')
     args = parser.parse_args()
-    conf = zenoh.Config()
-    conf.insert_json5('mode', '"client"')
-    conf.insert_json5('connect/endpoints', json.dumps([args.connect]))
-    conf.insert_json5('scouting/multicast/enabled', 'false')
-    session = zenoh.open(conf)
+    session = open_session(args.connect)
     payload = b'x' * args.bytes
     out = {}
     for key in args.keys:
@@ -50,10 +72,10 @@ def main():
             t.start()
         for t in threads:
             t.join()
-        after = ask(session, key, b'{}')
+        after_s = answered_after(args.connect, key)
         out[key] = {'sent': AT_ONCE, 'answered': sum(a is not None for a in answers),
                     'refusals': [a['error'] for a in answers if a and not a['ok']],
-                    'answered_after': after is not None}
+                    'answered_after': after_s is not None, 'after_s': after_s}
     session.close()
     print(json.dumps(out))
 
