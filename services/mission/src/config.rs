@@ -65,6 +65,10 @@ pub struct ExecutiveConfig {
     /// Plan the next window while the robot drives toward (and works at) this task, so
     /// that planning costs the next window nothing.
     pub plan_ahead: bool,
+    /// A window without a plan made ahead sets off at once on the fastest path (the
+    /// window computes it) while its curious plan is made from where the robot will be
+    /// when it comes, instead of waiting for the plan ([`crate::window`]).
+    pub set_off_at_once: bool,
     /// The largest share of the time left that a plan may cost on the mission clock:
     /// its deadline is cut to `replan_time_share × time left / clock rate` (at the
     /// demo's 20×, a minute left gives a replan 0.3 s of wall time).
@@ -141,6 +145,7 @@ impl ExecutiveConfig {
             slack_s: f64::INFINITY,
             behind: false,
             plan_ahead: false,
+            set_off_at_once: false,
             arrival_margin_share: 0.0,
             arrival_margin_min_s: 0.0,
             late_probability: 1.0,
@@ -240,11 +245,12 @@ impl Default for ExecutiveConfig {
             max_replans: 5,
             give_up_after_s: 60.0,
             controller_silence_s: 3.0,
-            slack_s: 10.0,
-            slack_interval_s: 10.0,
-            min_replan_window_s: 20.0,
+            slack_s: 3.0,
+            slack_interval_s: 5.0,
+            min_replan_window_s: 10.0,
             behind: true,
             plan_ahead: true,
+            set_off_at_once: true,
             replan_time_share: 0.1,
             arrival_margin_share: 0.05,
             arrival_margin_min_s: 2.0,

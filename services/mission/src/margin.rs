@@ -16,12 +16,16 @@
 //! ```text
 //! μ = Σe / (k₀ + n)        σ² = (k₀·σ₀² + Σ(e − μ)²) / (k₀ + n)
 //! q = μ + z_(1−p) · σ · √(1 + 1/(k₀ + n))        (the predictive quantile)
-//! budget = min(T / (1 + max(q, share)), T − min_s)
+//! budget = (T − min_s) / (1 + max(q, share))
 //! ```
 //!
 //! with `T` the time left to the task, `p` the late probability asked for (default
-//! 10⁻³, z = 3.09), `share` a floor share and `min_s` a floor in seconds (the arrival's
-//! own granularity: the controller's goal tolerance, a sim step). `q` is capped at
+//! 10⁻³, z = 3.09), `share` a floor share and `min_s` seconds kept back on top of the
+//! relative margin: what a drive loses whatever its length (setting off and turning
+//! toward the path, the controller's goal tolerance, a sim step). Measured in 20 batch
+//! days, a drive's excess over its prediction was up to 1.6 s on drives predicted at 1
+//! to 6 s (a relative error of up to +200%), which no share of a short drive covers:
+//! the two parts add. `q` is capped at
 //! [`MAX_SHARE`] so that a wildly wrong model still leaves a budget; the probability a
 //! plan actually has is reported with it ([`ArrivalMargin::late_probability`]). A drive
 //! the model overestimated (e < 0) narrows the margin, and the slack rule
@@ -84,9 +88,14 @@ impl ArrivalMargin {
         q.max(self.share).min(MAX_SHARE)
     }
 
-    /// The driving budget for `time_left_s` seconds to the task.
+    /// The driving budget for `time_left_s` seconds to the task (negative when not
+    /// even the seconds kept back fit).
     pub fn budget(&self, time_left_s: f64) -> f64 {
-        (time_left_s / (1.0 + self.allowance())).min(time_left_s - self.min_s)
+        let after_floor = time_left_s - self.min_s;
+        if after_floor <= 0.0 {
+            return after_floor;
+        }
+        after_floor / (1.0 + self.allowance())
     }
 
     /// The probability that a drive predicted at `predicted_s` takes longer than
@@ -216,8 +225,12 @@ mod tests {
         let m = ArrivalMargin::new(0.05, 2.0, 1e-3);
         let q = m.allowance();
         assert!((0.3..0.45).contains(&q), "{q}");
-        assert!((m.budget(100.0) - 100.0 / (1.0 + q)).abs() < 1e-9);
-        assert!((m.budget(3.0) - 1.0).abs() < 1e-12, "the 2 s floor");
+        assert!((m.budget(100.0) - 98.0 / (1.0 + q)).abs() < 1e-9);
+        assert!(
+            (m.budget(3.0) - 1.0 / (1.0 + q)).abs() < 1e-12,
+            "the 2 s floor, then the share"
+        );
+        assert!((m.budget(1.5) + 0.5).abs() < 1e-12, "not even the floor fits");
     }
 
     #[test]

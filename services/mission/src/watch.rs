@@ -20,13 +20,18 @@
 //!   than giving the rest of the window to the shortest path, and if the robot still
 //!   falls behind, the late rule takes over;
 //! - **pushed off the path**: an estimate farther than `off_path_m` from the path;
-//! - **slack**: the robot will arrive more than `slack_s` early (predicted from its own
-//!   progress along the path once it has driven a few seconds, from the time model
-//!   before), beyond what a replan costs on the mission clock (the time model overestimated the drive, or a replan
-//!   was cheap): replan a curious path from where it is with the time left, the mirror
-//!   of the late rule. At most once per `slack_interval_s`, and never after the window
-//!   slipped. The robot drives on while the plan is made; the window
-//!   ([`crate::window`]) plans from where it will be when the plan comes.
+//! - **slack**: a plan asked now would get a driving budget (what the arrival margin
+//!   leaves of the time left after the plan's cost, reckoned by the window,
+//!   [`crate::window`]) more than `slack_s` longer than the drive the robot still has
+//!   (predicted from its own progress along the path once it has driven a few seconds,
+//!   from the time model before): the time model overestimated the drive, or the margin
+//!   the plan kept back is no longer needed this close to the task. Replan a curious
+//!   path with the time left, the mirror of the late rule. At most once per
+//!   `slack_interval_s`, and never after the window slipped. The robot drives on while
+//!   the plan is made; the window plans from where it will be when the plan comes.
+//!   Comparing budgets, not arrival times, keeps the rule from firing on the margin
+//!   itself: a robot arriving early by exactly what a new plan would keep back has no
+//!   slack.
 //!
 //! Slack and behind replans need `min_replan_window_s` left to the task: a short
 //! replan near a window's end is the one a time model gets most wrong.
@@ -47,7 +52,7 @@ pub struct WatchParams {
     pub max_replans: u32,
     pub give_up_after_s: f64,
     pub controller_silence_s: f64,
-    /// Arriving this much earlier than the task's start is slack to spend, seconds.
+    /// A replan's budget this much longer than the drive left is slack to spend, seconds.
     pub slack_s: f64,
     /// Mission seconds between two slack replans at least (and two behind ones).
     pub slack_interval_s: f64,
@@ -72,11 +77,13 @@ pub enum Reason {
     Recovered,
     /// No planner answered: the fastest path the executive computes itself.
     NoPlanner,
+    /// The window's curious plan, made while the robot set off on the fastest path.
+    SetOff,
 }
 
 impl Reason {
     /// Every reason, in the order [`Reason::name`] lists them.
-    pub const ALL: [Reason; 9] = [
+    pub const ALL: [Reason; 10] = [
         Reason::ControllerSilent,
         Reason::Stuck,
         Reason::EtaSlipped,
@@ -86,6 +93,7 @@ impl Reason {
         Reason::LastSafeMoment,
         Reason::Recovered,
         Reason::NoPlanner,
+        Reason::SetOff,
     ];
 
     /// The reason's token, as reports and tables name it.
@@ -100,6 +108,7 @@ impl Reason {
             Reason::LastSafeMoment => "last_safe_moment",
             Reason::Recovered => "recovered",
             Reason::NoPlanner => "no_planner",
+            Reason::SetOff => "set_off",
         }
     }
 
@@ -120,6 +129,7 @@ impl Reason {
             Reason::LastSafeMoment => "the last safe moment: the fastest path now, or late",
             Reason::Recovered => "recovered from a PEB hold: a new path from where it has a fix",
             Reason::NoPlanner => "no planner answered: the fastest path the executive computes",
+            Reason::SetOff => "the curious path, planned while the robot set off on the fastest",
         }
     }
 }
@@ -235,14 +245,15 @@ impl Watch {
         Decision::Keep
     }
 
-    /// A status of the controller on the current mission; a replan now would cost
-    /// `planning_cost_s` of mission time.
+    /// A status of the controller on the current mission; a plan asked now would get a
+    /// driving budget of `replan_budget_s` (the window's reckoning: the margin and the
+    /// plan's cost taken off the time left).
     pub fn on_status(
         &mut self,
         status: Status,
         now_s: f64,
         wall_s: f64,
-        planning_cost_s: f64,
+        replan_budget_s: f64,
     ) -> Decision {
         self.heard_at_wall_s = wall_s;
         match status {
@@ -275,9 +286,8 @@ impl Watch {
                     }
                 }
                 let speed = progress.unwrap_or(self.params.expected_speed_m_per_s);
-                let arrival_s = now_s + distance_left_m / speed;
-                let early = self.task_start_s - arrival_s;
-                if early > self.params.slack_s + planning_cost_s && spaced {
+                let drive_left_s = distance_left_m / speed;
+                if replan_budget_s - drive_left_s > self.params.slack_s && spaced {
                     return self.replan(Reason::Slack, true);
                 }
                 Decision::Keep
@@ -361,14 +371,14 @@ mod tests {
     #[test]
     fn slack_fires_when_early_and_not_too_often() {
         let mut w = watch();
-        // 10 m left at 0.5 m/s = 20 s: at 6 s the robot would arrive at 26 s, 74 s early.
+        // 10 m left at 0.5 m/s = 20 s: at 6 s a replan would get 80 s of budget.
         let d = w.on_status(
             Status::Active {
                 distance_left_m: 10.0,
             },
             6.0,
             1.0,
-            1.0,
+            80.0,
         );
         assert_eq!(
             d,
@@ -387,11 +397,13 @@ mod tests {
                 },
                 8.0,
                 1.5,
-                1.0
+                80.0
             ),
             Decision::Keep
         );
-        // Early by less than slack_s plus the planning cost: nothing.
+        // Arriving 20 s early, but a plan asked now would keep most of it back as its
+        // margin and cost (a budget of 28 s for 20 s of drive, under slack_s more):
+        // nothing.
         assert_eq!(
             w.on_status(
                 Status::Active {
@@ -399,22 +411,25 @@ mod tests {
                 },
                 60.0,
                 1.8,
-                25.0
+                28.0
             ),
             Decision::Keep
         );
-        // On time (arriving 5 s early, under slack_s): nothing.
-        assert_eq!(
+        // A budget 10.5 s longer than the drive: slack.
+        assert!(matches!(
             w.on_status(
                 Status::Active {
                     distance_left_m: 10.0
                 },
-                75.0,
+                62.0,
                 2.0,
-                1.0
+                30.5
             ),
-            Decision::Keep
-        );
+            Decision::Replan {
+                reason: Reason::Slack,
+                ..
+            }
+        ));
     }
 
     #[test]
@@ -434,14 +449,19 @@ mod tests {
         let active = |left| Status::Active {
             distance_left_m: left,
         };
-        assert_eq!(w.on_status(active(40.0), 11.0, 0.1, 1.0), Decision::Keep);
+        // A replan's budget: the time left less 10%.
+        let budget = |now_s: f64| (100.0 - now_s) * 0.9;
         assert_eq!(
-            w.on_status(active(38.0), 13.0, 0.2, 1.0),
+            w.on_status(active(40.0), 11.0, 0.1, budget(11.0)),
+            Decision::Keep
+        );
+        assert_eq!(
+            w.on_status(active(38.0), 13.0, 0.2, budget(13.0)),
             Decision::Keep,
             "too soon to tell"
         );
         assert!(matches!(
-            w.on_status(active(35.0), 16.0, 0.3, 1.0),
+            w.on_status(active(35.0), 16.0, 0.3, budget(16.0)),
             Decision::Replan {
                 reason: Reason::Slack,
                 ..

@@ -9,10 +9,15 @@
 //! 1. **Begin** where the robot is. A task already over is skipped (the executive was
 //!    down through it). The plan made for the window ahead of time is used when it
 //!    starts within [`PREPLAN_FROM_M`] of the robot and the window begins when that
-//!    plan assumed; otherwise a plan is asked for, and asked again every
-//!    [`PLAN_RETRY_S`] (wall) after a failure. After [`FALLBACK_AFTER_FAILURES`]
-//!    failures the robot drives the fastest path the window computes itself (no
-//!    planner: degrade, don't stop) and curiosity comes back through the slack rule.
+//!    plan assumed. Otherwise, with `set_off_at_once`, the robot sets off at once on the
+//!    fastest path the window computes itself and the curious plan is asked from where
+//!    the robot will be when it comes (the window's time is not spent waiting for the
+//!    planner); if that plan fails the robot drives on and the slack rule may bring
+//!    curiosity back. Without it (or with no fastest path), a plan is asked for, and
+//!    asked again every [`PLAN_RETRY_S`] (wall) after a failure. After
+//!    [`FALLBACK_AFTER_FAILURES`] failures the robot drives the fastest path the window
+//!    computes itself (no planner: degrade, don't stop) and curiosity comes back
+//!    through the slack rule.
 //! 2. **Drive**: the plan's route is sent as a mission and the watch starts. Every good
 //!    estimate is recorded (the driven path, its PEB, the last point with a fix) and
 //!    fed to the watch, as are the controller's statuses on the current mission and
@@ -121,6 +126,9 @@ pub struct WindowRules {
     pub replan_time_share: f64,
     /// The configured deadline, wall seconds.
     pub plan_deadline_s: f64,
+    /// Without a plan made ahead, set off on the fastest path while the first curious
+    /// plan is made (module doc, step 1).
+    pub set_off_at_once: bool,
 }
 
 impl WindowRules {
@@ -134,6 +142,7 @@ impl WindowRules {
             fix_peb_m: config.fix_peb_m,
             replan_time_share: config.replan_time_share,
             plan_deadline_s: config.plan_deadline_s,
+            set_off_at_once: config.set_off_at_once,
         }
     }
 }
@@ -341,9 +350,33 @@ impl<'a> DowntimeWindow<'a> {
         });
         let actions = match ahead {
             Some(p) => w.start_driving(p.route, p.shortest, p.budget_s, p.time_left_s, now),
-            None => vec![w.ask_first_plan(now)],
+            None => w.set_off(now).unwrap_or_else(|| vec![w.ask_first_plan(now)]),
         };
         (w, actions)
+    }
+
+    /// Sets off on the window's own fastest path and asks for the curious plan from
+    /// where the robot will be when it comes (module doc, step 1); `None` when the rule
+    /// is off, plans are not curious or there is no fastest path.
+    fn set_off(&mut self, now: Now) -> Option<Vec<WindowAction>> {
+        let rules = self.setup.rules;
+        if !(rules.set_off_at_once && rules.curious) {
+            return None;
+        }
+        let route = self.fastest_from_here()?;
+        let time_left = self.setup.task.start_s - now.mission_s;
+        let budget = self.margin.budget(time_left);
+        let shortest = route.points.clone();
+        let mut actions = self.start_driving(route, shortest, budget, time_left, now);
+        let Phase::Driving(drive) = &self.phase else {
+            return Some(actions);
+        };
+        let lead_m = self.plan_cost_s(time_left, now) * self.setup.watch.expected_speed_m_per_s;
+        let from = straight::point_ahead(&drive.path, self.here, lead_m);
+        let (to, start) = (self.setup.task.at, self.setup.task.start_s);
+        let (ask, _, _) = self.ask(from, to, start, None, true, now);
+        actions.extend(self.ask_replan(Reason::SetOff, true, ask));
+        Some(actions)
     }
 
     /// An event at `now`; the actions to perform, in order.
@@ -452,6 +485,7 @@ impl<'a> DowntimeWindow<'a> {
     }
 
     fn on_status(&mut self, s: &ControllerStatus, now: Now) -> Vec<WindowAction> {
+        let replan_budget_s = self.replan_budget_s(now);
         let Phase::Driving(drive) = &mut self.phase else {
             return Vec::new();
         };
@@ -501,10 +535,9 @@ impl<'a> DowntimeWindow<'a> {
         if self.drive_ask.is_some() {
             return self.check_safe(now);
         }
-        let decision =
-            drive
-                .watch
-                .on_status(status, now.mission_s, now.wall_s, now.planning_cost_s);
+        let decision = drive
+            .watch
+            .on_status(status, now.mission_s, now.wall_s, replan_budget_s);
         let mut actions = self.decide(decision, now);
         actions.extend(self.check_safe(now));
         actions
@@ -581,7 +614,9 @@ impl<'a> DowntimeWindow<'a> {
             return Vec::new();
         }
         drive.safe_checked_at_s = now.mission_s;
-        let time_left = self.setup.task.start_s - now.mission_s;
+        // The next check may come `SAFE_CHECK_S` later: the rule fires when waiting for
+        // it would leave too little.
+        let time_left = self.setup.task.start_s - now.mission_s - SAFE_CHECK_S;
         let budget = self.margin.budget(time_left);
         // What is left of the route is a way to the task, so the fastest path takes no
         // longer: while the budget covers the route left, no search is needed (on a
@@ -677,9 +712,11 @@ impl<'a> DowntimeWindow<'a> {
         };
         // A slack or behind replan is made while the robot drives on: it starts where
         // the robot will be when the plan comes.
+        let time_left = self.setup.task.start_s - now.mission_s;
         let from = match reason {
             Reason::Slack | Reason::Behind => {
-                let lead_m = now.planning_cost_s * self.setup.watch.expected_speed_m_per_s;
+                let lead_m =
+                    self.plan_cost_s(time_left, now) * self.setup.watch.expected_speed_m_per_s;
                 straight::point_ahead(&drive.path, self.here, lead_m)
             }
             _ => self.here,

@@ -24,17 +24,12 @@ impl DowntimeWindow<'_> {
         curious: bool,
         now: Now,
     ) -> (PlanAsk, f64, f64) {
-        let rules = self.setup.rules;
         let set_off = leave_at_s.map_or(now.mission_s, |at| at.max(now.mission_s));
         let time_left = (task_start_s - set_off).max(0.0);
-        let rate = now.clock_rate.max(1e-9);
-        let deadline_s = rules
-            .plan_deadline_s
-            .min(rules.replan_time_share * time_left / rate)
-            .max(MIN_DEADLINE_S);
-        let curious = curious && rules.curious;
+        let deadline_s = self.deadline_s(time_left, now);
+        let curious = curious && self.setup.rules.curious;
         let cost = if curious {
-            now.planning_cost_s.min(deadline_s * rate)
+            self.plan_cost_s(time_left, now)
         } else {
             0.0
         };
@@ -51,6 +46,31 @@ impl DowntimeWindow<'_> {
         };
         self.record(&ask, leave_at_s.is_some(), now);
         (ask, budget_s, time_left)
+    }
+
+    /// The deadline of a plan asked with `time_left_s` to its task, wall seconds: the
+    /// configured one cut to `replan_time_share` of the time left at the clock's rate.
+    pub(super) fn deadline_s(&self, time_left_s: f64, now: Now) -> f64 {
+        let rules = self.setup.rules;
+        rules
+            .plan_deadline_s
+            .min(rules.replan_time_share * time_left_s.max(0.0) / now.clock_rate.max(1e-9))
+            .max(MIN_DEADLINE_S)
+    }
+
+    /// What a curious plan asked with `time_left_s` to its task costs on the mission
+    /// clock: the expected cost, cut to what its deadline allows.
+    pub(super) fn plan_cost_s(&self, time_left_s: f64, now: Now) -> f64 {
+        now.planning_cost_s
+            .min(self.deadline_s(time_left_s, now) * now.clock_rate.max(1e-9))
+    }
+
+    /// The driving budget a curious replan asked now would get: what the arrival margin
+    /// leaves of the time to the task after the plan's cost (the slack rule's measure).
+    pub(super) fn replan_budget_s(&self, now: Now) -> f64 {
+        let time_left = self.setup.task.start_s - now.mission_s;
+        self.margin
+            .budget(time_left - self.plan_cost_s(time_left, now))
     }
 
     pub(super) fn next_ask_id(&mut self) -> u64 {

@@ -55,7 +55,25 @@ impl DowntimeWindow<'_> {
                 reason,
                 resend,
                 ask,
-            } => self.send_route(ask.from, route, reason, Follows::Replan { resend }, now),
+            } => {
+                if reason == Reason::SetOff {
+                    self.took_set_off_plan(&route, ask.t_exec_s, now);
+                }
+                self.send_route(ask.from, route, reason, Follows::Replan { resend }, now)
+            }
+        }
+    }
+
+    /// The curious plan asked as the robot set off is the window's plan: its budget,
+    /// information and late probability are the report's.
+    fn took_set_off_plan(&mut self, route: &Route, budget_s: f64, now: Now) {
+        let time_left = self.setup.task.start_s - now.mission_s;
+        let late_probability = self.margin.late_probability(route.t_eta_s, time_left);
+        let information = self.setup.scale.of(&route.points);
+        if let Phase::Driving(drive) = &mut self.phase {
+            drive.budget_s = budget_s;
+            drive.planned_information = information;
+            drive.late_probability = late_probability;
         }
     }
 
@@ -81,6 +99,11 @@ impl DowntimeWindow<'_> {
                 };
                 Vec::new()
             }
+            // The robot set off on the fastest path already: it drives on.
+            DriveAsk::Replan {
+                reason: Reason::SetOff,
+                ..
+            } => Vec::new(),
             // A curious plan that fails (busy, an outage) leaves the shortest way.
             DriveAsk::Replan {
                 reason,

@@ -69,6 +69,7 @@ fn watch_params() -> WatchParams {
 
 fn rules() -> WindowRules {
     WindowRules {
+        set_off_at_once: false,
         curious: true,
         plan_ahead: false,
         recover: true,
@@ -866,3 +867,4 @@ fn a_task_over_before_its_window_is_skipped() {
 }
 
 mod late_held_ahead;
+mod set_off;
