@@ -12,6 +12,7 @@
 //! - [`config`]: [`config::ExecutiveConfig`], the one configuration of the live
 //!   executive and the batch; [`request`]: the planner request of a window's ask.
 //! - [`tasks`]: the task sequence and its checks; the built-in world's day.
+//! - [`shift`]: a fleet's shift (each robot's tasks), the built-in warehouse's.
 //! - [`day_check`]: a day checked against a map: every place free, every task
 //!   reachable in time from the previous one (paper 000's fastest path).
 //! - [`calibration`]: paper 000's time model (Eq. 2's v_lin, v_ang) fitted to what the
@@ -45,6 +46,7 @@ pub mod path;
 pub mod request;
 #[cfg(feature = "zenoh")]
 pub mod service;
+pub mod shift;
 pub mod tasks;
 pub mod watch;
 pub mod window;

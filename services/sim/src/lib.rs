@@ -9,7 +9,8 @@
 //!   streams, a Gaussian sampler, paper 002's TOA noise (σ² up to d0, σ²((d/d0)^K + 1)
 //!   beyond) and transition noise.
 //! - [`world`]: the static grid, anchors, scripted blocks (paper 004), random walkers,
-//!   the dynamic occupancy.
+//!   the dynamic occupancy; [`semi_static`]: objects that appear in zones and vanish
+//!   (the scenario's `changes`, a warehouse's pallets).
 //! - [`robot`]: a robot and paper 002's motion model (Eq. 1) with a top speed and
 //!   collisions; [`unicycle`]: roam's robot with a heading, which turns (at most
 //!   w_max·dt per step) before it drives, so turning costs time as paper 000's Eq. 2
@@ -33,6 +34,7 @@ pub mod messages;
 pub mod raster;
 pub mod render;
 pub mod robot;
+pub mod semi_static;
 pub mod sensors;
 #[cfg(feature = "zenoh")]
 pub mod service;

@@ -24,6 +24,7 @@ fn obstacle_name(obstacle: &Obstacle) -> String {
         Obstacle::Wall => "wall".into(),
         Obstacle::Block(name) => format!("block:{name}"),
         Obstacle::Walker(name) => format!("walker:{name}"),
+        Obstacle::Object(zone) => format!("object:{zone}"),
         Obstacle::OffMap => "off_map".into(),
     }
 }

@@ -463,6 +463,7 @@ fn describe(obstacle: &Obstacle) -> String {
         Obstacle::Wall => "an occupied or unknown cell of the map".into(),
         Obstacle::Block(name) => format!("block '{name}'"),
         Obstacle::Walker(name) => format!("walker '{name}'"),
+        Obstacle::Object(zone) => format!("an object of zone '{zone}'"),
         Obstacle::OffMap => "outside the map".into(),
     }
 }

@@ -8,6 +8,7 @@ use roam_world::scenario::{is_blocked, BlockSpec, Place, Scenario, WalkerSpec};
 use serde::Serialize;
 
 use crate::raster::CellXy;
+use crate::semi_static::{ChangeZone, Objects, SemiStatic};
 use roam_world::noise;
 
 /// An anchor (paper 002 §2): a beacon at a known position, world metres.
@@ -105,6 +106,8 @@ pub enum Obstacle {
     Block(String),
     /// A random walker, by name.
     Walker(String),
+    /// A semi-static object (a pallet), by its zone's name.
+    Object(String),
     /// Outside the map.
     OffMap,
 }
@@ -133,6 +136,10 @@ pub struct World {
     step: u64,
     /// The world's own random stream (walkers).
     rng: ChaCha8Rng,
+    /// The semi-static objects and their own stream.
+    objects: Objects,
+    /// Cells kept between a robot's cell and an object landing, each side.
+    clearance_cells: i64,
 }
 
 impl World {
@@ -208,6 +215,13 @@ impl World {
                 })
             })
             .collect::<Result<Vec<_>, _>>()?;
+        let zones = file
+            .changes
+            .iter()
+            .map(|z| ChangeZone::new(z, &meta, file.time.step_s))
+            .collect();
+        // A robot's body, and a little room: an object never lands on a robot.
+        let radius = file.robot_radius_m.unwrap_or(0.2) + 0.1;
         let mut world = World {
             meta,
             static_blocked: grid.cells.iter().map(|&v| is_blocked(v)).collect(),
@@ -217,6 +231,8 @@ impl World {
             walkers,
             step: 0,
             rng: noise::stream(seed, "world"),
+            objects: Objects::new(zones, seed),
+            clearance_cells: (radius / meta.resolution).ceil() as i64,
         };
         world.reset(seed);
         Ok(world)
@@ -230,6 +246,7 @@ impl World {
         for w in &mut self.walkers {
             w.at = w.start;
         }
+        self.objects.reset(seed);
         self.rebuild_dynamic();
     }
 
@@ -277,6 +294,38 @@ impl World {
                 self.cover(footprint, now, true);
             }
         }
+        let statics = &self.static_blocked;
+        let (w, h) = (i64::from(self.meta.width), i64::from(self.meta.height));
+        let free =
+            |(x, y): CellXy| x >= 0 && y >= 0 && x < w && y < h && !statics[(y * w + x) as usize];
+        let reach = self.clearance_cells;
+        let robot_on = |f: crate::world::Footprint, centre: CellXy| {
+            let (hw, hh) = (
+                i64::from(f.width_cells) / 2 + reach + 1,
+                i64::from(f.height_cells) / 2 + reach + 1,
+            );
+            robot_cells
+                .iter()
+                .any(|r| (r.0 - centre.0).abs() <= hw && (r.1 - centre.1).abs() <= hh)
+        };
+        let moves = self.objects.advance(step, free, robot_on);
+        for (footprint, centre) in moves.left {
+            self.cover(footprint, centre, false);
+        }
+        for (footprint, centre) in moves.landed {
+            self.cover(footprint, centre, true);
+        }
+    }
+
+    /// The semi-static objects now, landed or waiting for a robot to move off their
+    /// place (the scenario's `changes`).
+    pub fn objects(&self) -> &[SemiStatic] {
+        self.objects.objects()
+    }
+
+    /// The zones the objects appear in.
+    pub fn change_zones(&self) -> &[ChangeZone] {
+        self.objects.zones()
     }
 
     /// Recounts the dynamic layer from the blocks' and walkers' positions now.
@@ -294,6 +343,16 @@ impl World {
             if let Some(centre) = self.cell_of(self.walkers[i].at) {
                 self.cover(footprint, centre, true);
             }
+        }
+        let landed: Vec<_> = self
+            .objects
+            .objects()
+            .iter()
+            .filter(|o| o.landed_step.is_some())
+            .map(|o| (o.footprint, o.centre))
+            .collect();
+        for (footprint, centre) in landed {
+            self.cover(footprint, centre, true);
         }
     }
 
@@ -361,13 +420,19 @@ impl World {
         {
             return Some(Obstacle::Block(b.name.clone()));
         }
-        self.walkers
+        if let Some(w) = self.walkers.iter().find(|w| {
+            self.cell_of(w.at)
+                .is_some_and(|centre| w.footprint.cells(centre).any(|c| c == cell))
+        }) {
+            return Some(Obstacle::Walker(w.name.clone()));
+        }
+        self.objects
+            .objects()
             .iter()
-            .find(|w| {
-                self.cell_of(w.at)
-                    .is_some_and(|centre| w.footprint.cells(centre).any(|c| c == cell))
-            })
-            .map(|w| Obstacle::Walker(w.name.clone()))
+            .filter(|o| o.landed_step.is_some())
+            .find(|o| o.footprint.cells(o.centre).any(|c| c == cell))
+            .and_then(|o| self.objects.zones().get(o.zone))
+            .map(|z| Obstacle::Object(z.name.clone()))
     }
 
     /// The occupancy now: the static map with every block and walker on it (ROS

@@ -5,8 +5,11 @@
 //! - [`mapper`]: paper 004 §5, curious against recency- and Poisson-only mapping.
 //! - [`mission`]: the papers joined: seeded downtime missions, and the executive's
 //!   whole day in batch.
+//! - [`executive`]: the mission executive in process (its own window machine), one per
+//!   robot, for the days and the fleet.
 
 pub mod apf;
+pub mod executive;
 pub mod mapper;
 pub mod mission;
 pub mod planner;

@@ -40,6 +40,9 @@
 //!   - { name: b1, size_cells: [2, 2], period_steps: 7, path: [[1.0, 1.0], [3.0, 1.0]] }
 //! walkers:                     # random walkers
 //!   - { name: w1, at: [2.0, -5.0], size_m: 0.4, step_m: 0.2, every_steps: 3 }
+//! changes:                     # objects that appear in a zone and vanish (changes.rs)
+//!   - { name: dock, rect: [1.0, 1.0, 5.0, 3.0], size_m: [1.2, 1.0], appear_per_hour: 6.0,
+//!       mean_stay_s: 600.0, max_present: 2 }
 //! waypoints:                   # a mission, in order
 //!   - { name: A, at: [-8.0, -8.0] }
 //! time: { step_s: 0.4 }
@@ -55,6 +58,7 @@ use crate::load_dirs::{Access, LoadRefused};
 use crate::ros_map::{self, RosMapError};
 
 mod build;
+pub mod changes;
 mod motion;
 mod sim_sections;
 
@@ -101,6 +105,10 @@ pub struct ScenarioFile {
     /// Sim world: obstacles that wander at random.
     #[serde(default)]
     pub walkers: Vec<WalkerSpec>,
+    /// Sim world: semi-static objects that appear in zones and vanish again
+    /// ([`changes`]).
+    #[serde(default)]
+    pub changes: Vec<changes::ChangeZoneSpec>,
     /// A mission's waypoints in the order they are visited (paper 002 ES2: A, B, C, D).
     #[serde(default)]
     pub waypoints: Vec<Place>,

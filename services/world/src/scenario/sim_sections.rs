@@ -321,6 +321,14 @@ pub(super) fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<
             ));
         }
     }
+    let (x0, y0) = (meta.origin.x, meta.origin.y);
+    let extent = [
+        x0,
+        y0,
+        x0 + f64::from(meta.width) * meta.resolution,
+        y0 + f64::from(meta.height) * meta.resolution,
+    ];
+    super::changes::check(&file.changes, extent)?;
     unique(
         "waypoints",
         file.waypoints.iter().map(|w| w.name.as_str()).collect(),

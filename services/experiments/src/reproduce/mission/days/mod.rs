@@ -114,6 +114,8 @@ pub enum DaysError {
     Calibration(#[from] CalibrationError),
     #[error("the change map: {0}")]
     Mapper(String),
+    #[error("the executive: {0}")]
+    Executive(#[from] crate::reproduce::executive::ExecutiveError),
 }
 
 /// The batch's report: the options, the figures, the goals, every window.

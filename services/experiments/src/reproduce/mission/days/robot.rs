@@ -2,9 +2,10 @@
 //! controller one step at a time ([`Stepper`]), and the mapper's [`ChangeMap`] fed the
 //! robot's observation every step. Mission time is sim time.
 
+use crate::closed_loop::episode::EpisodeError;
 use crate::closed_loop::stepper::Stepper;
 use crate::closed_loop::PositionSource;
-use roam_controller::controller::Decision;
+use crate::reproduce::executive::Step;
 use roam_controller::params::ApfParams;
 use roam_mapper::change_map::{ChangeMap, MapParams, ObservationWindow};
 use roam_proto::cells::Cells;
@@ -12,21 +13,6 @@ use roam_proto::cells::Cells;
 use super::world::DayWorld;
 use super::DaysError;
 use roam_proto::controller::Mission;
-use roam_proto::localization::PositionEstimate;
-
-/// What one step showed of the robot.
-#[derive(Debug, Clone)]
-pub struct Step {
-    /// Sim time at the end of the step, seconds.
-    pub time_s: f64,
-    /// Its true position.
-    pub truth: [f64; 2],
-    /// The localization's estimate (what the executive hears); `None` when the scan
-    /// was refused.
-    pub estimate: Option<PositionEstimate>,
-    /// The controller's decision on this step.
-    pub decision: Option<Decision>,
-}
 
 /// One robot through its day.
 #[derive(Debug)]
@@ -89,7 +75,7 @@ impl Robot {
 
     /// Sends the controller a mission (an empty one holds the robot), as the
     /// executive's `mission` message does.
-    pub fn send(&mut self, mission: &Mission) -> Result<(), DaysError> {
+    pub fn send(&mut self, mission: &Mission) -> Result<(), EpisodeError> {
         if mission.recovery {
             self.stepper
                 .set_recovery(&self.name, mission.waypoints.clone())?;
