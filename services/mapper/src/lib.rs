@@ -21,6 +21,10 @@
 //! - [`learner`]: strategies, modes, the tile coder, V_S, its update and the softmax.
 //! - [`goals`]: goal sampling from the patch-averaged weights.
 //! - [`wavefront`]: the wavefront planner with hill climbing and "as close as possible".
+//! - [`prior`]: the Gamma prior on a cell's rates, λ̂ = (n + α)/(D + β).
+//! - [`news`]: the news value P_news = 1 − exp(−λ̂Δt) per cell, shared across a fleet
+//!   with each robot's reservation of its plan; the `news` scores.
+//! - [`reserve`]: the cells a robot's path will show it, with the times it should.
 //! - [`epoch`]: observation times against the sim clock; sim resets as epochs.
 //! - [`explorer`]: the per-robot loop: episodes, navigation, local exploration, reward.
 //! - [`seed`]: the seeded ChaCha8 streams every random choice draws from.
@@ -125,7 +129,10 @@ pub mod explorer;
 pub mod features;
 pub mod goals;
 pub mod learner;
+pub mod news;
 pub mod poisson;
+pub mod prior;
+pub mod reserve;
 pub use roam_world::seed;
 #[cfg(feature = "zenoh")]
 pub mod service;
@@ -136,3 +143,5 @@ pub use error::MapperError;
 pub use explorer::{EpisodeEnd, Explorer, ExplorerParams, ExplorerStep};
 pub use features::Features;
 pub use learner::{Mode, Strategy};
+pub use news::NewsMap;
+pub use prior::RatePrior;
