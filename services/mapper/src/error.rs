@@ -69,6 +69,16 @@ pub enum MapperError {
         got_width: u32,
         got_height: u32,
     },
+    #[error(
+        "the belief has {belief} cells and the truth {truth}; give one value per cell to both"
+    )]
+    ScoreSizes { belief: usize, truth: usize },
+    #[error("cell index {index} is outside the {cells} cells scored")]
+    ScoreCellOff { index: usize, cells: usize },
+    #[error("no cell to score: give at least one cell index")]
+    ScoreEmpty,
+    #[error("the belief at cell {index} is not a probability (NaN or -1 unknown); give 0..=1 or 0..=100")]
+    NoBelief { index: usize },
 }
 
 impl MapperError {
