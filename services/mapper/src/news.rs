@@ -31,12 +31,13 @@ use std::collections::BTreeMap;
 
 use roam_proto::map::GridMeta;
 use roam_world::grid::Grid;
+use serde::{Deserialize, Serialize};
 
 use crate::change_map::{scores, ChangeMap, MAX_MAP_CELLS};
 use crate::error::MapperError;
 use crate::poisson::CellProcess;
 use crate::prior::RatePrior;
-use crate::reserve::TimedCell;
+use crate::reserve::{ReserveParams, TimedCell};
 
 /// The news value's prior by default: α = 1 pseudo-event over β = 86,400 s, a change per
 /// cell per day. It errs toward looking: a robot that has not watched a cell for a day
@@ -49,6 +50,32 @@ pub const DEFAULT_NEWS_PRIOR: RatePrior = RatePrior {
     alpha: 1.0,
     beta_s: 86_400.0,
 };
+
+/// The news value's parameters (the mapper's `news:` config).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NewsParams {
+    /// The Gamma prior on the change rate (default [`DEFAULT_NEWS_PRIOR`]).
+    pub prior: RatePrior,
+    /// How the mapper turns a robot's mission into its reservation.
+    pub reserve: ReserveParams,
+}
+
+impl Default for NewsParams {
+    fn default() -> Self {
+        NewsParams {
+            prior: DEFAULT_NEWS_PRIOR,
+            reserve: ReserveParams::default(),
+        }
+    }
+}
+
+impl NewsParams {
+    pub fn check(&self) -> Result<(), MapperError> {
+        self.prior.check("news.prior")?;
+        self.reserve.check()
+    }
+}
 
 /// The most robots holding a reservation at once (limit `max_reserving_robots`).
 pub const MAX_RESERVING_ROBOTS: usize = 32;
