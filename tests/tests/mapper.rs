@@ -373,7 +373,8 @@ async fn layer_until(
 /// where no robot has looked. The `news` layer is 100 where no robot looked, 0 along b's
 /// mission (b will see it), and 100 there again once b's mission is cleared; the
 /// `occupied_now` layer has a's blocked cell occupied from the observation that saw it,
-/// and the static map's value where no robot looked.
+/// and the static map's value where no robot looked; a planner on the news product
+/// (`coupling: news`) plans on the `news` layer.
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn the_news_and_the_map_now_reach_the_map_server() {
     use roam_mapper::news::NewsParams;
@@ -500,6 +501,48 @@ async fn the_news_and_the_map_now_reach_the_map_server() {
     assert_eq!(occupied[cell(0, 0)], 100);
     assert_eq!(occupied[cell(12, 12)], 0);
     assert!(occupied.iter().all(|&v| (0..=100).contains(&v)));
+
+    // A planner on the news product plans on this layer.
+    let mut planner_config = harness.planner_config("news-coupled");
+    planner_config.change_layer = Some(NEWS_LAYER.into());
+    planner_config.coupling = roam_planner::coupling::Coupling::News;
+    let _planner = harness.start_role(planner_config).await;
+    let request = PlanRequest {
+        request_id: None,
+        cancel_token: None,
+        start: [0.5, 0.5],
+        goal: [0.5, -6.5],
+        t_exec_s: 60.0,
+        deadline_s: 2.0,
+        model: PlannerModel::Model1,
+        params: GaOverrides {
+            max_generations: Some(50),
+            ..GaOverrides::default()
+        },
+        seed: 1,
+        map_version: None,
+        shortest: ShortestPathUse::Omit,
+    };
+    let until = Instant::now() + Duration::from_secs(10);
+    let plan = loop {
+        let plan: Result<Plan, _> = within(
+            "a plan on the news product",
+            client.request::<PlanRequest, Plan>(
+                &keys::planner_plan_at(&root, "news-coupled"),
+                Some(&request),
+            ),
+        )
+        .await;
+        match plan {
+            Ok(plan) if plan.map_version.change.is_some() => break plan,
+            other => assert!(
+                Instant::now() < until,
+                "no plan on the news layer: {other:?}"
+            ),
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    };
+    assert!(plan.reaches_goal);
 
     // An empty mission clears b's reservation: its row is news again.
     put_mission(Vec::new()).await;
