@@ -230,7 +230,10 @@ mod tests {
             (m.budget(3.0) - 1.0 / (1.0 + q)).abs() < 1e-12,
             "the 2 s floor, then the share"
         );
-        assert!((m.budget(1.5) + 0.5).abs() < 1e-12, "not even the floor fits");
+        assert!(
+            (m.budget(1.5) + 0.5).abs() < 1e-12,
+            "not even the floor fits"
+        );
     }
 
     #[test]

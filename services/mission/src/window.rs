@@ -350,7 +350,9 @@ impl<'a> DowntimeWindow<'a> {
         });
         let actions = match ahead {
             Some(p) => w.start_driving(p.route, p.shortest, p.budget_s, p.time_left_s, now),
-            None => w.set_off(now).unwrap_or_else(|| vec![w.ask_first_plan(now)]),
+            None => w
+                .set_off(now)
+                .unwrap_or_else(|| vec![w.ask_first_plan(now)]),
         };
         (w, actions)
     }
