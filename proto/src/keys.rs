@@ -237,7 +237,8 @@ pub fn robot_mission(root: &str, robot: &str) -> String {
     format!("{root}/robot/{robot}/mission")
 }
 
-/// `<root>/robot/*/mission`: what the controller subscribes to.
+/// `<root>/robot/*/mission`: what the controller subscribes to, and the mapper (it
+/// counts each robot's current mission as seen ahead for the news value).
 pub fn robot_mission_any(root: &str) -> String {
     format!("{root}/robot/*/mission")
 }

@@ -19,6 +19,13 @@ pub const CHANGE_PROBABILITY_LAYER: &str = "change_probability";
 pub const CHANGE_INFORMATION_LAYER: &str = "change_information";
 /// Layer of recency r^c = t_now − t_last, seconds (paper 004 §3).
 pub const RECENCY_LAYER: &str = "recency";
+/// Layer of news scores round(100 · P_news) as u8 0–100: the probability that a cell
+/// changed since any robot last saw it, each robot's current mission counted as seen
+/// at the times it should pass (`roam_mapper::news`), for no robot in particular.
+pub const NEWS_LAYER: &str = "news";
+/// Layer of the fleet's belief that each cell is occupied now, ROS occupancy i8 0..=100
+/// (never -1: a cell never seen holds its prior; `roam_mapper::belief`).
+pub const OCCUPIED_NOW_LAYER: &str = "occupied_now";
 
 /// A goal the learner chose for a robot, on `<root>/robot/<id>/goal`, when it chooses one.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -55,6 +62,17 @@ pub struct MapperStatus {
     pub layers_sent: u64,
     /// The robots the learner drives.
     pub explorers: Vec<ExplorerStatus>,
+    /// The robots whose current mission the news value counts, by name.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub reservations: Vec<ReservationStatus>,
+}
+
+/// One robot's reservation: the cells its current mission will show it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReservationStatus {
+    pub robot: String,
+    pub cells: u64,
 }
 
 /// One driven robot's exploration.

@@ -596,7 +596,7 @@ mod localization_messages {
 mod controller_and_mapper_messages {
     use super::*;
     use roam_proto::controller::{ControllerStatus, Mission, MissionState};
-    use roam_proto::mapper::{ExplorationGoal, ExplorerStatus, MapperStatus};
+    use roam_proto::mapper::{ExplorationGoal, ExplorerStatus, MapperStatus, ReservationStatus};
 
     fn state() -> impl Strategy<Value = MissionState> {
         prop_oneof![
@@ -621,7 +621,7 @@ mod controller_and_mapper_messages {
         #[test]
         fn mapper_messages_round_trip(robot in name(), step in any::<u64>(), x in finite(), goal in prop::option::of([finite(), finite()])) {
             round_trips(&ExplorationGoal { robot: robot.clone(), step, time_s: x, goal: [x, x], strategy: "poisson".into(), episodes: step });
-            round_trips(&MapperStatus { observations: step, map_changes: step, p: x, r: x, layers_sent: 3, explorers: vec![ExplorerStatus { robot, strategy: None, goal, episodes: 1 }] });
+            round_trips(&MapperStatus { observations: step, map_changes: step, p: x, r: x, layers_sent: 3, explorers: vec![ExplorerStatus { robot: robot.clone(), strategy: None, goal, episodes: 1 }], reservations: vec![ReservationStatus { robot, cells: step }] });
         }
 
         #[test]

@@ -321,3 +321,237 @@ async fn a_forged_time_and_a_sim_reset_do_not_stop_the_mapper() {
     // clock); the ones after it are merged.
     let _ = step_until_merged(&client, &root, merged + 1).await;
 }
+
+/// Waits until the mapper's status satisfies `done`.
+async fn status_until(
+    client: &roam_runtime::Requester,
+    root: &str,
+    what: &str,
+    done: impl Fn(&MapperStatus) -> bool,
+) -> MapperStatus {
+    let until = Instant::now() + Duration::from_secs(10);
+    loop {
+        let status: MapperStatus = within(
+            "mapper status",
+            client.request::<MapperStatus, MapperStatus>(&keys::mapper_status(root), None),
+        )
+        .await
+        .expect("status");
+        if done(&status) {
+            return status;
+        }
+        assert!(Instant::now() < until, "{what}: {status:?}");
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+}
+
+/// Fetches layer `name` until `done` holds for it.
+async fn layer_until(
+    client: &roam_runtime::Requester,
+    root: &str,
+    name: &str,
+    done: impl Fn(&Layer) -> bool,
+) -> Layer {
+    let until = Instant::now() + Duration::from_secs(10);
+    loop {
+        if let Some(layer) = fetch(client, root, name).await {
+            if done(&layer) {
+                return layer;
+            }
+        }
+        assert!(
+            Instant::now() < until,
+            "the {name} layer never came as expected"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+/// The news value and the map now through Zenoh (no sim: observations and a mission put
+/// by hand on grid004's 25 × 25 cells of 1 m). Robot a watches a 5 × 5 window for three
+/// seconds and sees a cell blocked at the third; robot b is given a mission along row 20,
+/// where no robot has looked. The `news` layer is 100 where no robot looked, 0 along b's
+/// mission (b will see it), and 100 there again once b's mission is cleared; the
+/// `occupied_now` layer has a's blocked cell occupied from the observation that saw it,
+/// and the static map's value where no robot looked; a planner on the news product
+/// (`coupling: news`) plans on the `news` layer.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn the_news_and_the_map_now_reach_the_map_server() {
+    use roam_mapper::news::NewsParams;
+    use roam_mapper::prior::RatePrior;
+    use roam_mapper::reserve::ReserveParams;
+    use roam_proto::controller::Mission;
+    use roam_proto::map::{GridMeta, Origin};
+    use roam_proto::mapper::{NEWS_LAYER, OCCUPIED_NOW_LAYER};
+    use roam_proto::sim::LocalObservation;
+
+    let harness = Harness::start().await;
+    let mut map_config = harness.map_server_config();
+    map_config.map = Some(repo_path(GRID004));
+    let _map_server = harness.start_role(map_config).await;
+    let _mapper = harness
+        .start_role(MapperConfig {
+            scenario: Some(repo_path(GRID004)),
+            publish_period_s: 0.1,
+            news: NewsParams {
+                prior: RatePrior {
+                    alpha: 1.0,
+                    beta_s: 10.0,
+                },
+                reserve: ReserveParams {
+                    s_per_m: 2.0,
+                    radius_m: Some(0.0),
+                },
+            },
+            ..harness.mapper_config()
+        })
+        .await;
+    let client = harness.client().await;
+    let root = harness.root.clone();
+    let cell = |x: usize, y: usize| y * 25 + x;
+
+    // Robot a: cells (2..=6, 2..=6) free at t = 1 and 2; at t = 3 cell (4, 4) blocked.
+    for t in 1..=3u64 {
+        let mut cells = vec![0i8; 25];
+        if t == 3 {
+            cells[2 * 5 + 2] = 100;
+        }
+        let observation = LocalObservation {
+            robot: "a".into(),
+            step: t,
+            time_s: t as f64,
+            at: [-8.0, -8.0],
+            x0: 2,
+            y0: 2,
+            meta: GridMeta {
+                width: 5,
+                height: 5,
+                resolution: 1.0,
+                origin: Origin::default(),
+            },
+            cells: Cells::I8(cells),
+        };
+        within(
+            "put an observation",
+            client.session().put(
+                keys::robot_observation(&root, "a"),
+                roam_proto::encode(&observation),
+            ),
+        )
+        .await
+        .expect("put");
+        status_until(&client, &root, "the observation merged", |s| {
+            s.observations == t
+        })
+        .await;
+    }
+
+    // Robot b's mission along row 20, cells 5 to 15 (world y = 8).
+    let put_mission = |waypoints: Vec<[f64; 2]>| {
+        let mission = Mission {
+            robot: "b".into(),
+            id: "b-1".into(),
+            waypoints,
+            recovery: false,
+        };
+        let (session, key) = (client.session().clone(), keys::robot_mission(&root, "b"));
+        async move {
+            within(
+                "put a mission",
+                session.put(key, roam_proto::encode(&mission)),
+            )
+            .await
+            .expect("put");
+        }
+    };
+    put_mission(vec![[-7.0, 8.0], [3.0, 8.0]]).await;
+    let status = status_until(&client, &root, "b's reservation", |s| {
+        !s.reservations.is_empty()
+    })
+    .await;
+    assert_eq!(status.reservations.len(), 1);
+    assert_eq!(status.reservations[0].robot, "b");
+    assert_eq!(status.reservations[0].cells, 11, "row 20, cells 5 to 15");
+
+    let u8_cells = |layer: &Layer| match &layer.cells {
+        Cells::U8(c) => c.clone(),
+        other => panic!("news is not u8: {other:?}"),
+    };
+    let row_reserved = |news: &[u8]| (5..=15).all(|x| news[cell(x, 20)] == 0);
+    let news = layer_until(&client, &root, NEWS_LAYER, |l| row_reserved(&u8_cells(l))).await;
+    let news = u8_cells(&news);
+    // Where no robot looked nor will: news for certain; beside b's row too.
+    assert_eq!(news[cell(12, 12)], 100);
+    assert_eq!(news[cell(4, 20)], 100);
+    assert_eq!(news[cell(10, 21)], 100);
+    // a's window was seen at t = 3, the newest observation: no news yet.
+    assert_eq!(news[cell(3, 3)], 0);
+
+    let occupied = layer_until(&client, &root, OCCUPIED_NOW_LAYER, |_| true).await;
+    let Cells::I8(occupied) = &occupied.cells else {
+        panic!("occupied_now is not i8");
+    };
+    assert_eq!(
+        occupied[cell(4, 4)],
+        100,
+        "blocked from the observation that saw it"
+    );
+    assert_eq!(occupied[cell(3, 3)], 0);
+    // Never seen: the static map's value (grid004's border wall, its free interior).
+    assert_eq!(occupied[cell(0, 0)], 100);
+    assert_eq!(occupied[cell(12, 12)], 0);
+    assert!(occupied.iter().all(|&v| (0..=100).contains(&v)));
+
+    // A planner on the news product plans on this layer.
+    let mut planner_config = harness.planner_config("news-coupled");
+    planner_config.change_layer = Some(NEWS_LAYER.into());
+    planner_config.coupling = roam_planner::coupling::Coupling::News;
+    let _planner = harness.start_role(planner_config).await;
+    let request = PlanRequest {
+        request_id: None,
+        cancel_token: None,
+        start: [0.5, 0.5],
+        goal: [0.5, -6.5],
+        t_exec_s: 60.0,
+        deadline_s: 2.0,
+        model: PlannerModel::Model1,
+        params: GaOverrides {
+            max_generations: Some(50),
+            ..GaOverrides::default()
+        },
+        seed: 1,
+        map_version: None,
+        shortest: ShortestPathUse::Omit,
+    };
+    let until = Instant::now() + Duration::from_secs(10);
+    let plan = loop {
+        let plan: Result<Plan, _> = within(
+            "a plan on the news product",
+            client.request::<PlanRequest, Plan>(
+                &keys::planner_plan_at(&root, "news-coupled"),
+                Some(&request),
+            ),
+        )
+        .await;
+        match plan {
+            Ok(plan) if plan.map_version.change.is_some() => break plan,
+            other => assert!(
+                Instant::now() < until,
+                "no plan on the news layer: {other:?}"
+            ),
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    };
+    assert!(plan.reaches_goal);
+
+    // An empty mission clears b's reservation: its row is news again.
+    put_mission(Vec::new()).await;
+    status_until(&client, &root, "b's reservation released", |s| {
+        s.reservations.is_empty()
+    })
+    .await;
+    layer_until(&client, &root, NEWS_LAYER, |l| {
+        (5..=15).all(|x| u8_cells(l)[cell(x, 20)] == 100)
+    })
+    .await;
+}

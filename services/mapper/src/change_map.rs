@@ -26,8 +26,8 @@ use crate::features::{Features, TileCache};
 use crate::poisson::{CellProcess, Watch};
 
 /// The most cells a change map holds (limit `max_map_cells`): 2048 × 2048. Each cell
-/// costs about 41 bytes (its processes and its obstacle value), so the largest map
-/// takes about 170 MB; a full-size warehouse map (1.7 M cells) about 70 MB.
+/// costs about 49 bytes (its processes and its obstacle value), so the largest map
+/// takes about 205 MB; a full-size warehouse map (1.7 M cells) about 84 MB.
 pub const MAX_MAP_CELLS: u64 = 1 << 22;
 
 /// A seen value at or above this is occupied, below it free.
@@ -406,7 +406,7 @@ impl ChangeMap {
 
     /// The time the layers and features are evaluated at: `t_now`, but never before the
     /// latest observation (a cell cannot have been seen in the future).
-    fn now(&self, t_now: f64) -> f64 {
+    pub(crate) fn now(&self, t_now: f64) -> f64 {
         match self.t_latest {
             // NaN compares as not later: the latest time is used.
             Some(latest) if t_now.is_nan() || t_now < latest => latest,

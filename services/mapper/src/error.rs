@@ -2,6 +2,7 @@
 //! crate, so a caller can tell the user what to change.
 
 use crate::change_map::MAX_MAP_CELLS;
+use crate::news::{MAX_RESERVED_CELLS, MAX_RESERVING_ROBOTS};
 
 /// Why the change map or the explorer refused an input. Nothing changes when a call is
 /// refused.
@@ -48,6 +49,36 @@ pub enum MapperError {
         width: u32,
         height: u32,
     },
+    #[error(
+        "robot {robot:?} cannot reserve: reservations are held for at most {max} robots \
+         (limit max_reserving_robots); release another robot's first"
+    )]
+    TooManyRobots { robot: String, max: usize },
+    #[error(
+        "a reservation of more than {max} cells (limit max_reserved_cells); reserve the \
+         plan's first {max} cells"
+    )]
+    ReservationTooLarge { max: usize },
+    #[error(
+        "a {got_width} x {got_height} grid was given where the {width} x {height} one of \
+         the change map is expected; use grids of one size"
+    )]
+    GridMismatch {
+        width: u32,
+        height: u32,
+        got_width: u32,
+        got_height: u32,
+    },
+    #[error(
+        "the belief has {belief} cells and the truth {truth}; give one value per cell to both"
+    )]
+    ScoreSizes { belief: usize, truth: usize },
+    #[error("cell index {index} is outside the {cells} cells scored")]
+    ScoreCellOff { index: usize, cells: usize },
+    #[error("no cell to score: give at least one cell index")]
+    ScoreEmpty,
+    #[error("the belief at cell {index} is not a probability (NaN or -1 unknown); give 0..=1 or 0..=100")]
+    NoBelief { index: usize },
 }
 
 impl MapperError {
@@ -56,6 +87,21 @@ impl MapperError {
         MapperError::MapTooLarge {
             cells,
             max: MAX_MAP_CELLS,
+        }
+    }
+
+    /// The robot-count error for `robot`.
+    pub(crate) fn too_many_robots(robot: &str) -> MapperError {
+        MapperError::TooManyRobots {
+            robot: robot.chars().take(64).collect(),
+            max: MAX_RESERVING_ROBOTS,
+        }
+    }
+
+    /// The reservation-size error.
+    pub(crate) fn reservation_too_large() -> MapperError {
+        MapperError::ReservationTooLarge {
+            max: MAX_RESERVED_CELLS,
         }
     }
 }

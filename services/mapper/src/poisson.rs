@@ -28,6 +28,16 @@
 //! set the cell's state to the later one but are not an event: no time passed for a
 //! change to happen. So every event comes with a gap > 0, which adds to D, and D > 0
 //! whenever there is an event: Eq. 1 never divides zero by a count.
+//!
+//! **The watched time in each state** (not in paper 004, which needs only D; roam's,
+//! for the two-state Markov chain of [`crate::belief`]). A free→blocked event can only
+//! happen while the cell is free, so that process's rate is its events over the time
+//! the cell was watched *free*, D_free, and the blocked→free rate is over D_occ, as
+//! iMac (Saarinen et al., IROS 2012) learns each transition rate from the observations
+//! of its source state; over the whole D both processes count the same flux and would
+//! say every changing cell is occupied half the time. A gap's watched time goes to the
+//! state at both its ends, half to each when they differ (the change happened somewhere
+//! in the gap, in the middle on average), so D_free + D_occ = D.
 
 use serde::Serialize;
 
@@ -79,6 +89,8 @@ pub struct CellProcess {
     t_last: f64,
     /// t_not obs.: the time between t_init and t_last the cell was not watched.
     t_not_obs: f64,
+    /// D_occ: the watched time the cell was occupied (module doc).
+    t_occupied: f64,
     /// Free→blocked events seen.
     n_block: u32,
     /// Blocked→free events seen.
@@ -99,6 +111,7 @@ impl CellProcess {
         t_init: 0.0,
         t_last: 0.0,
         t_not_obs: 0.0,
+        t_occupied: 0.0,
         n_block: 0,
         n_free: 0,
         last: None,
@@ -126,6 +139,9 @@ impl CellProcess {
         if !watched {
             self.t_not_obs += gap - watch.period_s;
         }
+        let watched_time = gap.min(watch.period_s);
+        let occupied_ends = u8::from(previous == CellState::Occupied) + u8::from(occupied);
+        self.t_occupied += watched_time * f64::from(occupied_ends) / 2.0;
         self.t_last = self.t_last.max(t);
         self.last = Some(state);
         if previous == state || gap <= 0.0 || !(watched || watch.events_across_gaps) {
@@ -184,6 +200,16 @@ impl CellProcess {
     /// The time the cell was watched, D = t_last − t_not obs. − t_init, seconds.
     pub fn observed_time(&self) -> f64 {
         (self.t_last - self.t_not_obs - self.t_init).max(0.0)
+    }
+
+    /// D_occ: the watched time the cell was occupied, seconds (module doc).
+    pub fn observed_time_occupied(&self) -> f64 {
+        self.t_occupied.clamp(0.0, self.observed_time())
+    }
+
+    /// D_free = D − D_occ: the watched time the cell was free, seconds (module doc).
+    pub fn observed_time_free(&self) -> f64 {
+        (self.observed_time() - self.observed_time_occupied()).max(0.0)
     }
 
     /// E(T_block) of Eq. 1, seconds; infinite when no free→blocked event was seen.
@@ -318,6 +344,29 @@ mod tests {
         assert!(close(c.change_probability(13.0), 0.451_188_363_905_973_6));
         assert_eq!(c.change_probability(10.0), 0.0);
         assert_eq!(c.recency(13.0), Some(3.0));
+    }
+
+    #[test]
+    fn watched_time_is_split_by_state() {
+        // The cell of `eq_1_and_eq_2_by_hand`: free 0–1, a change in 1–2, blocked 2–4, a
+        // change in 4–5, free 5–8, a change in 8–9, blocked 9–10. Each change's second
+        // goes half to each state.
+        let states = [0, 0, 1, 1, 1, 0, 0, 0, 0, 1, 1];
+        let c = seen(
+            &states
+                .iter()
+                .enumerate()
+                .map(|(t, &s)| (t as f64, s == 1))
+                .collect::<Vec<_>>(),
+        );
+        assert!(close(c.observed_time_occupied(), 4.5));
+        assert!(close(c.observed_time_free(), 5.5));
+        // A gap: only its first period is watched, and it goes to the states at its ends.
+        let gap = seen(&[(0.0, true), (1.0, true), (41.0, false)]);
+        assert!(close(gap.observed_time(), 2.0));
+        assert!(close(gap.observed_time_occupied(), 1.5));
+        assert!(close(gap.observed_time_free(), 0.5));
+        assert_eq!(CellProcess::UNOBSERVED.observed_time_occupied(), 0.0);
     }
 
     #[test]

@@ -4,7 +4,8 @@
 //! | key | kind | payload |
 //! |---|---|---|
 //! | `<root>/robot/*/observation` | subscription | `observation` (from the sim or a robot) |
-//! | `<root>/map/update/{change_rate,change_probability,recency}` | queries to the map server, throttled | `layer_update` |
+//! | `<root>/robot/*/mission` | subscription | `mission` (a robot's current waypoints: its reservation) |
+//! | `<root>/map/update/{change_rate,change_probability,change_information,recency,news,occupied_now}` | queries to the map server, throttled | `layer_update` |
 //! | `<root>/robot/<id>/cmd` | publication, one per observation of a driven robot | `robot_command` |
 //! | `<root>/robot/<id>/goal` | publication, when the learner picks a goal | `exploration_goal` |
 //! | `<root>/mapper/status` | queryable | → `mapper_status` |
@@ -14,7 +15,21 @@
 //!
 //! Every robot's observations merge into one map. The layers are computed and sent at
 //! most once per `publish_period_s` (wall time), and only when something was observed
-//! since the last send: a map server is never flooded, whatever the robots' rate.
+//! (or a mission heard) since the last send: a map server is never flooded, whatever
+//! the robots' rate.
+//!
+//! **Reservations.** Each robot's current mission (the waypoints the executive or a user
+//! puts on `robot/<id>/mission`) is its reservation for the news value
+//! ([`crate::news`]): the cells within the observation radius of the path from the
+//! robot's last observed position through the waypoints, each at the time the robot
+//! should leave it, driving from the mapper's time when the mission is heard (the newest
+//! observation's) at `news.reserve.s_per_m` seconds per metre (paper 000's v_lin, 2 s/m
+//! by default; the mission carries no times, and this needs no planner's time model). A
+//! new mission replaces the robot's reservation, an empty one releases it; at most
+//! [`MAX_RESERVING_ROBOTS`] robots hold one and a reservation keeps the path's first
+//! [`MAX_RESERVED_CELLS`] cells. The `news` layer counts every robot's reservation (no
+//! robot in particular), so a robot's replan also sees its own plan as seen: a batch
+//! that plans per robot uses [`NewsMap::news_scores`] with `for_robot`.
 
 use roam_runtime::Delivery;
 use std::collections::{BTreeMap, BTreeSet};
@@ -26,23 +41,28 @@ use roam_proto::cells::Cells;
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
 
 type MapMeta = GridMeta;
+use roam_proto::controller::{Mission, MAX_MISSION_BYTES};
 use roam_proto::mapper::{
-    ExplorationGoal, ExplorerStatus, MapperStatus, CHANGE_INFORMATION_LAYER,
-    CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER, RECENCY_LAYER,
+    ExplorationGoal, ExplorerStatus, MapperStatus, ReservationStatus, CHANGE_INFORMATION_LAYER,
+    CHANGE_PROBABILITY_LAYER, CHANGE_RATE_LAYER, NEWS_LAYER, OCCUPIED_NOW_LAYER, RECENCY_LAYER,
 };
 use roam_proto::sim::{LocalObservation, RobotCommand, SimClock};
 use roam_proto::{keys, ErrorReply, Message};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::world_check::{self, WorldMismatch};
 use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
+use roam_world::grid::Grid;
 use roam_world::scenario::load_or_builtin;
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
 
+use crate::belief::{occupied_now, BeliefParams};
 use crate::change_map::{ChangeMap, MapParams, ObservationWindow};
 use crate::epoch::Epochs;
 use crate::explorer::{Explorer, ExplorerParams, Mode};
+use crate::news::{NewsMap, NewsParams, MAX_RESERVED_CELLS, MAX_RESERVING_ROBOTS};
+use crate::reserve::cells_along;
 
 pub const SERVICE_NAME: &str = "mapper";
 /// Robots the learner drives at most.
@@ -60,6 +80,12 @@ const MAX_CLOCK_BYTES: usize = 1024;
 /// explore: [robot]                          # robots the curious learner drives (default none)
 /// publish_period_s: 1.0                     # the layers go to the map server at most this often
 /// seed: 0
+/// news:                                     # the news value (crate::news)
+///   prior: { alpha: 1.0, beta_s: 86400.0 }  # λ̂ = (n + α)/(D + β)
+///   reserve: { s_per_m: 2.0 }               # radius_m: default the scenario's observation radius
+/// belief:                                   # the map now (crate::belief)
+///   prior: { alpha: 0.0001, beta_s: 60.0 }
+///   unseen_occupied: 0.5                    # a cell never seen where the static map has no value
 /// ```
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -73,6 +99,10 @@ pub struct MapperConfig {
     pub explorer: ExplorerParams,
     /// The map's parameters; `observation_period_s` is taken from the scenario's step.
     pub map: MapParams,
+    /// The news value's prior and how missions become reservations.
+    pub news: NewsParams,
+    /// The map now's prior.
+    pub belief: BeliefParams,
     pub zenoh: Option<serde_json::Value>,
 }
 
@@ -87,6 +117,8 @@ impl Default for MapperConfig {
             seed: 0,
             explorer: ExplorerParams::default(),
             map: MapParams::default(),
+            news: NewsParams::default(),
+            belief: BeliefParams::default(),
             zenoh: None,
         }
     }
@@ -104,9 +136,14 @@ pub enum MapperServiceError {
     World(#[from] WorldMismatch),
 }
 
-/// What observations change.
+/// What observations and missions change.
 struct Mapping {
     map: ChangeMap,
+    /// The robots' reservations (their current missions).
+    news: NewsMap,
+    /// Each reserving robot's last observed position, where its mission's path starts;
+    /// kept for at most [`MAX_RESERVING_ROBOTS`] robots.
+    positions: BTreeMap<String, [f64; 2]>,
     explorers: BTreeMap<String, Explorer>,
     /// The exploration goal last published per robot: a goal is published when it changes.
     published_goals: BTreeMap<String, ExplorationGoal>,
@@ -133,6 +170,12 @@ struct MapperShared {
     warnings: WarnLimiter,
     /// The world this service works on, sent with its layer updates.
     world: roam_proto::map::WorldId,
+    /// The scenario's static occupancy: the map now's prior for cells never seen.
+    static_map: Grid<i8>,
+    belief: BeliefParams,
+    /// How far a robot sees along its mission's path, metres, and how fast it drives it.
+    reserve_radius_m: f64,
+    reserve_s_per_m: f64,
 }
 
 impl MapperShared {
@@ -220,6 +263,9 @@ fn on_observation(state: &MapperShared, key: &str, o: LocalObservation) {
         };
         m.epochs.accepted(t);
         m.observations += 1;
+        if m.positions.len() < MAX_RESERVING_ROBOTS || m.positions.contains_key(robot) {
+            m.positions.insert(robot.to_owned(), o.at);
+        }
         m.map_changes += update.map_changes(true) as u64;
         m.now_s = m.now_s.max(t);
         m.dirty = true;
@@ -274,6 +320,49 @@ fn on_observation(state: &MapperShared, key: &str, o: LocalObservation) {
     }
 }
 
+/// A robot's new mission replaces its reservation ([`crate::news`]); an empty one
+/// releases it.
+fn on_mission(state: &MapperShared, key: &str, mission: Mission) {
+    let robot = match routing::robot_for(&state.root, key, &mission.robot) {
+        Ok(robot) => robot,
+        Err(e) => return limited_warn!(state.warnings, key, "ignoring a mission: {e}"),
+    };
+    if mission.waypoints.is_empty() {
+        let mut m = state.mapping();
+        if m.news.release(robot) {
+            m.dirty = true;
+        }
+        return;
+    }
+    // The path's cells are found outside the lock: a long path on a large map takes a
+    // while, and observations keep merging meanwhile.
+    let (start_s, position) = {
+        let m = state.mapping();
+        (m.now_s, m.positions.get(robot).copied())
+    };
+    let path: Vec<[f64; 2]> = position
+        .into_iter()
+        .chain(mission.waypoints.iter().copied())
+        .collect();
+    let reserved = cells_along(
+        &state.meta,
+        &path,
+        start_s,
+        state.reserve_s_per_m,
+        state.reserve_radius_m,
+        MAX_RESERVED_CELLS,
+    )
+    .and_then(|cells| {
+        let mut m = state.mapping();
+        let count = m.news.reserve(robot, cells)?;
+        m.dirty = true;
+        Ok(count)
+    });
+    if let Err(e) = reserved {
+        limited_warn!(state.warnings, robot, %robot, "no reservation for a mission: {e}");
+    }
+}
+
 fn status(state: &MapperShared) -> MapperStatus {
     let m = state.mapping();
     MapperStatus {
@@ -295,6 +384,14 @@ fn status(state: &MapperShared) -> MapperStatus {
                 }
             })
             .collect(),
+        reservations: m
+            .news
+            .reserving_robots()
+            .map(|robot| ReservationStatus {
+                robot: robot.to_owned(),
+                cells: m.news.reserved_cells(robot) as u64,
+            })
+            .collect(),
     }
 }
 
@@ -303,9 +400,9 @@ async fn answer_status(state: Arc<MapperShared>, query: Query) {
     reply::send_result(&query, result).await;
 }
 
-/// The three layers at the newest observation's time, if anything was observed since
-/// they were last sent.
-fn layers_to_send(state: &MapperShared) -> Option<[(&'static str, Cells); 4]> {
+/// The layers at the newest observation's time, if anything was observed (or a mission
+/// heard) since they were last sent.
+fn layers_to_send(state: &MapperShared) -> Option<Vec<(&'static str, Cells)>> {
     let mut m = state.mapping();
     if !m.dirty {
         return None;
@@ -314,7 +411,7 @@ fn layers_to_send(state: &MapperShared) -> Option<[(&'static str, Cells); 4]> {
     let now = m.now_s;
     let probability = m.map.probability_layer(now).cells;
     let scores = crate::change_map::scores(&probability);
-    Some([
+    let mut layers = vec![
         (
             CHANGE_RATE_LAYER,
             Cells::F32(f32_cells(m.map.rate_layer().cells)),
@@ -325,7 +422,18 @@ fn layers_to_send(state: &MapperShared) -> Option<[(&'static str, Cells); 4]> {
             RECENCY_LAYER,
             Cells::F32(f32_cells(m.map.recency_layer(now).cells)),
         ),
-    ])
+    ];
+    // Both are on the change map's grid by construction; an error would be a bug, logged
+    // and that layer left out.
+    match m.news.news_scores(&m.map, now, None) {
+        Ok(news) => layers.push((NEWS_LAYER, Cells::U8(news.cells))),
+        Err(e) => tracing::error!("no news layer: {e}"),
+    }
+    match occupied_now(&m.map, now, &state.belief, Some(&state.static_map)) {
+        Ok(belief) => layers.push((OCCUPIED_NOW_LAYER, Cells::I8(belief.cells))),
+        Err(e) => tracing::error!("no occupied_now layer: {e}"),
+    }
+    Some(layers)
 }
 
 /// Layers travel as f32 cells: the map server's float layer type, half the bytes.
@@ -419,8 +527,19 @@ pub async fn run(
     for robot in &explore {
         keys::check_name("robot", robot).map_err(|e| MapperServiceError::Config(e.to_string()))?;
     }
+    for checked in [config.news.check(), config.belief.check()] {
+        checked.map_err(|e| MapperServiceError::Config(e.to_string()))?;
+    }
     let (_, scenario) = load_or_builtin(config.scenario.as_deref())?;
     let meta = scenario.occupancy.meta;
+    let news = NewsMap::new(meta, config.news.prior)
+        .map_err(|e| MapperServiceError::Config(e.to_string()))?;
+    let reserve_radius_m = config
+        .news
+        .reserve
+        .radius_m
+        .unwrap_or(scenario.file.sensing.observation_radius_m)
+        .max(0.0);
     let observation_period_s = scenario.file.time.step_s;
     let map = ChangeMap::new(
         meta,
@@ -456,8 +575,14 @@ pub async fn run(
         root: config.root.clone(),
         session: service.session().clone(),
         meta,
+        static_map: scenario.occupancy.clone(),
+        belief: config.belief,
+        reserve_radius_m,
+        reserve_s_per_m: config.news.reserve.s_per_m,
         mapping: Mutex::new(Mapping {
             map,
+            news,
+            positions: BTreeMap::new(),
             explorers,
             published_goals: BTreeMap::new(),
             observations: 0,
@@ -489,6 +614,16 @@ pub async fn run(
             state.clone(),
             |state: &Arc<MapperShared>, key: &str, o: LocalObservation| {
                 on_observation(state, key, o)
+            },
+        )
+        .await?;
+    service
+        .subscribe_with(
+            &keys::robot_mission_any(&config.root),
+            MAX_MISSION_BYTES,
+            state.clone(),
+            |state: &Arc<MapperShared>, key: &str, mission: Mission| {
+                on_mission(state, key, mission)
             },
         )
         .await?;

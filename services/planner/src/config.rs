@@ -8,6 +8,7 @@
 //! map_history: 4               # map versions kept for requests that name one
 //! information_layer: information  # or change_information: plan on the mapper's P(E>0)
 //! change_layer: change_information # optional: plan on max(information, change) (crate::coupling)
+//! coupling: max                # or news: plan on round(information × change / 100), with change_layer: news
 //! planning_resolution_m: 0.2   # optional; default 0.2 (paper 000), or the map's if coarser (crate::resolution)
 //! # What one plan may cost, checked before any work (crate::limits):
 //! max_population_cells: 4000000   # population × longest path the budget allows
@@ -22,6 +23,7 @@
 use serde::Deserialize;
 
 use crate::budget::BudgetConfig;
+use crate::coupling::Coupling;
 use crate::limits::PlanLimits;
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -48,6 +50,10 @@ pub struct PlannerConfig {
     /// information map: the planner plans on max(I_xy, C_xy) cell by cell
     /// ([`crate::coupling`]). Off by default.
     pub change_layer: Option<String>,
+    /// How the change layer is coupled ([`crate::coupling`]): `max` (default),
+    /// max(I_xy, C_xy); or `news`, round(I_xy × N_xy / 100), interest × the probability
+    /// of news, with the mapper's `news` layer as `change_layer` (required).
+    pub coupling: Coupling,
     /// The resolution the planner plans at, metres ([`crate::resolution`]): planning
     /// cells of a whole number of map cells, the path driven on the map's cells. Absent:
     /// paper 000's 0.2 m, or the map's resolution where that is coarser. Finer than the
@@ -82,6 +88,7 @@ impl Default for PlannerConfig {
             map_history: 4,
             information_layer: crate::maps::INFORMATION.to_owned(),
             change_layer: None,
+            coupling: Coupling::Max,
             planning_resolution_m: None,
             max_population_cells: limits.max_population_cells,
             max_plan_cost: limits.max_plan_cost,
@@ -126,5 +133,14 @@ mod tests {
         assert!(parsed.budget().validate().is_ok());
         // Well under the 600 s a request may ask for.
         assert!(parsed.max_plan_seconds <= 60.0);
+    }
+
+    #[test]
+    fn the_coupling_is_max_unless_news_is_named() {
+        assert_eq!(PlannerConfig::default().coupling, Coupling::Max);
+        let news: PlannerConfig =
+            serde_json::from_str(r#"{"change_layer": "news", "coupling": "news"}"#).expect("news");
+        assert_eq!(news.coupling, Coupling::News);
+        assert!(serde_json::from_str::<PlannerConfig>(r#"{"coupling": "sum"}"#).is_err());
     }
 }

@@ -10,7 +10,7 @@ use roam_proto::map::Layer;
 use roam_proto::planner::MapVersion;
 use roam_world::grid::Grid;
 
-use crate::coupling;
+use crate::coupling::{self, Coupling};
 use crate::resolution::PAPER_RESOLUTION_M;
 use crate::world::{World, WorldError};
 
@@ -36,6 +36,8 @@ pub struct MapCache {
     /// The change layer coupled into the information map, if any, and its latest.
     change_layer: Option<String>,
     change: Option<Layer>,
+    /// How it is coupled ([`crate::coupling`]).
+    coupling: Coupling,
     /// The planning resolution ([`crate::resolution`]); `None`: paper 000's 0.2 m, or
     /// the map's resolution where that is coarser.
     planning_resolution_m: Option<f64>,
@@ -61,6 +63,12 @@ impl MapCache {
     /// `change_information`) coupled into the information map ([`crate::coupling`]).
     pub fn coupling_change(mut self, change_layer: Option<&str>) -> Self {
         self.change_layer = change_layer.map(str::to_owned);
+        self
+    }
+
+    /// This cache coupling its change layer by `rule` (default [`Coupling::Max`]).
+    pub fn coupled_by(mut self, rule: Coupling) -> Self {
+        self.coupling = rule;
         self
     }
 
@@ -145,7 +153,7 @@ impl MapCache {
         let info = Grid {
             meta: information.meta,
             cells: match change.map(|c| &c.cells) {
-                Some(Cells::U8(scores)) => coupling::couple(info, scores),
+                Some(Cells::U8(scores)) => self.coupling.apply(info, scores),
                 _ => info.clone(),
             },
         };
@@ -269,6 +277,21 @@ pub(crate) mod tests {
         assert_eq!(world.information, vec![90, 20, 35, 40]);
         // The static world stays for requests that name it.
         assert_eq!(cache.world(Some(first)).map(|(v, _)| v), Some(first));
+    }
+
+    #[test]
+    fn a_cache_coupled_by_the_news_product_plans_on_interest_times_news() {
+        let mut cache = MapCache::new(4)
+            .coupling_change(Some("news"))
+            .coupled_by(Coupling::News);
+        cache.update(layer(INFLATED, 1, Cells::I8(vec![0; 4])));
+        cache.update(layer(INFORMATION, 1, Cells::U8(vec![10, 20, 30, 40])));
+        let coupled = cache
+            .update(layer("news", 2, Cells::U8(vec![100, 0, 50, 25])))
+            .expect("a new world for the news layer");
+        assert_eq!(coupled.change, Some(2));
+        let (_, world) = cache.world(None).expect("world");
+        assert_eq!(world.information, vec![10, 0, 15, 10]);
     }
 
     #[test]

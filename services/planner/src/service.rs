@@ -29,6 +29,7 @@ use zenoh::query::Query;
 
 use crate::budget::{CpuBudget, Exhausted};
 use crate::config::PlannerConfig;
+use crate::coupling::Coupling;
 use crate::inflight::{CancelVerdict, InFlight};
 use crate::limits::PlanLimits;
 use crate::maps::MapCache;
@@ -148,6 +149,12 @@ pub fn check_config(config: &PlannerConfig) -> Result<(), PlannerError> {
     }
     keys::check_name("information_layer", &config.information_layer)
         .map_err(|e| PlannerError::Config(e.to_string()))?;
+    if config.coupling != Coupling::Max && config.change_layer.is_none() {
+        return Err(PlannerError::Config(format!(
+            "coupling: {} needs a change_layer to couple (the mapper's news layer): set change_layer: news, or leave coupling out",
+            config.coupling.as_str()
+        )));
+    }
     if let Some(change) = &config.change_layer {
         keys::check_name("change_layer", change)
             .map_err(|e| PlannerError::Config(e.to_string()))?;
@@ -182,6 +189,7 @@ pub async fn run(
         maps: Mutex::new(
             MapCache::with_information(config.map_history, &config.information_layer)
                 .coupling_change(config.change_layer.as_deref())
+                .coupled_by(config.coupling)
                 .planning_at(config.planning_resolution_m),
         ),
         queue: PlanQueue::new(QueueConfig {
@@ -701,4 +709,31 @@ fn plan_now(
     );
     plan.budget_s = budget_s;
     Ok((plan, share))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_news_coupling_needs_a_change_layer() {
+        let alone = PlannerConfig {
+            coupling: Coupling::News,
+            ..PlannerConfig::default()
+        };
+        match check_config(&alone) {
+            Err(PlannerError::Config(e)) => {
+                assert!(
+                    e.contains("coupling: news") && e.contains("change_layer"),
+                    "{e}"
+                )
+            }
+            other => panic!("{other:?}"),
+        }
+        let paired = PlannerConfig {
+            change_layer: Some("news".into()),
+            ..alone
+        };
+        assert!(check_config(&paired).is_ok());
+    }
 }

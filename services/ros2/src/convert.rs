@@ -38,7 +38,7 @@ pub enum Scale {
 pub const PEB_FULL_SCALE_M: f64 = 1.0;
 
 /// The layers roam publishes and how: (layer, relative topic name, scale).
-pub const LAYER_TOPICS: [(&str, &str, Scale); 5] = [
+pub const LAYER_TOPICS: [(&str, &str, Scale); 7] = [
     ("occupancy", "map", Scale::Occupancy),
     ("inflated", "roam/inflated", Scale::Occupancy),
     ("information", "roam/information", Scale::Score),
@@ -53,6 +53,12 @@ pub const LAYER_TOPICS: [(&str, &str, Scale); 5] = [
         roam_proto::mapper::CHANGE_PROBABILITY_LAYER,
         "roam/change_probability",
         Scale::Probability,
+    ),
+    (roam_proto::mapper::NEWS_LAYER, "roam/news", Scale::Score),
+    (
+        roam_proto::mapper::OCCUPIED_NOW_LAYER,
+        "roam/occupied_now",
+        Scale::Occupancy,
     ),
 ];
 
