@@ -5,6 +5,7 @@ mod bench;
 mod map;
 mod plan;
 mod reproduce;
+mod reproduce_fleet;
 mod roles;
 mod ros2;
 mod sim;

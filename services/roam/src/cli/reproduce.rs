@@ -47,6 +47,13 @@ pub(crate) enum ReproduceCommand {
         #[arg(long, default_value_t = 2000.0)]
         w_loc: f64,
     },
+    /// A fleet's week in the warehouse: ten robots' shifts repeated --days times, each
+    /// robot driven by the executive's own window machine, objects landing in and
+    /// leaving the aisles and the dock; per variant (tasks only, the operator's patrol,
+    /// independent curiosity, roam's shared news and each part of it off) the late
+    /// windows, how soon the fleet sees each change and how well its map predicts the
+    /// world now, against the goals.
+    Fleet(super::reproduce_fleet::FleetArgs),
     /// Paper 002 §4: ES1-ES3 for plain APF and the fixed, cutoff, linear and sinusoidal
     /// information-seeking weights.
     Apf {
@@ -120,6 +127,7 @@ pub(crate) enum ReproduceCommand {
 
 pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
     match command {
+        ReproduceCommand::Fleet(args) => super::reproduce_fleet::run(args).await,
         ReproduceCommand::Mission {
             json,
             days: Some(days),

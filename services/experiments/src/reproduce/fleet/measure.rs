@@ -1,0 +1,136 @@
+//! What the fleet's week is measured by: each window (late, the share driven, the
+//! information driven), the map error every sim minute, every change event, the plans.
+
+use roam_controller::controller::{Decision, MissionStatus};
+use roam_mapper::brier::brier;
+use serde::Serialize;
+
+use crate::reproduce::executive::track::Track;
+use crate::reproduce::executive::FinishedWindow;
+
+use super::events::{ChangeEvent, ChangeLog};
+use super::variant::FleetVariant;
+use super::world::FleetWorld;
+use super::FleetError;
+
+/// One robot's window.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WindowRecord {
+    pub robot: usize,
+    /// The shift (day) its task is in, from 0.
+    pub day: usize,
+    pub task: String,
+    pub window_s: f64,
+    pub late: bool,
+    /// From the first mission to the arrival over the window's length.
+    pub share: f64,
+    /// Paper 000's measure on the static map along the true driven path.
+    pub driven_information: f64,
+    pub ga_plans: u32,
+}
+
+impl WindowRecord {
+    pub fn of(world: &FleetWorld, robot: usize, shift_s: f64, w: FinishedWindow) -> WindowRecord {
+        let report = &w.outcome.report;
+        let window_s = w.task.start_s - w.began_s;
+        let sent = w.log.first_sent_at_s.unwrap_or(w.began_s);
+        let driving_s = report.arrival_s.map_or(0.0, |a| a - sent);
+        let track: &Track = &w.log.track;
+        WindowRecord {
+            robot,
+            day: (w.task.start_s / shift_s).floor().max(0.0) as usize,
+            task: w.task.name.clone(),
+            window_s,
+            late: report.arrival_s.is_none_or(|a| a > w.task.start_s),
+            share: if window_s > 0.0 {
+                driving_s / window_s
+            } else {
+                0.0
+            },
+            driven_information: track.information(&world.planning, &world.params),
+            ga_plans: w.log.ga_plans,
+        }
+    }
+}
+
+/// The fleet's map against the world, at one time.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MapSample {
+    pub t_s: f64,
+    /// The Brier score of P(occupied now) over the cells objects can cover, over the
+    /// sample of the others, and over both.
+    pub zones: f64,
+    pub others: f64,
+    pub all: f64,
+}
+
+impl MapSample {
+    /// The belief (per coarse cell) scored against the truth (occupied or not, per
+    /// coarse cell: [`FleetWorld::semi_static_truth`]) over the world's scored cells.
+    pub fn score(
+        world: &FleetWorld,
+        t_s: f64,
+        belief: &[f64],
+        truth: &[bool],
+    ) -> Result<MapSample, FleetError> {
+        let score = |cells: &[usize]| {
+            brier(belief, truth, cells.iter().copied())
+                .map_err(|e| FleetError::Mapper(e.to_string()))
+        };
+        let (zones, others) = world.scored.split_at(world.zone_cells);
+        Ok(MapSample {
+            t_s,
+            zones: score(zones)?,
+            others: score(others)?,
+            all: score(&world.scored)?,
+        })
+    }
+}
+
+/// Everything one variant's week recorded.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WeekRecord {
+    pub variant: FleetVariant,
+    pub robots: usize,
+    pub windows: Vec<WindowRecord>,
+    pub maps: Vec<MapSample>,
+    pub events: Vec<ChangeEvent>,
+    /// Each curious plan's computing time, seconds (wall, this machine).
+    pub plan_latencies_s: Vec<f64>,
+    /// Steps a robot's controller held it for its PEB, per robot.
+    pub halted_steps: Vec<u64>,
+    /// The sim time the week ended at, and the wall seconds it took.
+    pub end_s: f64,
+    pub wall_s: f64,
+}
+
+impl WeekRecord {
+    pub fn new(variant: FleetVariant, robots: usize) -> WeekRecord {
+        WeekRecord {
+            variant,
+            robots,
+            windows: Vec::new(),
+            maps: Vec::new(),
+            events: Vec::new(),
+            plan_latencies_s: Vec::new(),
+            halted_steps: vec![0; robots],
+            end_s: 0.0,
+            wall_s: 0.0,
+        }
+    }
+
+    /// Robot `robot`'s controller decided `decision` this step.
+    pub fn robot_step(&mut self, robot: usize, decision: Option<&Decision>) {
+        if decision.is_some_and(|d| d.status == MissionStatus::HaltedPeb) {
+            if let Some(h) = self.halted_steps.get_mut(robot) {
+                *h += 1;
+            }
+        }
+    }
+
+    pub fn finish(&mut self, changes: ChangeLog, end_s: f64, wall_s: f64) {
+        self.events = changes.events().to_vec();
+        self.end_s = end_s;
+        self.wall_s = wall_s;
+    }
+}

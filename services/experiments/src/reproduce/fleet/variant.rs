@@ -1,0 +1,180 @@
+//! What the fleet's week compares. Each variant is the executive's configuration
+//! ([`ExecutiveConfig`], what each robot's `roam mission` runs) and what the planner
+//! plans on (its information map: the static one, or the mapper's news coupled into
+//! it, `roam planner`'s `coupling: news`), so every row is something a fleet can run.
+//!
+//! - `tasks_only`: the fastest path to each task, then wait there: a fleet without
+//!   roam's curiosity (the executive's other rules kept: its margin, its recovery from a
+//!   PEB hold, its replans when blocked).
+//! - `patrol`: each idle robot on a fixed loop through every aisle, as far as its
+//!   window allows, back on time ([`super::patrol`]): what an operator would run.
+//! - `independent`: each robot curious on the static information (paper 000 Model I,
+//!   the PEB cost on), nothing shared: roam's single-robot executive, ten times.
+//! - `news`: roam for a fleet: the planner on interest × the probability of news, from
+//!   the fleet's shared map, with the cells on the other robots' plans counted as seen
+//!   at their times ([`roam_mapper::news`]).
+//! - `news_no_sharing`, `news_no_reservations`, `news_no_rates`: `news` with one part
+//!   off: each robot's news from its own observations only (and no reservations, which
+//!   need the others' plans); the others' plans not counted; the rates not learnt (a
+//!   prior so strong that no event moves it: news is then how long nobody looked).
+
+use roam_mapper::news::DEFAULT_NEWS_PRIOR;
+use roam_mapper::prior::RatePrior;
+use roam_mission::config::ExecutiveConfig;
+use serde::Serialize;
+
+/// One configuration of the fleet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FleetVariant {
+    TasksOnly,
+    Patrol,
+    Independent,
+    News,
+    NewsNoSharing,
+    NewsNoReservations,
+    NewsNoRates,
+}
+
+/// What curious plans are made on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Planning {
+    /// No curious plans: the fastest path.
+    Fastest,
+    /// The patrol loop.
+    Patrol,
+    /// The static information map.
+    Static,
+    /// Interest × P_news.
+    News {
+        shared: bool,
+        reservations: bool,
+        prior: RatePrior,
+    },
+}
+
+/// The prior that stands for "rates not learnt": the default's mean rate, a million
+/// times as sure.
+const RATES_OFF: RatePrior = RatePrior {
+    alpha: DEFAULT_NEWS_PRIOR.alpha * 1e6,
+    beta_s: DEFAULT_NEWS_PRIOR.beta_s * 1e6,
+};
+
+impl FleetVariant {
+    pub const ALL: [FleetVariant; 7] = [
+        FleetVariant::TasksOnly,
+        FleetVariant::Patrol,
+        FleetVariant::Independent,
+        FleetVariant::News,
+        FleetVariant::NewsNoSharing,
+        FleetVariant::NewsNoReservations,
+        FleetVariant::NewsNoRates,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            FleetVariant::TasksOnly => "tasks_only",
+            FleetVariant::Patrol => "patrol",
+            FleetVariant::Independent => "independent",
+            FleetVariant::News => "news",
+            FleetVariant::NewsNoSharing => "news_no_sharing",
+            FleetVariant::NewsNoReservations => "news_no_reservations",
+            FleetVariant::NewsNoRates => "news_no_rates",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<FleetVariant> {
+        FleetVariant::ALL.into_iter().find(|v| v.name() == name)
+    }
+
+    /// The executive's configuration: `base` (the robot, its week of tasks, the
+    /// generations, the seed) with this variant's rules; `w_loc` the PEB cost for the
+    /// curious variants.
+    pub fn config(self, base: ExecutiveConfig, w_loc: f64) -> ExecutiveConfig {
+        match self {
+            FleetVariant::TasksOnly => ExecutiveConfig {
+                model: roam_proto::planner::PlannerModel::Shortest,
+                w_loc: None,
+                ..base
+            },
+            FleetVariant::Patrol => ExecutiveConfig {
+                w_loc: None,
+                ..base
+            },
+            _ => ExecutiveConfig {
+                w_loc: Some(w_loc),
+                ..base
+            },
+        }
+    }
+
+    pub fn planning(self) -> Planning {
+        let news = |shared, reservations, prior| Planning::News {
+            shared,
+            reservations,
+            prior,
+        };
+        match self {
+            FleetVariant::TasksOnly => Planning::Fastest,
+            FleetVariant::Patrol => Planning::Patrol,
+            FleetVariant::Independent => Planning::Static,
+            FleetVariant::News => news(true, true, DEFAULT_NEWS_PRIOR),
+            FleetVariant::NewsNoSharing => news(false, false, DEFAULT_NEWS_PRIOR),
+            FleetVariant::NewsNoReservations => news(true, false, DEFAULT_NEWS_PRIOR),
+            FleetVariant::NewsNoRates => news(true, true, RATES_OFF),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roam_proto::planner::PlannerModel;
+
+    #[test]
+    fn names_round_trip_and_each_part_of_news_is_off_alone() {
+        for v in FleetVariant::ALL {
+            assert_eq!(FleetVariant::parse(v.name()), Some(v));
+            assert_eq!(v.config(ExecutiveConfig::default(), 2000.0).check(), Ok(()));
+        }
+        assert_eq!(
+            FleetVariant::TasksOnly
+                .config(ExecutiveConfig::default(), 2000.0)
+                .model,
+            PlannerModel::Shortest
+        );
+        let Planning::News {
+            shared,
+            reservations,
+            prior,
+        } = FleetVariant::News.planning()
+        else {
+            panic!("news plans on news");
+        };
+        assert!(shared && reservations && prior == DEFAULT_NEWS_PRIOR);
+        for (v, differs) in [
+            (FleetVariant::NewsNoReservations, "reservations"),
+            (FleetVariant::NewsNoRates, "prior"),
+        ] {
+            let Planning::News {
+                shared: s,
+                reservations: r,
+                prior: p,
+            } = v.planning()
+            else {
+                panic!("{differs}");
+            };
+            assert_eq!(
+                [s == shared, r == reservations, p == prior]
+                    .iter()
+                    .filter(|x| !**x)
+                    .count(),
+                1,
+                "{differs}"
+            );
+        }
+        // The strong prior's mean rate is the default's.
+        let mean = |p: RatePrior| p.alpha / p.beta_s;
+        assert!((mean(RATES_OFF) / mean(DEFAULT_NEWS_PRIOR) - 1.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,268 @@
+//! One variant's week: the warehouse's sim with every robot, one executive in process
+//! per robot ([`InProcessExecutive`], the executive's own window machine), the
+//! planner's own code for their plans, and the fleet's mapper fed every robot's
+//! observation every step; the shift repeated `days` times on one clock, so the
+//! world (its objects) and the fleet's map carry over from shift to shift.
+
+use std::time::Instant;
+
+use roam_controller::params::ApfParams;
+use roam_mission::calibration::TimeModel;
+use roam_mission::config::ExecutiveConfig;
+use roam_mission::information::InformationScale;
+use roam_planner::coupling::news_product;
+use roam_planner::params::GaParams;
+use roam_proto::controller::Mission;
+use roam_proto::planner::{Plan, PlanRequest, PlannerModel};
+use roam_world::seed::splitmix64;
+
+use crate::closed_loop::episode::{EpisodeError, PositionSource};
+use crate::closed_loop::stepper::Stepper;
+use crate::reproduce::executive::{InProcessExecutive, Io, Step};
+
+use super::events::ChangeLog;
+use super::mapper::FleetMapper;
+use super::measure::{MapSample, WeekRecord, WindowRecord};
+use super::variant::{FleetVariant, Planning};
+use super::world::FleetWorld;
+use super::{FleetError, FleetOptions};
+
+/// Sim seconds between two samples of the map error.
+pub const MAP_SAMPLE_S: f64 = 60.0;
+
+/// The sim's stream of a week (common to every variant).
+const SIM_STREAM: u64 = 0x46_4C_45_45_54_5F_53_49;
+
+/// A robot's plan seed (common to every variant).
+fn plan_seed(seed: u64, robot: usize) -> u64 {
+    splitmix64(seed ^ splitmix64(0x504C_414E ^ robot as u64))
+}
+
+/// The planner, the patrol and the mapper as one robot's executive asks them.
+struct FleetIo<'r, 'w> {
+    world: &'w FleetWorld,
+    planning: Planning,
+    stepper: &'r mut Stepper,
+    mapper: &'r mut FleetMapper,
+    robot: &'r str,
+    index: usize,
+    now_s: f64,
+    patrol_at: &'r mut usize,
+    latencies: &'r mut Vec<f64>,
+    /// The time model the robot plans with (for its reservations).
+    s_per_m: f64,
+    radius_m: f64,
+}
+
+impl Io for FleetIo<'_, '_> {
+    fn send(&mut self, mission: &Mission) -> Result<(), EpisodeError> {
+        if mission.recovery {
+            self.stepper
+                .set_recovery(self.robot, mission.waypoints.clone())?;
+            return Ok(());
+        }
+        self.stepper
+            .set_mission(self.robot, mission.waypoints.clone())?;
+        if let Planning::News {
+            reservations: true, ..
+        } = self.planning
+        {
+            // A failed reservation (a path off the map) leaves none: the news is then
+            // only less shared, never wrong.
+            let _ = self.mapper.reserve(
+                self.world,
+                self.robot,
+                &mission.waypoints,
+                self.now_s,
+                self.s_per_m,
+                self.radius_m,
+            );
+        }
+        Ok(())
+    }
+
+    fn answer(&mut self, request: &PlanRequest, now_s: f64) -> Option<Plan> {
+        let started = Instant::now();
+        let answer = self.plan(request, now_s);
+        if request.model != PlannerModel::Shortest {
+            self.latencies.push(started.elapsed().as_secs_f64());
+        }
+        answer
+    }
+}
+
+impl FleetIo<'_, '_> {
+    fn plan(&mut self, request: &PlanRequest, now_s: f64) -> Option<Plan> {
+        let world = &self.world.planning;
+        if request.model == PlannerModel::Shortest {
+            return roam_planner::answer::answer(world, request, 1).ok();
+        }
+        match self.planning {
+            Planning::Fastest | Planning::Static => {
+                roam_planner::answer::answer(world, request, 1).ok()
+            }
+            Planning::Patrol => self.patrol(request),
+            Planning::News { reservations, .. } => {
+                let news = self
+                    .mapper
+                    .news_scores(self.index, self.robot, now_s, reservations)
+                    .ok()?;
+                let mut coupled = world.clone();
+                coupled.information = news_product(&world.information, &news);
+                coupled.set_heuristic_compression(coupled.heuristic_compression);
+                roam_planner::answer::answer(&coupled, request, 1).ok()
+            }
+        }
+    }
+
+    /// The patrol's route as the plan's answer: the planner's own answer for the
+    /// shortest path (its fallback and its comparison), with the patrol as its route.
+    fn patrol(&mut self, request: &PlanRequest) -> Option<Plan> {
+        let world = &self.world.planning;
+        let shortest = PlanRequest {
+            model: PlannerModel::Shortest,
+            ..request.clone()
+        };
+        let mut plan = roam_planner::answer::answer(world, &shortest, 1).ok()?;
+        let params = GaParams::with_overrides(&request.params).ok()?;
+        let model = TimeModel {
+            v_lin: params.v_lin,
+            v_ang: params.v_ang,
+        };
+        let route = self.world.patrol.route(
+            world,
+            model,
+            request.start,
+            request.goal,
+            request.t_exec_s,
+            *self.patrol_at,
+        );
+        let Some(route) = route else {
+            return Some(plan);
+        };
+        *self.patrol_at = route.left_at;
+        plan.model = request.model;
+        plan.cells = route
+            .points
+            .iter()
+            .filter_map(|p| roam_world::grid::world_to_cell(&world.meta, p[0], p[1]))
+            .map(|(x, y)| [x as u32, y as u32])
+            .collect();
+        plan.points = route.points;
+        plan.t_eta_s = route.t_eta_s;
+        plan.reaches_goal = true;
+        plan.within_budget = true;
+        Some(plan)
+    }
+}
+
+/// Runs `variant`'s week.
+pub fn run_week(
+    world: &FleetWorld,
+    variant: FleetVariant,
+    options: &FleetOptions,
+) -> Result<WeekRecord, FleetError> {
+    let shift = &world.shift;
+    let robots = shift.robots.len();
+    let configs: Vec<ExecutiveConfig> = shift
+        .robots
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let base = ExecutiveConfig {
+                robot: r.robot.clone(),
+                tasks: shift.repeated(r, options.days),
+                max_generations: Some(options.generations),
+                seed: plan_seed(options.seed, i),
+                planning_cost_s: Some(options.plan_wall_s * options.rate),
+                ..ExecutiveConfig::default()
+            };
+            variant.config(base, options.w_loc)
+        })
+        .collect();
+    let scale = InformationScale {
+        world: &world.planning,
+        params: &world.params,
+    };
+    let mut executives = configs
+        .iter()
+        .map(|c| InProcessExecutive::new(c, scale, options.rate, options.plan_wall_s))
+        .collect::<Result<Vec<_>, _>>()?;
+    let planning = variant.planning();
+    let (own_maps, prior) = match planning {
+        Planning::News { shared, prior, .. } => (!shared, prior),
+        _ => (false, roam_mapper::news::DEFAULT_NEWS_PRIOR),
+    };
+    let mut mapper = FleetMapper::new(world, robots, own_maps, prior)?;
+    let mut stepper = Stepper::new(
+        &world.setup,
+        world.sim_params,
+        &ApfParams::indoor(),
+        PositionSource::Estimate,
+        splitmix64(options.seed ^ SIM_STREAM),
+    )?;
+    let names: Vec<String> = shift.robots.iter().map(|r| r.robot.clone()).collect();
+    let mut patrol_at = vec![0usize; robots];
+    let mut record = WeekRecord::new(variant, robots);
+    let mut changes = ChangeLog::default();
+    let end_s = options.days as f64 * shift.length_s;
+    let mut next_sample_s = MAP_SAMPLE_S;
+    let radius_m = world.sim_params.sensing.observation_radius_m;
+    let started = Instant::now();
+    while executives.iter().any(|e| !e.done()) && stepper.sim().time_s() < end_s {
+        let out = stepper.step()?;
+        let t = out.time_s;
+        changes.update(stepper.sim().world().objects(), t);
+        for r in &out.robots {
+            let Some(i) = names.iter().position(|n| *n == r.robot) else {
+                continue;
+            };
+            if let Some(o) = &r.messages.observation {
+                mapper.observe(world, i, o, t)?;
+                changes.observe(o, t);
+            }
+            record.robot_step(i, r.decision.as_ref());
+            let step = Step {
+                time_s: t,
+                truth: r.messages.truth.at,
+                estimate: r.estimate.clone(),
+                decision: r.decision,
+            };
+            let exec = &mut executives[i];
+            let s_per_m = exec.time_model().v_lin;
+            let mut io = FleetIo {
+                world,
+                planning,
+                stepper: &mut stepper,
+                mapper: &mut mapper,
+                robot: &names[i],
+                index: i,
+                now_s: t,
+                patrol_at: &mut patrol_at[i],
+                latencies: &mut record.plan_latencies_s,
+                s_per_m,
+                radius_m,
+            };
+            exec.on_step(&step, &mut io)?;
+            for finished in exec.take_finished() {
+                record
+                    .windows
+                    .push(WindowRecord::of(world, i, shift.length_s, finished));
+            }
+        }
+        if t >= next_sample_s {
+            next_sample_s += MAP_SAMPLE_S;
+            let belief = mapper.belief(world, t)?;
+            let truth = world.semi_static_truth(stepper.sim().world().objects());
+            record
+                .maps
+                .push(MapSample::score(world, t, &belief, &truth)?);
+        }
+    }
+    record.finish(
+        changes,
+        stepper.sim().time_s(),
+        started.elapsed().as_secs_f64(),
+    );
+    Ok(record)
+}

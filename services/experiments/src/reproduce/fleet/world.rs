@@ -1,0 +1,233 @@
+//! The warehouse as every service of the fleet sees it, built once and shared by every
+//! variant: the scenario at its 5 cm, the shift, the planner's grid at its own
+//! resolution (0.2 m, paper 000's) with localization's PEB field, and the mapper's grid,
+//! which is the planner's: the fleet's change map, its news and its map now are kept
+//! per planning cell, so that the planner reads them cell for cell.
+
+use std::path::Path;
+
+use roam_localization::field::{peb_field, GridRegion};
+use roam_localization::{FimOptions, RangingModel};
+use roam_mission::calibration::TimeModel;
+use roam_mission::shift::{Shift, WAREHOUSE_SCENARIO, WAREHOUSE_SHIFT};
+use roam_planner::params::GaParams;
+use roam_planner::world::World;
+use roam_proto::map::GridMeta;
+use roam_world::grid::Grid;
+use roam_world::layers::inflate;
+use roam_world::scenario::{self, Scenario};
+use roam_world::seed::splitmix64;
+use roam_world::DEFAULT_MAX_CELLS;
+
+use crate::closed_loop::episode::Setup;
+use crate::closed_loop::stepper::Stepper;
+
+use super::patrol::Patrol;
+use super::FleetError;
+
+/// The planner's (and the fleet mapper's) resolution, metres: paper 000's grid.
+pub const PLANNING_RESOLUTION_M: f64 = 0.2;
+
+/// The inflated map's occupied value (the map server's `inflated` layer).
+const INFLATED_COST: i8 = 65;
+
+/// Model II's heuristic compression (Table I).
+const HEURISTIC_COMPRESSION: f64 = 0.25;
+
+/// Cells scored for the map error beside the cells objects can cover: a seeded sample
+/// of the other free cells of this many.
+pub const OTHER_CELLS_SCORED: usize = 2000;
+
+/// What every variant of the fleet shares.
+#[derive(Debug, Clone)]
+pub struct FleetWorld {
+    pub setup: Setup,
+    /// The sim's parameters as the sim service runs them (observation on).
+    pub sim_params: roam_sim::SimParams,
+    pub shift: Shift,
+    /// The planner's grid at [`PLANNING_RESOLUTION_M`]: the inflated map, the static
+    /// information and the PEB field, as the planner service holds them.
+    pub planning: World,
+    pub params: GaParams,
+    /// The mapper's grid: the planning grid's cells.
+    pub coarse: GridMeta,
+    /// Map cells per planning cell along a side.
+    pub factor: u32,
+    /// The static map on the coarse grid (a cell occupied when any of its map cells
+    /// is): the map now's prior for cells never seen.
+    pub static_coarse: Grid<i8>,
+    /// The coarse cells the map error is scored on: every cell an object of a change
+    /// zone can cover, then a seeded sample of the others that are free.
+    pub scored: Vec<usize>,
+    /// How many of `scored` are cells objects can cover.
+    pub zone_cells: usize,
+    pub patrol: Patrol,
+    pub step_s: f64,
+}
+
+fn world_error(e: &dyn std::fmt::Display) -> FleetError {
+    FleetError::World(e.to_string())
+}
+
+impl FleetWorld {
+    /// The built-in warehouse and its shift.
+    pub fn warehouse() -> Result<FleetWorld, FleetError> {
+        FleetWorld::new(WAREHOUSE_SCENARIO, WAREHOUSE_SHIFT)
+    }
+
+    /// A fleet's world from a scenario's and a shift's text.
+    pub fn new(scenario_text: &str, shift_text: &str) -> Result<FleetWorld, FleetError> {
+        let scenario: Scenario = scenario::parse(
+            Path::new("warehouse.yaml"),
+            scenario_text,
+            DEFAULT_MAX_CELLS,
+        )
+        .map_err(|e| world_error(&e))?;
+        let shift = Shift::parse(shift_text, &scenario.file.places, &scenario.file.robots)
+            .map_err(|e| world_error(&e))?;
+        let meta = scenario.occupancy.meta;
+        let inflated = inflate(
+            &scenario.occupancy,
+            scenario.file.robot_radius_m.unwrap_or(0.2),
+            INFLATED_COST,
+        );
+        let mut planning = World::at_resolution(
+            &inflated,
+            &scenario.information,
+            HEURISTIC_COMPRESSION,
+            PLANNING_RESOLUTION_M,
+        )
+        .map_err(|e| world_error(&e))?;
+        let anchors: Vec<[f64; 2]> = scenario.file.anchors.iter().map(|a| a.at).collect();
+        let model = RangingModel::from_spec(&anchors, &scenario.file.sensing)
+            .map_err(|e| world_error(&e))?;
+        let region = GridRegion {
+            origin: [meta.origin.x, meta.origin.y],
+            resolution_m: meta.resolution,
+            width: meta.width as usize,
+            height: meta.height as usize,
+        };
+        let field =
+            peb_field(&model, &region, &FimOptions::default()).map_err(|e| world_error(&e))?;
+        planning.set_localizability(&field.peb);
+        shift
+            .check_on(&planning, TimeModel::table_i())
+            .map_err(|e| world_error(&e))?;
+        let coarse = planning.meta;
+        let factor = (coarse.resolution / meta.resolution).round() as u32;
+        let static_coarse = coarsen(&scenario.occupancy, coarse, factor);
+        let setup = Setup::new(&scenario).map_err(|e| world_error(&e))?;
+        let sim_params = Stepper::observing(&setup);
+        let (scored, zone_cells) = scored_cells(&scenario, &static_coarse);
+        let patrol = Patrol::through_aisles(&planning)?;
+        Ok(FleetWorld {
+            step_s: scenario.file.time.step_s,
+            setup,
+            sim_params,
+            shift,
+            planning,
+            params: GaParams::default(),
+            coarse,
+            factor,
+            static_coarse,
+            scored,
+            zone_cells,
+            patrol,
+        })
+    }
+
+    /// What a map of the world now should hold, per coarse cell: the static map and
+    /// every object that has landed (occupied when any of its map cells is). Carts and
+    /// people are left out: they are gone before a map could send a robot around
+    /// them, and no map predicts where a walker steps next.
+    pub fn semi_static_truth(&self, objects: &[roam_sim::semi_static::SemiStatic]) -> Vec<bool> {
+        let mut truth: Vec<bool> = self.static_coarse.cells.iter().map(|&v| v >= 50).collect();
+        for o in objects.iter().filter(|o| o.landed_step.is_some()) {
+            for (x, y) in o.footprint.cells(o.centre) {
+                if let Some(i) = self.coarse_index(x, y) {
+                    truth[i] = true;
+                }
+            }
+        }
+        truth
+    }
+
+    /// The coarse cell index of map cell (x, y).
+    pub fn coarse_index(&self, x: i64, y: i64) -> Option<usize> {
+        let f = i64::from(self.factor);
+        let (cx, cy) = (x.div_euclid(f), y.div_euclid(f));
+        (cx >= 0
+            && cy >= 0
+            && cx < i64::from(self.coarse.width)
+            && cy < i64::from(self.coarse.height))
+        .then(|| (cy * i64::from(self.coarse.width) + cx) as usize)
+    }
+}
+
+/// `fine` on the coarse grid `coarse` (`factor` map cells a side): a coarse cell is
+/// occupied when any of its map cells is, unknown when all are, free otherwise.
+pub fn coarsen(fine: &Grid<i8>, coarse: GridMeta, factor: u32) -> Grid<i8> {
+    let (cw, ch) = (coarse.width as usize, coarse.height as usize);
+    let mut cells = vec![-1i8; cw * ch];
+    let (fw, f) = (fine.meta.width as usize, factor as usize);
+    for (i, &v) in fine.cells.iter().enumerate() {
+        let (x, y) = (i % fw, i / fw);
+        let c = (y / f) * cw + x / f;
+        if let Some(slot) = cells.get_mut(c) {
+            if v >= 50 {
+                *slot = 100;
+            } else if v >= 0 && *slot < 0 {
+                *slot = 0;
+            }
+        }
+    }
+    Grid {
+        meta: coarse,
+        cells,
+    }
+}
+
+/// The cells the map error is scored on (module doc of [`FleetWorld::scored`]).
+fn scored_cells(scenario: &Scenario, static_coarse: &Grid<i8>) -> (Vec<usize>, usize) {
+    let meta = static_coarse.meta;
+    let (w, h) = (meta.width as usize, meta.height as usize);
+    let mut in_zone = vec![false; w * h];
+    for z in &scenario.file.changes {
+        // Every cell a footprint centred in the rect covers.
+        let [x0, y0, x1, y1] = z.rect;
+        let [sx, sy] = z.size_m;
+        let to = |v: f64, o: f64| ((v - o) / meta.resolution).floor() as i64;
+        let (cx0, cy0) = (
+            to(x0 - sx / 2.0, meta.origin.x),
+            to(y0 - sy / 2.0, meta.origin.y),
+        );
+        let (cx1, cy1) = (
+            to(x1 + sx / 2.0, meta.origin.x),
+            to(y1 + sy / 2.0, meta.origin.y),
+        );
+        for y in cy0.max(0)..=cy1.min(h as i64 - 1) {
+            for x in cx0.max(0)..=cx1.min(w as i64 - 1) {
+                let i = y as usize * w + x as usize;
+                in_zone[i] = static_coarse.cells[i] == 0;
+            }
+        }
+    }
+    let mut scored: Vec<usize> = (0..w * h).filter(|&i| in_zone[i]).collect();
+    let zone_cells = scored.len();
+    let others: Vec<usize> = (0..w * h)
+        .filter(|&i| !in_zone[i] && static_coarse.cells[i] == 0)
+        .collect();
+    // A seeded, even spread over the other free cells.
+    let mut state = 0x5C0_12ED;
+    let mut picked = vec![false; others.len()];
+    let want = OTHER_CELLS_SCORED.min(others.len());
+    while scored.len() < zone_cells + want {
+        state = splitmix64(state);
+        let k = (state % others.len() as u64) as usize;
+        if !picked[k] {
+            picked[k] = true;
+            scored.push(others[k]);
+        }
+    }
+    (scored, zone_cells)
+}

@@ -1,0 +1,76 @@
+//! `roam reproduce fleet`: the fleet's week in the warehouse, its table or JSON on stdout,
+//! its progress and runtime on stderr.
+
+use roam_experiments::reproduce::fleet::{self, FleetOptions, FleetVariant};
+
+#[derive(Debug, clap::Args)]
+pub(crate) struct FleetArgs {
+    /// Print the report as JSON: the variants' figures, the goals with verdicts, and
+    /// every variant's windows, map samples and change events.
+    #[arg(long)]
+    json: bool,
+    /// Shifts in a row (a week: 7).
+    #[arg(long, default_value_t = 7)]
+    days: usize,
+    /// The variants to run, comma-separated (default all: tasks_only, patrol,
+    /// independent, news, news_no_sharing, news_no_reservations, news_no_rates).
+    #[arg(long, value_delimiter = ',')]
+    variants: Vec<String>,
+    /// Threads the variants run on (default: the machine's cores; the report does not
+    /// depend on it, but for the plans' computing times).
+    #[arg(long)]
+    jobs: Option<usize>,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// GA generations per curious plan.
+    #[arg(long, default_value_t = FleetOptions::default().generations)]
+    generations: u32,
+}
+
+pub(crate) async fn run(args: FleetArgs) -> anyhow::Result<()> {
+    let mut options = FleetOptions {
+        days: args.days,
+        seed: args.seed,
+        generations: args.generations,
+        ..FleetOptions::default()
+    };
+    if !args.variants.is_empty() {
+        options.variants = args
+            .variants
+            .iter()
+            .map(|name| {
+                FleetVariant::parse(name).ok_or_else(|| {
+                    let all: Vec<&str> = FleetVariant::ALL.iter().map(|v| v.name()).collect();
+                    anyhow::anyhow!("no variant {name:?}; give some of {}", all.join(","))
+                })
+            })
+            .collect::<anyhow::Result<_>>()?;
+    }
+    if let Some(jobs) = args.jobs {
+        options.jobs = jobs;
+    }
+    let started = std::time::Instant::now();
+    let run = options.clone();
+    let report = tokio::task::spawn_blocking(move || {
+        fleet::run(&run, &|done, total| {
+            eprintln!(
+                "the fleet's week: {done}/{total} variants ({:.0} s)",
+                started.elapsed().as_secs_f64()
+            );
+        })
+    })
+    .await??;
+    eprintln!(
+        "{} shifts x {} variants in {:.1} s ({} threads)",
+        options.days,
+        report.variants.len(),
+        started.elapsed().as_secs_f64(),
+        options.jobs
+    );
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print!("{}", report.table());
+    }
+    Ok(())
+}
