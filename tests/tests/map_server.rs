@@ -370,42 +370,76 @@ async fn loads_read_only_the_load_directories_and_name_what_is_wrong() {
         base_version,
     };
 
+    // No reply names where the server keeps its directories.
+    let server_paths = [
+        dir.path().display().to_string(),
+        dir.path().canonicalize().expect("c").display().to_string(),
+        std::path::Path::new(maps)
+            .canonicalize()
+            .expect("c")
+            .display()
+            .to_string(),
+    ];
+    let tells_nothing = |reply: &ErrorReply| {
+        for path in &server_paths {
+            assert!(
+                !reply.message.contains(path.as_str()),
+                "the reply names the server's {path}: {}",
+                reply.message
+            );
+        }
+    };
+
     let missing =
         refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("missing.yaml", None))))
             .await;
     assert_eq!(missing.code, ErrorCode::NotFound);
     assert!(
-        missing.message.contains("missing.yaml") && missing.message.contains("load directories"),
+        missing.message.contains("'missing.yaml'")
+            && missing
+                .message
+                .contains("outside the configured load directories"),
         "{}",
         missing.message
     );
-    // Outside the directories: the same answer as a missing file, naming the directories.
+    tells_nothing(&missing);
+    // Outside the directories: the same answer as a missing file, naming the file as
+    // the peer gave it.
     let passwd =
         refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("/etc/passwd", None)))).await;
     assert_eq!(passwd.code, ErrorCode::NotFound);
     assert!(!passwd.message.contains("root:"), "{}", passwd.message);
-    assert!(
-        passwd
-            .message
-            .contains(&dir.path().canonicalize().expect("c").display().to_string()),
-        "{}",
-        passwd.message
+    assert_eq!(
+        passwd.message.replace("/etc/passwd", "missing.yaml"),
+        missing.message
     );
+    tells_nothing(&passwd);
 
-    // A map whose image is truncated.
+    // A map whose image is truncated: named relative to its load directory.
     std::fs::write(dir.path().join("bad.pgm"), b"P5\n10 10\n255\n\x00\x00").expect("pgm");
     std::fs::write(dir.path().join("bad.yaml"), "image: bad.pgm\nresolution: 0.05\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.196\n").expect("yaml");
     let corrupt =
         refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("bad.yaml", None)))).await;
     assert_eq!(corrupt.code, ErrorCode::CorruptFile);
-    assert!(corrupt.message.contains("bad.pgm"), "{}", corrupt.message);
+    assert!(
+        corrupt.message.contains("map image bad.pgm"),
+        "{}",
+        corrupt.message
+    );
+    tells_nothing(&corrupt);
 
     // A map inside the directories whose image is outside them is refused like a
-    // missing file.
+    // missing file, without naming what it refers to.
     std::fs::write(dir.path().join("escape.yaml"), "image: /etc/passwd\nresolution: 0.05\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.196\n").expect("yaml");
     let escape =
         refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("escape.yaml", None)))).await;
     assert_eq!(escape.code, ErrorCode::NotFound, "{}", escape.message);
+    assert!(
+        escape.message.contains("'escape.yaml'") && !escape.message.contains("/etc/passwd"),
+        "{}",
+        escape.message
+    );
+    tells_nothing(&escape);
 
     // A good map loads, bumps the versions and is served.
     let list: LayerList = within(

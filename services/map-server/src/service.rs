@@ -390,9 +390,11 @@ async fn answer_load(state: Arc<MapServerShared>, query: &Query) {
             reply::send(query, &list).await;
             state.publish(&changed).await;
         }
-        Ok(Err(error)) => {
-            roam_runtime::limited_warn!(state.warnings, "load", %error, "refused a map load");
-            reply::send_error(query, &error).await
+        Ok(Err(refused)) => {
+            // The log keeps the server's paths; the peer's reply does not.
+            let detail = &refused.detail;
+            roam_runtime::limited_warn!(state.warnings, "load", %detail, "refused a map load");
+            reply::send_error(query, &refused.reply).await
         }
         Err(e) => {
             reply::send_error(
@@ -404,13 +406,33 @@ async fn answer_load(state: Arc<MapServerShared>, query: &Query) {
     }
 }
 
+/// A refused load: the reply for the peer, and the detail for the server's log.
+struct LoadRefusal {
+    reply: ErrorReply,
+    detail: String,
+}
+
+impl From<ErrorReply> for LoadRefusal {
+    fn from(reply: ErrorReply) -> Self {
+        LoadRefusal {
+            detail: reply.to_string(),
+            reply,
+        }
+    }
+}
+
 fn load(
     state: &MapServerShared,
     request: &LoadMap,
-) -> Result<(LayerList, Vec<String>), ErrorReply> {
+) -> Result<(LayerList, Vec<String>), LoadRefusal> {
     let max_cells = state.store().limits().max_layer_cells;
-    let content = map_file::read_requested(&request.path, &state.load_dirs, max_cells)
-        .map_err(|e| e.to_reply())?;
+    let content =
+        map_file::read_requested(&request.path, &state.load_dirs, max_cells).map_err(|e| {
+            LoadRefusal {
+                reply: e.to_reply(&request.path, &state.load_dirs),
+                detail: e.to_string(),
+            }
+        })?;
     let mut store = state.store();
     if let (None, Some(r)) = (state.robot_radius_override, content.robot_radius_m) {
         store.set_robot_radius(r);

@@ -3,8 +3,9 @@
 //! hold asserted:
 //!
 //! - loads read no file outside the load directories, answer a forbidden file as a
-//!   missing one (no existence oracle) and never quote a file, in a reply or a log
-//!   ([`files`]);
+//!   missing one (no existence oracle), name the file as the peer gave it and none of
+//!   the server's paths (the log keeps them), and never quote a file, in a reply or a
+//!   log ([`files`]);
 //! - keys decide: a body naming another robot is refused, nothing is published on a key
 //!   a body chose, a forged mission or scan moves nothing ([`routing`]);
 //! - echoes are bounded and escaped: replies to megabyte fields stay under
@@ -42,7 +43,7 @@ async fn attacks_on_a_running_stack_find_nothing() {
     let from = log.len();
     files::map_loads(&harness, &client, &files).await;
     files::sim_loads(&harness, &client, &files).await;
-    files::check_log(&log, from);
+    files::check_log(&log, from, &files);
 
     routing::keys_decide(&harness, &client).await;
 
