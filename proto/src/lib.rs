@@ -22,4 +22,4 @@ pub mod sim;
 
 pub use codec::{decode, encode, DecodeError, Message, PROTOCOL_VERSION};
 pub use error::{ErrorCode, ErrorReply, LimitHit};
-pub use excerpt::{excerpt, Excerpt};
+pub use excerpt::{excerpt, number, Excerpt, Number};

@@ -21,7 +21,8 @@
 //! - [`learner`]: strategies, modes, the tile coder, V_S, its update and the softmax.
 //! - [`goals`]: goal sampling from the patch-averaged weights.
 //! - [`wavefront`]: the wavefront planner with hill climbing and "as close as possible".
-//! - [`epoch`]: observation times against the sim clock; sim resets as epochs.
+//! - observation times are checked against the sim clock by `roam_world::epoch`, shared
+//!   with localization.
 //! - [`explorer`]: the per-robot loop: episodes, navigation, local exploration, reward.
 //! - [`seed`]: the seeded ChaCha8 streams every random choice draws from.
 //! - [`error`]: [`MapperError`], naming the limit when a size is refused.
@@ -119,7 +120,6 @@
 //! mean, 530 µs p99), 400 × real time; the plain sum the cache replaces takes 10 ms.
 
 pub mod change_map;
-pub mod epoch;
 pub mod error;
 pub mod explorer;
 pub mod features;

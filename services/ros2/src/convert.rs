@@ -180,7 +180,8 @@ pub fn grid_to_occupancy(
     let resolution = f64::from(info.resolution);
     if !(resolution.is_finite() && resolution > 0.0) {
         return Err(ConvertError::Invalid(format!(
-            "the map's resolution must be a positive number of metres, got {resolution}"
+            "the map's resolution must be a positive number of metres, got {}",
+            roam_proto::number(resolution)
         )));
     }
     let p = info.origin.position;

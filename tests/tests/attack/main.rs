@@ -49,6 +49,7 @@ async fn attacks_on_a_running_stack_find_nothing() {
 
     echo::replies(&harness, &client).await;
     echo::logs(&harness, &client, &log).await;
+    echo::numbers(&harness, &client, &log).await;
 
     planner_flood::second_client(&harness).await;
 

@@ -396,7 +396,7 @@ fn check_meta(meta: &GridMeta) -> Result<(), StoreError> {
     if !(meta.resolution.is_finite() && meta.resolution > 0.0) {
         return Err(StoreError::Invalid(format!(
             "resolution must be a positive number of metres per cell, got {}",
-            meta.resolution
+            roam_proto::number(meta.resolution)
         )));
     }
     if !(o.x.is_finite() && o.y.is_finite() && o.yaw.is_finite()) {
