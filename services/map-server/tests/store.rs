@@ -255,3 +255,88 @@ fn persisted_layers_restore_with_their_versions() {
         Some(100.0)
     );
 }
+
+fn replace_f32(base_version: u64, w: u32, h: u32) -> LayerUpdate {
+    LayerUpdate {
+        base_version,
+        change: LayerChange::Replace {
+            meta: meta(w, h),
+            cells: Cells::F32(vec![0.0; (w * h) as usize]),
+        },
+        world: None,
+    }
+}
+
+/// The cells of all layers together stay within `max_total_cell_bytes`: a replace or a
+/// load that would hold more is refused, naming the limit, before anything changes; a
+/// replace of a layer counts its old cells as freed, and deleting frees them.
+#[test]
+fn the_cells_of_all_layers_together_are_bounded() {
+    // The 20 x 10 map: occupancy, inflated, information (200 bytes each) and a 4 x 2
+    // heuristic of f32 (32 bytes).
+    let base = 3 * 200 + 32;
+    let limits = Limits {
+        max_total_cell_bytes: base + 800,
+        ..DEFAULT_LIMITS
+    };
+    let mut store = store_with_map(limits);
+    assert_eq!(store.held_cell_bytes(), base);
+    store
+        .apply("a", &replace_f32(0, 10, 10))
+        .expect("400 bytes fit");
+    store
+        .apply("b", &replace_f32(0, 10, 10))
+        .expect("800 bytes fit");
+    assert_eq!(store.held_cell_bytes(), base + 800);
+    let refused = store
+        .apply("c", &replace_f32(0, 1, 1))
+        .expect_err("over the budget")
+        .to_reply();
+    assert_eq!(refused.code, ErrorCode::LimitExceeded);
+    let hit = refused.limit.expect("limit");
+    assert_eq!(
+        (hit.name.as_str(), hit.max, hit.actual),
+        ("max_total_cell_bytes", base + 800, base + 804)
+    );
+    assert!(
+        refused.message.contains("max_total_cell_bytes"),
+        "{}",
+        refused.message
+    );
+    assert!(store.get("c").is_none());
+    // Replacing a layer with one of the same size holds no more.
+    store
+        .apply("b", &replace_f32(1, 10, 10))
+        .expect("same size");
+    // A larger map is refused whole: occupancy stays as it was.
+    let refused = store
+        .load_map(Grid::filled(meta(40, 40), occupancy::FREE), None, None)
+        .expect_err("a larger map");
+    assert_eq!(
+        refused.to_reply().limit.map(|l| l.name),
+        Some("max_total_cell_bytes".to_owned())
+    );
+    assert_eq!(store.version(OCCUPANCY), 1);
+    // Deleting frees the room.
+    store.delete("a", 1).expect("delete");
+    store.apply("c", &replace_f32(0, 1, 1)).expect("fits again");
+}
+
+/// What the budget foresees for a load is what the load then holds (the derived layers
+/// included): a budget of exactly that admits it, one byte less does not.
+#[test]
+fn the_budget_foresees_a_load_exactly() {
+    let mut store = store_with_map(DEFAULT_LIMITS);
+    store
+        .load_map(Grid::filled(meta(40, 40), occupancy::FREE), None, None)
+        .expect("load");
+    let exact = store.held_cell_bytes();
+    for (max, fits) in [(exact, true), (exact - 1, false)] {
+        let mut store = store_with_map(Limits {
+            max_total_cell_bytes: max,
+            ..DEFAULT_LIMITS
+        });
+        let outcome = store.load_map(Grid::filled(meta(40, 40), occupancy::FREE), None, Some(1));
+        assert_eq!(outcome.is_ok(), fits, "max {max}: {outcome:?}");
+    }
+}

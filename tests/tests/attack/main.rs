@@ -6,6 +6,8 @@
 //!   missing one (no existence oracle), name the file as the peer gave it and none of
 //!   the server's paths (the log keeps them), and never quote a file, in a reply or a
 //!   log ([`files`]);
+//! - a stranger creating layers is refused once they would hold more than the map
+//!   server's `max_total_cell_bytes`, naming it ([`map_memory`]);
 //! - keys decide: a body naming another robot is refused, nothing is published on a key
 //!   a body chose, a forged mission or scan moves nothing ([`routing`]);
 //! - echoes are bounded and escaped: replies to megabyte fields stay under
@@ -27,6 +29,7 @@
 mod echo;
 mod files;
 mod logs;
+mod map_memory;
 mod planner_flood;
 mod routing;
 mod view;
@@ -44,6 +47,8 @@ async fn attacks_on_a_running_stack_find_nothing() {
     files::map_loads(&harness, &client, &files).await;
     files::sim_loads(&harness, &client, &files).await;
     files::check_log(&log, from, &files);
+
+    map_memory::layers_within_the_budget(&harness, &client).await;
 
     routing::keys_decide(&harness, &client).await;
 

@@ -16,6 +16,7 @@
 //! would lose. The layers of one change are installed together: a reader sees either
 //! all of them or none.
 
+mod budget;
 mod commit;
 mod error;
 mod limits;
@@ -25,6 +26,7 @@ mod stage;
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::Arc;
 
+use roam_proto::cells::Dtype;
 use roam_proto::keys;
 use roam_proto::map::{
     GridMeta, Layer, LayerChange, LayerDeleted, LayerInfo, LayerList, LayerUpdate, UpdateAck,
@@ -32,7 +34,7 @@ use roam_proto::map::{
 };
 
 pub use error::StoreError;
-pub use limits::{DerivedParams, Limits, DEFAULT_LIMITS};
+pub use limits::{DerivedParams, Limits, DEFAULT_LIMITS, DEFAULT_MAX_TOTAL_CELL_BYTES};
 
 use crate::derived::Derivation;
 use crate::edits::CellEdits;
@@ -179,6 +181,13 @@ impl LayerStore {
             self.check_base(OCCUPANCY, base, "load", "load the map again")?;
         }
         self.check_size(&occupancy_grid.meta)?;
+        let sizes = self.sizes_after(
+            OCCUPANCY,
+            &occupancy_grid.meta,
+            Dtype::I8,
+            information.is_some(),
+        );
+        self.check_budget(OCCUPANCY, &sizes)?;
         let mut pending = Pending::default();
         let info_cells = information.map(|g| roam_proto::cells::Cells::U8(g.cells));
         self.stage_source(
@@ -241,6 +250,7 @@ impl LayerStore {
                         "layers held (delete one with <root>/map/delete/<name>)".into(),
                     ));
                 }
+                self.check_budget(name, &self.sizes_after(name, meta, cells.dtype(), false))?;
                 if name == INFORMATION {
                     self.stage_information(&mut pending, *meta, cells.clone())?;
                 } else {

@@ -158,6 +158,13 @@ impl LayerStore {
             }
         }
         self.commit(pending)?;
+        let held = self.held_cell_bytes();
+        if held > self.limits.max_total_cell_bytes {
+            self.warn(format!(
+                "the restored layers hold {held} bytes of cells, over the limit max_total_cell_bytes = {}: they are all served, but a replace or a load that adds to them is refused until layers are deleted",
+                self.limits.max_total_cell_bytes
+            ));
+        }
         Ok(restored)
     }
 
