@@ -13,6 +13,7 @@ pub mod controller;
 pub mod error;
 pub mod excerpt;
 pub mod keys;
+pub mod layer_delta;
 pub mod localization;
 pub mod map;
 pub mod mapper;

@@ -7,6 +7,7 @@ use std::time::Duration;
 use roam_map_server::store::{Limits, DEFAULT_LIMITS};
 use roam_map_server::MapServerConfig;
 use roam_proto::cells::Cells;
+use roam_proto::layer_delta::LayerDelta;
 use roam_proto::map::{
     CellWrite, DeleteLayer, Layer, LayerChange, LayerDeleted, LayerList, LayerUpdate, LoadMap,
     UpdateAck,
@@ -104,19 +105,23 @@ async fn a_client_gets_every_layer_of_the_builtin_world() {
     harness.close().await;
 }
 
+/// A one-cell update is published as a delta of each changed layer (the cell written,
+/// and the cells `inflated` gains), which turns a follower's copy at the base version
+/// into the server's new version; nothing of the whole layer is published.
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
-async fn an_update_is_published_and_a_stale_one_refused() {
+async fn an_update_is_published_as_a_delta_and_a_stale_one_refused() {
     let harness = Harness::start().await;
     let server = harness.start_role(harness.map_server_config()).await;
     let client = harness.client().await;
-    let subscriber = within(
-        "subscribe",
-        client
-            .session()
-            .declare_subscriber(keys::map_layer(&harness.root, "inflated")),
-    )
-    .await
-    .expect("subscriber");
+    let subscribe = |key: String| within("subscribe", client.session().declare_subscriber(key));
+    let deltas = subscribe(keys::map_delta_any(&harness.root))
+        .await
+        .expect("subscriber");
+    let wholes = subscribe(keys::map_layer_any(&harness.root))
+        .await
+        .expect("subscriber");
+    let mut inflated = get_layer(&client, &harness.root, "inflated").await;
+    let mut occupancy = get_layer(&client, &harness.root, "occupancy").await;
 
     let update_key = keys::map_update(&harness.root, "occupancy");
     let ack: UpdateAck = within(
@@ -134,20 +139,43 @@ async fn an_update_is_published_and_a_stale_one_refused() {
         [("inflated", 2)]
     );
 
-    // The derived layer's publication arrives with the new version.
-    let published = loop {
-        let sample = within("publication", subscriber.recv_async())
-            .await
-            .expect("sample");
-        let layer: Layer = roam_proto::decode(&sample.payload().to_bytes()).expect("layer");
-        if layer.version == 2 {
-            break layer;
-        }
-    };
+    // Both deltas arrive, each from version 1 to 2, and apply to the copies held.
+    for _ in 0..2 {
+        let sample = within("delta", deltas.recv_async()).await.expect("sample");
+        let delta: LayerDelta = roam_proto::decode(&sample.payload().to_bytes()).expect("delta");
+        assert_eq!(
+            sample.key_expr().as_str(),
+            keys::map_delta(&harness.root, &delta.name)
+        );
+        assert_eq!((delta.base_version, delta.version), (1, 2));
+        assert!(
+            sample.payload().len() < 4096,
+            "{} bytes",
+            sample.payload().len()
+        );
+        let held = match delta.name.as_str() {
+            "occupancy" => &mut occupancy,
+            "inflated" => &mut inflated,
+            other => panic!("a delta of {other}"),
+        };
+        delta.apply(held).expect("applies to version 1");
+    }
     assert_eq!(
-        published.cells.get_f64(50 * 100 + 51),
+        inflated.cells.get_f64(50 * 100 + 51),
         Some(100.0),
         "inflated next to the new obstacle"
+    );
+    assert_eq!(
+        inflated,
+        get_layer(&client, &harness.root, "inflated").await
+    );
+    assert_eq!(
+        occupancy,
+        get_layer(&client, &harness.root, "occupancy").await
+    );
+    assert!(
+        wholes.try_recv().ok().flatten().is_none(),
+        "no whole layer is published for a one-cell update"
     );
 
     let occupancy = get_layer(&client, &harness.root, "occupancy").await;

@@ -2,10 +2,11 @@
 
 use roam_map_server::persist::DataDir;
 use roam_map_server::store::{
-    DerivedParams, LayerStore, Limits, StoreError, DEFAULT_LIMITS, HEURISTIC, INFLATED,
-    INFORMATION, OCCUPANCY,
+    DerivedParams, LayerStore, Limits, Publication, StoreError, DEFAULT_LIMITS, HEURISTIC,
+    INFLATED, INFORMATION, OCCUPANCY,
 };
 use roam_proto::cells::Cells;
+use roam_proto::layer_delta::CellPositions;
 use roam_proto::map::{CellWrite, GridMeta, LayerChange, LayerUpdate, Origin};
 use roam_proto::ErrorCode;
 use roam_world::grid::{occupancy, Grid};
@@ -66,7 +67,7 @@ fn an_update_bumps_the_layer_and_its_derived_layer() {
             .collect::<Vec<_>>(),
         vec![INFLATED]
     );
-    assert!(changed.contains(&INFLATED.to_owned()));
+    assert!(changed.iter().any(|p| p.name() == INFLATED));
     let inflated = store.get(INFLATED).expect("inflated");
     assert_eq!(inflated.version, 2);
     // Robot radius 0.2 m = 2 cells: (7, 5) is inflated, (8, 5) is not.
@@ -265,6 +266,42 @@ fn replace_f32(base_version: u64, w: u32, h: u32) -> LayerUpdate {
         },
         world: None,
     }
+}
+
+/// A one-cell update is published as the cell (a delta from the version it was based
+/// on), which turns a follower's copy into the store's; a change of many cells goes
+/// out whole.
+#[test]
+fn a_small_update_is_published_as_a_delta_and_a_large_one_whole() {
+    let mut store = store_with_map(DEFAULT_LIMITS);
+    store.apply("peb", &replace_f32(0, 64, 64)).expect("create");
+    let mut follower = store.get("peb").expect("peb").clone();
+
+    let (_, published) = store
+        .apply("peb", &set(1, &[(3, 4, 0.5)]))
+        .expect("one cell");
+    let [Publication::Delta(delta)] = published.as_slice() else {
+        panic!("one delta expected, got {published:?}");
+    };
+    assert_eq!((delta.base_version, delta.version), (1, 2));
+    assert_eq!(delta.positions, CellPositions(vec![(3, 4)]));
+    assert_eq!(delta.values, Cells::F32(vec![0.5]));
+    delta.apply(&mut follower).expect("applies");
+    assert_eq!(Some(&follower), store.get("peb"));
+
+    let many: Vec<(u32, u32, f64)> = (0..1000).map(|i| (i % 64, i / 64, 1.0)).collect();
+    let (_, published) = store.apply("peb", &set(2, &many)).expect("many cells");
+    assert_eq!(published, vec![Publication::Whole("peb".into())]);
+
+    // Occupancy's delta, and its derived layer's (whole or delta), both at the new version.
+    let (ack, published) = store
+        .apply(OCCUPANCY, &set(1, &[(5, 5, 100.0)]))
+        .expect("occupancy");
+    assert_eq!(ack.version, 2);
+    assert!(
+        matches!(&published[0], Publication::Delta(d) if d.name == OCCUPANCY && d.version == 2)
+    );
+    assert!(published.iter().any(|p| p.name() == INFLATED));
 }
 
 /// The cells of all layers together stay within `max_total_cell_bytes`: a replace or a

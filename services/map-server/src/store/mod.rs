@@ -20,6 +20,7 @@ mod budget;
 mod commit;
 mod error;
 mod limits;
+mod publication;
 pub mod restore;
 mod stage;
 
@@ -35,6 +36,7 @@ use roam_proto::map::{
 
 pub use error::StoreError;
 pub use limits::{DerivedParams, Limits, DEFAULT_LIMITS, DEFAULT_MAX_TOTAL_CELL_BYTES};
+pub use publication::{Publication, DELTA_MAX_SHARE};
 
 use crate::derived::Derivation;
 use crate::edits::CellEdits;
@@ -197,15 +199,16 @@ impl LayerStore {
             roam_proto::cells::Cells::I8(occupancy_grid.cells),
             info_cells,
         )?;
-        self.commit(pending)
+        Ok(names(&self.commit(pending)?))
     }
 
-    /// Applies one update to layer `name`.
+    /// Applies one update to layer `name`. Returns the acknowledgement and how each
+    /// changed layer is published (a `set_cells` change as a delta when small).
     pub fn apply(
         &mut self,
         name: &str,
         update: &LayerUpdate,
-    ) -> Result<(UpdateAck, Vec<String>), StoreError> {
+    ) -> Result<(UpdateAck, Vec<Publication>), StoreError> {
         keys::check_name("layer name", name).map_err(|e| StoreError::Invalid(e.to_string()))?;
         if let (Some(theirs), Some(mine)) = (&update.world, &self.world) {
             if theirs.hash != mine.hash {
@@ -280,7 +283,8 @@ impl LayerStore {
         let changed = self.commit(pending)?;
         let derived = changed
             .iter()
-            .filter(|n| n.as_str() != name)
+            .map(Publication::name)
+            .filter(|&n| n != name)
             .filter_map(|n| self.layers.get(n))
             .map(|l| info(l))
             .collect();
@@ -369,6 +373,11 @@ impl LayerStore {
         }
         Ok(())
     }
+}
+
+/// The names of the layers published.
+fn names(publications: &[Publication]) -> Vec<String> {
+    publications.iter().map(|p| p.name().to_owned()).collect()
 }
 
 /// Records that `name` reached `version`, keeping the newest [`MAX_TOMBSTONES`].

@@ -25,7 +25,8 @@ use roam_proto::map::Layer;
 
 use super::stage::{Change, Pending, Staged};
 use super::{
-    derived_source, remember, LayerStore, StoreError, HEURISTIC, INFLATED, INFORMATION, OCCUPANCY,
+    derived_source, names, remember, LayerStore, StoreError, HEURISTIC, INFLATED, INFORMATION,
+    OCCUPANCY,
 };
 use crate::derived::{Derivation, Recipe};
 use roam_world::grid::Grid;
@@ -347,7 +348,7 @@ impl LayerStore {
         for w in warnings {
             self.warn(w);
         }
-        Ok(changed)
+        Ok(names(&changed))
     }
 }
 
