@@ -313,7 +313,8 @@ fn position(what: &str, pose: &PoseStamped) -> Result<[f64; 2], ErrorReply> {
             ErrorCode::InvalidRequest,
             format!(
                 "{what} must be finite coordinates in metres, got ({}, {})",
-                p.x, p.y
+                roam_proto::number(p.x),
+                roam_proto::number(p.y)
             ),
         ));
     }
@@ -333,7 +334,7 @@ pub fn plan_downtime_request(request: &PlanDowntimeRequest) -> Result<PlanReques
             ErrorCode::InvalidRequest,
             format!(
                 "budget_s must be a positive number of seconds, got {}",
-                request.budget_s
+                roam_proto::number(request.budget_s)
             ),
         ));
     }
@@ -342,7 +343,7 @@ pub fn plan_downtime_request(request: &PlanDowntimeRequest) -> Result<PlanReques
             ErrorCode::InvalidRequest,
             format!(
                 "deadline_s must be 0 (the default, {DEFAULT_DEADLINE_S} s) or a positive number of seconds, got {}",
-                request.deadline_s
+                roam_proto::number(request.deadline_s)
             ),
         ));
     }

@@ -16,6 +16,9 @@
 //!   log line ([`echo`]);
 //! - a client flooding the planner's queue leaves another its fair share
 //!   ([`planner_flood`]);
+//! - the ROS 2 node answers every call to its services, one without rmw_zenoh's
+//!   attachment, one of 8 MB and a storm of them, and refuses a map whose header
+//!   claims 10⁸ cells from its header, and goes on ([`ros2`]);
 //! - the live view refuses a page from a foreign Origin and lets a real client in past
 //!   hundreds of half-open connections ([`view`]).
 //!
@@ -31,6 +34,7 @@ mod files;
 mod logs;
 mod map_memory;
 mod planner_flood;
+mod ros2;
 mod routing;
 mod view;
 
@@ -57,6 +61,9 @@ async fn attacks_on_a_running_stack_find_nothing() {
     echo::numbers(&harness, &client, &log).await;
 
     planner_flood::second_client(&harness).await;
+
+    ros2::services(&harness, &client).await;
+    ros2::map_input(&harness, &client, &log).await;
 
     view::origins(&harness).await;
     view::half_open(&harness).await;
