@@ -67,6 +67,30 @@ impl fmt::Display for Excerpt<'_> {
     }
 }
 
+/// A number from the wire, displayed in a bounded length: as Rust writes it (`12.5`)
+/// when that is short, in scientific notation (`1e300`, `1e-300`) otherwise. Rust
+/// writes an `f64` without an exponent, so a forged `1e300` would otherwise be 301
+/// digits in a log line or a reply.
+#[derive(Debug, Clone, Copy)]
+pub struct Number(pub f64);
+
+/// `x` as a [`Number`] for a log line or a message.
+pub fn number(x: f64) -> Number {
+    Number(x)
+}
+
+impl fmt::Display for Number {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        let magnitude = x.abs();
+        if !x.is_finite() || x == 0.0 || (1e-5..1e16).contains(&magnitude) {
+            write!(f, "{x}")
+        } else {
+            write!(f, "{x:e}")
+        }
+    }
+}
+
 /// A parser's message (serde_json's, serde_yaml's) made safe to send back: serde quotes
 /// offending strings whole (`invalid type: string "<the whole input>", expected ...`), so
 /// the message is cut to [`MAX_REASON_CHARS`] and escaped, and the position it ends
@@ -191,6 +215,19 @@ mod tests {
             file_parse_reason(cases[1]),
             "unknown field `…`, expected one of `image`, `resolution` at line 1 column 1"
         );
+    }
+
+    #[test]
+    fn numbers_are_short_whatever_their_size() {
+        assert_eq!(number(12.5).to_string(), "12.5");
+        assert_eq!(number(0.0).to_string(), "0");
+        assert_eq!(number(1e300).to_string(), "1e300");
+        assert_eq!(number(-1e-300).to_string(), "-1e-300");
+        assert_eq!(number(f64::NAN).to_string(), "NaN");
+        for x in [f64::MAX, f64::MIN_POSITIVE, 9.999e15, 1.234_567_890_123e-5] {
+            let shown = number(x).to_string();
+            assert!(shown.len() <= 26, "{shown}");
+        }
     }
 
     #[test]

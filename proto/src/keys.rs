@@ -79,16 +79,32 @@ pub fn liveliness_all(root: &str) -> String {
 }
 
 /// `<root>/map/layer/<layer>`: the map server publishes a
-/// [`Layer`](crate::map::Layer) here each time the layer changes (congestion control
-/// `Block`, so large layers are never dropped), and answers a `get` with the latest one.
-/// Rate: on change only.
+/// [`Layer`](crate::map::Layer) here each time the whole layer changes (a replace, a
+/// map load, a change too large for a delta; congestion control `Block`, so large
+/// layers are never dropped), and answers a `get` with the latest one. A `set_cells`
+/// change is published on [`map_delta`] instead. Rate: on change only.
 pub fn map_layer(root: &str, layer: &str) -> String {
     format!("{root}/map/layer/{layer}")
 }
 
-/// `<root>/map/layer/*`: subscribe here to follow every layer.
+/// `<root>/map/layer/*`: subscribe here to follow every layer (with [`map_delta_any`]).
 pub fn map_layer_any(root: &str) -> String {
     format!("{root}/map/layer/*")
+}
+
+/// `<root>/map/delta/<layer>`: the map server publishes a
+/// [`LayerDelta`](crate::layer_delta::LayerDelta) here for each `set_cells` change of the
+/// layer (and for the cells its derived layer gains from one): the cells written, the
+/// version they apply to and the version they make (congestion control `Block`). A
+/// follower holding the layer at the delta's base version applies it; one that does
+/// not gets the whole layer with a `get` on [`map_layer`]. Rate: on change only.
+pub fn map_delta(root: &str, layer: &str) -> String {
+    format!("{root}/map/delta/{layer}")
+}
+
+/// `<root>/map/delta/*`: subscribe here to follow every layer's small changes.
+pub fn map_delta_any(root: &str) -> String {
+    format!("{root}/map/delta/*")
 }
 
 /// `<root>/map/update/<layer>`: the map server answers a `get` carrying a
@@ -331,6 +347,8 @@ mod tests {
             "roam/@live/map-server/a1"
         );
         assert_eq!(map_layer("r", "occupancy"), "r/map/layer/occupancy");
+        assert_eq!(map_delta("r", "peb"), "r/map/delta/peb");
+        assert_eq!(map_delta_any("r"), "r/map/delta/*");
         assert_eq!(map_update("r", "peb"), "r/map/update/peb");
         assert_eq!(map_delete("r", "peb"), "r/map/delete/peb");
         assert_eq!(map_delete_any("r"), "r/map/delete/*");

@@ -13,6 +13,7 @@ pub mod controller;
 pub mod error;
 pub mod excerpt;
 pub mod keys;
+pub mod layer_delta;
 pub mod localization;
 pub mod map;
 pub mod mapper;
@@ -22,4 +23,4 @@ pub mod sim;
 
 pub use codec::{decode, encode, DecodeError, Message, PROTOCOL_VERSION};
 pub use error::{ErrorCode, ErrorReply, LimitHit};
-pub use excerpt::{excerpt, Excerpt};
+pub use excerpt::{excerpt, number, Excerpt, Number};

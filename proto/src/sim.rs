@@ -44,6 +44,8 @@ pub struct NamedPoint {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SimStatus {
+    /// The scenario's file name (`es1.yaml`), never a path on the sim's machine, or the
+    /// built-in world's name.
     pub scenario: String,
     pub seed: u64,
     pub step: u64,

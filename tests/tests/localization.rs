@@ -4,8 +4,8 @@
 use roam_proto::cells::Cells;
 use roam_proto::localization::{PebQuery, PebReply, PebWhere, PositionEstimate};
 use roam_proto::map::{GridMeta, Layer, Origin};
-use roam_proto::sim::{GroundTruth, SimControl, SimStatus};
-use roam_proto::{decode, keys, ErrorCode};
+use roam_proto::sim::{GroundTruth, RangeScan, SimControl, SimStatus};
+use roam_proto::{decode, encode, keys, ErrorCode};
 use roam_runtime::ClientError;
 use roam_tests::{repo_path, within, Harness};
 
@@ -77,6 +77,84 @@ async fn ranges_in_estimates_out_at_the_sim_rate() {
         );
         assert!(e.anchors_used.len() >= 3);
     }
+    localization.stop().await.1.expect("clean stop");
+    sim.stop().await.1.expect("clean stop");
+    harness.close().await;
+}
+
+/// A scan's time is checked against the sim clock as the mapper checks an
+/// observation's: one stamped far ahead of the clock (a forged 1e300, or 1000 s on)
+/// gives no estimate, and the next scan on the clock does.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_scan_stamped_ahead_of_the_sim_clock_gives_no_estimate() {
+    let harness = Harness::start().await;
+    let sim = harness
+        .start_role(harness.sim_config(Some("config/scenarios/es1.yaml")))
+        .await;
+    let localization = harness
+        .start_role(harness.localization_config(Some("config/scenarios/es1.yaml")))
+        .await;
+    let client = harness.client().await;
+    let root = harness.root.clone();
+    let subscribe = |key: String| within("subscribe", client.session().declare_subscriber(key));
+    let estimates = subscribe(keys::robot_estimate(&root, "robot"))
+        .await
+        .expect("sub");
+    let scans = subscribe(keys::robot_ranges(&root, "robot"))
+        .await
+        .expect("sub");
+    let status: SimStatus = within(
+        "step",
+        client.request(&keys::sim_control(&root), Some(&SimControl::Step { n: 3 })),
+    )
+    .await
+    .expect("step");
+    let mut last: Option<RangeScan> = None;
+    for _ in 0..3 {
+        let sample = within("scan", scans.recv_async()).await.expect("sample");
+        last = Some(decode(&sample.payload().to_bytes()).expect("scan"));
+        within("estimate", estimates.recv_async())
+            .await
+            .expect("estimate");
+    }
+    let last = last.expect("a scan");
+    for (step, time_s) in [(100, status.time_s + 1000.0), (101, 1e300)] {
+        let forged = RangeScan {
+            step,
+            time_s,
+            ..last.clone()
+        };
+        within(
+            "put",
+            client
+                .session()
+                .put(keys::robot_ranges(&root, "robot"), encode(&forged)),
+        )
+        .await
+        .expect("put");
+    }
+    let on_clock = RangeScan {
+        step: 102,
+        ..last.clone()
+    };
+    within(
+        "put",
+        client
+            .session()
+            .put(keys::robot_ranges(&root, "robot"), encode(&on_clock)),
+    )
+    .await
+    .expect("put");
+    let e: PositionEstimate = decode(
+        &within("estimate", estimates.recv_async())
+            .await
+            .expect("sample")
+            .payload()
+            .to_bytes(),
+    )
+    .expect("estimate");
+    assert_eq!(e.step, 102, "the scans ahead of the clock gave no estimate");
+    assert_eq!(e.time_s, last.time_s);
     localization.stop().await.1.expect("clean stop");
     sim.stop().await.1.expect("clean stop");
     harness.close().await;

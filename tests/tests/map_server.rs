@@ -7,6 +7,7 @@ use std::time::Duration;
 use roam_map_server::store::{Limits, DEFAULT_LIMITS};
 use roam_map_server::MapServerConfig;
 use roam_proto::cells::Cells;
+use roam_proto::layer_delta::LayerDelta;
 use roam_proto::map::{
     CellWrite, DeleteLayer, Layer, LayerChange, LayerDeleted, LayerList, LayerUpdate, LoadMap,
     UpdateAck,
@@ -104,19 +105,23 @@ async fn a_client_gets_every_layer_of_the_builtin_world() {
     harness.close().await;
 }
 
+/// A one-cell update is published as a delta of each changed layer (the cell written,
+/// and the cells `inflated` gains), which turns a follower's copy at the base version
+/// into the server's new version; nothing of the whole layer is published.
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
-async fn an_update_is_published_and_a_stale_one_refused() {
+async fn an_update_is_published_as_a_delta_and_a_stale_one_refused() {
     let harness = Harness::start().await;
     let server = harness.start_role(harness.map_server_config()).await;
     let client = harness.client().await;
-    let subscriber = within(
-        "subscribe",
-        client
-            .session()
-            .declare_subscriber(keys::map_layer(&harness.root, "inflated")),
-    )
-    .await
-    .expect("subscriber");
+    let subscribe = |key: String| within("subscribe", client.session().declare_subscriber(key));
+    let deltas = subscribe(keys::map_delta_any(&harness.root))
+        .await
+        .expect("subscriber");
+    let wholes = subscribe(keys::map_layer_any(&harness.root))
+        .await
+        .expect("subscriber");
+    let mut inflated = get_layer(&client, &harness.root, "inflated").await;
+    let mut occupancy = get_layer(&client, &harness.root, "occupancy").await;
 
     let update_key = keys::map_update(&harness.root, "occupancy");
     let ack: UpdateAck = within(
@@ -134,20 +139,43 @@ async fn an_update_is_published_and_a_stale_one_refused() {
         [("inflated", 2)]
     );
 
-    // The derived layer's publication arrives with the new version.
-    let published = loop {
-        let sample = within("publication", subscriber.recv_async())
-            .await
-            .expect("sample");
-        let layer: Layer = roam_proto::decode(&sample.payload().to_bytes()).expect("layer");
-        if layer.version == 2 {
-            break layer;
-        }
-    };
+    // Both deltas arrive, each from version 1 to 2, and apply to the copies held.
+    for _ in 0..2 {
+        let sample = within("delta", deltas.recv_async()).await.expect("sample");
+        let delta: LayerDelta = roam_proto::decode(&sample.payload().to_bytes()).expect("delta");
+        assert_eq!(
+            sample.key_expr().as_str(),
+            keys::map_delta(&harness.root, &delta.name)
+        );
+        assert_eq!((delta.base_version, delta.version), (1, 2));
+        assert!(
+            sample.payload().len() < 4096,
+            "{} bytes",
+            sample.payload().len()
+        );
+        let held = match delta.name.as_str() {
+            "occupancy" => &mut occupancy,
+            "inflated" => &mut inflated,
+            other => panic!("a delta of {other}"),
+        };
+        delta.apply(held).expect("applies to version 1");
+    }
     assert_eq!(
-        published.cells.get_f64(50 * 100 + 51),
+        inflated.cells.get_f64(50 * 100 + 51),
         Some(100.0),
         "inflated next to the new obstacle"
+    );
+    assert_eq!(
+        inflated,
+        get_layer(&client, &harness.root, "inflated").await
+    );
+    assert_eq!(
+        occupancy,
+        get_layer(&client, &harness.root, "occupancy").await
+    );
+    assert!(
+        wholes.try_recv().ok().flatten().is_none(),
+        "no whole layer is published for a one-cell update"
     );
 
     let occupancy = get_layer(&client, &harness.root, "occupancy").await;
@@ -370,42 +398,76 @@ async fn loads_read_only_the_load_directories_and_name_what_is_wrong() {
         base_version,
     };
 
+    // No reply names where the server keeps its directories.
+    let server_paths = [
+        dir.path().display().to_string(),
+        dir.path().canonicalize().expect("c").display().to_string(),
+        std::path::Path::new(maps)
+            .canonicalize()
+            .expect("c")
+            .display()
+            .to_string(),
+    ];
+    let tells_nothing = |reply: &ErrorReply| {
+        for path in &server_paths {
+            assert!(
+                !reply.message.contains(path.as_str()),
+                "the reply names the server's {path}: {}",
+                reply.message
+            );
+        }
+    };
+
     let missing =
         refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("missing.yaml", None))))
             .await;
     assert_eq!(missing.code, ErrorCode::NotFound);
     assert!(
-        missing.message.contains("missing.yaml") && missing.message.contains("load directories"),
+        missing.message.contains("'missing.yaml'")
+            && missing
+                .message
+                .contains("outside the configured load directories"),
         "{}",
         missing.message
     );
-    // Outside the directories: the same answer as a missing file, naming the directories.
+    tells_nothing(&missing);
+    // Outside the directories: the same answer as a missing file, naming the file as
+    // the peer gave it.
     let passwd =
         refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("/etc/passwd", None)))).await;
     assert_eq!(passwd.code, ErrorCode::NotFound);
     assert!(!passwd.message.contains("root:"), "{}", passwd.message);
-    assert!(
-        passwd
-            .message
-            .contains(&dir.path().canonicalize().expect("c").display().to_string()),
-        "{}",
-        passwd.message
+    assert_eq!(
+        passwd.message.replace("/etc/passwd", "missing.yaml"),
+        missing.message
     );
+    tells_nothing(&passwd);
 
-    // A map whose image is truncated.
+    // A map whose image is truncated: named relative to its load directory.
     std::fs::write(dir.path().join("bad.pgm"), b"P5\n10 10\n255\n\x00\x00").expect("pgm");
     std::fs::write(dir.path().join("bad.yaml"), "image: bad.pgm\nresolution: 0.05\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.196\n").expect("yaml");
     let corrupt =
         refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("bad.yaml", None)))).await;
     assert_eq!(corrupt.code, ErrorCode::CorruptFile);
-    assert!(corrupt.message.contains("bad.pgm"), "{}", corrupt.message);
+    assert!(
+        corrupt.message.contains("map image bad.pgm"),
+        "{}",
+        corrupt.message
+    );
+    tells_nothing(&corrupt);
 
     // A map inside the directories whose image is outside them is refused like a
-    // missing file.
+    // missing file, without naming what it refers to.
     std::fs::write(dir.path().join("escape.yaml"), "image: /etc/passwd\nresolution: 0.05\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.196\n").expect("yaml");
     let escape =
         refusal(client.request::<LoadMap, LayerList>(&key, Some(&load("escape.yaml", None)))).await;
     assert_eq!(escape.code, ErrorCode::NotFound, "{}", escape.message);
+    assert!(
+        escape.message.contains("'escape.yaml'") && !escape.message.contains("/etc/passwd"),
+        "{}",
+        escape.message
+    );
+    tells_nothing(&escape);
 
     // A good map loads, bumps the versions and is served.
     let list: LayerList = within(

@@ -305,6 +305,17 @@ async fn bad_requests_get_errors_that_name_what_to_fix() {
         "{}",
         invalid.message
     );
+    // Neither a reply nor the status names where the sim keeps its scenarios.
+    let folders = [
+        dir.path().display().to_string(),
+        dir.path().canonicalize().expect("c").display().to_string(),
+    ];
+    for message in [&missing.message, &invalid.message] {
+        assert!(
+            folders.iter().all(|f| !message.contains(f.as_str())),
+            "{message}"
+        );
+    }
 
     let too_many = refused(&client, &root, SimControl::Step { n: 1_000_000 }).await;
     assert_eq!(
@@ -368,5 +379,39 @@ async fn bad_requests_get_errors_that_name_what_to_fix() {
         other => panic!("{other:?}"),
     };
     assert_eq!(malformed.code, ErrorCode::Malformed);
+    // A scenario in the load directory loads, and the status names it by its file.
+    std::fs::copy(
+        roam_tests::repo_path("config/scenarios/grid004.yaml"),
+        dir.path().join("good.yaml"),
+    )
+    .expect("copy");
+    let loaded = control(
+        &client,
+        &root,
+        SimControl::Load {
+            path: "good.yaml".into(),
+            seed: 0,
+        },
+    )
+    .await
+    .expect("a scenario in the load directory loads");
+    assert_eq!(loaded.scenario, "good.yaml");
+    stop(harness, sim).await;
+}
+
+/// The sim's status tells any peer which scenario runs by its file name, never by where
+/// it lies on the sim's machine (here an absolute path from the config).
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn the_status_names_the_scenario_file_not_its_path() {
+    let harness = Harness::start().await;
+    let config = harness.sim_config(Some("config/scenarios/es1.yaml"));
+    let configured = config.scenario.clone().expect("a scenario");
+    assert!(configured.is_absolute(), "{}", configured.display());
+    let sim = harness.start_role(config).await;
+    let client = harness.client().await;
+    let status = control(&client, &harness.root, SimControl::Status)
+        .await
+        .expect("status");
+    assert_eq!(status.scenario, "es1.yaml");
     stop(harness, sim).await;
 }

@@ -4,13 +4,17 @@
 //! | key | kind | payload |
 //! |---|---|---|
 //! | `<root>/robot/*/ranges` | subscription | `range_scan` (from the sim or a robot) |
+//! | `<root>/sim/clock` | subscription | `sim_clock` (scan times are checked against it) |
 //! | `<root>/robot/<id>/estimate` | publication, one per scan | `position_estimate` |
 //! | `<root>/localization/peb` | queryable | `peb_query` → `peb_reply` |
 //! | `<root>/map/update/peb` | query to the map server, once at start | `layer_update` (the PEB layer) |
 //!
 //! A scan names its anchors and their positions, so the estimate uses exactly the
 //! anchors the robot heard; the sensing model (σ, d0, K, range) and the default
-//! constellation for PEB queries come from the configured scenario.
+//! constellation for PEB queries come from the configured scenario. A scan's time is
+//! checked against the sim clock the way the mapper checks an observation's
+//! ([`roam_world::epoch`]): a scan stamped far ahead of the clock gives no estimate, so a
+//! forged time never reaches the controller or the executive.
 
 use roam_runtime::Delivery;
 use std::path::PathBuf;
@@ -20,11 +24,12 @@ use std::time::Duration;
 use roam_proto::cells::Cells;
 use roam_proto::localization::{CrbCells, PebAt, PebQuery, PebReply, PebWhere};
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
-use roam_proto::sim::{NamedPoint, RangeScan};
+use roam_proto::sim::{NamedPoint, RangeScan, SimClock};
 use roam_proto::{keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::world_check::{self, WorldMismatch};
 use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
+use roam_world::epoch::Epochs;
 use roam_world::scenario::load_or_builtin;
 use roam_world::scenario::SensingSpec;
 use serde::Deserialize;
@@ -47,6 +52,8 @@ pub const MAX_REQUEST_BYTES: usize = 4 * 1024 * 1024;
 /// Largest range scan decoded, bytes: a scan of [`MAX_ANCHORS`](crate::model::MAX_ANCHORS)
 /// anchors at about 100 bytes each, with room.
 pub const MAX_SCAN_BYTES: usize = 1024 * 1024;
+/// Largest sim clock decoded, bytes (one is about 60).
+const MAX_CLOCK_BYTES: usize = 1024;
 /// The name of the layer the service publishes to the map server.
 pub const PEB_LAYER: &str = "peb";
 
@@ -106,6 +113,8 @@ struct LocalizationShared {
     fim: FimOptions,
     /// Per-robot priors: the one estimation code path the batch episodes share.
     tracker: Mutex<Tracker>,
+    /// Scan times against the sim clock.
+    epochs: Mutex<Epochs>,
     /// Refused scans, logged a few per key and window.
     warnings: WarnLimiter,
     /// The world this service works on, sent with its layer updates.
@@ -177,8 +186,19 @@ pub async fn run(
         map: scenario.occupancy.meta,
         fim,
         tracker: Mutex::new(Tracker::new(sensing, fim)),
+        epochs: Mutex::new(Epochs::default()),
         warnings: WarnLimiter::new(),
     });
+    service
+        .subscribe_with(
+            &keys::sim_clock(&config.root),
+            MAX_CLOCK_BYTES,
+            state.clone(),
+            |state: &Arc<LocalizationShared>, _key: &str, clock: SimClock| {
+                roam_runtime::lock(&state.epochs).on_clock(clock.time_s)
+            },
+        )
+        .await?;
     service
         .subscribe_with(
             &keys::robot_ranges_any(&config.root),
@@ -212,6 +232,12 @@ fn on_scan(state: &LocalizationShared, key: &str, scan: RangeScan) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "ignoring a scan: {e}"),
     };
+    let time = roam_runtime::lock(&state.epochs).observation_time(scan.time_s);
+    let time = match time {
+        Ok(t) => t,
+        Err(e) => return limited_warn!(state.warnings, robot, %robot, "ignoring a scan: {e}"),
+    };
+    roam_runtime::lock(&state.epochs).accepted(time);
     let message = match roam_runtime::lock(&state.tracker).on_scan(&scan) {
         Ok(m) => m,
         Err(e) => return limited_warn!(state.warnings, robot, %robot, "ignoring a scan: {e}"),

@@ -10,7 +10,8 @@
 //! heuristic_compression: 0.25    # paper 000 c_h
 //! lethal_threshold: 65           # occupancy value from which a cell is an obstacle
 //! limits: { max_layer_cells: 16777216, max_cells_per_update: 100000,
-//!           max_request_bytes: 100663296, max_layers: 64 }
+//!           max_request_bytes: 100663296, max_layers: 64,
+//!           max_total_cell_bytes: 1073741824 }
 //! zenoh: { mode: client, connect: { endpoints: ["tcp/router:7447"] } }
 //! ```
 

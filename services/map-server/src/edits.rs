@@ -4,6 +4,7 @@
 
 use roam_proto::cells::{Cells, Dtype};
 use roam_proto::map::{CellWrite, GridMeta, Layer};
+use roam_proto::number;
 
 use roam_world::grid::occupancy;
 
@@ -27,7 +28,7 @@ pub enum EditError {
         width: u32,
         height: u32,
     },
-    #[error("value {value} at ({x}, {y}) is outside {lo}..={hi} for layer '{layer}'")]
+    #[error("value {} at ({x}, {y}) is outside {}..={} for layer '{layer}'", number(*.value), number(*.lo), number(*.hi))]
     Value {
         layer: String,
         x: u32,

@@ -34,9 +34,12 @@ pub enum MapFileError {
 }
 
 impl MapFileError {
-    /// The error reply for a load request.
-    pub fn to_reply(&self) -> ErrorReply {
-        let message = self.to_string();
+    /// The error reply to a peer's load of `requested`: refusals name the file as the
+    /// peer gave it, and every other message names files relative to their load
+    /// directory, so the reply holds none of the server's absolute paths (its log,
+    /// given the error itself, keeps them).
+    pub fn to_reply(&self, requested: &str, dirs: &LoadDirs) -> ErrorReply {
+        let message = dirs.redact(&self.to_string());
         match self {
             MapFileError::Refused(refused)
             | MapFileError::Ros(RosMapError::Refused(refused))
@@ -44,13 +47,10 @@ impl MapFileError {
             | MapFileError::Scenario(ScenarioError::Map {
                 source: RosMapError::Refused(refused),
                 ..
-            }) => refused.to_reply(),
+            }) => refused.to_reply(requested),
             MapFileError::Ros(RosMapError::Missing { .. })
-            | MapFileError::Scenario(ScenarioError::Missing { .. }) => ErrorReply::new(
-                ErrorCode::NotFound,
-                format!("{message}; give a path on the map server's machine"),
-            ),
-            MapFileError::Scenario(ScenarioError::Map {
+            | MapFileError::Scenario(ScenarioError::Missing { .. })
+            | MapFileError::Scenario(ScenarioError::Map {
                 source: RosMapError::Missing { .. },
                 ..
             }) => ErrorReply::new(ErrorCode::NotFound, message),

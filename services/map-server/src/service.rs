@@ -3,7 +3,8 @@
 //!
 //! | key | kind | payload |
 //! |---|---|---|
-//! | `<root>/map/layer/<name>` | queryable + publication | [`Layer`](roam_proto::map::Layer) |
+//! | `<root>/map/layer/<name>` | queryable + publication of whole layers | [`Layer`](roam_proto::map::Layer) |
+//! | `<root>/map/delta/<name>` | publication of `set_cells` changes | [`LayerDelta`](roam_proto::layer_delta::LayerDelta) |
 //! | `<root>/map/update/<name>` | queryable | `LayerUpdate` → `UpdateAck` |
 //! | `<root>/map/delete/<name>` | queryable | `DeleteLayer` → `LayerDeleted` |
 //! | `<root>/map/layers` | queryable | → `LayerList` |
@@ -26,7 +27,7 @@ use zenoh::Session;
 use crate::config::MapServerConfig;
 use crate::map_file::{self, MapFileError};
 use crate::persist::{DataDir, PersistError};
-use crate::store::{DerivedParams, LayerStore, OCCUPANCY};
+use crate::store::{DerivedParams, LayerStore, Publication, OCCUPANCY};
 use roam_world::load_dirs::LoadDirs;
 
 /// The service name in liveliness tokens and logs.
@@ -100,15 +101,31 @@ impl MapServerShared {
         bytes
     }
 
-    async fn publish(&self, names: &[String]) {
-        for name in names {
-            let Some(bytes) = self.encoded(name) else {
-                continue;
+    /// Publishes each changed layer: a delta on `map/delta/<name>`, or the whole layer
+    /// (as the store holds it now) on `map/layer/<name>`.
+    async fn publish(&self, publications: &[Publication]) {
+        for publication in publications {
+            let (key, bytes) = match publication {
+                Publication::Whole(name) => {
+                    let Some(bytes) = self.encoded(name) else {
+                        continue;
+                    };
+                    (keys::map_layer(&self.root, name), bytes)
+                }
+                Publication::Delta(delta) => (
+                    keys::map_delta(&self.root, &delta.name),
+                    ZBytes::from(encode(delta)),
+                ),
             };
-            let key = keys::map_layer(&self.root, name);
             // A layer version is delivered: subscribers plan and drive on it.
             roam_runtime::publish_bytes(&self.session, &key, bytes, Delivery::Reliable).await;
         }
+    }
+
+    /// Publishes whole layers.
+    async fn publish_whole(&self, names: &[String]) {
+        let whole: Vec<Publication> = names.iter().cloned().map(Publication::Whole).collect();
+        self.publish(&whole).await;
     }
 }
 
@@ -237,7 +254,7 @@ pub async fn run(
     let load_q = service.declare_queryable(&keys::map_load(root)).await?;
 
     let all: Vec<String> = state.store().names().map(str::to_owned).collect();
-    state.publish(&all).await;
+    state.publish_whole(&all).await;
 
     service.serve(layer_q, state.clone(), |s, q| async move {
         answer_layer(&s, &q).await
@@ -388,11 +405,13 @@ async fn answer_load(state: Arc<MapServerShared>, query: &Query) {
     match outcome {
         Ok(Ok((list, changed))) => {
             reply::send(query, &list).await;
-            state.publish(&changed).await;
+            state.publish_whole(&changed).await;
         }
-        Ok(Err(error)) => {
-            roam_runtime::limited_warn!(state.warnings, "load", %error, "refused a map load");
-            reply::send_error(query, &error).await
+        Ok(Err(refused)) => {
+            // The log keeps the server's paths; the peer's reply does not.
+            let detail = &refused.detail;
+            roam_runtime::limited_warn!(state.warnings, "load", %detail, "refused a map load");
+            reply::send_error(query, &refused.reply).await
         }
         Err(e) => {
             reply::send_error(
@@ -404,13 +423,33 @@ async fn answer_load(state: Arc<MapServerShared>, query: &Query) {
     }
 }
 
+/// A refused load: the reply for the peer, and the detail for the server's log.
+struct LoadRefusal {
+    reply: ErrorReply,
+    detail: String,
+}
+
+impl From<ErrorReply> for LoadRefusal {
+    fn from(reply: ErrorReply) -> Self {
+        LoadRefusal {
+            detail: reply.to_string(),
+            reply,
+        }
+    }
+}
+
 fn load(
     state: &MapServerShared,
     request: &LoadMap,
-) -> Result<(LayerList, Vec<String>), ErrorReply> {
+) -> Result<(LayerList, Vec<String>), LoadRefusal> {
     let max_cells = state.store().limits().max_layer_cells;
-    let content = map_file::read_requested(&request.path, &state.load_dirs, max_cells)
-        .map_err(|e| e.to_reply())?;
+    let content =
+        map_file::read_requested(&request.path, &state.load_dirs, max_cells).map_err(|e| {
+            LoadRefusal {
+                reply: e.to_reply(&request.path, &state.load_dirs),
+                detail: e.to_string(),
+            }
+        })?;
     let mut store = state.store();
     if let (None, Some(r)) = (state.robot_radius_override, content.robot_radius_m) {
         store.set_robot_radius(r);

@@ -2,10 +2,11 @@
 
 use roam_map_server::persist::DataDir;
 use roam_map_server::store::{
-    DerivedParams, LayerStore, Limits, StoreError, DEFAULT_LIMITS, HEURISTIC, INFLATED,
-    INFORMATION, OCCUPANCY,
+    DerivedParams, LayerStore, Limits, Publication, StoreError, DEFAULT_LIMITS, HEURISTIC,
+    INFLATED, INFORMATION, OCCUPANCY,
 };
 use roam_proto::cells::Cells;
+use roam_proto::layer_delta::CellPositions;
 use roam_proto::map::{CellWrite, GridMeta, LayerChange, LayerUpdate, Origin};
 use roam_proto::ErrorCode;
 use roam_world::grid::{occupancy, Grid};
@@ -66,7 +67,7 @@ fn an_update_bumps_the_layer_and_its_derived_layer() {
             .collect::<Vec<_>>(),
         vec![INFLATED]
     );
-    assert!(changed.contains(&INFLATED.to_owned()));
+    assert!(changed.iter().any(|p| p.name() == INFLATED));
     let inflated = store.get(INFLATED).expect("inflated");
     assert_eq!(inflated.version, 2);
     // Robot radius 0.2 m = 2 cells: (7, 5) is inflated, (8, 5) is not.
@@ -254,4 +255,125 @@ fn persisted_layers_restore_with_their_versions() {
             .and_then(|l| l.cells.get_f64(3 * 20 + 3)),
         Some(100.0)
     );
+}
+
+fn replace_f32(base_version: u64, w: u32, h: u32) -> LayerUpdate {
+    LayerUpdate {
+        base_version,
+        change: LayerChange::Replace {
+            meta: meta(w, h),
+            cells: Cells::F32(vec![0.0; (w * h) as usize]),
+        },
+        world: None,
+    }
+}
+
+/// A one-cell update is published as the cell (a delta from the version it was based
+/// on), which turns a follower's copy into the store's; a change of many cells goes
+/// out whole.
+#[test]
+fn a_small_update_is_published_as_a_delta_and_a_large_one_whole() {
+    let mut store = store_with_map(DEFAULT_LIMITS);
+    store.apply("peb", &replace_f32(0, 64, 64)).expect("create");
+    let mut follower = store.get("peb").expect("peb").clone();
+
+    let (_, published) = store
+        .apply("peb", &set(1, &[(3, 4, 0.5)]))
+        .expect("one cell");
+    let [Publication::Delta(delta)] = published.as_slice() else {
+        panic!("one delta expected, got {published:?}");
+    };
+    assert_eq!((delta.base_version, delta.version), (1, 2));
+    assert_eq!(delta.positions, CellPositions(vec![(3, 4)]));
+    assert_eq!(delta.values, Cells::F32(vec![0.5]));
+    delta.apply(&mut follower).expect("applies");
+    assert_eq!(Some(&follower), store.get("peb"));
+
+    let many: Vec<(u32, u32, f64)> = (0..1000).map(|i| (i % 64, i / 64, 1.0)).collect();
+    let (_, published) = store.apply("peb", &set(2, &many)).expect("many cells");
+    assert_eq!(published, vec![Publication::Whole("peb".into())]);
+
+    // Occupancy's delta, and its derived layer's (whole or delta), both at the new version.
+    let (ack, published) = store
+        .apply(OCCUPANCY, &set(1, &[(5, 5, 100.0)]))
+        .expect("occupancy");
+    assert_eq!(ack.version, 2);
+    assert!(
+        matches!(&published[0], Publication::Delta(d) if d.name == OCCUPANCY && d.version == 2)
+    );
+    assert!(published.iter().any(|p| p.name() == INFLATED));
+}
+
+/// The cells of all layers together stay within `max_total_cell_bytes`: a replace or a
+/// load that would hold more is refused, naming the limit, before anything changes; a
+/// replace of a layer counts its old cells as freed, and deleting frees them.
+#[test]
+fn the_cells_of_all_layers_together_are_bounded() {
+    // The 20 x 10 map: occupancy, inflated, information (200 bytes each) and a 4 x 2
+    // heuristic of f32 (32 bytes).
+    let base = 3 * 200 + 32;
+    let limits = Limits {
+        max_total_cell_bytes: base + 800,
+        ..DEFAULT_LIMITS
+    };
+    let mut store = store_with_map(limits);
+    assert_eq!(store.held_cell_bytes(), base);
+    store
+        .apply("a", &replace_f32(0, 10, 10))
+        .expect("400 bytes fit");
+    store
+        .apply("b", &replace_f32(0, 10, 10))
+        .expect("800 bytes fit");
+    assert_eq!(store.held_cell_bytes(), base + 800);
+    let refused = store
+        .apply("c", &replace_f32(0, 1, 1))
+        .expect_err("over the budget")
+        .to_reply();
+    assert_eq!(refused.code, ErrorCode::LimitExceeded);
+    let hit = refused.limit.expect("limit");
+    assert_eq!(
+        (hit.name.as_str(), hit.max, hit.actual),
+        ("max_total_cell_bytes", base + 800, base + 804)
+    );
+    assert!(
+        refused.message.contains("max_total_cell_bytes"),
+        "{}",
+        refused.message
+    );
+    assert!(store.get("c").is_none());
+    // Replacing a layer with one of the same size holds no more.
+    store
+        .apply("b", &replace_f32(1, 10, 10))
+        .expect("same size");
+    // A larger map is refused whole: occupancy stays as it was.
+    let refused = store
+        .load_map(Grid::filled(meta(40, 40), occupancy::FREE), None, None)
+        .expect_err("a larger map");
+    assert_eq!(
+        refused.to_reply().limit.map(|l| l.name),
+        Some("max_total_cell_bytes".to_owned())
+    );
+    assert_eq!(store.version(OCCUPANCY), 1);
+    // Deleting frees the room.
+    store.delete("a", 1).expect("delete");
+    store.apply("c", &replace_f32(0, 1, 1)).expect("fits again");
+}
+
+/// What the budget foresees for a load is what the load then holds (the derived layers
+/// included): a budget of exactly that admits it, one byte less does not.
+#[test]
+fn the_budget_foresees_a_load_exactly() {
+    let mut store = store_with_map(DEFAULT_LIMITS);
+    store
+        .load_map(Grid::filled(meta(40, 40), occupancy::FREE), None, None)
+        .expect("load");
+    let exact = store.held_cell_bytes();
+    for (max, fits) in [(exact, true), (exact - 1, false)] {
+        let mut store = store_with_map(Limits {
+            max_total_cell_bytes: max,
+            ..DEFAULT_LIMITS
+        });
+        let outcome = store.load_map(Grid::filled(meta(40, 40), occupancy::FREE), None, Some(1));
+        assert_eq!(outcome.is_ok(), fits, "max {max}: {outcome:?}");
+    }
 }

@@ -28,7 +28,8 @@
 //!   rates as a two-state Markov chain; the `occupied_now` layer.
 //! - [`brier`]: the Brier score of a belief against the truth.
 //! - [`reserve`]: the cells a robot's path will show it, with the times it should.
-//! - [`epoch`]: observation times against the sim clock; sim resets as epochs.
+//! - observation times are checked against the sim clock by `roam_world::epoch`, shared
+//!   with localization.
 //! - [`explorer`]: the per-robot loop: episodes, navigation, local exploration, reward.
 //! - [`seed`]: the seeded ChaCha8 streams every random choice draws from.
 //! - [`error`]: [`MapperError`], naming the limit when a size is refused.
@@ -128,7 +129,6 @@
 pub mod belief;
 pub mod brier;
 pub mod change_map;
-pub mod epoch;
 pub mod error;
 pub mod explorer;
 pub mod features;

@@ -11,7 +11,7 @@
 //! | `<root>/mapper/status` | queryable | → `mapper_status` |
 //!
 //! The robot is the one the observation's key names; observation times are checked
-//! against the sim clock, and a sim reset starts a new epoch ([`crate::epoch`]).
+//! against the sim clock, and a sim reset starts a new epoch ([`roam_world::epoch`]).
 //!
 //! Every robot's observations merge into one map. The layers are computed and sent at
 //! most once per `publish_period_s` (wall time), and only when something was observed
@@ -59,10 +59,10 @@ use zenoh::query::Query;
 
 use crate::belief::{occupied_now, BeliefParams};
 use crate::change_map::{ChangeMap, MapParams, ObservationWindow};
-use crate::epoch::Epochs;
 use crate::explorer::{Explorer, ExplorerParams, Mode};
 use crate::news::{NewsMap, NewsParams, MAX_RESERVED_CELLS, MAX_RESERVING_ROBOTS};
 use crate::reserve::cells_along;
+use roam_world::epoch::Epochs;
 
 pub const SERVICE_NAME: &str = "mapper";
 /// Robots the learner drives at most.
@@ -194,7 +194,8 @@ fn check_observation(meta: &MapMeta, o: &LocalObservation) -> Result<(), String>
     if (o.meta.resolution - meta.resolution).abs() > 1e-9 * meta.resolution {
         return Err(format!(
             "its resolution {} m differs from the map's {} m",
-            o.meta.resolution, meta.resolution
+            roam_proto::number(o.meta.resolution),
+            meta.resolution
         ));
     }
     let (x1, y1) = (

@@ -6,6 +6,7 @@ use std::collections::VecDeque;
 use std::sync::Arc;
 
 use roam_proto::cells::Cells;
+use roam_proto::layer_delta::LayerDelta;
 use roam_proto::map::Layer;
 use roam_proto::planner::MapVersion;
 use roam_world::grid::Grid;
@@ -22,6 +23,21 @@ pub const PEB: &str = "peb";
 /// Heuristic compression the cached worlds are built with (Table I); requests with
 /// another c_h get their blocks recut.
 pub const DEFAULT_COMPRESSION: f64 = 0.25;
+
+/// What a delta did to the cache ([`MapCache::apply_delta`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum DeltaOutcome {
+    /// Applied; the version of the world built from it, when one was.
+    Applied(Option<MapVersion>),
+    /// The cache holds the delta's version or a later one already.
+    Held,
+    /// A layer the cache does not follow.
+    NotFollowed,
+    /// The delta does not apply to what the cache holds (it missed a delta, holds
+    /// nothing of the layer yet, or the delta does not fit the layer; the reason says
+    /// which): the whole layer is needed.
+    Gap(String),
+}
 
 /// Latest layers and the worlds built from them.
 #[derive(Debug, Default)]
@@ -95,6 +111,34 @@ impl MapCache {
         let mut names = vec![INFLATED, self.information_layer.as_str(), PEB];
         names.extend(self.change_layer.as_deref());
         names.into_iter().map(str::to_owned).collect()
+    }
+
+    /// Takes a delta of a followed layer: applied to the layer held when that is the
+    /// delta's base version (then as [`MapCache::update`] takes a layer). A delta of a
+    /// layer not followed, or one the cache already has (the version held is the
+    /// delta's or later), changes nothing.
+    pub fn apply_delta(&mut self, delta: &LayerDelta) -> DeltaOutcome {
+        let slot = match delta.name.as_str() {
+            PEB => &mut self.peb,
+            INFLATED => &mut self.inflated,
+            name if name == self.information_layer => &mut self.information,
+            name if Some(name) == self.change_layer.as_deref() => &mut self.change,
+            _ => return DeltaOutcome::NotFollowed,
+        };
+        let Some(mut layer) = slot.take() else {
+            return DeltaOutcome::Gap(format!("no version of '{}' held yet", delta.name));
+        };
+        if layer.version >= delta.version {
+            *slot = Some(layer);
+            return DeltaOutcome::Held;
+        }
+        match delta.apply(&mut layer) {
+            Ok(()) => DeltaOutcome::Applied(self.update(layer)),
+            Err(e) => {
+                *slot = Some(layer);
+                DeltaOutcome::Gap(e.to_string())
+            }
+        }
     }
 
     /// Takes a new layer; rebuilds the world when both layers are present and agree in
@@ -292,6 +336,48 @@ pub(crate) mod tests {
         assert_eq!(coupled.change, Some(2));
         let (_, world) = cache.world(None).expect("world");
         assert_eq!(world.information, vec![10, 0, 15, 10]);
+    }
+
+    #[test]
+    fn a_delta_at_the_held_version_makes_a_new_world_and_any_other_asks_for_the_layer() {
+        use roam_proto::layer_delta::CellPositions;
+        let mut cache = MapCache::new(4);
+        let delta = |base: u64, x: u32, value: u8| LayerDelta {
+            name: INFORMATION.into(),
+            base_version: base,
+            version: base + 1,
+            positions: CellPositions(vec![(x, 0)]),
+            values: Cells::U8(vec![value]),
+        };
+        assert!(matches!(
+            cache.apply_delta(&delta(1, 0, 50)),
+            DeltaOutcome::Gap(_)
+        ));
+        cache.update(layer(INFLATED, 1, Cells::I8(vec![0; 4])));
+        cache.update(layer(INFORMATION, 1, Cells::U8(vec![1; 4])));
+        let outcome = cache.apply_delta(&delta(1, 2, 50));
+        let DeltaOutcome::Applied(Some(version)) = outcome else {
+            panic!("a new world expected, got {outcome:?}");
+        };
+        assert_eq!(version.information, 2);
+        let (_, world) = cache.world(None).expect("world");
+        assert_eq!(world.information, vec![1, 1, 50, 1]);
+        assert_eq!(cache.apply_delta(&delta(1, 2, 60)), DeltaOutcome::Held);
+        assert!(matches!(
+            cache.apply_delta(&delta(3, 0, 60)),
+            DeltaOutcome::Gap(_)
+        ));
+        // A delta that does not fit (a cell outside the layer) changes nothing.
+        assert!(matches!(
+            cache.apply_delta(&delta(2, 9, 60)),
+            DeltaOutcome::Gap(_)
+        ));
+        assert_eq!(cache.versions().last().map(|v| v.information), Some(2));
+        let other = LayerDelta {
+            name: "recency".into(),
+            ..delta(1, 0, 1)
+        };
+        assert_eq!(cache.apply_delta(&other), DeltaOutcome::NotFollowed);
     }
 
     #[test]

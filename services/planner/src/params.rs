@@ -121,7 +121,7 @@ pub const MAX_PERCEPTION_DIAMETER: u32 = 15;
 
 /// A parameter outside its range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("parameter {name} = {value} is out of range; use {range}")]
+#[error("parameter {name} = {} is out of range; use {range}", roam_proto::number(*.value))]
 pub struct ParamError {
     pub name: &'static str,
     pub value: f64,

@@ -23,7 +23,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use roam_proto::planner::{FitnessTerms, PlannerModel, ShortestPathUse, StopReason};
-use roam_proto::{ErrorCode, ErrorReply};
+use roam_proto::{number, ErrorCode, ErrorReply};
 
 use crate::best::{ranked, PlanSource, Scored};
 use crate::curiosity::{Evaluation, Evaluator, Model};
@@ -148,7 +148,7 @@ pub struct ShortestOutcome {
 /// Why a plan was refused. Each says what to change.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PlanError {
-    #[error("the {which} ({x}, {y}) is off the map, which spans x {x0}..{x1} and y {y0}..{y1} m")]
+    #[error("the {which} ({}, {}) is off the map, which spans x {x0}..{x1} and y {y0}..{y1} m", number(*.x), number(*.y))]
     OffMap {
         which: &'static str,
         x: f64,
@@ -158,13 +158,13 @@ pub enum PlanError {
         y0: f64,
         y1: f64,
     },
-    #[error("the {which} ({x}, {y}) is inside an obstacle or its inflation (or unknown space); move it to free space")]
+    #[error("the {which} ({}, {}) is inside an obstacle or its inflation (or unknown space); move it to free space", number(*.x), number(*.y))]
     Blocked { which: &'static str, x: f64, y: f64 },
     #[error("there is no path from the start to the goal on this map")]
     NoPath,
-    #[error("the {which} ({x}, {y}) is free on the map but in a pocket of free space that no planning cell reaches (its planning cell's free space is elsewhere, behind an obstacle thinner than a planning cell, and no neighbouring planning cell touches it); move it, or plan at a finer planning_resolution_m")]
+    #[error("the {which} ({}, {}) is free on the map but in a pocket of free space that no planning cell reaches (its planning cell's free space is elsewhere, behind an obstacle thinner than a planning cell, and no neighbouring planning cell touches it); move it, or plan at a finer planning_resolution_m", number(*.x), number(*.y))]
     Pocket { which: &'static str, x: f64, y: f64 },
-    #[error("the start ({x}, {y}) is also the goal, so the plan is a round trip, but no legal move leaves the start's cell (its 8 neighbours are obstacles, their inflation, or corners that cannot be cut): no loop fits any t_exec_s; move the start to open floor, or ask model shortest to stay")]
+    #[error("the start ({}, {}) is also the goal, so the plan is a round trip, but no legal move leaves the start's cell (its 8 neighbours are obstacles, their inflation, or corners that cannot be cut): no loop fits any t_exec_s; move the start to open floor, or ask model shortest to stay", number(*.x), number(*.y))]
     Enclosed { x: f64, y: f64 },
     #[error("the budget t_exec = {given_s:.1} s is {short_by_s:.1} s shorter than the fastest path's ETA of {needed_s:.1} s (Eq. 2, turns counted); give at least {needed_s:.1} s")]
     BudgetTooShort {
@@ -172,7 +172,7 @@ pub enum PlanError {
         needed_s: f64,
         short_by_s: f64,
     },
-    #[error("{name} = {value} is out of range; use {range}")]
+    #[error("{name} = {} is out of range; use {range}", number(*.value))]
     OutOfRange {
         name: &'static str,
         value: f64,

@@ -6,7 +6,8 @@
 //! | `<root>/planner/instance/<instance>/plan` | queryable (this instance) | `plan_request` → `plan` |
 //! | `<root>/planner/progress/<request_id>` | publication | `plan_progress`, at most every 50 ms |
 //! | `<root>/planner/cancel/*` | subscription | `cancel_plan`, honoured only with the request's `cancel_token` |
-//! | `<root>/map/layer/{inflated,information}` | subscription + get | `layer` |
+//! | `<root>/map/layer/{inflated,information,peb}` | subscription + get | `layer` |
+//! | `<root>/map/delta/{inflated,information,peb}` | subscription | `layer_delta`, applied to the layer held at its base version; any other version gets the whole layer |
 //!
 //! Every plan is checked against this instance's limits before any work: its slot
 //! (`max_concurrent_plans`), its size ([`crate::limits`]) and its wall time from the CPU
@@ -14,11 +15,13 @@
 //! cancel is [`crate::inflight`]'s.
 
 use roam_runtime::Delivery;
+use std::collections::BTreeSet;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use roam_proto::excerpt;
+use roam_proto::layer_delta::{LayerDelta, MAX_DELTA_BYTES};
 use roam_proto::map::Layer;
 use roam_proto::planner::{CancelPlan, Plan, PlanProgress, PlanRequest, PlannerModel, StopReason};
 use roam_proto::{keys, ErrorCode, ErrorReply};
@@ -32,7 +35,7 @@ use crate::config::PlannerConfig;
 use crate::coupling::Coupling;
 use crate::inflight::{CancelVerdict, InFlight};
 use crate::limits::PlanLimits;
-use crate::maps::MapCache;
+use crate::maps::{DeltaOutcome, MapCache};
 use crate::params::GaParams;
 use crate::plan::{check_spec, plan, PlanSpec};
 use crate::queue::{ClientId, PlanQueue, QueueConfig, Refusal, Turn, MAX_QUEUED_PLANS};
@@ -89,6 +92,13 @@ struct PlannerInstance {
     budget: CpuBudget,
     /// Refused and unknown cancels, logged a few per window (`roam_runtime::warn_limit`).
     cancel_warnings: WarnLimiter,
+    /// Layers to get whole (a delta did not apply to the version held), and the wake-up
+    /// of the task that gets them: a burst of such deltas costs one `get` per layer.
+    wanted: Mutex<BTreeSet<String>>,
+    want: tokio::sync::Notify,
+    /// Deltas ignored (a body naming another layer than its key), logged a few per
+    /// window.
+    delta_warnings: WarnLimiter,
 }
 
 impl PlannerInstance {
@@ -201,6 +211,9 @@ pub async fn run(
         limits: config.limits(),
         budget: CpuBudget::new(config.budget(), Instant::now()),
         cancel_warnings: WarnLimiter::new(),
+        wanted: Mutex::new(BTreeSet::new()),
+        want: tokio::sync::Notify::new(),
+        delta_warnings: WarnLimiter::new(),
     });
     let root = config.root.as_str();
 
@@ -215,10 +228,36 @@ pub async fn run(
             )
             .await?;
     }
+    for layer in &layers {
+        service
+            .subscribe_with(
+                &keys::map_delta(root, layer),
+                MAX_DELTA_BYTES,
+                state.clone(),
+                |state: &Arc<PlannerInstance>, key: &str, delta: LayerDelta| {
+                    // Keys decide: a delta is of the layer its key names.
+                    if key.rsplit('/').next() == Some(delta.name.as_str()) {
+                        take_delta(state, &delta)
+                    } else {
+                        roam_runtime::limited_warn!(
+                            state.delta_warnings, "mismatch",
+                            key = %excerpt(key), layer = %excerpt(&delta.name),
+                            "delta ignored: its body names another layer than its key"
+                        );
+                    }
+                },
+            )
+            .await?;
+    }
     {
         let (state, cancel) = (state.clone(), service.cancel_token());
         let requester = Requester::new(service.session().clone(), Duration::from_secs(5));
         service.spawn(async move { fetch_maps(state, requester, cancel).await });
+    }
+    {
+        let (state, cancel) = (state.clone(), service.cancel_token());
+        let requester = Requester::new(service.session().clone(), Duration::from_secs(5));
+        service.spawn(async move { fetch_wanted(state, requester, cancel).await });
     }
     service
         .subscribe_with(
@@ -284,6 +323,51 @@ fn take_layer(state: &PlannerInstance, layer: Layer) {
             information = version.information,
             "planning on a new map"
         );
+    }
+}
+
+/// A delta of a followed layer: applied, or (when it does not apply to the version
+/// held) the whole layer is asked for.
+fn take_delta(state: &PlannerInstance, delta: &LayerDelta) {
+    match state.maps().apply_delta(delta) {
+        DeltaOutcome::Applied(Some(version)) => tracing::info!(
+            inflated = version.inflated,
+            information = version.information,
+            "planning on a new map"
+        ),
+        DeltaOutcome::Gap(why) => {
+            tracing::debug!(layer = %excerpt(&delta.name), "getting the whole layer: {why}");
+            roam_runtime::lock(&state.wanted).insert(delta.name.clone());
+            state.want.notify_one();
+        }
+        DeltaOutcome::Applied(None) | DeltaOutcome::Held | DeltaOutcome::NotFollowed => {}
+    }
+}
+
+/// Gets each layer a delta could not be applied to, whole.
+async fn fetch_wanted(
+    state: Arc<PlannerInstance>,
+    requester: Requester,
+    cancel: CancellationToken,
+) {
+    loop {
+        tokio::select! {
+            _ = cancel.cancelled() => return,
+            _ = state.want.notified() => {}
+        }
+        let wanted = std::mem::take(&mut *roam_runtime::lock(&state.wanted));
+        for name in wanted {
+            match requester
+                .request::<Layer, Layer>(&keys::map_layer(&state.root, &name), None)
+                .await
+            {
+                Ok(layer) if layer.name == name => take_layer(&state, layer),
+                Ok(_) => {
+                    tracing::warn!(layer = %name, "the map server answered with another layer")
+                }
+                Err(e) => tracing::debug!("map layer {name} not fetched: {e}"),
+            }
+        }
     }
 }
 

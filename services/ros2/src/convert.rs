@@ -186,7 +186,8 @@ pub fn grid_to_occupancy(
     let resolution = f64::from(info.resolution);
     if !(resolution.is_finite() && resolution > 0.0) {
         return Err(ConvertError::Invalid(format!(
-            "the map's resolution must be a positive number of metres, got {resolution}"
+            "the map's resolution must be a positive number of metres, got {}",
+            roam_proto::number(resolution)
         )));
     }
     let p = info.origin.position;
@@ -318,7 +319,8 @@ fn position(what: &str, pose: &PoseStamped) -> Result<[f64; 2], ErrorReply> {
             ErrorCode::InvalidRequest,
             format!(
                 "{what} must be finite coordinates in metres, got ({}, {})",
-                p.x, p.y
+                roam_proto::number(p.x),
+                roam_proto::number(p.y)
             ),
         ));
     }
@@ -338,7 +340,7 @@ pub fn plan_downtime_request(request: &PlanDowntimeRequest) -> Result<PlanReques
             ErrorCode::InvalidRequest,
             format!(
                 "budget_s must be a positive number of seconds, got {}",
-                request.budget_s
+                roam_proto::number(request.budget_s)
             ),
         ));
     }
@@ -347,7 +349,7 @@ pub fn plan_downtime_request(request: &PlanDowntimeRequest) -> Result<PlanReques
             ErrorCode::InvalidRequest,
             format!(
                 "deadline_s must be 0 (the default, {DEFAULT_DEADLINE_S} s) or a positive number of seconds, got {}",
-                request.deadline_s
+                roam_proto::number(request.deadline_s)
             ),
         ));
     }

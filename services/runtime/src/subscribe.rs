@@ -25,10 +25,13 @@ pub async fn subscribe_latest(
 }
 
 /// The streams a follower of the whole fleet reads (the live view, the ROS 2 node):
-/// every map layer, and every robot's true position, estimate and mission, each a ring
-/// of its newest samples.
+/// every map layer and layer delta, and every robot's true position, estimate and
+/// mission, each a ring of its newest samples.
 pub struct FleetStreams {
     pub layers: LatestSamples,
+    /// Small changes of layers (`<root>/map/delta/*`): a follower holding the layer at
+    /// a delta's base version applies it, any other gets the whole layer.
+    pub deltas: LatestSamples,
     pub truth: LatestSamples,
     pub estimate: LatestSamples,
     pub mission: LatestSamples,
@@ -38,6 +41,7 @@ impl std::fmt::Debug for FleetStreams {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("FleetStreams")
             .field("layers", &self.layers.key_expr().as_str())
+            .field("deltas", &self.deltas.key_expr().as_str())
             .field("truth", &self.truth.key_expr().as_str())
             .field("estimate", &self.estimate.key_expr().as_str())
             .field("mission", &self.mission.key_expr().as_str())
@@ -50,6 +54,9 @@ impl FleetStreams {
     /// one again at its next refresh of the map index, whose version check sees it
     /// missing).
     pub const LAYER_QUEUE: usize = 8;
+    /// Deltas the delta ring holds before the oldest go (a follower that misses one
+    /// sees the next one's base version differ from its own, and gets the whole layer).
+    pub const DELTA_QUEUE: usize = 32;
     /// Samples each robot ring holds before the oldest go.
     pub const ROBOT_QUEUE: usize = 256;
 
@@ -71,6 +78,7 @@ impl FleetStreams {
         };
         Ok(FleetStreams {
             layers: ring(keys::map_layer_any(root), Self::LAYER_QUEUE).await?,
+            deltas: ring(keys::map_delta_any(root), Self::DELTA_QUEUE).await?,
             // `robot_truth` with the robot `*`: every robot's true position.
             truth: ring(keys::robot_truth(root, "*"), Self::ROBOT_QUEUE).await?,
             estimate: ring(keys::robot_estimate_any(root), Self::ROBOT_QUEUE).await?,

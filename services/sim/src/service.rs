@@ -112,6 +112,14 @@ pub enum SimServiceError {
     World(#[from] WorldMismatch),
 }
 
+/// The scenario as a status names it to any peer: its file name, never a path on the
+/// sim's machine (the built-in world's name has no folder, so it stays as it is).
+fn shown_name(scenario: &str) -> String {
+    Path::new(scenario)
+        .file_name()
+        .map_or_else(|| scenario.to_owned(), |n| n.to_string_lossy().into_owned())
+}
+
 /// What control requests change.
 struct Control {
     sim: Sim,
@@ -149,7 +157,7 @@ impl SimShared {
         let c = self.control();
         let (robots, anchors) = points(&c.sim);
         SimStatus {
-            scenario: c.scenario.clone(),
+            scenario: shown_name(&c.scenario),
             seed: c.sim.seed(),
             step: c.sim.steps(),
             time_s: c.sim.time_s(),
@@ -465,14 +473,16 @@ fn sim_error(e: &SimError) -> ErrorReply {
     }
 }
 
-fn scenario_error(e: &ScenarioError) -> ErrorReply {
-    let message = e.to_string();
+/// The reply to a peer's load of `requested`: refusals name the file as the peer gave
+/// it, other errors name files relative to their load directory.
+fn scenario_error(e: &ScenarioError, requested: &str, dirs: &LoadDirs) -> ErrorReply {
+    let message = dirs.redact(&e.to_string());
     match e {
         ScenarioError::Refused(refused)
         | ScenarioError::Map {
             source: roam_world::ros_map::RosMapError::Refused(refused),
             ..
-        } => refused.to_reply(),
+        } => refused.to_reply(requested),
         ScenarioError::Missing { .. } => ErrorReply::new(ErrorCode::NotFound, message),
         ScenarioError::Io { .. } => ErrorReply::new(ErrorCode::Internal, message),
         ScenarioError::Map { .. } => ErrorReply::new(ErrorCode::CorruptFile, message),
@@ -485,37 +495,49 @@ async fn answer_control(state: Arc<SimShared>, query: Query) {
         Ok(r) => r,
         Err(e) => return reply::send_error(&query, &e).await,
     };
-    let is_load = matches!(request, SimControl::Load { .. });
     let outcome = control(&state, request).await;
     state.wake.notify_waiters();
-    if let (true, Err(error)) = (is_load, &outcome) {
-        roam_runtime::limited_warn!(state.warnings, "load", %error, "refused a scenario load");
-    }
     reply::send_result(&query, outcome.map(|()| state.status())).await;
+}
+
+/// Loads the scenario a peer named, relative to the load directories. A refusal is
+/// logged with the server's paths, and answered with the file as the peer named it.
+async fn load(state: &Arc<SimShared>, path: String, seed: u64) -> Result<(), ErrorReply> {
+    let dirs = state.load_dirs.clone();
+    let loaded = tokio::task::spawn_blocking(move || {
+        let file = dirs
+            .resolve(&path)
+            .map_err(|e| (e.to_string(), e.to_reply(&path)))?;
+        let scenario = scenario::load_with(&file, DEFAULT_MAX_CELLS, Access::Within(&dirs))
+            .map_err(|e| (e.to_string(), scenario_error(&e, &path, &dirs)))?;
+        let sim = Sim::new(&scenario, seed).map_err(|e| (e.to_string(), sim_error(&e)))?;
+        Ok((file.display().to_string(), sim))
+    })
+    .await
+    .unwrap_or_else(|e| {
+        let reply = ErrorReply::new(ErrorCode::Internal, format!("loading failed: {e}"));
+        Err((reply.to_string(), reply))
+    });
+    let (name, sim) = match loaded {
+        Ok(loaded) => loaded,
+        Err((detail, reply)) => {
+            roam_runtime::limited_warn!(state.warnings, "load", %detail, "refused a scenario load");
+            return Err(reply);
+        }
+    };
+    let mut c = state.control();
+    c.scenario = name;
+    c.sim = sim;
+    c.running = false;
+    c.pending.clear();
+    c.late_steps = 0;
+    c.free_steps = 0;
+    Ok(())
 }
 
 async fn control(state: &Arc<SimShared>, request: SimControl) -> Result<(), ErrorReply> {
     match request {
-        SimControl::Load { path, seed } => {
-            let dirs = state.load_dirs.clone();
-            let loaded = tokio::task::spawn_blocking(move || {
-                let file = dirs.resolve(&path).map_err(|e| e.to_reply())?;
-                let scenario = scenario::load_with(&file, DEFAULT_MAX_CELLS, Access::Within(&dirs))
-                    .map_err(|e| scenario_error(&e))?;
-                let name = file.display().to_string();
-                let sim = Sim::new(&scenario, seed).map_err(|e| sim_error(&e))?;
-                Ok::<_, ErrorReply>((name, sim))
-            })
-            .await
-            .map_err(|e| ErrorReply::new(ErrorCode::Internal, format!("loading failed: {e}")))??;
-            let mut c = state.control();
-            c.scenario = loaded.0;
-            c.sim = loaded.1;
-            c.running = false;
-            c.pending.clear();
-            c.late_steps = 0;
-            c.free_steps = 0;
-        }
+        SimControl::Load { path, seed } => load(state, path, seed).await?,
         SimControl::Reset { seed } => {
             let mut c = state.control();
             c.sim.reset(seed);

@@ -232,11 +232,22 @@ pub fn truth(t: &GroundTruth, timestamp: Timestamp) -> SceneUpdate {
     ));
     e.metadata = metadata(&[
         ("step", t.step.to_string()),
-        ("sim_time_s", format!("{:.3}", t.time_s)),
+        ("sim_time_s", fixed(t.time_s, 3)),
     ]);
     SceneUpdate {
         entities: vec![e],
         ..SceneUpdate::default()
+    }
+}
+
+/// A number from the wire with `decimals` decimals when it is of a sane size, else in
+/// scientific notation ([`roam_proto::number`]): a forged 1e300 is not 300 digits of
+/// metadata.
+fn fixed(x: f64, decimals: usize) -> String {
+    if x.abs() < 1e12 {
+        format!("{x:.decimals$}")
+    } else {
+        roam_proto::number(x).to_string()
     }
 }
 
@@ -280,11 +291,10 @@ pub fn estimate(p: &PositionEstimate, timestamp: Timestamp) -> SceneUpdate {
     }
     e.metadata = metadata(&[
         ("step", p.step.to_string()),
-        ("sim_time_s", format!("{:.3}", p.time_s)),
+        ("sim_time_s", fixed(p.time_s, 3)),
         (
             "peb_m",
-            p.peb_m
-                .map_or("unbounded".to_owned(), |v| format!("{v:.4}")),
+            p.peb_m.map_or("unbounded".to_owned(), |v| fixed(v, 4)),
         ),
         ("degraded", p.degraded.to_string()),
         ("anchors_used", listed(&p.anchors_used, ANCHORS_LISTED)),
@@ -479,6 +489,14 @@ mod tests {
 
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() < 1e-9
+    }
+
+    #[test]
+    fn numbers_in_metadata_are_short_whatever_the_wire_said() {
+        assert_eq!(fixed(12.34567, 3), "12.346");
+        assert_eq!(fixed(1e300, 3), "1e300");
+        assert_eq!(fixed(-1e300, 4), "-1e300");
+        assert_eq!(fixed(f64::NAN, 3), "NaN");
     }
 
     #[test]

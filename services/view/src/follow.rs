@@ -1,9 +1,10 @@
 //! The Zenoh side: follows roam's keys and logs what it sees on the Foxglove topics.
 //!
 //! Two loops share the outputs. The *world* loop follows the map server's layers (each
-//! publication, plus a look at `<root>/map/layers` at start and every
-//! [`REFRESH_PERIOD`], fetching every layer whose version it has not shown: a view
-//! started after the map server, or a map server restarted, is caught up) and asks the sim
+//! publication; each delta, applied to the layer shown when it is the delta's base
+//! version, else the whole layer is fetched; plus a look at `<root>/map/layers` at start
+//! and every [`REFRESH_PERIOD`], fetching every layer whose version it has not shown: a
+//! view started after the map server, or a map server restarted, is caught up) and asks the sim
 //! for its anchors and robots on the same period. The *robots* loop follows the true
 //! positions, the estimates and the missions.
 //!
@@ -23,6 +24,7 @@ use std::time::Duration;
 use foxglove::messages::{Grid, SceneUpdate, Timestamp};
 use roam_map_server::store::DEFAULT_LIMITS;
 use roam_proto::controller::{Mission, MAX_WAYPOINTS};
+use roam_proto::layer_delta::{LayerDelta, MAX_DELTA_BYTES};
 use roam_proto::localization::PositionEstimate;
 use roam_proto::map::{Layer, LayerList};
 use roam_proto::sim::{GroundTruth, NamedPoint, SimControl, SimStatus};
@@ -46,6 +48,10 @@ pub const MAX_LAYER_CELLS: u64 = DEFAULT_LIMITS.max_layer_cells;
 /// The most bytes of grid cells kept for the layers shown, together (their latched
 /// messages): nine full-size layers of f32 fit, 64 of them do not.
 pub const MAX_LAYER_BYTES_SHOWN: usize = 1 << 30;
+/// The largest layer kept as well as shown, bytes of cells, for deltas to apply to (a
+/// 1.7-million-cell warehouse map's f32 layers are 6.8 MB); a delta of a larger layer
+/// fetches it whole, so the largest layers are not held twice.
+pub const MAX_LAYER_BYTES_KEPT: usize = 16 << 20;
 /// The most robots whose missions are kept, and the most whose driven paths are.
 pub const MAX_ROBOTS: usize = 256;
 /// The most points kept per driven path, and the least distance between two of them.
@@ -133,6 +139,7 @@ pub(crate) async fn follow(
 ) {
     let FleetStreams {
         layers,
+        deltas,
         truth,
         estimate,
         mission,
@@ -162,15 +169,17 @@ pub(crate) async fn follow(
         sim: sim_rx,
     };
     tokio::join!(
-        world.run(layers, cancel.clone()),
+        world.run(layers, deltas, cancel.clone()),
         robots.run(truth, estimate, mission, cancel),
     );
 }
 
-/// A layer shown: its topic, the version shown and the bytes its cells take.
+/// A layer shown: its topic, its version, the layer itself when it is small enough to
+/// keep for deltas ([`MAX_LAYER_BYTES_KEPT`]) and the bytes its cells take.
 struct Shown {
     topic: Topic,
     version: u64,
+    layer: Option<Layer>,
     bytes: usize,
 }
 
@@ -190,7 +199,7 @@ struct World {
 }
 
 impl World {
-    async fn run(mut self, layers: Ring, cancel: CancellationToken) {
+    async fn run(mut self, layers: Ring, deltas: Ring, cancel: CancellationToken) {
         let mut refresh = tokio::time::interval(REFRESH_PERIOD);
         refresh.set_missed_tick_behavior(MissedTickBehavior::Delay);
         loop {
@@ -199,6 +208,15 @@ impl World {
                 _ = cancel.cancelled() => break,
                 sample = layers.recv_async() => match sample {
                     Ok(sample) => self.on_layer(&sample),
+                    Err(_) => break,
+                },
+                sample = deltas.recv_async() => match sample {
+                    Ok(sample) => {
+                        tokio::select! {
+                            _ = cancel.cancelled() => break,
+                            _ = self.on_delta(&sample) => {}
+                        }
+                    }
                     Err(_) => break,
                 },
                 _ = refresh.tick() => {
@@ -223,12 +241,73 @@ impl World {
             );
             return;
         }
-        self.show_layer(&layer, true);
+        self.show_layer(layer, true);
+    }
+
+    /// A delta of a layer shown: applied to it when it is the delta's base version;
+    /// ignored when the view already shows the delta's version or a later one (a delta
+    /// that arrived late; a map server restarted with lower versions is caught up by the
+    /// refresh); otherwise (the view missed a delta, shows nothing of the layer, or did
+    /// not keep a layer that large) the whole layer is fetched.
+    async fn on_delta(&mut self, sample: &Sample) {
+        let key = sample.key_expr().as_str();
+        let Some(delta) = decode_sample::<LayerDelta>(&self.out, sample, MAX_DELTA_BYTES) else {
+            return;
+        };
+        if key != keys::map_delta(&self.root, &delta.name) {
+            return self.out.counters.dropped(
+                key,
+                &format!("a delta of \"{}\" on another key", shown(&delta.name)),
+            );
+        }
+        let Some(held) = self.layers.get(&delta.name) else {
+            return self.fetch(&delta.name).await;
+        };
+        if held.version >= delta.version {
+            return;
+        }
+        let Some(mut layer) = held.layer.clone() else {
+            return self.fetch(&delta.name).await;
+        };
+        match delta.apply(&mut layer) {
+            Ok(()) => self.show_layer(layer, true),
+            Err(e) => {
+                tracing::debug!(layer = %delta.name, "roam view: {e}");
+                self.fetch(&delta.name).await;
+            }
+        }
+    }
+
+    /// Fetches layer `name` whole and shows it when its version is not the one shown.
+    async fn fetch(&mut self, name: &str) {
+        // A name that is not a key segment would make a key of its own (a wildcard, say).
+        let index = keys::map_index(&self.root);
+        if keys::check_name("layer", name).is_err() {
+            let reason = format!("a layer named \"{}\"", shown(name));
+            return self.out.counters.dropped(&index, &reason);
+        }
+        let key = keys::map_layer(&self.root, name);
+        let fetched = wire::query::<Layer, Layer>(
+            &self.session,
+            &key,
+            None,
+            wire::MAX_LAYER_BYTES,
+            QUERY_TIMEOUT,
+        )
+        .await;
+        match fetched {
+            Ok(layer) if layer.name == name => self.show_layer(layer, false),
+            Ok(layer) => self
+                .out
+                .counters
+                .dropped(&key, &format!("a layer named \"{}\"", shown(&layer.name))),
+            Err(e) => self.out.counters.unread(&key, &e),
+        }
     }
 
     /// Shows a layer unless this version is already shown. A published layer is always
     /// news; a fetched one only when its version differs from the one shown.
-    fn show_layer(&mut self, layer: &Layer, published: bool) {
+    fn show_layer(&mut self, layer: Layer, published: bool) {
         let key = keys::map_layer(&self.root, &layer.name);
         let shown_before = self.layers.get(&layer.name);
         if let Some(before) = shown_before {
@@ -263,24 +342,27 @@ impl World {
         if let Some(reason) = refusal {
             return self.out.counters.dropped(&key, &reason);
         }
-        let grid = match convert::grid(layer, Timestamp::now()) {
+        let grid = match convert::grid(&layer, Timestamp::now()) {
             Ok(grid) => grid,
             Err(e) => return self.out.counters.dropped(&key, &e),
         };
         let out = &self.out;
-        let entry = self
-            .layers
-            .entry(layer.name.clone())
-            .or_insert_with(|| Shown {
-                topic: out.topic::<Grid>(&convert::layer_topic(&layer.name), true),
-                version: 0,
-                bytes: 0,
-            });
-        out.log(&entry.topic, &grid);
-        entry.version = layer.version;
-        entry.bytes = bytes;
-        self.layer_bytes = others + bytes;
         tracing::debug!(layer = %layer.name, version = layer.version, "roam view: layer shown");
+        let topic = match self.layers.remove(&layer.name) {
+            Some(before) => before.topic,
+            None => out.topic::<Grid>(&convert::layer_topic(&layer.name), true),
+        };
+        out.log(&topic, &grid);
+        self.layers.insert(
+            layer.name.clone(),
+            Shown {
+                topic,
+                version: layer.version,
+                layer: (bytes <= MAX_LAYER_BYTES_KEPT).then_some(layer),
+                bytes,
+            },
+        );
+        self.layer_bytes = others + bytes;
     }
 
     /// Fetches every layer not shown at its current version, and the sim's status.
@@ -308,23 +390,7 @@ impl World {
                     if version == Some(info.version) {
                         continue;
                     }
-                    let key = keys::map_layer(&self.root, &info.name);
-                    let fetched = wire::query::<Layer, Layer>(
-                        &self.session,
-                        &key,
-                        None,
-                        wire::MAX_LAYER_BYTES,
-                        QUERY_TIMEOUT,
-                    )
-                    .await;
-                    match fetched {
-                        Ok(layer) if layer.name == info.name => self.show_layer(&layer, false),
-                        Ok(layer) => self
-                            .out
-                            .counters
-                            .dropped(&key, &format!("a layer named \"{}\"", shown(&layer.name))),
-                        Err(e) => self.out.counters.unread(&key, &e),
-                    }
+                    self.fetch(&info.name).await;
                 }
             }
             Err(e) => tracing::debug!("roam view: no layer index yet: {}", clipped(&e.to_string())),

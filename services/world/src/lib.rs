@@ -9,11 +9,13 @@
 //!   world's sections), its checks and loader, and the built-in world;
 //!   [`ros_map`]: ROS `map_server` maps as Nav2 reads and writes them;
 //!   [`load_dirs`]: which directories a load request from the wire may read.
-//! - [`world_id`]: which world a map is (one stack runs one world).
+//! - [`world_id`]: which world a map is (one stack runs one world); [`epoch`]: message
+//!   times checked against the sim clock, resets as new epochs.
 //! - [`seed`]: the seeded random streams behind every random choice; [`noise`]: the
 //!   Gaussian sampler and paper 002's TOA and transition noise drawn from them.
 
 pub mod distance;
+pub mod epoch;
 pub mod grid;
 pub mod layers;
 pub mod load_dirs;

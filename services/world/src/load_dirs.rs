@@ -23,23 +23,41 @@ pub struct LoadDirs {
 
 /// Why a load request's file was refused. The same for a missing file and one outside
 /// the directories.
+///
+/// Its message names the server's directories and paths: it is for the service's own
+/// log. What goes back to the peer is [`LoadRefused::to_reply`], which names only the
+/// file as the peer gave it, so a peer learns nothing of the server's file system.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LoadRefused {
     #[error("loads are off: this service has no load directories configured (set load_dirs in its config, or --load-dir)")]
     Off,
-    #[error("no file '{requested}' in the load directories ({dirs}); name a file relative to one of them")]
+    #[error("no file '{requested}' in the load directories ({dirs})")]
     NotAllowed { requested: String, dirs: String },
+    #[error("the loaded file refers to {path}, which does not exist or is outside the load directories ({dirs})")]
+    Referenced { path: String, dirs: String },
 }
 
 impl LoadRefused {
-    /// The error reply for a refused load: `not_found` either way, so a missing file and
-    /// a forbidden one look alike.
-    pub fn to_reply(&self) -> ErrorReply {
-        let code = match self {
-            LoadRefused::Off => ErrorCode::InvalidRequest,
-            LoadRefused::NotAllowed { .. } => ErrorCode::NotFound,
-        };
-        ErrorReply::new(code, self.to_string())
+    /// The error reply to a peer that asked to load `requested`: `not_found` for a
+    /// missing file and a forbidden one alike, naming the file as the peer gave it and
+    /// none of the server's paths.
+    pub fn to_reply(&self, requested: &str) -> ErrorReply {
+        let requested = excerpt(requested);
+        match self {
+            LoadRefused::Off => ErrorReply::new(ErrorCode::InvalidRequest, self.to_string()),
+            LoadRefused::NotAllowed { .. } => ErrorReply::new(
+                ErrorCode::NotFound,
+                format!(
+                    "'{requested}' does not exist or is outside the configured load directories; name a file relative to one of them"
+                ),
+            ),
+            LoadRefused::Referenced { .. } => ErrorReply::new(
+                ErrorCode::NotFound,
+                format!(
+                    "'{requested}' refers to a file (a map image, a scenario's map) that does not exist or is outside the configured load directories"
+                ),
+            ),
+        }
     }
 }
 
@@ -115,8 +133,10 @@ impl LoadDirs {
         if self.dirs.is_empty() {
             return Err(LoadRefused::Off);
         }
-        self.inside(path)
-            .ok_or_else(|| self.not_allowed(&path.to_string_lossy()))
+        self.inside(path).ok_or_else(|| LoadRefused::Referenced {
+            path: excerpt(&path.to_string_lossy()).to_string(),
+            dirs: self.listed(),
+        })
     }
 
     /// The resolved path when it exists and lies inside one of the directories.
@@ -131,13 +151,31 @@ impl LoadDirs {
     fn not_allowed(&self, requested: &str) -> LoadRefused {
         LoadRefused::NotAllowed {
             requested: excerpt(requested).to_string(),
-            dirs: self
-                .dirs
-                .iter()
-                .map(|d| d.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
+            dirs: self.listed(),
         }
+    }
+
+    /// The directories, for the service's own log.
+    fn listed(&self) -> String {
+        self.dirs
+            .iter()
+            .map(|d| d.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// `text` (an error about a file read for a load request) with each directory's
+    /// absolute path taken out: a file inside one is named relative to it, so a reply
+    /// to the peer tells nothing of where the directories are.
+    pub fn redact(&self, text: &str) -> String {
+        let mut redacted = text.to_owned();
+        for dir in &self.dirs {
+            let dir = dir.display().to_string();
+            redacted = redacted
+                .replace(&format!("{dir}{}", std::path::MAIN_SEPARATOR), "")
+                .replace(&dir, "<load dir>");
+        }
+        redacted
     }
 }
 
@@ -208,10 +246,20 @@ mod tests {
         ];
         for requested in &tries {
             let refused = dirs.resolve(requested).expect_err(requested);
-            let reply = refused.to_reply();
+            let reply = refused.to_reply(requested);
             assert_eq!(reply.code, ErrorCode::NotFound, "{requested}");
-            assert!(reply.message.contains("no file"), "{}", reply.message);
+            assert_eq!(
+                reply.message.replacen(&format!("'{requested}'"), "'<file>'", 1),
+                "'<file>' does not exist or is outside the configured load directories; name a file relative to one of them"
+            );
             assert!(!reply.message.contains("password"));
+            let maps = dirs.dirs()[0].display().to_string();
+            assert!(
+                requested.contains(&maps) || !reply.message.contains(&maps),
+                "the reply names the server's directory: {}",
+                reply.message
+            );
+            assert!(refused.to_string().contains(&maps), "the log keeps it");
         }
     }
 
@@ -219,6 +267,28 @@ mod tests {
     fn without_directories_loads_are_off() {
         let refused = LoadDirs::none().resolve("a.yaml").expect_err("off");
         assert_eq!(refused, LoadRefused::Off);
+    }
+
+    #[test]
+    fn redacted_errors_name_files_relative_to_their_directory() {
+        let (root, dirs) = setup();
+        let maps = dirs.dirs()[0].clone();
+        let text = format!(
+            "map file {} is invalid, beside {}",
+            maps.join("a.yaml").display(),
+            maps.display()
+        );
+        assert_eq!(
+            dirs.redact(&text),
+            "map file a.yaml is invalid, beside <load dir>"
+        );
+        let refused = dirs
+            .check_referenced(&root.path().join("secret.txt"))
+            .expect_err("outside");
+        let reply = refused.to_reply("a.yaml");
+        assert_eq!(reply.code, ErrorCode::NotFound);
+        assert!(reply.message.starts_with("'a.yaml' refers to a file"));
+        assert!(!reply.message.contains(&root.path().display().to_string()));
     }
 
     #[test]

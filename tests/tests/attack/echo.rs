@@ -1,9 +1,12 @@
 //! Bounded, escaped echoes: a huge field comes back as a short excerpt, a flood of bad
-//! puts makes a few log lines, and a name with a newline or a terminal escape cannot
-//! forge a log line.
+//! puts makes a few log lines, a name with a newline or a terminal escape cannot forge a
+//! log line, and a number like 1e300 is logged and answered as `1e300`, not as 301
+//! digits.
 
+use roam_proto::cells::Cells;
 use roam_proto::controller::Mission;
-use roam_proto::map::UpdateAck;
+use roam_proto::map::{CellWrite, GridMeta, LayerChange, LayerUpdate, UpdateAck};
+use roam_proto::sim::{AnchorRange, LocalObservation, RangeScan};
 use roam_proto::{encode, keys};
 use roam_runtime::{ClientError, Requester};
 use roam_tests::{within, Harness};
@@ -118,5 +121,110 @@ pub(crate) async fn logs(harness: &Harness, client: &Requester, log: &Captured) 
     assert!(
         text.contains("mission refused"),
         "the refusals are logged:\n{text}"
+    );
+}
+
+/// 1e300 written out: what a number from the wire must never become in a log or a reply.
+fn digits() -> String {
+    format!("1{}", "0".repeat(40))
+}
+
+/// Numbers from the wire, huge ones included, reach logs and replies in a few
+/// characters: a scan and an observation stamped 1e300 (localization and the mapper log
+/// why they ignore them), a cell written with 1e300 (the map server's refusal).
+pub(crate) async fn numbers(harness: &Harness, client: &Requester, log: &Captured) {
+    let server = harness.start_role(harness.map_server_config()).await;
+    let localization = harness.start_role(harness.localization_config(None)).await;
+    let mapper = harness.start_role(harness.mapper_config()).await;
+    let root = harness.root.clone();
+    let session = client.session();
+    let before = log.len();
+
+    let scan = RangeScan {
+        robot: "robot".into(),
+        step: 1,
+        time_s: 1e300,
+        ranges: (0..3)
+            .map(|i| AnchorRange {
+                anchor: format!("a{i}"),
+                at: [f64::from(i) * 5.0, 1e300],
+                range_m: 1.0,
+            })
+            .collect(),
+    };
+    within(
+        "put",
+        session.put(keys::robot_ranges(&root, "robot"), encode(&scan)),
+    )
+    .await
+    .expect("put");
+    let observation = LocalObservation {
+        robot: "robot".into(),
+        step: 1,
+        time_s: 1e300,
+        at: [0.0, 0.0],
+        x0: 0,
+        y0: 0,
+        meta: GridMeta {
+            width: 1,
+            height: 1,
+            resolution: 0.2,
+            origin: Default::default(),
+        },
+        cells: Cells::I8(vec![0]),
+    };
+    within(
+        "put",
+        session.put(
+            keys::robot_observation(&root, "robot"),
+            encode(&observation),
+        ),
+    )
+    .await
+    .expect("put");
+    log.wait_for(before, "ignoring a scan: its time 1e300 s")
+        .await;
+    log.wait_for(before, "ignoring an observation: its time 1e300 s")
+        .await;
+
+    let huge = LayerUpdate {
+        base_version: 1,
+        change: LayerChange::SetCells {
+            cells: vec![CellWrite {
+                x: 0,
+                y: 0,
+                value: 1e300,
+            }],
+        },
+        world: None,
+    };
+    let refused = match client
+        .request::<LayerUpdate, UpdateAck>(&keys::map_update(&root, "peb"), Some(&huge))
+        .await
+    {
+        Err(ClientError::Refused(reply)) => reply,
+        other => panic!("expected a refusal, got {other:?}"),
+    };
+    let occupancy = match client
+        .request::<LayerUpdate, UpdateAck>(&keys::map_update(&root, "occupancy"), Some(&huge))
+        .await
+    {
+        Err(ClientError::Refused(reply)) => reply,
+        other => panic!("expected a refusal, got {other:?}"),
+    };
+    assert!(
+        occupancy.message.contains("value 1e300"),
+        "{}",
+        occupancy.message
+    );
+    for reply in [&refused, &occupancy] {
+        assert!(!reply.message.contains(&digits()), "{}", reply.message);
+    }
+    mapper.stop().await.1.expect("clean stop");
+    localization.stop().await.1.expect("clean stop");
+    server.stop().await.1.expect("clean stop");
+    assert!(
+        !log.since(before).contains(&digits()),
+        "a number from the wire was logged in full"
     );
 }

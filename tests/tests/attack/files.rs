@@ -104,6 +104,24 @@ fn assert_no_content(reply: &ErrorReply, what: &str) {
     }
 }
 
+/// A refused load names the file as the peer gave it and none of the server's own
+/// paths: not the load directory, nor the folder around it (unless the peer named it).
+fn assert_no_server_path(reply: &ErrorReply, requested: &str, files: &Files) {
+    let mut paths = vec![files.maps(), files.dir.path().to_owned()];
+    paths.extend(paths.clone().iter().filter_map(|p| p.canonicalize().ok()));
+    for path in paths {
+        let path = path.display().to_string();
+        if requested.contains(&path) {
+            continue;
+        }
+        assert!(
+            !reply.message.contains(&path),
+            "'{requested}': the reply names the server's {path}: {}",
+            reply.message
+        );
+    }
+}
+
 /// The map server's loads.
 pub(crate) async fn map_loads(harness: &Harness, client: &Requester, files: &Files) {
     let server = harness
@@ -133,11 +151,20 @@ pub(crate) async fn map_loads(harness: &Harness, client: &Requester, files: &Fil
             &requested,
         );
         assert_no_content(&reply, &requested);
+        assert_no_server_path(&reply, &requested, files);
         if !requested.is_empty() {
             assert_eq!(
                 shape(&reply, &requested),
                 missing_shape,
                 "'{requested}' is answered otherwise than a missing file: an existence oracle"
+            );
+            assert!(
+                reply.message.contains(&format!("'{requested}'"))
+                    && reply
+                        .message
+                        .contains("outside the configured load directories"),
+                "{}",
+                reply.message
             );
         }
     }
@@ -156,8 +183,10 @@ pub(crate) async fn map_loads(harness: &Harness, client: &Requester, files: &Fil
             reply.message
         );
         assert_no_content(&reply, requested);
+        assert_no_server_path(&reply, requested, files);
     }
-    // Inside the directory and not a map: named as corrupt, without its content.
+    // Inside the directory and not a map: named as corrupt, without its content, and
+    // relative to its directory.
     let notes = refusal(
         client
             .request::<LoadMap, LayerList>(&key, Some(&load("notes.yaml")))
@@ -165,6 +194,8 @@ pub(crate) async fn map_loads(harness: &Harness, client: &Requester, files: &Fil
         "notes",
     );
     assert_no_content(&notes, "notes.yaml");
+    assert_no_server_path(&notes, "notes.yaml", files);
+    assert!(notes.message.contains("notes.yaml"), "{}", notes.message);
     // And a real map in the directory loads.
     let list: LayerList = client
         .request(&key, Some(&load("ok.yaml")))
@@ -206,6 +237,7 @@ pub(crate) async fn sim_loads(harness: &Harness, client: &Requester, files: &Fil
             &requested,
         );
         assert_no_content(&reply, &requested);
+        assert_no_server_path(&reply, &requested, files);
         if files.forbidden().contains(&requested) && !requested.is_empty() {
             assert_eq!(
                 shape(&reply, &requested),
@@ -217,12 +249,18 @@ pub(crate) async fn sim_loads(harness: &Harness, client: &Requester, files: &Fil
     sim.stop().await.1.expect("clean stop");
 }
 
-/// No secret in the log, and every refused load logged.
-pub(crate) fn check_log(log: &Captured, from: usize) {
+/// No secret in the log, and every refused load logged, with the detail the peer's
+/// reply leaves out (the server's load directory).
+pub(crate) fn check_log(log: &Captured, from: usize, files: &Files) {
     let text = log.since(from);
     assert!(!text.contains(MARKER), "a secret reached the log");
     assert!(
         text.contains("refused a map load") && text.contains("refused a scenario load"),
         "refused loads are logged at the default level"
+    );
+    let maps = files.maps().canonicalize().unwrap_or_else(|_| files.maps());
+    assert!(
+        text.contains(&maps.display().to_string()),
+        "the log keeps the load directory of a refused load"
     );
 }

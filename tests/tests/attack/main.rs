@@ -3,8 +3,11 @@
 //! hold asserted:
 //!
 //! - loads read no file outside the load directories, answer a forbidden file as a
-//!   missing one (no existence oracle) and never quote a file, in a reply or a log
-//!   ([`files`]);
+//!   missing one (no existence oracle), name the file as the peer gave it and none of
+//!   the server's paths (the log keeps them), and never quote a file, in a reply or a
+//!   log ([`files`]);
+//! - a stranger creating layers is refused once they would hold more than the map
+//!   server's `max_total_cell_bytes`, naming it ([`map_memory`]);
 //! - keys decide: a body naming another robot is refused, nothing is published on a key
 //!   a body chose, a forged mission or scan moves nothing ([`routing`]);
 //! - echoes are bounded and escaped: replies to megabyte fields stay under
@@ -13,6 +16,9 @@
 //!   log line ([`echo`]);
 //! - a client flooding the planner's queue leaves another its fair share
 //!   ([`planner_flood`]);
+//! - the ROS 2 node answers every call to its services, one without rmw_zenoh's
+//!   attachment, one of 8 MB and a storm of them, and refuses a map whose header
+//!   claims 10⁸ cells from its header, and goes on ([`ros2`]);
 //! - the live view refuses a page from a foreign Origin and lets a real client in past
 //!   hundreds of half-open connections ([`view`]).
 //!
@@ -26,7 +32,9 @@
 mod echo;
 mod files;
 mod logs;
+mod map_memory;
 mod planner_flood;
+mod ros2;
 mod routing;
 mod view;
 
@@ -42,14 +50,20 @@ async fn attacks_on_a_running_stack_find_nothing() {
     let from = log.len();
     files::map_loads(&harness, &client, &files).await;
     files::sim_loads(&harness, &client, &files).await;
-    files::check_log(&log, from);
+    files::check_log(&log, from, &files);
+
+    map_memory::layers_within_the_budget(&harness, &client).await;
 
     routing::keys_decide(&harness, &client).await;
 
     echo::replies(&harness, &client).await;
     echo::logs(&harness, &client, &log).await;
+    echo::numbers(&harness, &client, &log).await;
 
     planner_flood::second_client(&harness).await;
+
+    ros2::services(&harness, &client).await;
+    ros2::map_input(&harness, &client, &log).await;
 
     view::origins(&harness).await;
     view::half_open(&harness).await;

@@ -8,26 +8,33 @@
 
 use std::sync::Arc;
 
+use super::publication::{self, Publication};
 use super::stage::{Change, Pending, Staged};
 use super::{LayerStore, StoreError};
 
 impl LayerStore {
-    /// Persists then installs the staged layers; returns their names.
-    pub(super) fn commit(&mut self, pending: Pending) -> Result<Vec<String>, StoreError> {
+    /// Persists then installs the staged layers; returns how each is published.
+    pub(super) fn commit(&mut self, pending: Pending) -> Result<Vec<Publication>, StoreError> {
         self.persist(&pending)?;
         let names: Vec<String> = pending.staged.iter().map(|s| s.name.clone()).collect();
         let mut appended = Vec::new();
+        let mut publications = Vec::with_capacity(pending.staged.len());
         for staged in pending.staged {
-            if matches!(staged.change, Change::Edits(_)) {
-                appended.push(staged.name.clone());
-            }
+            let publication = match (&staged.change, self.layers.get(&staged.name)) {
+                (Change::Edits(edits), Some(current)) => {
+                    appended.push(staged.name.clone());
+                    publication::of_edits(current, staged.version, edits)
+                }
+                _ => Publication::Whole(staged.name.clone()),
+            };
+            publications.push(publication);
             self.install(staged);
         }
         self.forget_tombstones_of(&names);
         for name in appended {
             self.compact_if_due(&name);
         }
-        Ok(names)
+        Ok(publications)
     }
 
     fn persist(&mut self, pending: &Pending) -> Result<(), StoreError> {

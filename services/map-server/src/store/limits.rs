@@ -15,6 +15,11 @@ pub struct Limits {
     pub max_request_bytes: u64,
     /// Layers held at once.
     pub max_layers: u64,
+    /// Bytes of cells held across all layers together (1 byte a cell for i8 and u8, 4 for
+    /// f32). `max_layers` full-size layers from anonymous writers would otherwise reach
+    /// about 4 GiB of cells (f32) and as much again encoded: a change that would hold
+    /// more is refused before it is staged.
+    pub max_total_cell_bytes: u64,
 }
 
 pub const DEFAULT_LIMITS: Limits = Limits {
@@ -22,7 +27,14 @@ pub const DEFAULT_LIMITS: Limits = Limits {
     max_cells_per_update: 100_000,
     max_request_bytes: 96 * 1024 * 1024,
     max_layers: 64,
+    max_total_cell_bytes: DEFAULT_MAX_TOTAL_CELL_BYTES,
 };
+
+/// The default of [`Limits::max_total_cell_bytes`]: 1 GiB. A 1.7-million-cell
+/// warehouse map with its derived layers, localization's PEB and the mapper's four
+/// layers holds about 34 MB (i8 and u8 layers 1.7 MB each, f32 layers 6.8 MB), so 30
+/// such sets fit; so do 16 full-size (4096²) f32 layers.
+pub const DEFAULT_MAX_TOTAL_CELL_BYTES: u64 = 1 << 30;
 
 impl Default for Limits {
     fn default() -> Self {

@@ -16,15 +16,18 @@
 //! would lose. The layers of one change are installed together: a reader sees either
 //! all of them or none.
 
+mod budget;
 mod commit;
 mod error;
 mod limits;
+mod publication;
 pub mod restore;
 mod stage;
 
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::Arc;
 
+use roam_proto::cells::Dtype;
 use roam_proto::keys;
 use roam_proto::map::{
     GridMeta, Layer, LayerChange, LayerDeleted, LayerInfo, LayerList, LayerUpdate, UpdateAck,
@@ -32,7 +35,8 @@ use roam_proto::map::{
 };
 
 pub use error::StoreError;
-pub use limits::{DerivedParams, Limits, DEFAULT_LIMITS};
+pub use limits::{DerivedParams, Limits, DEFAULT_LIMITS, DEFAULT_MAX_TOTAL_CELL_BYTES};
+pub use publication::{Publication, DELTA_MAX_SHARE};
 
 use crate::derived::Derivation;
 use crate::edits::CellEdits;
@@ -179,6 +183,13 @@ impl LayerStore {
             self.check_base(OCCUPANCY, base, "load", "load the map again")?;
         }
         self.check_size(&occupancy_grid.meta)?;
+        let sizes = self.sizes_after(
+            OCCUPANCY,
+            &occupancy_grid.meta,
+            Dtype::I8,
+            information.is_some(),
+        );
+        self.check_budget(OCCUPANCY, &sizes)?;
         let mut pending = Pending::default();
         let info_cells = information.map(|g| roam_proto::cells::Cells::U8(g.cells));
         self.stage_source(
@@ -188,15 +199,16 @@ impl LayerStore {
             roam_proto::cells::Cells::I8(occupancy_grid.cells),
             info_cells,
         )?;
-        self.commit(pending)
+        Ok(names(&self.commit(pending)?))
     }
 
-    /// Applies one update to layer `name`.
+    /// Applies one update to layer `name`. Returns the acknowledgement and how each
+    /// changed layer is published (a `set_cells` change as a delta when small).
     pub fn apply(
         &mut self,
         name: &str,
         update: &LayerUpdate,
-    ) -> Result<(UpdateAck, Vec<String>), StoreError> {
+    ) -> Result<(UpdateAck, Vec<Publication>), StoreError> {
         keys::check_name("layer name", name).map_err(|e| StoreError::Invalid(e.to_string()))?;
         if let (Some(theirs), Some(mine)) = (&update.world, &self.world) {
             if theirs.hash != mine.hash {
@@ -241,6 +253,7 @@ impl LayerStore {
                         "layers held (delete one with <root>/map/delete/<name>)".into(),
                     ));
                 }
+                self.check_budget(name, &self.sizes_after(name, meta, cells.dtype(), false))?;
                 if name == INFORMATION {
                     self.stage_information(&mut pending, *meta, cells.clone())?;
                 } else {
@@ -270,7 +283,8 @@ impl LayerStore {
         let changed = self.commit(pending)?;
         let derived = changed
             .iter()
-            .filter(|n| n.as_str() != name)
+            .map(Publication::name)
+            .filter(|&n| n != name)
             .filter_map(|n| self.layers.get(n))
             .map(|l| info(l))
             .collect();
@@ -361,6 +375,11 @@ impl LayerStore {
     }
 }
 
+/// The names of the layers published.
+fn names(publications: &[Publication]) -> Vec<String> {
+    publications.iter().map(|p| p.name().to_owned()).collect()
+}
+
 /// Records that `name` reached `version`, keeping the newest [`MAX_TOMBSTONES`].
 fn remember(tombstones: &mut Vec<Tombstone>, name: &str, version: u64) {
     tombstones.retain(|t| t.name != name);
@@ -396,7 +415,7 @@ fn check_meta(meta: &GridMeta) -> Result<(), StoreError> {
     if !(meta.resolution.is_finite() && meta.resolution > 0.0) {
         return Err(StoreError::Invalid(format!(
             "resolution must be a positive number of metres per cell, got {}",
-            meta.resolution
+            roam_proto::number(meta.resolution)
         )));
     }
     if !(o.x.is_finite() && o.y.is_finite() && o.yaw.is_finite()) {

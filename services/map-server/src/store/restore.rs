@@ -25,7 +25,8 @@ use roam_proto::map::Layer;
 
 use super::stage::{Change, Pending, Staged};
 use super::{
-    derived_source, remember, LayerStore, StoreError, HEURISTIC, INFLATED, INFORMATION, OCCUPANCY,
+    derived_source, names, remember, LayerStore, StoreError, HEURISTIC, INFLATED, INFORMATION,
+    OCCUPANCY,
 };
 use crate::derived::{Derivation, Recipe};
 use roam_world::grid::Grid;
@@ -158,6 +159,13 @@ impl LayerStore {
             }
         }
         self.commit(pending)?;
+        let held = self.held_cell_bytes();
+        if held > self.limits.max_total_cell_bytes {
+            self.warn(format!(
+                "the restored layers hold {held} bytes of cells, over the limit max_total_cell_bytes = {}: they are all served, but a replace or a load that adds to them is refused until layers are deleted",
+                self.limits.max_total_cell_bytes
+            ));
+        }
         Ok(restored)
     }
 
@@ -340,7 +348,7 @@ impl LayerStore {
         for w in warnings {
             self.warn(w);
         }
-        Ok(changed)
+        Ok(names(&changed))
     }
 }
 

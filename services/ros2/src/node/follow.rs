@@ -1,9 +1,11 @@
 //! roam → ROS 2: follows the map server's layers and the robots' estimates, missions and
 //! true positions on roam's keys, and publishes them as ROS topics.
 //!
-//! Layers: each publication on `<root>/map/layer/*`, and at start and every
-//! [`REFRESH_PERIOD`] a look at `<root>/map/layers`, fetching any layer whose version was
-//! not published yet (a node started after the map server catches up). Robots: their
+//! Layers: each publication on `<root>/map/layer/*`, each delta on `<root>/map/delta/*`
+//! (applied to the layer last published when it is the delta's base version, else the
+//! whole layer is fetched), and at start and every [`REFRESH_PERIOD`] a look at
+//! `<root>/map/layers`, fetching any layer whose version was not published yet (a node
+//! started after the map server catches up). Robots: their
 //! estimates (`/<robot>/pose`), missions (`/<robot>/plan`) and true positions (the path
 //! driven, `/<robot>/driven`, at most every [`DRIVEN_PERIOD`]).
 
@@ -12,6 +14,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use roam_proto::controller::{Mission, MAX_MISSION_BYTES, MAX_WAYPOINTS};
+use roam_proto::layer_delta::{LayerDelta, MAX_DELTA_BYTES};
 use roam_proto::localization::PositionEstimate;
 use roam_proto::map::{Layer, LayerList};
 use roam_proto::sim::GroundTruth;
@@ -86,6 +89,7 @@ pub(super) async fn run(
 ) {
     let FleetStreams {
         layers,
+        deltas,
         estimate,
         mission,
         truth,
@@ -102,7 +106,7 @@ pub(super) async fn run(
         driven: BTreeMap::new(),
     };
     tokio::join!(
-        world.run(layers, cancel.clone()),
+        world.run(layers, deltas, cancel.clone()),
         robots.run(estimate, mission, truth, cancel)
     );
 }
@@ -111,12 +115,12 @@ struct Layers {
     out: Arc<Output>,
     root: String,
     requester: Requester,
-    /// The version published of each layer.
-    published: BTreeMap<String, u64>,
+    /// Each layer published, as published: deltas apply to it.
+    published: BTreeMap<String, Layer>,
 }
 
 impl Layers {
-    async fn run(mut self, layers: Ring, cancel: CancellationToken) {
+    async fn run(mut self, layers: Ring, deltas: Ring, cancel: CancellationToken) {
         let mut refresh = tokio::time::interval(REFRESH_PERIOD);
         refresh.set_missed_tick_behavior(MissedTickBehavior::Delay);
         loop {
@@ -128,12 +132,16 @@ impl Layers {
                         let key = sample.key_expr().as_str().to_owned();
                         if let Some(layer) = decode_sample::<Layer>(&self.out, &sample, MAX_LAYER_BYTES) {
                             if key == keys::map_layer(&self.root, &layer.name) {
-                                self.publish(&layer).await;
+                                self.publish(layer).await;
                             } else {
                                 self.out.refuse(&key, "a layer named for another key");
                             }
                         }
                     }
+                    Err(_) => break,
+                },
+                sample = deltas.recv_async() => match sample {
+                    Ok(sample) => self.on_delta(&sample).await,
                     Err(_) => break,
                 },
                 _ = refresh.tick() => {
@@ -146,22 +154,65 @@ impl Layers {
         }
     }
 
-    async fn publish(&mut self, layer: &Layer) {
+    /// Publishes a layer of [`LAYER_TOPICS`], and keeps it.
+    async fn publish(&mut self, layer: Layer) {
         let Some((_, topic, scale)) = LAYER_TOPICS.iter().find(|(name, ..)| *name == layer.name)
         else {
             return;
         };
-        match convert::layer_to_grid(layer, *scale, now()) {
+        match convert::layer_to_grid(&layer, *scale, now()) {
             Ok(grid) => {
                 self.out
                     .publish(topic, types::OCCUPANCY_GRID, Qos::LATCHED, &grid)
                     .await;
-                self.published.insert(layer.name.clone(), layer.version);
                 tracing::debug!(layer = %layer.name, version = layer.version, "roam ros2: layer published");
+                self.published.insert(layer.name.clone(), layer);
             }
             Err(e) => self
                 .out
                 .refuse(&keys::map_layer(&self.root, &layer.name), &e.to_string()),
+        }
+    }
+
+    /// A delta of a layer published: applied to it when it is the delta's base version;
+    /// ignored when the node already holds the delta's version or a later one (a delta
+    /// that arrived late; a map server restarted with lower versions is caught up by
+    /// the refresh); otherwise (the node missed a delta) the whole layer is fetched.
+    async fn on_delta(&mut self, sample: &Sample) {
+        let Some(delta) = decode_sample::<LayerDelta>(&self.out, sample, MAX_DELTA_BYTES) else {
+            return;
+        };
+        let key = sample.key_expr().as_str();
+        if key != keys::map_delta(&self.root, &delta.name) {
+            return self.out.refuse(key, "a delta named for another key");
+        }
+        if !LAYER_TOPICS.iter().any(|(name, ..)| *name == delta.name) {
+            return;
+        }
+        let Some(mut layer) = self.published.remove(&delta.name) else {
+            return self.fetch(&delta.name).await;
+        };
+        if layer.version >= delta.version {
+            self.published.insert(delta.name.clone(), layer);
+            return;
+        }
+        match delta.apply(&mut layer) {
+            Ok(()) => self.publish(layer).await,
+            Err(e) => {
+                tracing::debug!(layer = %delta.name, "roam ros2: {e}");
+                self.published.insert(delta.name.clone(), layer);
+                self.fetch(&delta.name).await;
+            }
+        }
+    }
+
+    /// Fetches layer `name` whole and publishes it.
+    async fn fetch(&mut self, name: &str) {
+        let key = keys::map_layer(&self.root, name);
+        match self.requester.request::<Layer, Layer>(&key, None).await {
+            Ok(layer) if layer.name == name => self.publish(layer).await,
+            Ok(_) => self.out.refuse(&key, "a layer named for another key"),
+            Err(e) => tracing::debug!(%key, "roam ros2: layer not fetched: {e}"),
         }
     }
 
@@ -179,15 +230,10 @@ impl Layers {
             let Some(info) = list.layers.iter().find(|l| l.name == name) else {
                 continue;
             };
-            if self.published.get(name) == Some(&info.version) {
+            if self.published.get(name).map(|l| l.version) == Some(info.version) {
                 continue;
             }
-            let key = keys::map_layer(&self.root, name);
-            match self.requester.request::<Layer, Layer>(&key, None).await {
-                Ok(layer) if layer.name == name => self.publish(&layer).await,
-                Ok(_) => self.out.refuse(&key, "a layer named for another key"),
-                Err(e) => tracing::debug!(%key, "roam ros2: layer not fetched: {e}"),
-            }
+            self.fetch(name).await;
         }
     }
 }

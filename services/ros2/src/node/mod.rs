@@ -22,6 +22,8 @@ use tokio_util::sync::CancellationToken;
 use crate::names::{self, NodeInfo};
 
 pub use output::Output;
+/// What every call to the node's services is promised (see `services`).
+pub use services::{GET_PLAN_ANSWER_S, MAX_CONCURRENT_CALLS, MAX_REQUEST_BYTES};
 
 /// The role's name in `<root>/@live/ros2/<instance>`.
 pub const SERVICE_NAME: &str = "ros2";
