@@ -11,9 +11,11 @@
 //! of 0 reserves the cells the path crosses (and a few corner neighbours).
 //!
 //! Bounded work on any path: the path is clipped to the map (a waypoint a million metres
-//! off costs nothing), at most `max_cells` cells are reserved (the path's first ones, in
-//! the order it reaches them) and at most [`WORK_PER_CELL`] × `max_cells` cells are
-//! looked at, so a path that sweeps the same cells again and again stops there.
+//! off costs nothing), repeated points are passed over, at most `max_cells` cells are
+//! reserved (the path's first ones, in the order it reaches them) and at most
+//! [`WORK_PER_CELL`] times as many cells as can be reserved (`max_cells`, or the map's
+//! cells if fewer) are looked at, so a path that sweeps the same cells again and again
+//! stops there: a straight path looks at about four cells for each it reserves.
 
 use std::collections::HashMap;
 
@@ -29,7 +31,7 @@ pub type TimedCell = ((u32, u32), f64);
 pub const DEFAULT_S_PER_M: f64 = 2.0;
 
 /// Cells looked at per cell reservable, at most (module doc).
-pub const WORK_PER_CELL: usize = 64;
+pub const WORK_PER_CELL: usize = 32;
 
 /// How a mission becomes a reservation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -99,18 +101,24 @@ pub fn cells_along(
             reason: format!("point {i} is not a finite position"),
         });
     }
+    let map_cells =
+        usize::try_from(u64::from(meta.width) * u64::from(meta.height)).unwrap_or(usize::MAX);
     let mut sweep = Sweep {
         meta,
         reach: radius_m.max(meta.resolution * std::f64::consts::FRAC_1_SQRT_2),
         max_cells,
-        work_left: max_cells.saturating_mul(WORK_PER_CELL),
+        work_left: max_cells.min(map_cells).saturating_mul(WORK_PER_CELL),
         reserved: HashMap::new(),
     };
     let mut travelled = 0.0;
-    let segments: Vec<([f64; 2], [f64; 2])> = match path {
+    // A point repeated adds nothing its neighbours' segments do not; a path of one
+    // point (or of one point repeated) is that point.
+    let mut points = path.to_vec();
+    points.dedup();
+    let segments: Vec<([f64; 2], [f64; 2])> = match points.as_slice() {
         [] => Vec::new(),
         [only] => vec![(*only, *only)],
-        _ => path.windows(2).map(|w| (w[0], w[1])).collect(),
+        many => many.windows(2).map(|w| (w[0], w[1])).collect(),
     };
     for (a, b) in segments {
         let t_a = start_s + travelled * s_per_m;
@@ -338,12 +346,18 @@ mod tests {
         let far = [[0.5, 1.5], [1e9, 1.5]];
         let cells = cells_along(&meta(), &far, 0.0, 1.0, 0.0, 1000).expect("cells");
         assert_eq!(cells.len(), 10);
-        // Sweeping the same row a thousand times stops at the work limit.
+        // Sweeping the same row a thousand times stops at the work limit: the row's ten
+        // cells, from the first few passes.
         let zigzag: Vec<[f64; 2]> = (0..1000)
             .map(|i| if i % 2 == 0 { [0.5, 1.5] } else { [9.5, 1.5] })
             .collect();
-        let swept = cells_along(&meta(), &zigzag, 0.0, 1.0, 0.0, 10).expect("cells");
+        let swept = cells_along(&meta(), &zigzag, 0.0, 1.0, 0.0, 1000).expect("cells");
         assert_eq!(swept.len(), 10);
+        assert!(swept.iter().all(|&(_, t)| t < 9.0 * 100.0), "{swept:?}");
+        // Ten thousand copies of one point are that point.
+        let repeated =
+            cells_along(&meta(), &[[2.5, 1.5]; 10_000], 7.0, 1.0, 0.0, 10).expect("point");
+        assert_eq!(repeated, vec![((2, 1), 7.0)]);
         assert!(cells_along(&meta(), &[], 0.0, 1.0, 0.0, 10)
             .expect("empty")
             .is_empty());

@@ -141,8 +141,9 @@ struct Mapping {
     map: ChangeMap,
     /// The robots' reservations (their current missions).
     news: NewsMap,
-    /// Each reserving robot's last observed position, where its mission's path starts;
-    /// kept for at most [`MAX_RESERVING_ROBOTS`] robots.
+    /// Each robot's last observed position, where its mission's path starts; kept for
+    /// the first [`MAX_RESERVING_ROBOTS`] robots heard (a mission of any other starts at
+    /// its first waypoint).
     positions: BTreeMap<String, [f64; 2]>,
     explorers: BTreeMap<String, Explorer>,
     /// The exploration goal last published per robot: a goal is published when it changes.
