@@ -180,6 +180,66 @@ pub fn planner_cancel_any(root: &str) -> String {
     format!("{root}/planner/cancel/*")
 }
 
+/// `<root>/planner/robot/<robot>/plan`: every planner instance answers a `get` carrying
+/// a [`PlanRequest`](crate::planner::PlanRequest) for `robot` (its mission executive asks
+/// here) as on [`planner_plan`], and keeps the plan's progress and cancel under the
+/// robot's keys ([`planner_robot_progress`], [`planner_robot_cancel`]): a router's access
+/// control can then give each robot's credentials its own robot's plans only.
+pub fn planner_robot_plan(root: &str, robot: &str) -> String {
+    format!("{root}/planner/robot/{robot}/plan")
+}
+
+/// `<root>/planner/robot/*/plan`: what every planner instance declares for robots' plans.
+pub fn planner_robot_plan_any(root: &str) -> String {
+    format!("{root}/planner/robot/*/plan")
+}
+
+/// `<root>/planner/instance/<instance>/robot/<robot>/plan`: [`planner_robot_plan`] on one
+/// instance's own key, for clients that choose among instances ([`planner_plan_at`]).
+pub fn planner_robot_plan_at(root: &str, instance: &str, robot: &str) -> String {
+    format!("{root}/planner/instance/{instance}/robot/{robot}/plan")
+}
+
+/// `<root>/planner/instance/<instance>/robot/*/plan`: what one instance declares for
+/// robots' plans on its own key.
+pub fn planner_robot_plan_at_any(root: &str, instance: &str) -> String {
+    format!("{root}/planner/instance/{instance}/robot/*/plan")
+}
+
+/// `<root>/planner/robot/<robot>/progress/<request_id>`: [`planner_progress`] of a plan
+/// asked on one of the robot's plan keys.
+pub fn planner_robot_progress(root: &str, robot: &str, request_id: &str) -> String {
+    format!("{root}/planner/robot/{robot}/progress/{request_id}")
+}
+
+/// `<root>/planner/robot/<robot>/cancel/<request_id>`: put a
+/// [`CancelPlan`](crate::planner::CancelPlan) here to stop a plan asked on one of the
+/// robot's plan keys (with the request's `cancel_token`, as on [`planner_cancel`]). Such a
+/// plan is cancelled here only: a cancel on another robot's key or on [`planner_cancel`]
+/// does not reach it.
+pub fn planner_robot_cancel(root: &str, robot: &str, request_id: &str) -> String {
+    format!("{root}/planner/robot/{robot}/cancel/{request_id}")
+}
+
+/// `<root>/planner/robot/*/cancel/*`: what planner instances subscribe to for robots'
+/// plans.
+pub fn planner_robot_cancel_any(root: &str) -> String {
+    format!("{root}/planner/robot/*/cancel/*")
+}
+
+/// The robot a plan query's key is for: `<robot>` of [`planner_robot_plan`] or
+/// [`planner_robot_plan_at`], as the key has it (a query's key may hold a wildcard:
+/// check it with [`check_name`]); `None` for any other key, [`planner_plan`]'s included.
+pub fn planner_robot_of<'k>(root: &str, key: &'k str) -> Option<&'k str> {
+    let rest = key.strip_prefix(root)?.strip_prefix("/planner/")?;
+    let rest = match rest.strip_prefix("instance/") {
+        Some(at_instance) => at_instance.split_once('/')?.1,
+        None => rest,
+    };
+    let robot = rest.strip_prefix("robot/")?.strip_suffix("/plan")?;
+    (!robot.is_empty() && !robot.contains('/')).then_some(robot)
+}
+
 /// `<root>/sim/control`: the sim answers a `get` carrying a
 /// [`SimControl`](crate::sim::SimControl) with a [`SimStatus`](crate::sim::SimStatus).
 pub fn sim_control(root: &str) -> String {
@@ -337,6 +397,43 @@ mod tests {
             "roamx/robot/r1/mission",
         ] {
             assert_eq!(robot_of("roam", bad), None, "{bad}");
+        }
+    }
+
+    #[test]
+    fn a_robots_plan_keys_name_it() {
+        assert_eq!(planner_robot_plan("r", "r1"), "r/planner/robot/r1/plan");
+        assert_eq!(
+            planner_robot_plan_at("r", "p1", "r1"),
+            "r/planner/instance/p1/robot/r1/plan"
+        );
+        assert_eq!(
+            planner_robot_cancel("r", "r1", "q"),
+            "r/planner/robot/r1/cancel/q"
+        );
+        assert_eq!(
+            planner_robot_progress("r", "r1", "q"),
+            "r/planner/robot/r1/progress/q"
+        );
+        for key in [
+            planner_robot_plan("site/r", "r-1"),
+            planner_robot_plan_at("site/r", "p1", "r-1"),
+        ] {
+            assert_eq!(planner_robot_of("site/r", &key), Some("r-1"), "{key}");
+        }
+        assert_eq!(
+            planner_robot_of("r", &planner_robot_plan("r", "*")),
+            Some("*")
+        );
+        for other in [
+            planner_plan("r"),
+            planner_plan_at("r", "p1"),
+            "r/planner/robot/a/b/plan".to_owned(),
+            "r/planner/robot//plan".to_owned(),
+            "r/planner/instance/p1/plan/robot/r1/plan".to_owned(),
+            "rx/planner/robot/r1/plan".to_owned(),
+        ] {
+            assert_eq!(planner_robot_of("r", &other), None, "{other}");
         }
     }
 

@@ -270,8 +270,16 @@ impl Harness {
     /// announces itself once it has a map, so start the map server first).
     pub async fn start_role(&self, role: impl Into<Role>) -> RunningService {
         let role = role.into();
-        let (name, key) = (role.name(), role.live_key());
-        self.start_service_as(name, key, |zenoh, cancel| role.run(zenoh, cancel))
+        let name = role.name();
+        self.start_role_as(name, role).await
+    }
+
+    /// [`Harness::start_role`] with the credentials of `user` (on a secure site, a user
+    /// whose name is not the service's: a robot's `controller-<id>`, say).
+    pub async fn start_role_as(&self, user: &str, role: impl Into<Role>) -> RunningService {
+        let role = role.into();
+        let key = role.live_key();
+        self.start_service_as(user, key, |zenoh, cancel| role.run(zenoh, cancel))
             .await
     }
 

@@ -1,9 +1,9 @@
 //! The planner through Zenoh: plans, determinism against the in-process planner, the
 //! shortest path attached, progress, cancel (only with the requester's token), busy, the
-//! limits and the CPU budget, made-up request ids, and two instances sharing load and
-//! surviving one's death (its refusals: `planner_refusals.rs`; at scale and queued:
-//! `planner_scale.rs`). Real map server and planners in process, used only as a Zenoh
-//! client.
+//! limits and the CPU budget, made-up request ids, a robot's plans on its own keys, and
+//! two instances sharing load and surviving one's death (its refusals:
+//! `planner_refusals.rs`; at scale and queued: `planner_scale.rs`). Real map server and
+//! planners in process, used only as a Zenoh client.
 
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
@@ -472,6 +472,118 @@ async fn a_strangers_cancel_does_nothing_and_the_requesters_cancel_ends_the_plan
         .expect("plan");
     assert_eq!(a.stop_reason, StopReason::MaxGenerations);
     assert_eq!(a.generations, generations);
+    running.stop().await;
+}
+
+/// A robot's plans live on the robot's keys (`roam_planner::scope`): the same request id
+/// is planned at once for robot r1, robot r2 and on the shared key, with the same
+/// token, and each plan is cancelled only by a cancel on its own key. r1's plan is asked
+/// through `PlannerClient::for_robot` (an instance's robot key) and its progress comes
+/// on r1's progress key. A query whose robot is a wildcard is refused.
+///
+/// Each cancel is followed by the reply of the plan it was for, so it had been handled
+/// (the planner handles one subscription's samples in order, and only that plan ended)
+/// when the other plans are checked to be still planning.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_robots_plan_is_cancelled_on_its_own_keys_only() {
+    let running = boot_with(&[("solo", 3)], |config| roam_planner::PlannerConfig {
+        plan_seconds_burst: 300.0,
+        ..config
+    })
+    .await;
+    let root = running.harness.root.clone();
+    let client = running.harness.client().await;
+    let id = "trip";
+
+    let r1_progress = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::planner_robot_progress(&root, "r1", id)),
+    )
+    .await
+    .expect("r1's progress subscriber");
+    let r1_planner = std::sync::Arc::new(PlannerClient::for_robot(
+        client.session().clone(),
+        &root,
+        "r1",
+    ));
+    let mut r1_request = endless(id, Some(TOKEN_A));
+    let r1_ticket = roam_planner::client::PlanTicket::issue(&mut r1_request);
+    let r1 = tokio::spawn({
+        let planner = r1_planner.clone();
+        async move { planner.plan(&r1_request).await }
+    });
+    planning(&r1_progress).await;
+
+    let long = Requester::new(client.session().clone(), Duration::from_secs(60));
+    let ask_on = |key: String| {
+        let long = long.clone();
+        tokio::spawn(async move {
+            long.request::<PlanRequest, Plan>(&key, Some(&endless(id, Some(TOKEN_A))))
+                .await
+        })
+    };
+    let r2 = ask_on(keys::planner_robot_plan(&root, "r2"));
+    let shared = ask_on(keys::planner_plan(&root));
+    for progress in [
+        keys::planner_robot_progress(&root, "r2", id),
+        keys::planner_progress(&root, id),
+    ] {
+        let subscriber = within("subscribe", client.session().declare_subscriber(progress))
+            .await
+            .expect("progress subscriber");
+        planning(&subscriber).await;
+    }
+
+    cancel(client.session(), &root, id, Some(TOKEN_A)).await;
+    let shared = within("the shared plan", shared)
+        .await
+        .expect("join")
+        .expect("plan");
+    assert_eq!(shared.stop_reason, StopReason::Cancelled);
+    assert!(
+        !r1.is_finished() && !r2.is_finished(),
+        "a cancel on the shared key must not stop a robot's plan"
+    );
+
+    within(
+        "r2's cancel",
+        client.session().put(
+            keys::planner_robot_cancel(&root, "r2", id),
+            roam_proto::encode(&r1_ticket.cancel_message()),
+        ),
+    )
+    .await
+    .expect("cancel put");
+    let r2 = within("r2's plan", r2).await.expect("join").expect("plan");
+    assert_eq!(r2.stop_reason, StopReason::Cancelled);
+    assert!(
+        !r1.is_finished(),
+        "a cancel on r2's key must not stop r1's plan"
+    );
+
+    within("r1's cancel", r1_planner.cancel(&r1_ticket))
+        .await
+        .expect("cancel put");
+    let r1 = within("r1's plan", r1).await.expect("join").expect("plan");
+    assert_eq!(r1.stop_reason, StopReason::Cancelled);
+    assert_eq!(r1.instance, "solo");
+
+    let wildcard = within(
+        "a plan for any robot",
+        client.request::<PlanRequest, Plan>(
+            &keys::planner_robot_plan(&root, "*"),
+            Some(&request([-8.0, -8.0], [6.0, -7.0], 80.0, 5)),
+        ),
+    )
+    .await;
+    match wildcard {
+        Err(ClientError::Refused(reply)) => {
+            assert_eq!(reply.code, ErrorCode::InvalidRequest, "{reply}")
+        }
+        other => panic!("a wildcard robot must be refused, got {other:?}"),
+    }
     running.stop().await;
 }
 

@@ -494,7 +494,12 @@ pub async fn run(
         session,
         root,
         config,
-        planner: Arc::new(PlannerClient::new(session.clone(), root)),
+        // The robot's own plan keys: on a secure site its credentials reach no others.
+        planner: Arc::new(PlannerClient::for_robot(
+            session.clone(),
+            root,
+            &config.robot,
+        )),
         inputs,
         position: None,
         calibration: load_calibration(config)?,

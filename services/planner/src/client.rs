@@ -17,6 +17,12 @@
 //! Every request names its client (`?client=<name>` on the key, by default this
 //! session's Zenoh id), so that each planner instance gives each client its fair share
 //! of its queue ([`crate::queue`]).
+//!
+//! A client for one robot ([`PlannerClient::for_robot`]: the robot's mission executive)
+//! asks and cancels on that robot's keys (`<root>/planner/robot/<id>/plan`,
+//! `…/instance/<instance>/robot/<id>/plan`, `<root>/planner/robot/<id>/cancel/<request_id>`;
+//! [`crate::scope`]), so a router's access control can give each robot's credentials its
+//! own robot's plans only.
 
 use roam_runtime::Delivery;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -35,6 +41,8 @@ pub const REPLY_MARGIN: Duration = Duration::from_secs(10);
 pub struct PlannerClient {
     session: zenoh::Session,
     root: String,
+    /// The robot whose plans this client asks for; `None`: the shared keys.
+    robot: Option<String>,
     /// The name sent for the queue's fair share.
     client: String,
     next: AtomicUsize,
@@ -101,7 +109,7 @@ impl Drop for CancelOnDrop<'_> {
             return;
         };
         let session = self.client.session.clone();
-        let key = keys::planner_cancel(&self.client.root, &ticket.request_id);
+        let key = self.client.cancel_key(&ticket.request_id);
         let message = encode(&ticket.cancel_message());
         // Delivered: a lost cancel keeps an instance busy until the plan's deadline.
         runtime.spawn(async move {
@@ -117,7 +125,40 @@ impl PlannerClient {
             client: session.zid().to_string(),
             session,
             root: root.to_owned(),
+            robot: None,
             next: AtomicUsize::new(0),
+        }
+    }
+
+    /// A client that asks for `robot`'s plans, on the robot's own plan and cancel keys.
+    pub fn for_robot(session: zenoh::Session, root: &str, robot: &str) -> Self {
+        PlannerClient {
+            robot: Some(robot.to_owned()),
+            ..PlannerClient::new(session, root)
+        }
+    }
+
+    /// The key every instance answers on (used when no instance is seen).
+    fn shared_key(&self) -> String {
+        match &self.robot {
+            Some(robot) => keys::planner_robot_plan(&self.root, robot),
+            None => keys::planner_plan(&self.root),
+        }
+    }
+
+    /// The key `instance` alone answers on.
+    fn instance_key(&self, instance: &str) -> String {
+        match &self.robot {
+            Some(robot) => keys::planner_robot_plan_at(&self.root, instance, robot),
+            None => keys::planner_plan_at(&self.root, instance),
+        }
+    }
+
+    /// The key a cancel of `request_id` goes to.
+    fn cancel_key(&self, request_id: &str) -> String {
+        match &self.robot {
+            Some(robot) => keys::planner_robot_cancel(&self.root, robot, request_id),
+            None => keys::planner_cancel(&self.root, request_id),
         }
     }
 
@@ -155,7 +196,7 @@ impl PlannerClient {
     /// Cancels the plan of `ticket` on every instance: the one planning it stops and
     /// replies with its best path so far (`stop_reason: cancelled`).
     pub async fn cancel(&self, ticket: &PlanTicket) -> Result<(), ClientError> {
-        let key = keys::planner_cancel(&self.root, &ticket.request_id);
+        let key = self.cancel_key(&ticket.request_id);
         self.session
             .put(&key, encode(&ticket.cancel_message()))
             .await
@@ -190,7 +231,7 @@ impl PlannerClient {
         if instances.is_empty() {
             // No token seen (yet): fall back to the shared key.
             return requester
-                .request(&self.named(keys::planner_plan(&self.root)), Some(request))
+                .request(&self.named(self.shared_key()), Some(request))
                 .await;
         }
         let first = self.next.fetch_add(1, Ordering::Relaxed);
@@ -198,10 +239,7 @@ impl PlannerClient {
         for k in 0..instances.len() {
             let instance = &instances[(first + k) % instances.len()];
             match requester
-                .request(
-                    &self.named(keys::planner_plan_at(&self.root, instance)),
-                    Some(request),
-                )
+                .request(&self.named(self.instance_key(instance)), Some(request))
                 .await
             {
                 Ok(plan) => return Ok(plan),
@@ -217,7 +255,7 @@ impl PlannerClient {
             }
         }
         Err(last_error.unwrap_or_else(|| ClientError::NoReply {
-            key: keys::planner_plan(&self.root),
+            key: self.shared_key(),
             timeout,
         }))
     }

@@ -1,4 +1,5 @@
-//! The plans an instance has in flight, by request id, and who may cancel them.
+//! The plans an instance has in flight, by the key their cancel comes on (which names
+//! the request id; [`crate::scope`]), and who may cancel them.
 //!
 //! A plan is registered with the `cancel_token` its request carried. A cancel is
 //! honoured only when it brings the same token (compared in constant time,
@@ -36,7 +37,7 @@ pub enum CancelVerdict {
     Unknown,
 }
 
-/// The request id is already being planned on this instance.
+/// The request id is already being planned on this instance (under the same key).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("the request id is already being planned")]
 pub struct AlreadyInFlight;
@@ -61,22 +62,23 @@ impl InFlight {
         roam_runtime::lock(&self.plans)
     }
 
-    /// Registers a plan (queued or planning); returns the flag that stops it and the
-    /// token that wakes it while it waits in the queue. A request id already in flight
-    /// is refused.
+    /// Registers a plan (queued or planning) under the key its cancel comes on;
+    /// returns the flag that stops it and the token that wakes it while it waits in the
+    /// queue. A key already in flight (the same request id, asked the same way) is
+    /// refused.
     pub fn register(
         &self,
-        request_id: &str,
+        key: &str,
         token: Option<String>,
     ) -> Result<(Arc<AtomicBool>, CancellationToken), AlreadyInFlight> {
         let mut plans = self.lock();
-        if plans.contains_key(request_id) {
+        if plans.contains_key(key) {
             return Err(AlreadyInFlight);
         }
         let stop = Arc::new(AtomicBool::new(false));
         let wake = CancellationToken::new();
         plans.insert(
-            request_id.to_owned(),
+            key.to_owned(),
             Entry {
                 stop: stop.clone(),
                 wake: wake.clone(),
@@ -87,15 +89,15 @@ impl InFlight {
     }
 
     /// Forgets a plan (it has ended).
-    pub fn remove(&self, request_id: &str) {
-        self.lock().remove(request_id);
+    pub fn remove(&self, key: &str) {
+        self.lock().remove(key);
     }
 
-    /// A cancel for `request_id` with `token`: stops the plan only if the token is the
-    /// one its request carried.
-    pub fn cancel(&self, request_id: &str, token: Option<&str>) -> CancelVerdict {
+    /// A cancel heard on `key` with `token`: stops the plan registered under that key
+    /// only if the token is the one its request carried.
+    pub fn cancel(&self, key: &str, token: Option<&str>) -> CancelVerdict {
         let plans = self.lock();
-        let Some(entry) = plans.get(request_id) else {
+        let Some(entry) = plans.get(key) else {
             return CancelVerdict::Unknown;
         };
         let Some(expected) = &entry.token else {

@@ -24,8 +24,9 @@
 //! [`service`] is the thin Zenoh adapter, with what it needs against other clients:
 //! [`queue`] (a bounded queue served in order, admission by expected wait),
 //! [`budget`] (the CPU budget across clients), [`token`] and [`inflight`] (request
-//! ids, cancel tokens, who may cancel); bounded logs and echoes of untrusted input come
-//! from `roam_runtime::warn_limit` and `roam_proto::excerpt`, shared by every service.
+//! ids, cancel tokens, who may cancel), [`scope`] (a robot's plans on its own keys);
+//! bounded logs and echoes of untrusted input come from `roam_runtime::warn_limit` and
+//! `roam_proto::excerpt`, shared by every service.
 
 pub mod answer;
 pub mod best;
@@ -50,6 +51,8 @@ pub mod plan;
 #[cfg(feature = "zenoh")]
 pub mod queue;
 pub mod resolution;
+#[cfg(feature = "zenoh")]
+pub mod scope;
 pub mod search;
 pub mod seeds;
 #[cfg(feature = "zenoh")]

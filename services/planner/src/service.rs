@@ -6,13 +6,17 @@
 //! | `<root>/planner/instance/<instance>/plan` | queryable (this instance) | `plan_request` → `plan` |
 //! | `<root>/planner/progress/<request_id>` | publication | `plan_progress`, at most every 50 ms |
 //! | `<root>/planner/cancel/*` | subscription | `cancel_plan`, honoured only with the request's `cancel_token` |
+//! | `<root>/planner/robot/*/plan` | queryable (every instance) | `plan_request` → `plan`, a robot's plan ([`crate::scope`]) |
+//! | `<root>/planner/instance/<instance>/robot/*/plan` | queryable (this instance) | the same on its own key |
+//! | `<root>/planner/robot/<id>/progress/<request_id>` | publication | `plan_progress` of a robot's plan |
+//! | `<root>/planner/robot/*/cancel/*` | subscription | `cancel_plan` of a robot's plan: only on that robot's key, with the token |
 //! | `<root>/map/layer/{inflated,information,peb}` | subscription + get | `layer` |
 //! | `<root>/map/delta/{inflated,information,peb}` | subscription | `layer_delta`, applied to the layer held at its base version; any other version gets the whole layer |
 //!
 //! Every plan is checked against this instance's limits before any work: its slot
 //! (`max_concurrent_plans`), its size ([`crate::limits`]) and its wall time from the CPU
 //! budget ([`crate::budget`]). Request ids and tokens are [`crate::token`]'s; who may
-//! cancel is [`crate::inflight`]'s.
+//! cancel is [`crate::inflight`]'s, on which keys [`crate::scope`]'s.
 
 use roam_runtime::Delivery;
 use std::collections::BTreeSet;
@@ -39,6 +43,7 @@ use crate::maps::{DeltaOutcome, MapCache};
 use crate::params::GaParams;
 use crate::plan::{check_spec, plan, PlanSpec};
 use crate::queue::{ClientId, PlanQueue, QueueConfig, Refusal, Turn, MAX_QUEUED_PLANS};
+use crate::scope::{self, PlanKeys};
 use crate::token;
 use crate::world::World;
 
@@ -110,12 +115,13 @@ impl PlannerInstance {
 /// Removes a request from the table of plans in flight however it ends.
 struct Registration<'a> {
     plans: &'a InFlight,
-    request_id: String,
+    /// The plan's cancel key, which it is registered under.
+    key: String,
 }
 
 impl Drop for Registration<'_> {
     fn drop(&mut self) {
-        self.plans.remove(&self.request_id);
+        self.plans.remove(&self.key);
     }
 }
 
@@ -259,33 +265,45 @@ pub async fn run(
         let requester = Requester::new(service.session().clone(), Duration::from_secs(5));
         service.spawn(async move { fetch_wanted(state, requester, cancel).await });
     }
-    service
-        .subscribe_with(
-            &keys::planner_cancel_any(root),
-            MAX_CANCEL_BYTES,
-            state.clone(),
-            |state: &Arc<PlannerInstance>, key: &str, request: CancelPlan| {
-                // Keys decide: the request a cancel is for is the one its key names.
-                if key.rsplit('/').next() == Some(request.request_id.as_str()) {
-                    take_cancel(state, &request)
-                } else if let Some(suppressed) = state.cancel_warnings.allow("mismatch") {
-                    tracing::warn!(
-                        key = %excerpt(key), request_id = %excerpt(&request.request_id), suppressed,
-                        "cancel ignored: its body names another request than its key"
-                    );
-                }
-            },
-        )
-        .await?;
+    for cancels in [
+        keys::planner_cancel_any(root),
+        keys::planner_robot_cancel_any(root),
+    ] {
+        service
+            .subscribe_with(
+                &cancels,
+                MAX_CANCEL_BYTES,
+                state.clone(),
+                |state: &Arc<PlannerInstance>, key: &str, request: CancelPlan| {
+                    // Keys decide: the request a cancel is for is the one its key names,
+                    // and only the plan registered under that very key ([`crate::scope`]).
+                    if key.rsplit('/').next() == Some(request.request_id.as_str()) {
+                        take_cancel(state, key, &request)
+                    } else if let Some(suppressed) = state.cancel_warnings.allow("mismatch") {
+                        tracing::warn!(
+                            key = %excerpt(key), request_id = %excerpt(&request.request_id), suppressed,
+                            "cancel ignored: its body names another request than its key"
+                        );
+                    }
+                },
+            )
+            .await?;
+    }
 
-    let shared = service.declare_queryable(&keys::planner_plan(root)).await?;
-    let own = service
-        .declare_queryable(&keys::planner_plan_at(root, service.instance()))
-        .await?;
+    let instance = service.instance().to_owned();
+    let mut queryables = Vec::new();
+    for key in [
+        keys::planner_plan(root),
+        keys::planner_plan_at(root, &instance),
+        keys::planner_robot_plan_any(root),
+        keys::planner_robot_plan_at_any(root, &instance),
+    ] {
+        queryables.push(service.declare_queryable(&key).await?);
+    }
     // Each request in the queue holds its query: room for all of them, and for the
     // refusals of a burst, which are answered at once.
     let max_in_flight = config.max_concurrent_plans + config.max_queued_plans + 64;
-    for queryable in [shared, own] {
+    for queryable in queryables {
         service.serve_up_to(queryable, max_in_flight, state.clone(), |s, q| {
             // Arrival order, taken as the query is received: the queue serves in it.
             let seq = s.arrivals.fetch_add(1, Ordering::Relaxed);
@@ -371,12 +389,11 @@ async fn fetch_wanted(
     }
 }
 
-/// A cancel: honoured only with the plan's own token ([`InFlight::cancel`]); refusals
-/// are logged, rate-limited, with the id cut to an excerpt and never the token.
-fn take_cancel(state: &PlannerInstance, request: &CancelPlan) {
-    let verdict = state
-        .plans
-        .cancel(&request.request_id, request.token.as_deref());
+/// A cancel heard on `key`: honoured only for the plan registered under that key, with
+/// the plan's own token ([`InFlight::cancel`]); refusals are logged, rate-limited, with
+/// the id cut to an excerpt and never the token.
+fn take_cancel(state: &PlannerInstance, key: &str, request: &CancelPlan) {
+    let verdict = state.plans.cancel(key, request.token.as_deref());
     let id = || excerpt(&request.request_id).to_string();
     match verdict {
         CancelVerdict::Cancelled => {
@@ -433,11 +450,21 @@ async fn answer_plan(state: Arc<PlannerInstance>, query: Query, seq: u64, arrive
         // The codec's refusals quote the payload only as a bounded excerpt.
         Err(e) => return reply::send_error(&query, &e).await,
     };
+    let robot = match scope::robot_of_query(&state.root, query.key_expr().as_str()) {
+        Ok(robot) => robot,
+        Err(e) => {
+            let refusal = ErrorReply::new(
+                ErrorCode::InvalidRequest,
+                format!("{e}: ask on one robot's plan key, or on the shared one"),
+            );
+            return reply::send_error(&query, &refusal).await;
+        }
+    };
     let client = query
         .parameters()
         .get(CLIENT_PARAMETER)
         .map_or_else(ClientId::anonymous, ClientId::named);
-    let result = serve_plan(&state, request, &client, seq, arrived).await;
+    let result = serve_plan(&state, request, robot, &client, seq, arrived).await;
     reply::send_result(&query, result).await;
 }
 
@@ -445,6 +472,7 @@ async fn answer_plan(state: Arc<PlannerInstance>, query: Query, seq: u64, arrive
 struct Prepared<'a> {
     request: PlanRequest,
     request_id: String,
+    plan_keys: PlanKeys,
     registration: Registration<'a>,
     stop: Arc<AtomicBool>,
     /// Cancelled with `stop`: wakes the request while it waits in the queue.
@@ -463,11 +491,12 @@ struct Prepared<'a> {
 async fn serve_plan(
     state: &Arc<PlannerInstance>,
     request: PlanRequest,
+    robot: Option<&str>,
     client: &ClientId,
     seq: u64,
     arrived: Instant,
 ) -> Result<Plan, ErrorReply> {
-    let prepared = prepare(state, request)?;
+    let prepared = prepare(state, request, robot)?;
     let max_plan_s = state.budget.config().max_plan_seconds;
     // The reply must reach the requester within its deadline: the plan ends earlier.
     let margin = reply_margin_s(prepared.spec.deadline_s);
@@ -489,8 +518,8 @@ async fn serve_plan(
             best_fitness: Vec::new(),
             done: false,
         };
-        let key = keys::planner_progress(&state.root, &prepared.request_id);
-        roam_runtime::publish(&state.session, &key, &message, Delivery::Latest).await;
+        let key = &prepared.plan_keys.progress;
+        roam_runtime::publish(&state.session, key, &message, Delivery::Latest).await;
     }
     let turn = ticket.wait_turn(&prepared.wake).await;
     if turn == Turn::Displaced {
@@ -506,6 +535,7 @@ async fn serve_plan(
     let Prepared {
         request,
         request_id,
+        plan_keys,
         registration,
         stop,
         map_version,
@@ -533,6 +563,7 @@ async fn serve_plan(
                 &state,
                 &request,
                 request_id,
+                &plan_keys.progress,
                 map_version,
                 &world,
                 spec,
@@ -582,16 +613,22 @@ pub fn reply_margin_s(deadline_s: f64) -> f64 {
     (0.1 * deadline_s).min(0.1)
 }
 
-/// Checks a request against this instance's state and registers it.
-fn prepare(state: &PlannerInstance, request: PlanRequest) -> Result<Prepared<'_>, ErrorReply> {
+/// Checks a request (for `robot`, or asked on the shared keys) against this instance's
+/// state and registers it under its cancel key.
+fn prepare<'a>(
+    state: &'a PlannerInstance,
+    request: PlanRequest,
+    robot: Option<&str>,
+) -> Result<Prepared<'a>, ErrorReply> {
     let request_id = request_id(&request)?;
+    let plan_keys = PlanKeys::new(&state.root, robot, &request_id);
     if let Some(token) = &request.cancel_token {
         token::check_token(token)
             .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.to_string()))?;
     }
     let (stop, wake) = state
         .plans
-        .register(&request_id, request.cancel_token.clone())
+        .register(&plan_keys.cancel, request.cancel_token.clone())
         .map_err(|_| {
             ErrorReply::new(
                 ErrorCode::InvalidRequest,
@@ -603,7 +640,7 @@ fn prepare(state: &PlannerInstance, request: PlanRequest) -> Result<Prepared<'_>
         })?;
     let registration = Registration {
         plans: &state.plans,
-        request_id: request_id.clone(),
+        key: plan_keys.cancel.clone(),
     };
     let (map_version, world) = {
         let maps = state.maps();
@@ -648,6 +685,7 @@ fn prepare(state: &PlannerInstance, request: PlanRequest) -> Result<Prepared<'_>
     Ok(Prepared {
         request,
         request_id,
+        plan_keys,
         registration,
         stop,
         wake,
@@ -738,6 +776,7 @@ fn plan_now(
     state: &PlannerInstance,
     request: &PlanRequest,
     request_id: String,
+    progress_key: &str,
     map_version: roam_proto::planner::MapVersion,
     world: &World,
     mut spec: PlanSpec,
@@ -750,7 +789,6 @@ fn plan_now(
         .map_err(|e| exhausted(state, e))?;
     spec.deadline_s = grant.seconds;
 
-    let progress_key = keys::planner_progress(&state.root, &request_id);
     let mut batch = Vec::new();
     let mut last_sent = Instant::now();
     let publish = |batch: &mut Vec<(u32, f64)>, done: bool| {
@@ -760,7 +798,7 @@ fn plan_now(
             done,
         };
         // The next batch of progress supersedes this one.
-        roam_runtime::publish_wait(&state.session, &progress_key, &message, Delivery::Latest);
+        roam_runtime::publish_wait(&state.session, progress_key, &message, Delivery::Latest);
     };
     let mut outcome = plan(world, &spec, stop, |generation, best| {
         batch.push((generation, best));

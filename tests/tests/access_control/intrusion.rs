@@ -1,5 +1,6 @@
 //! What an intruder tries and the checks that it had no effect: the router refusing
-//! sessions without the right credentials, the `Watch` on the robot, the map server's
+//! sessions without the right credentials (a robot's generated config, without them or
+//! with a wrong password), the `Watch` on the robot, the map server's
 //! versions and two spies with the sim's and the planner's rights, and the
 //! `assert_intrusion_*` checks run against it.
 
@@ -18,7 +19,7 @@ use zenoh::pubsub::Subscriber;
 use zenoh::sample::Sample;
 
 use crate::observe::{drain, put, sim_status, step_and_locate, subscribe, versions};
-use crate::site::{client_config, Secrets};
+use crate::site::{credentials, user_config, Secrets};
 use crate::{ROBOT, ROOT};
 
 /// A free layer the operator (a map writer) creates, so that an intruder's deletion of it
@@ -27,7 +28,7 @@ pub(crate) const SCRATCH: &str = "scratch";
 
 /// How long a query whose reply can never come is waited for (Zenoh in fact ends a
 /// query the router drops at once, with no reply).
-const DENIED_QUERY_WAIT: Duration = Duration::from_millis(1500);
+pub(crate) const DENIED_QUERY_WAIT: Duration = Duration::from_millis(1500);
 
 /// What the test watches: the robot (through the sim), the map server's versions, and
 /// two spies that hold the sim's and the planner's credentials, so they receive what the
@@ -240,30 +241,29 @@ pub(crate) async fn assert_only_the_right_credentials_open(secrets: &Secrets, en
     // No credentials (TLS with the site CA, no user/password) or a wrong password: the
     // router refuses the session while it opens. (`connect/timeout_ms: 0` so the refused
     // client gives up instead of retrying as deployed services do.)
-    let give_up = ["connect/timeout_ms:0".to_owned()];
-    let anonymous = client_config(secrets, endpoint, None, &give_up);
+    let user = "controller-robot";
+    let give_up = "connect/timeout_ms:0".to_owned();
+    let with = |mut settings: Vec<String>| {
+        settings.push(give_up.clone());
+        user_config(secrets, endpoint, user, &settings)
+    };
+    let anonymous = with(credentials(None));
     let refused = within("anonymous open", roam_runtime::session::open(anonymous)).await;
     assert!(
         refused.is_err(),
         "a session without credentials must be refused at open"
     );
-    let wrong = client_config(
-        secrets,
-        endpoint,
-        Some(("controller", "not-the-password")),
-        &give_up,
-    );
+    let wrong = with(credentials(Some((user, "not-the-password"))));
     let refused = within("wrong password open", roam_runtime::session::open(wrong)).await;
     assert!(
         refused.is_err(),
         "a session with a wrong password must be refused at open"
     );
-    // ... while the same config with the right credentials opens (so the refusals above
-    // are the authentication's, not a TLS or config problem).
-    let password = secrets.passwords["controller"].as_str();
-    let right = client_config(secrets, endpoint, Some(("controller", password)), &give_up);
+    // ... while the generated config itself opens (so the refusals above are the
+    // authentication's, not a TLS or config problem).
+    let right = with(Vec::new());
     let accepted = within("right password open", roam_runtime::session::open(right))
         .await
-        .expect("the controller's credentials open a session");
+        .unwrap_or_else(|e| panic!("{user}'s generated config opens a session: {e}"));
     accepted.close().await.expect("close");
 }

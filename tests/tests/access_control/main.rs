@@ -1,16 +1,20 @@
-//! A secure site through the real `deploy/secure/router.json5`: TLS, user/password
-//! authentication and access control. One test attacks a real map server and sim with
-//! no credentials, a wrong password, an authenticated user no rule names, and other
-//! roles' credentials; the other runs every role's real service through the router, to
-//! show the policy lets each role do its whole job.
+//! A secure site as `deploy/secure/make-secrets.sh` makes it: TLS, user/password
+//! authentication, and access control by role and, for each robot's executive and
+//! controller, by robot. One test attacks a real map server and sim with no credentials,
+//! a wrong password, an authenticated user no rule names, and other roles' credentials;
+//! `robots.rs` has robot r1's credentials try robot r2's keys and plans, `ros2.rs` the ROS
+//! 2 node's credentials what its node does not use; another test runs every role's real
+//! service through the router (the built-in world's robot with its own executive and
+//! controller, and the ROS 2 node), to show the policy lets each do its whole job.
 //!
-//! Certificates and the user dictionary are made at test time (rcgen) in a temporary
-//! directory; the router loads the shipped config with only the paths and the port
-//! overridden, and every session uses the shipped `deploy/secure/client.json5` with one
-//! role's credentials. Each negative check is one that would fail with the access control
-//! off (`access_control/enabled:false` on the router makes every one of them fail): a
-//! command that would move the robot, a write that a subscriber would receive, a map
-//! update, deletion or load the map server would accept.
+//! The generator writes the CA, the certificates, the user dictionary, every user's
+//! client config and the router's config (for the robots `robot`, `r1` and `r2`) into a
+//! temporary directory, and the test uses those files, with only the endpoints (a free
+//! port) overridden (`site.rs`). Each negative check is one that would fail with the
+//! access control off (`access_control/enabled:false` on the router makes every one of
+//! them fail): a command that would move the robot, a write that a subscriber would
+//! receive, a map update, deletion or load the map server would accept, a plan query
+//! the planner would answer, a cancel it would honour.
 
 use std::time::Duration;
 
@@ -26,11 +30,14 @@ use roam_proto::mapper::MapperStatus;
 use roam_proto::mission::WindowReport;
 use roam_proto::sim::RobotCommand;
 use roam_proto::{decode, encode, keys, ErrorCode};
+use roam_ros2::node::Ros2Config;
 use roam_runtime::ClientError;
 use roam_tests::{within, RunningService};
 
 mod intrusion;
 mod observe;
+mod robots;
+mod ros2;
 mod site;
 
 use intrusion::{
@@ -42,7 +49,8 @@ use site::{secure_site, GUEST};
 
 /// The key root `router.json5`'s rules are written for.
 const ROOT: &str = "roam";
-/// The built-in world's robot.
+/// The built-in world's robot (its executive and controller log in as `mission-robot`
+/// and `controller-robot`).
 const ROBOT: &str = "robot";
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
@@ -59,9 +67,9 @@ async fn only_the_controller_drives_and_only_map_writers_change_the_map() {
     let watch = Watch::start(&harness).await;
     let planner = harness.client_as("planner").await;
 
-    // Positive control: the controller's command moves the robot in one step, and the
+    // Positive control: the robot's controller's command moves it in one step, and the
     // sim's rights receive it.
-    let controller = harness.client_as("controller").await;
+    let controller = harness.client_as("controller-robot").await;
     let at_start = step_and_locate(&watch.operator).await;
     drain(&watch.sim_spy);
     put(
@@ -267,11 +275,14 @@ async fn a_map_writer_cannot_read_the_routers_secrets_through_a_load() {
 }
 
 /// The policy is complete: every role, run as itself, does its whole job through the
-/// secure router. The mission executive finds the planner by liveliness, gets maps and a
-/// curious plan, gives the controller its waypoints, the controller drives the sim on
+/// secure router. The robot's executive (`mission-robot`) finds the planner by
+/// liveliness, gets maps and a curious plan on the robot's plan keys, gives the robot's
+/// controller (`controller-robot`) its waypoints, the controller drives the sim on
 /// localization's estimates, and the first window's report reaches the operator; the
 /// mapper's and localization's layers reach the map server; the operator can ask the
-/// localization and the mapper and see every service's liveliness token.
+/// localization and the mapper and see every service's liveliness token; a ROS 2 node
+/// sees the ROS 2 node's graph token and the robot's pose, and gets a plan through its
+/// service.
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn every_role_does_its_job_through_the_secure_router() {
     let (_secrets, harness) = secure_site().await;
@@ -287,22 +298,38 @@ async fn every_role_does_its_job_through_the_secure_router() {
     services.push(harness.start_role(harness.localization_config(None)).await);
     services.push(
         harness
-            .start_role(ControllerConfig {
-                apf: roam::demo::indoor_apf(),
-                ..harness.controller_config()
-            })
+            .start_role_as(
+                "controller-robot",
+                ControllerConfig {
+                    apf: roam::demo::indoor_apf(),
+                    robots: vec![ROBOT.to_owned()],
+                    ..harness.controller_config()
+                },
+            )
             .await,
     );
     services.push(harness.start_role(harness.mapper_config()).await);
+    services.push(
+        harness
+            .start_role(Ros2Config {
+                root: ROOT.to_owned(),
+                ..Ros2Config::default()
+            })
+            .await,
+    );
 
     let operator = harness.client_as("operator").await;
     let reports = subscribe(&operator, &keys::robot_mission_report(ROOT, ROBOT)).await;
+    let plans = subscribe(&operator, &keys::planner_robot_progress(ROOT, ROBOT, "*")).await;
     services.push(
         harness
-            .start_role(MissionConfig {
-                root: ROOT.to_owned(),
-                ..MissionConfig::default()
-            })
+            .start_role_as(
+                "mission-robot",
+                MissionConfig {
+                    root: ROOT.to_owned(),
+                    ..MissionConfig::default()
+                },
+            )
             .await,
     );
 
@@ -316,6 +343,10 @@ async fn every_role_does_its_job_through_the_secure_router() {
     assert!(
         report.driven_information > 0.0,
         "the robot drove and saw: {report:?}"
+    );
+    assert!(
+        !drain(&plans).is_empty(),
+        "the planner planned the robot's window on the robot's plan keys"
     );
 
     // The map writers' layers are on the map server.
@@ -367,10 +398,12 @@ async fn every_role_does_its_job_through_the_secure_router() {
             "mapper",
             "mission",
             "planner",
+            "ros2",
             "sim"
         ],
         "the operator sees every service's liveliness token"
     );
+    ros2::assert_the_node_serves_ros_2(&harness.client_as("ros-node").await).await;
 
     for service in services.into_iter().rev() {
         stop(service).await;

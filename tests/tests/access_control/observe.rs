@@ -9,7 +9,7 @@ use roam_proto::keys;
 use roam_proto::map::LayerList;
 use roam_proto::sim::{SimControl, SimStatus};
 use roam_runtime::Requester;
-use roam_tests::within;
+use roam_tests::{within, Harness};
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::pubsub::Subscriber;
 use zenoh::sample::Sample;
@@ -17,8 +17,9 @@ use zenoh::sample::Sample;
 use crate::{ROBOT, ROOT};
 
 /// Time for messages already sent on other sessions to reach the router and the sim
-/// before a step: Zenoh orders messages per session, not across sessions.
-const SETTLE: Duration = Duration::from_millis(300);
+/// before a step, or every receiver: Zenoh orders messages per session, not across
+/// sessions.
+pub(crate) const SETTLE: Duration = Duration::from_millis(300);
 
 pub(crate) async fn sim_status(operator: &Requester) -> SimStatus {
     within(
@@ -106,4 +107,44 @@ pub(crate) async fn alive_services(client: &Requester) -> Vec<String> {
         }
     }
     alive.into_iter().collect()
+}
+
+/// A session with one user's credentials, subscribed to a key: where a message would
+/// arrive if the router let it through.
+pub(crate) struct Spy {
+    pub(crate) user: &'static str,
+    pub(crate) subscriber: Subscriber<FifoChannelHandler<Sample>>,
+    _session: Requester,
+}
+
+impl Spy {
+    pub(crate) async fn on(harness: &Harness, user: &'static str, key: &str) -> Spy {
+        let session = harness.client_as(user).await;
+        let subscriber = subscribe(&session, key).await;
+        Spy {
+            user,
+            subscriber,
+            _session: session,
+        }
+    }
+}
+
+/// Waits until `spy` receives a sample on `key`, and returns the keys of every sample it
+/// received until then and within [`SETTLE`] after. A sender that ends with `key` shows
+/// this way what else of its own reached the spy: anything it sent before would have
+/// arrived before.
+pub(crate) async fn heard_until(spy: &Spy, key: &str) -> Vec<String> {
+    let mut heard = Vec::new();
+    loop {
+        let sample = within("a spy's sample", spy.subscriber.recv_async())
+            .await
+            .unwrap_or_else(|e| panic!("{} receives {key}: {e}", spy.user));
+        heard.push(sample.key_expr().to_string());
+        if sample.key_expr().as_str() == key {
+            break;
+        }
+    }
+    tokio::time::sleep(SETTLE).await;
+    heard.extend(drain(&spy.subscriber));
+    heard
 }

@@ -1,99 +1,75 @@
-//! The secure site under test: its secrets (a CA, the router's certificate and key, and a
-//! user dictionary, made with rcgen in a temporary directory), the router started from the
-//! shipped `deploy/secure/router.json5`, and one client config per role from the shipped
-//! `deploy/secure/client.json5`.
+//! The secure site under test, made the way a site operator makes one: the shipped
+//! `deploy/secure/make-secrets.sh --robots robot,r1,r2` writes the CA, the router's
+//! certificate and key, the user dictionary, one client config per user and the router's
+//! config (the shipped `deploy/secure/router.json5` with the three robots' rules) into a
+//! temporary directory; the router and every session use those files, with only the
+//! endpoints overridden (a free loopback port).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
-use rcgen::{
-    BasicConstraints, CertificateParams, CertifiedIssuer, DnType, ExtendedKeyUsagePurpose, IsCa,
-    KeyPair, KeyUsagePurpose,
-};
 use roam_runtime::SessionArgs;
 use roam_stack::router::{free_loopback_port, Router};
 use roam_tests::{repo_path, within, Harness, SecureSite};
 
 use crate::ROOT;
 
-/// The roles of `router.json5`, each with a user in the dictionary.
-const ROLES: [&str; 8] = [
-    "map-server",
-    "planner",
-    "localization",
-    "controller",
-    "mapper",
-    "mission",
-    "sim",
-    "operator",
-];
+/// The fleet the secrets are made for: the built-in world's robot, and r1 and r2 of the
+/// fleet world.
+pub(crate) const ROBOTS: [&str; 3] = ["robot", "r1", "r2"];
 /// A user the dictionary knows but the access control does not: authenticated, and
-/// matching no subject.
+/// matching no subject. The test adds it to a copy of the generated dictionary.
 pub(crate) const GUEST: &str = "guest";
 
-/// The site's files: CA, router certificate and key, user dictionary.
+/// The site's files, as the generator wrote them.
 pub(crate) struct Secrets {
     _dir: tempfile::TempDir,
-    ca: PathBuf,
-    router_cert: PathBuf,
-    router_key: PathBuf,
+    /// make-secrets.sh's output directory.
+    out: PathBuf,
+    /// The dictionary the router reads: the generated `users.txt` and [`GUEST`].
     pub(crate) users: PathBuf,
+    /// Every user's password, [`GUEST`]'s included.
     pub(crate) passwords: BTreeMap<String, String>,
 }
 
 fn make_secrets() -> Secrets {
     let dir = tempfile::tempdir().expect("temp dir");
-    let write = |name: &str, text: &str| {
-        let path = dir.path().join(name);
-        std::fs::write(&path, text).expect("write a secret");
-        path
-    };
-
-    let mut ca_params = CertificateParams::new(Vec::<String>::new()).expect("CA params");
-    ca_params.is_ca = IsCa::Ca(BasicConstraints::Unconstrained);
-    ca_params
-        .distinguished_name
-        .push(DnType::CommonName, "roam test CA");
-    ca_params.key_usages = vec![KeyUsagePurpose::KeyCertSign, KeyUsagePurpose::CrlSign];
-    let ca = CertifiedIssuer::self_signed(ca_params, KeyPair::generate().expect("CA key"))
-        .expect("CA certificate");
-
-    let mut router_params = CertificateParams::new(vec!["localhost".into(), "127.0.0.1".into()])
-        .expect("router params");
-    router_params
-        .distinguished_name
-        .push(DnType::CommonName, "router");
-    router_params.key_usages = vec![KeyUsagePurpose::DigitalSignature];
-    router_params.extended_key_usages = vec![ExtendedKeyUsagePurpose::ServerAuth];
-    let router_key = KeyPair::generate().expect("router key");
-    let router_cert = router_params
-        .signed_by(&router_key, &ca)
-        .expect("router certificate");
-
-    let passwords: BTreeMap<String, String> = ROLES
-        .iter()
-        .copied()
-        .chain([GUEST])
-        .enumerate()
-        .map(|(i, user)| {
-            (
-                user.to_owned(),
-                format!("pw{i}-{:016x}", rand::random::<u64>()),
-            )
-        })
+    let out = dir.path().join("secrets");
+    let script = repo_path("deploy/secure/make-secrets.sh");
+    let made = Command::new(&script)
+        .arg("--robots")
+        .arg(ROBOTS.join(","))
+        .arg("--out")
+        .arg(&out)
+        .arg("--install-dir")
+        .arg(&out)
+        .args(["localhost", "127.0.0.1"])
+        .output()
+        .unwrap_or_else(|e| panic!("{} does not run: {e}", script.display()));
+    assert!(
+        made.status.success(),
+        "make-secrets.sh failed (it needs bash and the openssl CLI): {}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    let generated = std::fs::read_to_string(out.join("users.txt")).expect("users.txt");
+    let mut passwords: BTreeMap<String, String> = generated
+        .lines()
+        .filter_map(|line| line.split_once(':'))
+        .map(|(user, password)| (user.to_owned(), password.to_owned()))
         .collect();
-    let users: String = passwords
-        .iter()
-        .map(|(user, password)| format!("{user}:{password}\n"))
-        .collect();
-
+    passwords.insert(
+        GUEST.to_owned(),
+        format!("guest-{:016x}", rand::random::<u64>()),
+    );
+    let users = dir.path().join("users-and-guest.txt");
+    let dictionary = format!("{generated}{GUEST}:{}\n", passwords[GUEST]);
+    std::fs::write(&users, dictionary).expect("write the dictionary");
     Secrets {
-        ca: write("ca.crt", &ca.pem()),
-        router_cert: write("router.crt", &router_cert.pem()),
-        router_key: write("router.key", &router_key.serialize_pem()),
-        users: write("users.txt", &users),
-        passwords,
         _dir: dir,
+        out,
+        users,
+        passwords,
     }
 }
 
@@ -106,10 +82,10 @@ fn path_str(path: &Path) -> &str {
     path.to_str().expect("a UTF-8 temp path")
 }
 
-/// The router, from the shipped `deploy/secure/router.json5` with only the listen
-/// endpoint (a free loopback port) and the secrets' paths overridden.
+/// The router, from the generated `router.json5` with only the listen endpoint (a free
+/// loopback port) and the dictionary (with the guest) overridden.
 async fn start_router(secrets: &Secrets) -> Router {
-    let file = repo_path("deploy/secure/router.json5");
+    let file = secrets.out.join("router.json5");
     let mut last = String::new();
     for _ in 0..5 {
         let port = free_loopback_port().expect("a free port");
@@ -117,18 +93,6 @@ async fn start_router(secrets: &Secrets) -> Router {
         let args = SessionArgs {
             cfg: vec![
                 format!("listen/endpoints:[\"{endpoint}\"]"),
-                cfg(
-                    "transport/link/tls/listen_certificate",
-                    path_str(&secrets.router_cert),
-                ),
-                cfg(
-                    "transport/link/tls/listen_private_key",
-                    path_str(&secrets.router_key),
-                ),
-                cfg(
-                    "transport/link/tls/root_ca_certificate",
-                    path_str(&secrets.ca),
-                ),
                 cfg(
                     "transport/auth/usrpwd/dictionary_file",
                     path_str(&secrets.users),
@@ -138,7 +102,7 @@ async fn start_router(secrets: &Secrets) -> Router {
         };
         let config = args
             .zenoh_config_with(None, Some(&file))
-            .expect("deploy/secure/router.json5 is a valid Zenoh config");
+            .expect("the generated router.json5 is a valid Zenoh config");
         match within("router start", roam_runtime::session::open(config)).await {
             Ok(session) => return Router { session, endpoint },
             Err(e) => last = e.to_string(),
@@ -147,53 +111,56 @@ async fn start_router(secrets: &Secrets) -> Router {
     panic!("no secure router could be started: {last}");
 }
 
-/// A client config from the shipped `deploy/secure/client.json5`: this router, the
-/// test CA, and the given credentials (none: the user and password are removed).
-pub(crate) fn client_config(
+/// The generated client config of `user` (`<user>.json5`) connected to this router,
+/// with `extra` `--cfg` settings on top.
+pub(crate) fn user_config(
     secrets: &Secrets,
     endpoint: &str,
-    credentials: Option<(&str, &str)>,
+    user: &str,
     extra: &[String],
 ) -> zenoh::Config {
-    let mut cfgs = vec![
-        format!("connect/endpoints:[\"{endpoint}\"]"),
-        cfg(
-            "transport/link/tls/root_ca_certificate",
-            path_str(&secrets.ca),
-        ),
-    ];
-    match credentials {
-        Some((user, password)) => {
-            cfgs.push(cfg("transport/auth/usrpwd/user", user));
-            cfgs.push(cfg("transport/auth/usrpwd/password", password));
-        }
-        None => {
-            cfgs.push("transport/auth/usrpwd/user:null".into());
-            cfgs.push("transport/auth/usrpwd/password:null".into());
-        }
-    }
+    let mut cfgs = vec![format!("connect/endpoints:[\"{endpoint}\"]")];
     cfgs.extend_from_slice(extra);
+    let file = secrets.out.join(format!("{user}.json5"));
     SessionArgs {
         cfg: cfgs,
         ..SessionArgs::default()
     }
-    .zenoh_config_with(None, Some(&repo_path("deploy/secure/client.json5")))
-    .expect("deploy/secure/client.json5 is a valid Zenoh config")
+    .zenoh_config_with(None, Some(&file))
+    .unwrap_or_else(|e| panic!("{} is not a valid Zenoh config: {e}", file.display()))
+}
+
+/// `--cfg` settings that give a session other credentials (`None`: none at all).
+pub(crate) fn credentials(user_and_password: Option<(&str, &str)>) -> Vec<String> {
+    match user_and_password {
+        Some((user, password)) => vec![
+            cfg("transport/auth/usrpwd/user", user),
+            cfg("transport/auth/usrpwd/password", password),
+        ],
+        None => vec![
+            "transport/auth/usrpwd/user:null".into(),
+            "transport/auth/usrpwd/password:null".into(),
+        ],
+    }
 }
 
 fn site(secrets: &Secrets, endpoint: &str) -> SecureSite {
+    // The guest has no config of its own: the operator's, with the guest's credentials.
+    let guest = credentials(Some((GUEST, secrets.passwords[GUEST].as_str())));
     let roles = secrets
         .passwords
-        .iter()
-        .map(|(user, password)| {
-            (
-                user.clone(),
-                client_config(secrets, endpoint, Some((user, password)), &[]),
-            )
+        .keys()
+        .map(|user| {
+            let config = if user == GUEST {
+                user_config(secrets, endpoint, "operator", &guest)
+            } else {
+                user_config(secrets, endpoint, user, &[])
+            };
+            (user.clone(), config)
         })
         .collect();
     SecureSite {
-        anonymous: client_config(secrets, endpoint, None, &[]),
+        anonymous: user_config(secrets, endpoint, "operator", &credentials(None)),
         roles,
     }
 }
