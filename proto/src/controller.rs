@@ -42,6 +42,13 @@ pub struct Mission {
     /// other rule (stuck, step limit, stale estimates) still holds. Absent: `false`.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub recovery: bool,
+    /// The estimate step the sender decided the mission on (the executive sets it): the
+    /// controller answers that estimate on the mission before and starts this one from
+    /// the next. A mission that overtook the estimate it was decided on would otherwise
+    /// answer it, and whether it did would depend on the machine's load. Absent: the
+    /// mission starts at once.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub after_step: Option<u64>,
 }
 
 impl Message for Mission {

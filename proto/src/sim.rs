@@ -65,6 +65,22 @@ pub struct SimStatus {
     /// Robots at their true positions.
     pub robots: Vec<NamedPoint>,
     pub anchors: Vec<NamedPoint>,
+    /// The commands waiting for the next step, by robot: the estimate step each answers
+    /// (`RobotCommand::step`). A lock-step driver steps only once the command it saw
+    /// leave the controller is here: the command and the driver's step request reach
+    /// the sim on different links, in no promised order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pending: Vec<PendingCommand>,
+}
+
+/// A command the sim holds for its next step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PendingCommand {
+    pub robot: String,
+    /// The estimate step the command answers, if it names one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<u64>,
 }
 
 impl Message for SimStatus {

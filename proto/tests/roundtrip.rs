@@ -491,8 +491,8 @@ mod planner_messages {
 mod sim_messages {
     use super::*;
     use roam_proto::sim::{
-        AnchorRange, GroundTruth, LocalObservation, NamedPoint, RangeScan, RobotCommand,
-        RobotEventKind, RobotEvents, SimClock, SimControl, SimStatus,
+        AnchorRange, GroundTruth, LocalObservation, NamedPoint, PendingCommand, RangeScan,
+        RobotCommand, RobotEventKind, RobotEvents, SimClock, SimControl, SimStatus,
     };
 
     fn point() -> impl Strategy<Value = [f64; 2]> {
@@ -544,7 +544,7 @@ mod sim_messages {
         #[test]
         fn status_and_clock_round_trip(scenario in name(), seed in any::<u64>(), step in any::<u64>(), time_s in finite(), running in any::<bool>(), robots in prop::collection::vec((name(), point()), 0..4)) {
             let robots: Vec<NamedPoint> = robots.into_iter().map(|(name, at)| NamedPoint { name, at }).collect();
-            round_trips(&SimStatus { scenario, seed, step, time_s, running, rate: 1.0, step_s: 0.1, late_steps: 1, free_steps: 9, anchors: robots.clone(), robots });
+            round_trips(&SimStatus { scenario, seed, step, time_s, running, rate: 1.0, step_s: 0.1, late_steps: 1, free_steps: 9, anchors: robots.clone(), robots, pending: vec![PendingCommand { robot: "r1".into(), step: Some(step) }] });
             round_trips(&SimClock { step, time_s });
         }
 
@@ -613,7 +613,7 @@ mod controller_and_mapper_messages {
     proptest! {
         #[test]
         fn controller_messages_round_trip(id in name(), waypoints in prop::collection::vec([finite(), finite()], 0..6), state in state(), steps in any::<u64>(), peb in prop::option::of(finite()), x in finite()) {
-            let mission = Mission { robot: id.clone(), id: id.clone(), waypoints, recovery: false };
+            let mission = Mission { after_step: None, robot: id.clone(), id: id.clone(), waypoints, recovery: false };
             round_trips(&mission);
             round_trips(&ControllerStatus { robot: id.clone(), mission: Some(id), state, waypoint: Some(2), waypoints: 5, distance_left_m: Some(x), steps, estimate_step: Some(steps), peb_m: peb, omega_deg: x, z_isa: x, u: [x, x] });
         }
@@ -626,7 +626,7 @@ mod controller_and_mapper_messages {
 
         #[test]
         fn controller_messages_refuse_garbage_and_versions(id in name(), g in garbage(), v in other_version()) {
-            let m = Mission { robot: id.clone(), id, waypoints: vec![[1.0, 2.0]], recovery: false };
+            let m = Mission { after_step: None, robot: id.clone(), id, waypoints: vec![[1.0, 2.0]], recovery: false };
             refuses_trailing(&m, &g);
             refuses_version(&m, v);
         }

@@ -251,9 +251,36 @@ impl LockstepDay {
                 }
                 tokio::time::sleep(Duration::from_millis(1)).await;
             }
+            self.until_the_sim_holds_the_command(stepped.step).await;
         }
         seen.reports.extend(drain::<WindowReport>(&self.reports));
         seen
+    }
+
+    /// Waits until the sim holds the command answering `step`: this driver heard it
+    /// leave the controller, but the sim hears it on another link, and a step request
+    /// that overtook it would drive the robot on the previous command.
+    async fn until_the_sim_holds_the_command(&self, step: u64) {
+        let root = &self.harness.root;
+        let robot = &self.heard.robot;
+        let until = Instant::now() + Duration::from_secs(10);
+        while Instant::now() < until {
+            let status: Result<SimStatus, _> = self
+                .client
+                .request(&keys::sim_control(root), Some(&SimControl::Status))
+                .await;
+            if let Ok(status) = status {
+                if status
+                    .pending
+                    .iter()
+                    .any(|p| &p.robot == robot && p.step == Some(step))
+                {
+                    return;
+                }
+            }
+            tokio::time::sleep(Duration::from_millis(1)).await;
+        }
+        eprintln!("step {step}: the sim never held its command");
     }
 
     /// What came after the last step (a moment's wait).

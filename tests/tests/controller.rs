@@ -50,6 +50,7 @@ async fn give_path(
     waypoints: Vec<[f64; 2]>,
 ) {
     let mission = Mission {
+        after_step: None,
         robot: "robot".into(),
         id: id.into(),
         waypoints,
@@ -433,4 +434,72 @@ async fn a_detour_is_driven_as_planned_under_follow_path() {
         top >= -5.5 - MAX_CROSS_TRACK_M,
         "the detour's top was cut: y ≤ {top}"
     );
+}
+
+/// A mission decided on estimate k (`after_step: k`) that reaches the controller before
+/// estimate k starts after the controller has answered k: whatever the machine's load,
+/// the command for k comes from the mission before, as in the batch.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_mission_decided_on_an_estimate_starts_after_that_estimate_is_answered() {
+    let scenario = "config/scenarios/es2.yaml";
+    let harness = Harness::start().await;
+    let _controller = harness
+        .start_role(ControllerConfig {
+            scenario: Some(repo_path(scenario)),
+            stale_after_s: 60.0,
+            ..harness.controller_config()
+        })
+        .await;
+    let client = harness.client().await;
+    let root = harness.root.clone();
+    let statuses = subscribe(&client, keys::robot_controller(&root, "robot")).await;
+    let estimate = |step: u64| PositionEstimate {
+        robot: "robot".into(),
+        step,
+        time_s: step as f64 * 0.4,
+        position: [5.0, 5.0],
+        crb: None,
+        peb_m: Some(0.1),
+        anchors_used: Vec::new(),
+        degraded: false,
+    };
+    let estimates = keys::robot_estimate(&root, "robot");
+    put(&client, estimates.clone(), &estimate(1)).await;
+    give_mission(&client, &root, "first", [40.0, 40.0]).await;
+    status_until(&statuses, Duration::from_secs(10), |s| {
+        s.mission.as_deref() == Some("first")
+    })
+    .await;
+
+    let second = Mission {
+        robot: "robot".into(),
+        id: "second".into(),
+        waypoints: vec![[5.0, 40.0]],
+        recovery: false,
+        after_step: Some(3),
+    };
+    put(&client, keys::robot_mission(&root, "robot"), &second).await;
+    for step in [2, 3] {
+        put(&client, estimates.clone(), &estimate(step)).await;
+        let answered = status_until(&statuses, Duration::from_secs(10), |s| {
+            s.estimate_step == Some(step) || s.mission.as_deref() == Some("second")
+        })
+        .await;
+        assert_eq!(
+            answered.mission.as_deref(),
+            Some("first"),
+            "estimate {step} is answered on the mission before: {answered:?}"
+        );
+    }
+    let started = status_until(&statuses, Duration::from_secs(10), |s| {
+        s.mission.as_deref() == Some("second")
+    })
+    .await;
+    assert_eq!(started.state, MissionState::Active);
+    put(&client, estimates, &estimate(4)).await;
+    let next = status_until(&statuses, Duration::from_secs(10), |s| {
+        s.estimate_step == Some(4)
+    })
+    .await;
+    assert_eq!(next.mission.as_deref(), Some("second"));
 }

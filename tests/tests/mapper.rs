@@ -449,6 +449,7 @@ async fn the_news_and_the_map_now_reach_the_map_server() {
     // Robot b's mission along row 20, cells 5 to 15 (world y = 8).
     let put_mission = |waypoints: Vec<[f64; 2]>| {
         let mission = Mission {
+            after_step: None,
             robot: "b".into(),
             id: "b-1".into(),
             waypoints,

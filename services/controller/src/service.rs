@@ -149,6 +149,12 @@ struct ControllerShared {
     /// [`MAX_ROBOTS`]: with the scenario's robots, what "a robot the world has" means
     /// to the controller.
     seen: Mutex<HashMap<String, Instant>>,
+    /// The step of each robot's last estimate answered, kept with `seen`.
+    answered: Mutex<HashMap<String, u64>>,
+    /// Missions decided on an estimate this controller has not answered yet
+    /// ([`Mission::after_step`]), one per robot (the latest), for robots the world has:
+    /// each starts once that estimate is answered.
+    queued: Mutex<HashMap<String, Mission>>,
     /// Missions for robots not yet heard of, waiting for their first estimate: at most
     /// [`MAX_HELD_MISSIONS`], the oldest dropped first, each for `release_after`.
     held: Mutex<HashMap<String, (Instant, Mission)>>,
@@ -175,6 +181,29 @@ impl ControllerShared {
             }
         }
         seen.insert(robot.to_owned(), Instant::now());
+    }
+
+    /// Whether `mission` waits for an estimate `robot`'s controller has not answered.
+    fn waits(&self, robot: &str, mission: &Mission) -> bool {
+        let Some(after) = mission.after_step else {
+            return false;
+        };
+        roam_runtime::lock(&self.answered)
+            .get(robot)
+            .is_none_or(|answered| *answered < after)
+    }
+
+    /// The mission queued for `robot` if it may start before (`before: true`) or after
+    /// answering the estimate of `step`.
+    fn take_queued(&self, robot: &str, step: u64, before: bool) -> Option<Mission> {
+        let mut queued = roam_runtime::lock(&self.queued);
+        let after = queued.get(robot)?.after_step.unwrap_or(0);
+        let due = if before { after < step } else { after <= step };
+        if due {
+            queued.remove(robot)
+        } else {
+            None
+        }
     }
 
     /// Holds a mission until the robot's first estimate.
@@ -279,6 +308,13 @@ fn on_mission(state: &ControllerShared, key: &str, mission: Mission) {
         state.hold(robot, mission);
         return;
     }
+    if state.waits(robot, &mission) {
+        // Decided on an estimate not answered yet: it starts once it is (the queue
+        // holds one mission per robot the world has, the latest).
+        roam_runtime::lock(&state.queued).insert(robot.to_owned(), mission);
+        return;
+    }
+    roam_runtime::lock(&state.queued).remove(robot);
     install_mission(state, robot, &mission);
 }
 
@@ -352,6 +388,10 @@ fn on_estimate(state: &ControllerShared, key: &str, estimate: PositionEstimate) 
     if let Some(mission) = state.take_held(robot) {
         install_mission(state, robot, &mission);
     }
+    if let Some(mission) = state.take_queued(robot, estimate.step, true) {
+        install_mission(state, robot, &mission);
+    }
+    roam_runtime::lock(&state.answered).insert(robot.to_owned(), estimate.step);
     let (status, u) = {
         let mut robots = state.robots();
         let Some(driven) = robots.get_mut(robot) else {
@@ -372,6 +412,9 @@ fn on_estimate(state: &ControllerShared, key: &str, estimate: PositionEstimate) 
         state.command(robot, u, Some(estimate.step));
     }
     state.put(&keys::robot_controller(&state.root, robot), &status);
+    if let Some(mission) = state.take_queued(robot, estimate.step, false) {
+        install_mission(state, robot, &mission);
+    }
 }
 
 /// Holds every robot whose estimates have stopped: a zero command and `halted_stale`;
@@ -417,6 +460,21 @@ fn release_gone(state: &ControllerShared) {
     let release_after = state.release_after;
     state.seen().retain(|_, t| t.elapsed() < release_after);
     roam_runtime::lock(&state.held).retain(|_, (t, _)| t.elapsed() < release_after);
+    {
+        let seen = state.seen();
+        roam_runtime::lock(&state.answered).retain(|robot, _| seen.contains_key(robot));
+    }
+    let queued: Vec<String> = roam_runtime::lock(&state.queued).keys().cloned().collect();
+    let gone: Vec<String> = queued
+        .into_iter()
+        .filter(|r| !state.is_present(r))
+        .collect();
+    if !gone.is_empty() {
+        let mut queued = roam_runtime::lock(&state.queued);
+        for robot in gone {
+            queued.remove(&robot);
+        }
+    }
     state.robots().retain(|robot, d| {
         let keep = d.last_estimate.elapsed() < release_after;
         if !keep {
@@ -488,6 +546,8 @@ pub async fn run(
             .collect(),
         seen: Mutex::new(HashMap::new()),
         held: Mutex::new(HashMap::new()),
+        answered: Mutex::new(HashMap::new()),
+        queued: Mutex::new(HashMap::new()),
         warnings: WarnLimiter::new(),
     });
     let (mission_keys, estimate_keys): (Vec<String>, Vec<String>) = if config.robots.is_empty() {

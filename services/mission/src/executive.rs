@@ -218,9 +218,15 @@ impl Executive<'_> {
         }
     }
 
+    /// Sends `mission`, decided on the last estimate heard: the controller starts it
+    /// after answering that estimate ([`Mission::after_step`]), as the batch does.
     fn publish(&self, mission: &Mission) {
         let key = keys::robot_mission(self.root, &self.config.robot);
-        roam_runtime::publish_wait(self.session, &key, mission, Delivery::Reliable);
+        let mission = Mission {
+            after_step: self.heard.estimate_step,
+            ..mission.clone()
+        };
+        roam_runtime::publish_wait(self.session, &key, &mission, Delivery::Reliable);
     }
 
     /// What the executive is doing, for operators and for lock-step drivers: the sim

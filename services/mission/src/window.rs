@@ -185,6 +185,7 @@ impl MissionIds {
     fn next(&mut self, waypoints: Vec<[f64; 2]>, recovery: bool) -> Mission {
         self.sent += 1;
         Mission {
+            after_step: None,
             robot: self.robot.clone(),
             id: format!(
                 "{}-{}-w{}-m{}",

@@ -95,6 +95,7 @@ async fn a_ros2_client_reads_the_map_and_plans_and_calls_the_planner() {
     }
     let waypoints = vec![[-8.0, -8.0], [-7.5, -8.0], [-7.0, -7.5]];
     let mission = Mission {
+        after_step: None,
         robot: "r1".into(),
         id: "ros2-test".into(),
         waypoints: waypoints.clone(),

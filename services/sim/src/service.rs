@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
-use roam_proto::sim::{RobotCommand, SimClock, SimControl, SimStatus};
+use roam_proto::sim::{PendingCommand, RobotCommand, SimClock, SimControl, SimStatus};
 use roam_proto::{decode, keys, ErrorCode, ErrorReply, Message};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::world_check::{self, WorldMismatch};
@@ -127,7 +127,7 @@ struct Control {
     running: bool,
     rate: f64,
     /// The latest command per robot, taken by the next step.
-    pending: BTreeMap<String, [f64; 2]>,
+    pending: BTreeMap<String, RobotCommand>,
     late_steps: u64,
     free_steps: u64,
 }
@@ -168,6 +168,14 @@ impl SimShared {
             free_steps: c.free_steps,
             robots,
             anchors,
+            pending: c
+                .pending
+                .iter()
+                .map(|(robot, command)| PendingCommand {
+                    robot: robot.clone(),
+                    step: command.step,
+                })
+                .collect(),
         }
     }
 }
@@ -237,7 +245,9 @@ pub async fn run(
         warnings: WarnLimiter::new(),
     });
 
-    // Commands: a callback, so a command is pending before any later query is handled.
+    // Commands: a callback, so a command is pending as soon as it arrives (the status names
+    // it, for a lock-step driver: a command and a step request from another session
+    // arrive in no promised order).
     let command_key = keys::robot_command_any(&config.root);
     let commands = {
         let state = state.clone();
@@ -362,7 +372,7 @@ fn take_command(state: &SimShared, key: &str, payload: &[u8]) {
     };
     let mut control = state.control();
     if control.sim.robot(robot).is_some() {
-        control.pending.insert(robot.to_owned(), command.u);
+        control.pending.insert(robot.to_owned(), command);
     } else {
         tracing::debug!(%robot, "dropping a command for a robot the sim does not have");
     }
@@ -373,7 +383,7 @@ fn step_once(state: &SimShared) -> Result<(SimClock, Vec<RobotMessages>), ErrorR
     let mut control = state.control();
     let commands: Vec<Command> = std::mem::take(&mut control.pending)
         .into_iter()
-        .map(|(robot, u)| Command { robot, u })
+        .map(|(robot, c)| Command { robot, u: c.u })
         .collect();
     let report = control.sim.step(&commands).map_err(|e| sim_error(&e))?;
     let clock = SimClock {

@@ -652,6 +652,7 @@ mod tests {
     #[test]
     fn a_mission_is_a_line_through_its_waypoints_and_an_empty_one_deletes_it() {
         let m = Mission {
+            after_step: None,
             robot: "r1".into(),
             id: "w1".into(),
             waypoints: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 2.0]],
@@ -677,6 +678,7 @@ mod tests {
     #[test]
     fn a_long_mission_is_drawn_within_the_bounds() {
         let m = Mission {
+            after_step: None,
             robot: "r1".into(),
             id: "x".repeat(1 << 20),
             waypoints: (0..MAX_WAYPOINTS + 5).map(|i| [i as f64, 0.0]).collect(),
@@ -720,6 +722,7 @@ mod tests {
             degraded: false,
         };
         let m = Mission {
+            after_step: None,
             robot: evil.clone(),
             id: evil.clone(),
             waypoints: vec![[0.0, 0.0]],

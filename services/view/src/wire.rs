@@ -182,6 +182,7 @@ mod tests {
     fn the_longest_mission_the_controller_takes_fits_the_mission_cap() {
         let extreme = -2.225_073_858_507_201_4e-308;
         let mission = Mission {
+            after_step: None,
             robot: "r".repeat(roam_proto::keys::MAX_SEGMENT_LEN),
             id: "i".repeat(roam_proto::controller::MAX_MISSION_ID_BYTES),
             waypoints: vec![[extreme, extreme]; MAX_WAYPOINTS],

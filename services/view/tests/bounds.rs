@@ -168,6 +168,7 @@ async fn names_with_newlines_and_escapes_reach_no_entity_or_log_line_raw() {
         step_s: 0.4,
         late_steps: 0,
         free_steps: 0,
+        pending: Vec::new(),
         robots: vec![
             NamedPoint {
                 name: EVIL.into(),

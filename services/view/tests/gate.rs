@@ -28,6 +28,7 @@ async fn view_with_a_mission(access: Access) -> (Stack, ViewHandle, Cancellation
     let (view, cancel) = start_view(&stack.router, &stack.root, access, None).await;
     let client = stack.client().await;
     let mission = Mission {
+        after_step: None,
         robot: "r1".into(),
         id: "m-gate".into(),
         waypoints: vec![[0.0, 0.0], [1.0, 2.0]],

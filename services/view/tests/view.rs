@@ -159,6 +159,7 @@ async fn an_mcap_recording_of_a_short_run_holds_the_map_robots_and_anchors() {
     .await
     .expect("subscriber");
     let mission = Mission {
+        after_step: None,
         robot: "robot".into(),
         id: "m1".into(),
         waypoints: vec![[-8.0, -8.0], [-6.0, -8.0]],

@@ -61,7 +61,7 @@ async fn a_robots_credentials_publish_and_hear_its_own_keys_only() {
     put(&executive, &r1_mission, forged()).await;
     assert_eq!(
         heard_until(&operator, &r1_mission).await,
-        [r1_mission.clone()]
+        std::slice::from_ref(&r1_mission)
     );
     assert_eq!(heard_until(&r1_controller, &r1_mission).await, [r1_mission]);
 

@@ -64,6 +64,7 @@ pub(crate) async fn logs(harness: &Harness, client: &Requester, log: &Captured) 
     let kind = "k".repeat(1_000_000);
     let huge_kind = format!(r#"{{"v":1,"kind":"{kind}","body":{{}}}}"#);
     let long_id = Mission {
+        after_step: None,
         robot: "robot".into(),
         id: "i".repeat(1_000_000),
         waypoints: vec![[1.0, 1.0]],
@@ -86,6 +87,7 @@ pub(crate) async fn logs(harness: &Harness, client: &Requester, log: &Captured) 
     // A forged name, then a valid put on the same keys so the flood has been handled
     // when the check runs (each subscriber handles its samples in order).
     let forged = Mission {
+        after_step: None,
         robot: format!("robot\n{FORGED_LINE}\u{1b}[31m"),
         id: format!("id\n{FORGED_LINE}"),
         waypoints: vec![],

@@ -46,6 +46,7 @@ pub(crate) async fn keys_decide(harness: &Harness, client: &Requester) {
 
     // 1. A mission on robot AAA's key whose body names robot `robot`.
     let forged = Mission {
+        after_step: None,
         robot: "robot".into(),
         id: "forged".into(),
         waypoints: vec![[9.0, 9.0]],

@@ -391,6 +391,7 @@ pub(crate) fn estimate_bases() -> Vec<Vec<u8>> {
 pub(crate) fn mission_bases() -> Vec<Vec<u8>> {
     let mission = |robot: &str, waypoints: Vec<[f64; 2]>| {
         encode(&Mission {
+            after_step: None,
             robot: robot.into(),
             id: "fuzz".into(),
             waypoints,

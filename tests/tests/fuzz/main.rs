@@ -461,6 +461,7 @@ async fn every_queryable_and_subscriber_survives_random_and_mutated_payloads() {
     .await
     .expect("subscriber");
     let mission = Mission {
+        after_step: None,
         robot: "robot".into(),
         id: "after-the-storm".into(),
         waypoints: vec![[60.0, 16.0]],

@@ -260,6 +260,7 @@ async fn run(
     for (k, &at) in places.iter().enumerate() {
         let name = format!("fleet-{k}");
         let mission = Mission {
+            after_step: None,
             robot: name.clone(),
             id: format!("bench-{k}"),
             waypoints: vec![places[(k + robots / 2) % robots], at],

@@ -2,6 +2,7 @@
 //! its progress and runtime on stderr.
 
 use roam_experiments::reproduce::fleet::{self, FleetOptions, FleetVariant};
+use roam_proto::planner::PlannerModel;
 
 #[derive(Debug, clap::Args)]
 pub(crate) struct FleetArgs {
@@ -22,9 +23,25 @@ pub(crate) struct FleetArgs {
     jobs: Option<usize>,
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// GA generations per curious plan.
+    /// GA generations per curious plan (model0, model1, model2).
     #[arg(long, default_value_t = FleetOptions::default().generations)]
     generations: u32,
+    /// The curious variants' planner: greedy (default) or a GA model (model0, model1,
+    /// model2).
+    #[arg(long, default_value = "greedy")]
+    model: String,
+}
+
+/// The curious planner named `name`.
+fn curious_model(name: &str) -> Option<PlannerModel> {
+    [
+        PlannerModel::Greedy,
+        PlannerModel::Model0,
+        PlannerModel::Model1,
+        PlannerModel::Model2,
+    ]
+    .into_iter()
+    .find(|m| m.as_str() == name)
 }
 
 pub(crate) async fn run(args: FleetArgs) -> anyhow::Result<()> {
@@ -32,6 +49,12 @@ pub(crate) async fn run(args: FleetArgs) -> anyhow::Result<()> {
         days: args.days,
         seed: args.seed,
         generations: args.generations,
+        model: curious_model(&args.model).ok_or_else(|| {
+            anyhow::anyhow!(
+                "no planner model {:?}; give greedy, model0, model1 or model2",
+                args.model
+            )
+        })?,
         ..FleetOptions::default()
     };
     if !args.variants.is_empty() {

@@ -13,6 +13,7 @@ pub(crate) const GHOSTS: usize = 1000;
 
 pub(crate) async fn attack(session: &zenoh::Session, root: &str) -> usize {
     let huge = encode(&Mission {
+        after_step: None,
         robot: "robot".into(),
         id: "huge".into(),
         waypoints: vec![[1.234_567_890_123, -9.876_543_210_987]; 10_000_000],
@@ -28,6 +29,7 @@ pub(crate) async fn attack(session: &zenoh::Session, root: &str) -> usize {
     for i in 0..GHOSTS {
         let ghost = format!("ghost-{i}");
         let mission = Mission {
+            after_step: None,
             robot: ghost.clone(),
             id: format!("ghost-mission-{i}"),
             waypoints: vec![[1.0, 1.0]],
@@ -39,6 +41,7 @@ pub(crate) async fn attack(session: &zenoh::Session, root: &str) -> usize {
             .expect("put");
     }
     let long_id = Mission {
+        after_step: None,
         robot: "robot".into(),
         id: "i".repeat(1_000_000),
         waypoints: vec![[1.0, 1.0]],

@@ -403,6 +403,7 @@ impl std::io::Write for LogWriter {
 /// A mission for `robot` with `waypoints` waypoints.
 pub fn mission(robot: &str, id: &str, waypoints: usize) -> roam_proto::controller::Mission {
     roam_proto::controller::Mission {
+        after_step: None,
         robot: robot.into(),
         id: id.into(),
         waypoints: (0..waypoints).map(|i| [i as f64 * 0.5, 1.5]).collect(),

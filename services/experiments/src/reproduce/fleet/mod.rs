@@ -27,6 +27,7 @@ pub mod world;
 
 use std::fmt::Write;
 
+use roam_proto::planner::PlannerModel;
 use serde::Serialize;
 
 use crate::parallel::run_in_order;
@@ -44,7 +45,12 @@ pub const MAX_FLEET_DAYS: usize = 365;
 pub struct FleetOptions {
     pub days: usize,
     pub seed: u64,
-    /// GA generations per curious plan.
+    /// The planner's model for curious plans: `greedy` by default (roam's peer of
+    /// paper 000's GA: more information in a twentieth of the time, planner README
+    /// "The peer"; ten robots replanning every few seconds need plans in tens of
+    /// milliseconds), `model1` for paper 000's.
+    pub model: PlannerModel,
+    /// GA generations per curious plan (the GA models only).
     pub generations: u32,
     /// W_loc of the PEB cost for the curious variants.
     pub w_loc: f64,
@@ -61,10 +67,12 @@ impl Default for FleetOptions {
         FleetOptions {
             days: 7,
             seed: 0,
+            model: PlannerModel::Greedy,
             generations: 200,
             w_loc: 2000.0,
             plan_wall_s: 0.2,
-            rate: 20.0,
+            // A fleet runs on the wall clock: a plan's computing time is its cost.
+            rate: 1.0,
             variants: FleetVariant::ALL.to_vec(),
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
         }
@@ -95,6 +103,8 @@ pub enum FleetError {
 pub struct FleetReport {
     pub days: usize,
     pub seed: u64,
+    /// The curious variants' planner.
+    pub model: PlannerModel,
     pub generations: u32,
     pub robots: usize,
     pub shift_s: f64,
@@ -191,6 +201,7 @@ pub fn run_on(
     Ok(FleetReport {
         days: options.days,
         seed: options.seed,
+        model: options.model,
         generations: options.generations,
         robots: world.shift.robots.len(),
         shift_s,
@@ -216,8 +227,8 @@ impl FleetReport {
         let mut out = String::new();
         let _ = writeln!(
             out,
-            "roam reproduce fleet: {} robots, {} shifts of {:.0} s, seed {}, {} generations",
-            self.robots, self.days, self.shift_s, self.seed, self.generations
+            "roam reproduce fleet: {} robots, {} shifts of {:.0} s, seed {}, curious plans by {} ({} generations for a GA)",
+            self.robots, self.days, self.shift_s, self.seed, self.model.as_str(), self.generations
         );
         let _ = writeln!(
             out,

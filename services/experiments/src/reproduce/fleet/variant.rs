@@ -21,6 +21,7 @@
 use roam_mapper::news::DEFAULT_NEWS_PRIOR;
 use roam_mapper::prior::RatePrior;
 use roam_mission::config::ExecutiveConfig;
+use roam_proto::planner::PlannerModel;
 use serde::Serialize;
 
 /// One configuration of the fleet.
@@ -88,9 +89,14 @@ impl FleetVariant {
     }
 
     /// The executive's configuration: `base` (the robot, its week of tasks, the
-    /// generations, the seed) with this variant's rules; `w_loc` the PEB cost for the
-    /// curious variants.
-    pub fn config(self, base: ExecutiveConfig, w_loc: f64) -> ExecutiveConfig {
+    /// generations, the seed) with this variant's rules; `w_loc` the PEB cost and
+    /// `curious` the planner's model for the curious variants.
+    pub fn config(
+        self,
+        base: ExecutiveConfig,
+        w_loc: f64,
+        curious: PlannerModel,
+    ) -> ExecutiveConfig {
         match self {
             FleetVariant::TasksOnly => ExecutiveConfig {
                 model: roam_proto::planner::PlannerModel::Shortest,
@@ -102,6 +108,7 @@ impl FleetVariant {
                 ..base
             },
             _ => ExecutiveConfig {
+                model: curious,
                 w_loc: Some(w_loc),
                 ..base
             },
@@ -129,17 +136,20 @@ impl FleetVariant {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use roam_proto::planner::PlannerModel;
 
     #[test]
     fn names_round_trip_and_each_part_of_news_is_off_alone() {
         for v in FleetVariant::ALL {
             assert_eq!(FleetVariant::parse(v.name()), Some(v));
-            assert_eq!(v.config(ExecutiveConfig::default(), 2000.0).check(), Ok(()));
+            assert_eq!(
+                v.config(ExecutiveConfig::default(), 2000.0, PlannerModel::Greedy)
+                    .check(),
+                Ok(())
+            );
         }
         assert_eq!(
             FleetVariant::TasksOnly
-                .config(ExecutiveConfig::default(), 2000.0)
+                .config(ExecutiveConfig::default(), 2000.0, PlannerModel::Greedy)
                 .model,
             PlannerModel::Shortest
         );

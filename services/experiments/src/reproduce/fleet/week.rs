@@ -177,7 +177,7 @@ pub fn run_week(
                 planning_cost_s: Some(options.plan_wall_s * options.rate),
                 ..ExecutiveConfig::default()
             };
-            variant.config(base, options.w_loc)
+            variant.config(base, options.w_loc, options.model)
         })
         .collect();
     let scale = InformationScale {
