@@ -8,8 +8,8 @@
 //! flies) and no PEB cost (`w_loc: None`), so the curious plan is free to visit the
 //! archive, the room's interesting and uncovered part (no anchor stands in the
 //! north-east: fewer than three are in range there, the fix is lost). The executive's
-//! seed is one whose curious path takes the robot over the edge of the coverage at about
-//! (2.1, 2.9), where the controller's guard holds it (`halted_peb`).
+//! seed is one whose curious path takes the robot over the edge of the coverage, where
+//! the controller's guard holds it (`halted_peb`).
 //!
 //! With `recover: true` the executive must get it out: after `hold_patience_s` back
 //! along its own track to its last fix, then the window's fastest path to the task, on
@@ -32,9 +32,11 @@ const SCENARIO: &str = "config/scenarios/day.yaml";
 /// 0.1 m).
 const TASK_AT: [f64; 2] = [2.0, 0.0];
 const TASK_START_S: f64 = 120.0;
-/// The executive's seed: `day_seed(7, 1)`, whose curious path crosses into the room
-/// (checked in batch with the same window machine).
-const SEED_BASE: u64 = 7;
+/// The executive's seed: `day_seed(12, 1)`, whose curious path crosses into the room
+/// (checked in batch with the same window machine: held once and late without
+/// recovery, recovered once and on time with it; the window's rules of issue 26 moved
+/// `day_seed(7, 1)`'s path off the room).
+const SEED_BASE: u64 = 12;
 const SEED_DAY: usize = 1;
 /// The window is given up this long after the task's start (a held robot's report
 /// comes then).

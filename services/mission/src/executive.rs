@@ -27,7 +27,7 @@ use std::time::{Duration, Instant};
 
 use roam_planner::client::PlannerClient;
 use roam_planner::params::GaParams;
-use roam_proto::controller::Mission;
+use roam_proto::controller::{ControllerStatus, Mission};
 use roam_proto::keys;
 use roam_proto::mission::ExecutiveStatus;
 use roam_proto::planner::{Plan, PlannerModel};
@@ -358,6 +358,11 @@ impl Executive<'_> {
         let mut tick = tokio::time::interval(TICK);
         tick.set_missed_tick_behavior(MissedTickBehavior::Delay);
         let name = || task.name.clone();
+        // A controller status on an estimate not heard yet (it came first: the two
+        // arrive on different links) waits for that estimate, so the window machine
+        // meets them in the order the batch does: the estimate, then the status on it.
+        let mut early_status: Option<ControllerStatus> = None;
+        let mut released: Option<ControllerStatus> = None;
         loop {
             while let Some(action) = pending.pop_front() {
                 match action {
@@ -411,33 +416,51 @@ impl Executive<'_> {
                     }
                 }
             }
-            let event = tokio::select! {
-                _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
-                _ = tick.tick() => WindowEvent::Tick,
-                Some(answered) = in_flight.join_next(), if !in_flight.is_empty() => {
-                    let Ok((id, curious, took_s, reply)) = answered else { continue };
-                    match reply {
-                        Ok(plan) => {
-                            self.took(&plan, took_s);
-                            WindowEvent::PlanReply { id, plan: Box::new(plan) }
-                        }
-                        Err(e) => {
-                            tracing::warn!(task = %task.name, curious, "the plan request failed: {e}");
-                            WindowEvent::PlanFailed { id }
+            let event = if let Some(s) = released.take() {
+                self.heard.status_step = s.estimate_step.or(self.heard.status_step);
+                WindowEvent::Status(s)
+            } else {
+                tokio::select! {
+                    _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
+                    _ = tick.tick() => WindowEvent::Tick,
+                    Some(answered) = in_flight.join_next(), if !in_flight.is_empty() => {
+                        let Ok((id, curious, took_s, reply)) = answered else { continue };
+                        match reply {
+                            Ok(plan) => {
+                                self.took(&plan, took_s);
+                                WindowEvent::PlanReply { id, plan: Box::new(plan) }
+                            }
+                            Err(e) => {
+                                tracing::warn!(task = %task.name, curious, "the plan request failed: {e}");
+                                WindowEvent::PlanFailed { id }
+                            }
                         }
                     }
-                }
-                sample = self.inputs.estimates.recv_async() => {
-                    let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
-                    let Some(e) = self.inputs.estimate(&sample) else { continue };
-                    self.heard.estimate_step = Some(e.step);
-                    WindowEvent::Estimate { position: e.position, peb_m: e.peb_m, degraded: e.degraded }
-                }
-                sample = self.inputs.statuses.recv_async() => {
-                    let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
-                    let Some(s) = self.inputs.status(&sample) else { continue };
-                    self.heard.status_step = s.estimate_step.or(self.heard.status_step);
-                    WindowEvent::Status(s)
+                    sample = self.inputs.estimates.recv_async() => {
+                        let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
+                        let Some(e) = self.inputs.estimate(&sample) else { continue };
+                        self.heard.estimate_step = Some(e.step);
+                        if early_status.as_ref().is_some_and(|s| s.estimate_step <= Some(e.step)) {
+                            released = early_status.take();
+                        }
+                        WindowEvent::Estimate { position: e.position, peb_m: e.peb_m, degraded: e.degraded }
+                    }
+                    sample = self.inputs.statuses.recv_async() => {
+                        let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
+                        let Some(s) = self.inputs.status(&sample) else { continue };
+                        let ahead = s.estimate_step.is_some() && s.estimate_step > self.heard.estimate_step;
+                        let s = if ahead {
+                            // At most one waits: an older one goes now (its estimate was lost).
+                            match early_status.replace(s) {
+                                Some(older) => older,
+                                None => continue,
+                            }
+                        } else {
+                            s
+                        };
+                        self.heard.status_step = s.estimate_step.or(self.heard.status_step);
+                        WindowEvent::Status(s)
+                    }
                 }
             };
             let tick_only = matches!(event, WindowEvent::Tick);

@@ -141,6 +141,9 @@ struct SimShared {
     /// Held by whoever steps and publishes (the free run, one `step` request), so the
     /// messages of two steps never interleave and two lock-step drivers cannot pile up.
     stepper: tokio::sync::Mutex<()>,
+    /// Held by the step request being served: a second one is told `busy` at once,
+    /// while one that only meets the free run's last step (just paused) waits for it.
+    step_request: tokio::sync::Mutex<()>,
     /// Woken by every control request, so the free run sees a pause, a new rate or a
     /// reset at once instead of after the sleep it was in.
     wake: tokio::sync::Notify,
@@ -241,6 +244,7 @@ pub async fn run(
         }),
         load_dirs,
         stepper: tokio::sync::Mutex::new(()),
+        step_request: tokio::sync::Mutex::new(()),
         wake: tokio::sync::Notify::new(),
         warnings: WarnLimiter::new(),
     });
@@ -577,12 +581,13 @@ async fn control(state: &Arc<SimShared>, request: SimControl) -> Result<(), Erro
                     ),
                 ));
             }
-            let Ok(_stepping) = state.stepper.try_lock() else {
+            let Ok(_request) = state.step_request.try_lock() else {
                 return Err(ErrorReply::new(
                     ErrorCode::Busy,
                     "another step request is running; wait for its reply, then step again",
                 ));
             };
+            let _stepping = state.stepper.lock().await;
             if state.control().running {
                 return Err(ErrorReply::new(
                     ErrorCode::InvalidRequest,

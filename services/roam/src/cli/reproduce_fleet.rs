@@ -30,6 +30,11 @@ pub(crate) struct FleetArgs {
     /// model2).
     #[arg(long, default_value = "greedy")]
     model: String,
+    /// Write the week's pictures into this directory: detection.svg (the share of the
+    /// changes seen within t minutes, per variant) and warehouse-<variant>.svg (paths,
+    /// changes, zones, anchors).
+    #[arg(long)]
+    svg: Option<std::path::PathBuf>,
 }
 
 /// The curious planner named `name`.
@@ -90,6 +95,12 @@ pub(crate) async fn run(args: FleetArgs) -> anyhow::Result<()> {
         started.elapsed().as_secs_f64(),
         options.jobs
     );
+    if let Some(dir) = &args.svg {
+        let world = fleet::FleetWorld::warehouse()?;
+        for path in fleet::picture::write(dir, &world, &report.weeks)? {
+            eprintln!("wrote {}", path.display());
+        }
+    }
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
     } else {

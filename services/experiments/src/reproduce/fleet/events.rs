@@ -37,6 +37,11 @@ impl ChangeEvent {
     pub fn latency_s(&self) -> Option<f64> {
         self.seen_s.map(|s| s - self.at_s)
     }
+
+    /// The footprint's map cells: x0, y0, x1, y1 inclusive.
+    pub fn bounds(&self) -> [i64; 4] {
+        self.bounds
+    }
 }
 
 /// Every change of a run, and the ones not yet seen.

@@ -87,6 +87,9 @@ impl MapSample {
     }
 }
 
+/// The picture's paths keep one step in this many.
+pub const PATH_EVERY_STEPS: u64 = 5;
+
 /// Everything one variant's week recorded.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct WeekRecord {
@@ -99,6 +102,10 @@ pub struct WeekRecord {
     pub plan_latencies_s: Vec<f64>,
     /// Steps a robot's controller held it for its PEB, per robot.
     pub halted_steps: Vec<u64>,
+    /// Each robot's true path through the first shift, every [`PATH_EVERY_STEPS`]th
+    /// step: for the picture, not the report (at most a shift's steps per robot).
+    #[serde(skip)]
+    pub paths: Vec<Vec<[f64; 2]>>,
     /// The sim time the week ended at, and the wall seconds it took.
     pub end_s: f64,
     pub wall_s: f64,
@@ -114,6 +121,7 @@ impl WeekRecord {
             events: Vec::new(),
             plan_latencies_s: Vec::new(),
             halted_steps: vec![0; robots],
+            paths: vec![Vec::new(); robots],
             end_s: 0.0,
             wall_s: 0.0,
         }

@@ -20,6 +20,7 @@ pub mod goals;
 pub mod mapper;
 pub mod measure;
 pub mod patrol;
+pub mod picture;
 pub mod summary;
 pub mod variant;
 pub mod week;

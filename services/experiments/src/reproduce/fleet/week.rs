@@ -22,7 +22,7 @@ use crate::reproduce::executive::{InProcessExecutive, Io, Step};
 
 use super::events::ChangeLog;
 use super::mapper::FleetMapper;
-use super::measure::{MapSample, WeekRecord, WindowRecord};
+use super::measure::{MapSample, WeekRecord, WindowRecord, PATH_EVERY_STEPS};
 use super::variant::{FleetVariant, Planning};
 use super::world::FleetWorld;
 use super::{FleetError, FleetOptions};
@@ -222,6 +222,9 @@ pub fn run_week(
                 changes.observe(o, t);
             }
             record.robot_step(i, r.decision.as_ref());
+            if t <= shift.length_s && out.step % PATH_EVERY_STEPS == 0 {
+                record.paths[i].push(r.messages.truth.at);
+            }
             let step = Step {
                 time_s: t,
                 truth: r.messages.truth.at,
