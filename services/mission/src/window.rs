@@ -290,10 +290,15 @@ pub struct DowntimeWindow<'a> {
     began_s: f64,
     /// The robot's last good estimate.
     here: [f64; 2],
-    /// Where the window began, then every good estimate until the robot arrived.
+    /// The previous window's track end (`carried` points, for recoveries: see
+    /// [`Handover::track`]), then where this window began and every good estimate
+    /// until the robot arrived.
     driven: Vec<[f64; 2]>,
+    carried: usize,
     /// The index in `driven` of the last estimate with a fix.
     last_fix: usize,
+    /// The track handed to the next window, kept when the drive's outcome is made.
+    track_out: Option<(Vec<[f64; 2]>, usize)>,
     pebs: Vec<f64>,
     drive_ask: Option<(u64, DriveAsk)>,
     ahead_ask: Option<(u64, AheadAsk)>,
@@ -313,6 +318,10 @@ impl<'a> DowntimeWindow<'a> {
         now: Now,
     ) -> (DowntimeWindow<'a>, Vec<WindowAction>) {
         let from = setup.from;
+        let mut driven = handover.track;
+        let carried = driven.len();
+        let last_fix = handover.fix.min(carried.saturating_sub(1));
+        driven.push(from);
         let mut w = DowntimeWindow {
             ids: MissionIds {
                 robot: setup.robot.clone(),
@@ -325,8 +334,10 @@ impl<'a> DowntimeWindow<'a> {
             planned_ahead: None,
             began_s: now.mission_s,
             here: from,
-            driven: vec![from],
-            last_fix: 0,
+            driven,
+            carried,
+            last_fix,
+            track_out: None,
             pebs: Vec::new(),
             drive_ask: None,
             ahead_ask: None,

@@ -133,7 +133,10 @@ impl DowntimeWindow<'_> {
         time_model: TimeModelReport,
     ) -> WindowOutcome {
         let task = &self.setup.task;
-        let driven = std::mem::take(&mut self.driven);
+        self.track_out = Some(super::handover::carried(&self.driven, self.last_fix));
+        let mut driven = std::mem::take(&mut self.driven);
+        // The previous window's track, carried for recoveries, is not this window's.
+        let driven = driven.split_off(self.carried.min(driven.len()));
         let pebs = &self.pebs;
         let report = WindowReport {
             robot: self.setup.robot.clone(),
@@ -190,6 +193,10 @@ impl DowntimeWindow<'_> {
         self.phase = Phase::Done;
         self.drive_ask = None;
         self.ahead_ask = None;
+        let (track, fix) = self
+            .track_out
+            .take()
+            .unwrap_or_else(|| super::handover::carried(&self.driven, self.last_fix));
         WindowAction::Done(Box::new(WindowEnd {
             outcome,
             handover: Handover {
@@ -197,6 +204,8 @@ impl DowntimeWindow<'_> {
                 missions_sent: self.ids.sent,
                 asks_made: self.asks_made,
                 planned_ahead: self.planned_ahead.take(),
+                track,
+                fix,
             },
             position: self.here,
         }))

@@ -28,6 +28,23 @@ pub struct Handover {
     pub asks_made: u64,
     /// The next window's plan, made during this window.
     pub planned_ahead: Option<PlannedAhead>,
+    /// The end of the robot's driven track (at most [`CARRIED_TRACK_POINTS`]) and the
+    /// index in it of its last estimate with a fix: a robot still held when its window
+    /// ends is driven back along it by the next window, instead of staying held where
+    /// its new window's track has no fix to go back to.
+    pub track: Vec<[f64; 2]>,
+    pub fix: usize,
+}
+
+/// How much of a window's track the next one keeps: 600 estimates, four minutes at the
+/// sim's 0.4 s step.
+pub const CARRIED_TRACK_POINTS: usize = 600;
+
+/// The last [`CARRIED_TRACK_POINTS`] of `driven` and `fix` as an index into them (the
+/// oldest kept point when the fix is older).
+pub(super) fn carried(driven: &[[f64; 2]], fix: usize) -> (Vec<[f64; 2]>, usize) {
+    let start = driven.len().saturating_sub(CARRIED_TRACK_POINTS);
+    (driven[start..].to_vec(), fix.saturating_sub(start))
 }
 
 impl Handover {
@@ -38,6 +55,8 @@ impl Handover {
             missions_sent: 0,
             asks_made: 0,
             planned_ahead: None,
+            track: Vec::new(),
+            fix: 0,
         }
     }
 }

@@ -153,3 +153,52 @@ fn with_plan_ahead_the_next_window_is_asked_while_driving_beside_a_replan() {
         "{actions:?}"
     );
 }
+
+/// A robot still held when its window ended: the next window has no fix on its own
+/// track (it begins where the robot is held) and drives it back along the previous
+/// window's track to that window's last fix, instead of holding it there for good.
+#[test]
+fn a_robot_held_across_windows_is_driven_back_along_the_previous_track() {
+    let f = fixture();
+    // The previous window: a fix at [-2.1, 0.1], then into the gap to FROM.
+    let track = vec![[-3.1, 0.1], [-2.1, 0.1], [-1.1, 0.1], FROM];
+    let handover = Handover {
+        track: track.clone(),
+        fix: 1,
+        ..Handover::first(margin())
+    };
+    let (mut w, _) = DowntimeWindow::begin(f.setup(0, FROM, false), handover, at(0.0, 0.0));
+    let first = sent(&answer(&mut w, curious_reply(true), at(1.0, 0.0)));
+    // Held at once, its estimates without a fix.
+    assert!(w.handle(estimate(FROM, 9.0), at(2.0, 0.1)).is_empty());
+    let held = |w: &mut DowntimeWindow<'_>, t: f64| {
+        w.handle(status(&first.id, MissionState::HaltedPeb, 2.0), at(t, 0.2))
+    };
+    assert!(held(&mut w, 3.0).is_empty());
+    let actions = held(&mut w, 8.0);
+    assert!(
+        matches!(actions[0], WindowAction::Recovering { .. }),
+        "{actions:?}"
+    );
+    let back = sent(&actions);
+    assert!(back.recovery);
+    // Back to the previous window's fix ([-2.1, 0.1], more than RECOVERY_BACK_M back).
+    assert_eq!(back.waypoints.last().copied(), Some(track[1]), "{back:?}");
+    // The window's own track (its report) does not hold the previous one's.
+    let onward = sent(&answer_status(
+        &mut w,
+        &back,
+        MissionState::Completed,
+        at(20.0, 0.3),
+    ));
+    answer_status(&mut w, &onward, MissionState::Completed, at(70.0, 0.5));
+    let end = w.handle(WindowEvent::Tick, at(105.0, 0.6));
+    let outcome = end
+        .iter()
+        .find_map(|a| match a {
+            WindowAction::Done(end) => end.outcome.clone(),
+            _ => None,
+        })
+        .expect("the window's outcome");
+    assert_eq!(outcome.driven.first().copied(), Some(FROM));
+}
