@@ -1,29 +1,22 @@
 //! The fleet's goals, each judged from the figures (the verdict is the comparison of
 //! the figure with its threshold, nothing else).
 
-use serde::Serialize;
-
-use crate::reproduce::mission::days::goals::{judge, Target, Verdict};
+use crate::reproduce::mission::days::goals::{judge, Goal, Target};
 
 use super::summary::FleetSummary;
 
-/// One goal of the fleet's week.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct FleetGoal {
-    pub goal: &'static str,
-    pub figure: Option<f64>,
-    pub target: Target,
-    pub threshold: f64,
-    pub verdict: Verdict,
-}
+/// One goal of the fleet's week: the days batch's [`Goal`], judged the same way; the
+/// fleet's figures are their own account, so it names no shortfall.
+pub type FleetGoal = Goal;
 
 fn goal(goal: &'static str, figure: Option<f64>, target: Target, threshold: f64) -> FleetGoal {
-    FleetGoal {
+    Goal {
         goal,
         figure,
         target,
         threshold,
         verdict: judge(figure, target, threshold),
+        shortfall: None,
     }
 }
 
