@@ -12,6 +12,8 @@
 //! - [`config`]: [`config::ExecutiveConfig`], the one configuration of the live
 //!   executive and the batch; [`request`]: the planner request of a window's ask.
 //! - [`tasks`]: the task sequence and its checks; the built-in world's day.
+//! - [`site`]: a world and one robot's day in it: the built-in day or a user's Nav2
+//!   map and day file.
 //! - [`shift`]: a fleet's shift (each robot's tasks), the built-in warehouse's.
 //! - [`day_check`]: a day checked against a map: every place free, every task
 //!   reachable in time from the previous one (paper 000's fastest path).
@@ -47,6 +49,7 @@ pub mod request;
 #[cfg(feature = "zenoh")]
 pub mod service;
 pub mod shift;
+pub mod site;
 pub mod tasks;
 pub mod watch;
 pub mod window;

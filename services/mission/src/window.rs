@@ -30,9 +30,11 @@
 //!    one for the shortest path; when that fails too, the window's own fastest path.
 //! 4. **The last safe moment.** At most every [`SAFE_CHECK_S`] on a curious route, the
 //!    window computes the fastest path from where the robot is; when the budget the
-//!    arrival margin leaves of the time left no longer exceeds that path's time, the
-//!    robot goes straight, at once, without the planner, and never curious again in
-//!    the window. A late ETA does the same.
+//!    arrival margin leaves of the time left, less twice the check's period, no
+//!    longer exceeds that path's time, the robot goes straight, at once, without the
+//!    planner, and never curious again in the window (until the next check the
+//!    curious route may lead the robot away from the task, and back costs as much). A
+//!    late ETA does the same.
 //! 5. **Holds.** When the controller's PEB guard holds the robot for
 //!    `hold_patience_s`, the window sends a recovery mission back along the robot's own
 //!    track to the last estimate with a fix (PEB at most `fix_peb_m`) and at least
@@ -385,11 +387,22 @@ impl<'a> DowntimeWindow<'a> {
         let Phase::Driving(drive) = &self.phase else {
             return Some(actions);
         };
+        // The window's own curious plan goes to the planner before the next window's
+        // (asked as the robot set off): a planner answers one client's requests in
+        // order, and a short first drive ends before a plan queued second comes.
+        let ahead_at = actions
+            .iter()
+            .position(|a| matches!(a, WindowAction::RequestPlan(_)));
+        let ahead: Vec<WindowAction> = match ahead_at {
+            Some(i) => actions.split_off(i),
+            None => Vec::new(),
+        };
         let lead_m = self.plan_cost_s(time_left, now) * self.setup.watch.expected_speed_m_per_s;
         let from = straight::point_ahead(&drive.path, self.here, lead_m);
         let (to, start) = (self.setup.task.at, self.setup.task.start_s);
         let (ask, _, _) = self.ask(from, to, start, None, true, now);
         actions.extend(self.ask_replan(Reason::SetOff, true, ask));
+        actions.extend(ahead);
         Some(actions)
     }
 
@@ -461,12 +474,20 @@ impl<'a> DowntimeWindow<'a> {
             recoveries: 0,
         }));
         let mut actions = vec![planned, WindowAction::Drive(mission)];
-        let ahead_due =
-            self.setup.rules.plan_ahead && self.planned_ahead.is_none() && self.ahead_ask.is_none();
-        if ahead_due {
-            actions.extend(self.ask_next_window(now));
-        }
+        actions.extend(self.ask_ahead_if_due(now));
         actions
+    }
+
+    /// The next window's plan, asked while this one drives (`plan_ahead`), unless it is
+    /// in or asked.
+    fn ask_ahead_if_due(&mut self, now: Now) -> Vec<WindowAction> {
+        let due =
+            self.setup.rules.plan_ahead && self.planned_ahead.is_none() && self.ahead_ask.is_none();
+        if due {
+            self.ask_next_window(now)
+        } else {
+            Vec::new()
+        }
     }
 
     fn on_estimate(
@@ -628,9 +649,10 @@ impl<'a> DowntimeWindow<'a> {
             return Vec::new();
         }
         drive.safe_checked_at_s = now.mission_s;
-        // The next check may come `SAFE_CHECK_S` later: the rule fires when waiting for
-        // it would leave too little.
-        let time_left = self.setup.task.start_s - now.mission_s - SAFE_CHECK_S;
+        // The next check may come `SAFE_CHECK_S` later, and the curious route may take
+        // the robot that long away from the task, which costs as long again to come
+        // back: the rule fires when waiting for the next check would leave too little.
+        let time_left = self.setup.task.start_s - now.mission_s - 2.0 * SAFE_CHECK_S;
         let budget = self.margin.budget(time_left);
         // What is left of the route is a way to the task, so the fastest path takes no
         // longer: while the budget covers the route left, no search is needed (on a

@@ -13,6 +13,7 @@ use std::time::{Duration, Instant};
 use image::{Rgb, RgbImage};
 use roam_controller::params::ApfParams;
 use roam_mission::executive::{self, ExecutiveConfig, Progress, WindowOutcome};
+use roam_mission::site::Site;
 use roam_proto::cells::Cells;
 use roam_proto::map::{GridMeta, Layer};
 use roam_proto::map::{
@@ -55,6 +56,9 @@ pub struct DemoOptions {
     /// The stack router's endpoint, where other processes connect (a ROS 2 system
     /// over rmw_zenoh, `roam plan`, a Zenoh client); a free loopback port when `None`.
     pub listen: Option<String>,
+    /// The world and the robot's day: the built-in day, or a user's Nav2 map and day
+    /// file ([`roam_mission::site`]).
+    pub site: Site,
 }
 
 impl Default for DemoOptions {
@@ -69,6 +73,7 @@ impl Default for DemoOptions {
             view_access: roam_view::Access::default(),
             ros2: None,
             listen: None,
+            site: Site::builtin_day(),
         }
     }
 }
@@ -102,6 +107,8 @@ pub struct DemoReport {
     /// The mean PEB of the estimates along the way, metres.
     pub peb_mean_m: Option<f64>,
     pub windows: Vec<WindowReport>,
+    /// The site the day ran on (the built-in day, or the day file's name).
+    pub site: String,
     pub sim_rate: f64,
     pub seed: u64,
     pub wall_s: f64,
@@ -143,8 +150,10 @@ pub async fn run(
     // The day's world goes to every service as a file in the report directory, so the
     // report holds the world it was made on.
     let world = options.out_dir.join("world.yaml");
-    std::fs::write(&world, roam_mission::tasks::DAY_SCENARIO)
-        .map_err(|e| write_error(&world, e))?;
+    std::fs::write(&world, &options.site.scenario_yaml).map_err(|e| write_error(&world, e))?;
+    for warning in &options.site.warnings {
+        progress(&format!("warning: {warning}"));
+    }
     progress("booting the stack (map server, planner, sim, localization, controller, mapper)");
     let stack = Stack::start(
         StackOptions {
@@ -243,7 +252,7 @@ async fn drive(
     let truth: Arc<Mutex<Vec<[f64; 2]>>> = Arc::default();
     let recorded = truth.clone();
     let _truth = session
-        .declare_subscriber(keys::robot_truth(&root, "robot"))
+        .declare_subscriber(keys::robot_truth(&root, &options.site.robot))
         .callback(move |sample| {
             if let Ok(t) = decode::<GroundTruth>(&sample.payload().to_bytes()) {
                 let mut path = roam_runtime::lock(&recorded);
@@ -257,7 +266,8 @@ async fn drive(
         .map_err(|e| DemoError::Zenoh(e.to_string()))?;
     let config = ExecutiveConfig {
         seed: options.seed,
-        tasks: roam_mission::tasks::day(),
+        robot: options.site.robot.clone(),
+        tasks: options.site.tasks.clone(),
         w_loc: Some(DEMO_W_LOC),
         ..ExecutiveConfig::default()
     };
@@ -341,6 +351,7 @@ async fn drive(
         todays_plans: today,
         peb_mean_m: (!pebs.is_empty()).then(|| pebs.iter().sum::<f64>() / pebs.len() as f64),
         windows,
+        site: options.site.name.clone(),
         sim_rate: options.rate,
         seed: options.seed,
         wall_s: started.elapsed().as_secs_f64(),
@@ -387,8 +398,18 @@ pub fn cell_of(meta: &GridMeta, p: [f64; 2]) -> [u32; 2] {
     ]
 }
 
-/// Pixels per cell in the demo's picture.
+/// Pixels per cell in the demo's picture of a small world (the built-in day's 100 × 100
+/// cells: 800 pixels).
 pub const SCALE: u32 = 8;
+/// The longer side of the picture, pixels, that a larger world is drawn within (at
+/// least one pixel a cell).
+pub const PICTURE_SIDE: u32 = 800;
+
+/// Pixels per cell for a world of `meta`'s size: [`SCALE`], fewer where the picture
+/// would pass [`PICTURE_SIDE`].
+pub fn picture_scale(meta: &GridMeta) -> u32 {
+    (PICTURE_SIDE / meta.width.max(meta.height).max(1)).clamp(1, SCALE)
+}
 
 fn draw_world(
     occupancy: &Grid<i8>,
@@ -402,32 +423,33 @@ fn draw_world(
     let cells = |points: &[[f64; 2]]| -> Vec<[u32; 2]> {
         points.iter().map(|p| cell_of(&meta, *p)).collect()
     };
-    let mut image = render_map(occupancy, Some(information), SCALE);
+    let scale = picture_scale(&meta);
+    let mut image = render_map(occupancy, Some(information), scale);
     for o in outcomes {
         draw_path(
             &mut image,
             meta.height,
             &cells(&o.shortest),
-            SCALE,
+            scale,
             BASELINE,
         );
         for plan in &o.plans {
-            draw_path(&mut image, meta.height, &cells(plan), SCALE, PATH);
+            draw_path(&mut image, meta.height, &cells(plan), scale, PATH);
         }
     }
-    draw_path(&mut image, meta.height, &cells(driven), SCALE, DRIVEN);
+    draw_path(&mut image, meta.height, &cells(driven), scale, DRIVEN);
     for a in anchors {
-        draw_marker(&mut image, meta.height, cell_of(&meta, *a), SCALE, ANCHOR);
+        draw_marker(&mut image, meta.height, cell_of(&meta, *a), scale, ANCHOR);
     }
     for t in &config.tasks {
-        draw_marker(&mut image, meta.height, cell_of(&meta, t.at), SCALE, MARKER);
+        draw_marker(&mut image, meta.height, cell_of(&meta, t.at), scale, MARKER);
     }
     if let Some(start) = driven.first() {
         draw_marker(
             &mut image,
             meta.height,
             cell_of(&meta, *start),
-            SCALE,
+            scale,
             MARKER,
         );
     }
@@ -437,8 +459,13 @@ fn draw_world(
 fn markdown(r: &DemoReport) -> String {
     let mut out = String::from("# roam demo\n\n");
     out.push_str(&format!(
-        "One robot, a day of {} tasks in the demo's day world (`world.yaml`), the sim at {}x (seed {}), {:.1} s of wall time.\n\n",
+        "One robot, a day of {} tasks in {} (`world.yaml`), the sim at {}x (seed {}), {:.1} s of wall time.\n\n",
         r.windows.len(),
+        if r.site == roam_mission::site::BUILTIN_DAY {
+            "the demo's day world".to_owned()
+        } else {
+            format!("the site `{}`", r.site)
+        },
         r.sim_rate,
         r.seed,
         r.wall_s

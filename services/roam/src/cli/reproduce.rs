@@ -46,6 +46,12 @@ pub(crate) enum ReproduceCommand {
         /// W_loc of the PEB-cost variant.
         #[arg(long, default_value_t = 2000.0)]
         w_loc: f64,
+        /// With --days: your own site's Nav2 map, with --tasks (as `roam demo --map`).
+        #[arg(long, value_name = "MAP.yaml", requires = "tasks")]
+        map: Option<PathBuf>,
+        /// With --days: your own site's day file, with --map.
+        #[arg(long, value_name = "DAY.yaml", requires = "map")]
+        tasks: Option<PathBuf>,
     },
     /// A fleet's week in the warehouse: ten robots' shifts repeated --days times, each
     /// robot driven by the executive's own window machine, objects landing in and
@@ -138,8 +144,14 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             seed,
             generations,
             w_loc,
+            map,
+            tasks,
             ..
         } => {
+            let site = super::roles::site(map.as_deref(), tasks.as_deref())?;
+            for warning in &site.warnings {
+                eprintln!("warning: {warning}");
+            }
             reproduce_days(
                 json,
                 days,
@@ -150,6 +162,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 seed,
                 generations,
                 w_loc,
+                site,
             )
             .await
         }
@@ -160,8 +173,12 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             seed,
             generations,
             w_loc,
+            map,
             ..
         } => {
+            if map.is_some() {
+                bail!("--map and --tasks run the executive's day: give --days N too");
+            }
             if missions == 0 || generations == 0 || !(w_loc.is_finite() && w_loc >= 0.0) {
                 bail!("--missions and --generations must be at least 1, --w-loc 0 or more");
             }
@@ -341,6 +358,7 @@ async fn reproduce_days(
     seed: u64,
     generations: u32,
     w_loc: f64,
+    site: roam_mission::site::Site,
 ) -> anyhow::Result<()> {
     use roam_experiments::reproduce::mission::days::{self, DaysOptions, Variant};
     let mut options = DaysOptions {
@@ -350,6 +368,7 @@ async fn reproduce_days(
         w_loc,
         plan_wall_s: plan_wall,
         rate,
+        site,
         ..DaysOptions::default()
     };
     if !variants.is_empty() {

@@ -346,12 +346,33 @@ pub(crate) struct DemoArgs {
     /// (with --ros2) or any Zenoh client connects; a free loopback port when absent.
     #[arg(long, value_name = "ENDPOINT")]
     listen: Option<String>,
+    /// Your own site: a Nav2 map (map.yaml and its image) to run the day on, with
+    /// --tasks (services/mission/README.md, "Your own site").
+    #[arg(long, value_name = "MAP.yaml", requires = "tasks")]
+    map: Option<PathBuf>,
+    /// Your own site: the day file (the robot's start, its tasks; optionally zones of
+    /// interest, anchors, sensing, moving things), with --map.
+    #[arg(long, value_name = "DAY.yaml", requires = "map")]
+    tasks: Option<PathBuf>,
+}
+
+/// The built-in day, or the user's map and day file, refused with what to fix.
+pub(crate) fn site(
+    map: Option<&std::path::Path>,
+    tasks: Option<&std::path::Path>,
+) -> anyhow::Result<roam_mission::site::Site> {
+    match (map, tasks) {
+        (Some(map), Some(tasks)) => Ok(roam_mission::site::Site::load(map, tasks)?),
+        (None, None) => Ok(roam_mission::site::Site::builtin_day()),
+        _ => anyhow::bail!("give --map and --tasks together (your Nav2 map and your day file)"),
+    }
 }
 
 pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
     if !(args.rate.is_finite() && args.rate > 0.0 && args.rate <= 100.0) {
         anyhow::bail!("--rate must be more than 0 and at most 100 (times real time)");
     }
+    let site = site(args.map.as_deref(), args.tasks.as_deref())?;
     let options = roam::demo::DemoOptions {
         out_dir: args.out,
         rate: args.rate,
@@ -371,6 +392,7 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
         },
         ros2: args.ros2.then(|| args.ros.config()),
         listen: args.listen,
+        site,
     };
     let say = |line: &str| eprintln!("roam demo: {line}");
     let report = roam::demo::run(&options, &say).await?;

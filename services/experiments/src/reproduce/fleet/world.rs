@@ -10,6 +10,7 @@ use roam_localization::field::{peb_field, GridRegion};
 use roam_localization::{FimOptions, RangingModel};
 use roam_mission::calibration::TimeModel;
 use roam_mission::shift::{Shift, WAREHOUSE_SCENARIO, WAREHOUSE_SHIFT};
+use roam_mission::site::{HEURISTIC_COMPRESSION, INFLATED_COST};
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
 use roam_proto::map::GridMeta;
@@ -27,12 +28,6 @@ use super::FleetError;
 
 /// The planner's (and the fleet mapper's) resolution, metres: paper 000's grid.
 pub const PLANNING_RESOLUTION_M: f64 = 0.2;
-
-/// The inflated map's occupied value (the map server's `inflated` layer).
-const INFLATED_COST: i8 = 65;
-
-/// Model II's heuristic compression (Table I).
-const HEURISTIC_COMPRESSION: f64 = 0.25;
 
 /// Cells scored for the map error beside the cells objects can cover: a seeded sample
 /// of the other free cells of this many.

@@ -52,6 +52,7 @@ pub use variant::Variant;
 pub use world::DayWorld;
 
 use roam_mission::calibration::CalibrationError;
+use roam_mission::site::Site;
 
 /// The most days one batch runs.
 pub const MAX_DAYS: usize = 10_000;
@@ -79,6 +80,8 @@ pub struct DaysOptions {
     pub variants: Vec<Variant>,
     /// Threads the days run on (the report does not depend on it).
     pub jobs: usize,
+    /// The world and the day's tasks: the demo's day, or a user's map and day file.
+    pub site: Site,
 }
 
 impl Default for DaysOptions {
@@ -92,6 +95,7 @@ impl Default for DaysOptions {
             rate: 20.0,
             variants: Variant::ALL.to_vec(),
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            site: Site::builtin_day(),
         }
     }
 }
@@ -185,7 +189,7 @@ pub fn run(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<DaysReport, DaysError> {
     check(options)?;
-    let world = DayWorld::new()?;
+    let world = DayWorld::new(&options.site)?;
     let mut variants = options.variants.clone();
     variants.sort();
     variants.dedup();

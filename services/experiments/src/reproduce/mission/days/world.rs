@@ -1,7 +1,6 @@
-//! The day's world, built once and shared by every day and variant: the demo's day
-//! scenario ([`roam_mission::tasks::DAY_SCENARIO`]) as each service sees it.
-
-use std::path::Path;
+//! The day's world, built once and shared by every day and variant: the site's scenario
+//! (the demo's day, [`roam_mission::tasks::DAY_SCENARIO`], or a user's map and day file,
+//! [`roam_mission::site`]) as each service sees it.
 
 use crate::closed_loop::episode::Setup;
 use crate::closed_loop::stepper::Stepper;
@@ -13,18 +12,12 @@ use roam_planner::params::GaParams;
 use roam_planner::world::World;
 use roam_world::grid::Grid;
 use roam_world::layers::inflate;
-use roam_world::scenario::{self, Scenario};
-use roam_world::DEFAULT_MAX_CELLS;
+use roam_world::scenario::Scenario;
 
 use super::DaysError;
 use roam_mission::calibration::TimeModel;
-use roam_mission::tasks::{self, Task, DAY_SCENARIO};
-
-/// The inflated map's occupied value (the map server's `inflated` layer).
-const INFLATED_COST: i8 = 65;
-
-/// Model II's heuristic compression the planner's map cache cuts blocks for (Table I).
-const HEURISTIC_COMPRESSION: f64 = 0.25;
+use roam_mission::site::{Site, DEFAULT_ROBOT_RADIUS_M, HEURISTIC_COMPRESSION, INFLATED_COST};
+use roam_mission::tasks::Task;
 
 /// What every day shares.
 #[derive(Debug, Clone)]
@@ -53,21 +46,22 @@ pub struct DayWorld {
 }
 
 impl DayWorld {
-    /// The day of [`tasks::day`] in [`DAY_SCENARIO`].
-    pub fn new() -> Result<DayWorld, DaysError> {
+    /// The site's day in its world (the demo's: [`Site::builtin_day`]).
+    pub fn new(site: &Site) -> Result<DayWorld, DaysError> {
         let world = |e: &dyn std::fmt::Display| DaysError::World(e.to_string());
-        let scenario: Scenario =
-            scenario::parse(Path::new("day.yaml"), DAY_SCENARIO, DEFAULT_MAX_CELLS)
-                .map_err(|e| world(&e))?;
-        let robot = scenario
-            .file
-            .robots
-            .first()
-            .map(|r| r.name.clone())
-            .ok_or_else(|| DaysError::World("the day scenario has no robot".into()))?;
+        let scenario: Scenario = site.scenario().map_err(|e| world(&e))?;
+        let robot = site.robot.clone();
+        if !scenario.file.robots.iter().any(|r| r.name == robot) {
+            return Err(DaysError::World(format!(
+                "the site's scenario has no robot {robot:?}"
+            )));
+        }
         let inflated = inflate(
             &scenario.occupancy,
-            scenario.file.robot_radius_m.unwrap_or(0.2),
+            scenario
+                .file
+                .robot_radius_m
+                .unwrap_or(DEFAULT_ROBOT_RADIUS_M),
             INFLATED_COST,
         );
         let mut planning = World::new(&inflated, &scenario.information, HEURISTIC_COMPRESSION)
@@ -86,8 +80,13 @@ impl DayWorld {
         planning.set_localizability(&field.peb);
         let setup = Setup::new(&scenario).map_err(|e| world(&e))?;
         let sim_params = Stepper::observing(&setup);
-        let tasks = tasks::day();
-        let start = scenario.file.robots.first().map(|r| r.at);
+        let tasks = site.tasks.clone();
+        let start = scenario
+            .file
+            .robots
+            .iter()
+            .find(|r| r.name == robot)
+            .map(|r| r.at);
         roam_mission::day_check::check_day(&tasks, &planning, TimeModel::table_i(), start)
             .map_err(|e| world(&e))?;
         let step_s = scenario.file.time.step_s;
@@ -154,7 +153,7 @@ mod tests {
 
     #[test]
     fn the_day_world_has_its_cart_a_peb_field_and_four_windows() {
-        let w = DayWorld::new().expect("world");
+        let w = DayWorld::new(&Site::builtin_day()).expect("world");
         assert_eq!(w.tasks.len(), 4);
         assert_eq!(w.robot, "robot");
         assert!(w.sim_params.sensing.observation_radius_m > 0.0);
