@@ -47,6 +47,42 @@ fn at_the_last_safe_moment_the_robot_goes_straight_and_stays_straight() {
 }
 
 #[test]
+fn the_last_safe_moment_leaves_room_for_a_check_away_and_back() {
+    let f = fixture();
+    let here = [0.1, 1.1];
+    let fastest = straight::fastest_route(&f.scale(), TimeModel::table_i(), here, GOAL)
+        .expect("a fastest path")
+        .t_eta_s;
+    // The margin's budget of the time left less two check periods (the robot may drive
+    // one away from the task before the next check, and one back) meets the fastest
+    // path's time between these two moments.
+    let fires = |t: f64| {
+        let (mut w, _) = f.driving(false);
+        let actions = w.handle(estimate(here, 0.1), at(t, 0.5));
+        actions.first()
+            == Some(&WindowAction::Replanned {
+                reason: Reason::LastSafeMoment,
+            })
+    };
+    let start = 100.0;
+    let latest = (0..400)
+        .map(|i| start - 20.0 + 0.05 * f64::from(i))
+        .find(|&t| fires(t))
+        .expect("fires before the task");
+    let time_left = start - latest;
+    assert!(
+        margin().budget(time_left - 2.0 * SAFE_CHECK_S) <= fastest + 1e-9,
+        "fired at {time_left} s left"
+    );
+    assert!(
+        margin().budget(time_left + 0.05 - 2.0 * SAFE_CHECK_S) > fastest,
+        "fired late: {time_left} s left, fastest {fastest} s"
+    );
+    // With one check period only, it would have waited longer than it may.
+    assert!(margin().budget(time_left - SAFE_CHECK_S) > fastest);
+}
+
+#[test]
 fn a_robot_held_for_its_peb_is_driven_back_to_its_last_fix_then_replanned() {
     let f = fixture();
     let (mut w, first) = f.driving(false);

@@ -83,3 +83,24 @@ fn no_slack_when_a_replan_would_only_keep_the_earliness_back_as_its_margin() {
     let w2 = w.handle(status(&first.id, MissionState::Active, 4.0), at(80.5, 0.3));
     assert!(asked(&w2).curious, "{w2:?}");
 }
+
+#[test]
+fn the_window_asks_its_own_curious_plan_before_the_next_windows() {
+    let f = fixture();
+    let mut setup = f.setup(0, FROM, true);
+    setup.rules.set_off_at_once = true;
+    setup.rules.plan_ahead = true;
+    let (_, actions) = DowntimeWindow::begin(setup, Handover::first(margin()), at(0.0, 0.0));
+    let asks: Vec<&PlanAsk> = actions
+        .iter()
+        .filter_map(|a| match a {
+            WindowAction::RequestPlan(ask) => Some(ask),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(asks.len(), 2, "{actions:?}");
+    // The planner answers a client's requests in order: this window's first, from the
+    // way to GOAL; then the next window's, from GOAL.
+    assert!(distance(asks[0].from, [0.6, 0.1]) < 1e-9, "{:?}", asks[0]);
+    assert_eq!(asks[1].from, GOAL);
+}
