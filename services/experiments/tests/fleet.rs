@@ -47,7 +47,7 @@ fn run(world: &FleetWorld, variants: Vec<FleetVariant>, jobs: usize) -> FleetRep
         jobs,
         ..FleetOptions::default()
     };
-    fleet::run_on(world, &options, &|_, _| {}).expect("the fleet's batch")
+    fleet::run_on(world, &options, &roam_experiments::progress::silent).expect("the fleet's batch")
 }
 
 #[test]

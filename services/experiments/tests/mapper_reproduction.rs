@@ -149,7 +149,7 @@ fn the_same_output_for_any_thread_count() {
     assert_eq!(a, b);
     assert_eq!(
         seen.into_inner().expect("lock"),
-        (1..=8).collect::<Vec<_>>()
+        (1..=8).collect::<Vec<u64>>()
     );
     // Different base seeds, different runs.
     let other = ExperimentOptions {

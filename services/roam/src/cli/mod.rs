@@ -4,6 +4,7 @@
 mod bench;
 mod map;
 mod plan;
+mod progress;
 mod reproduce;
 mod reproduce_fleet;
 mod roles;
@@ -20,10 +21,10 @@ use roam_proto::keys;
 use roam_runtime::{Requester, SessionArgs};
 use roam_stack::{Role, RoleConfig};
 
-use bench::BenchCommand;
+use bench::BenchArgs;
 use map::MapCommand;
 use plan::PlanArgs;
-use reproduce::ReproduceCommand;
+use reproduce::ReproduceArgs;
 use roles::{MapServerArgs, PlannerArgs, RouterArgs, StackArgs};
 
 const ABOUT: &str = "roam: curious, time-aware robot navigation as Zenoh services.";
@@ -135,11 +136,9 @@ enum Command {
     #[command(subcommand)]
     Map(MapCommand),
     /// Benchmarks; each prints JSON with --json.
-    #[command(subcommand)]
-    Bench(BenchCommand),
+    Bench(BenchArgs),
     /// Reproduce a paper's evaluation and print ours next to its figures.
-    #[command(subcommand)]
-    Reproduce(ReproduceCommand),
+    Reproduce(ReproduceArgs),
 }
 
 #[derive(Debug, Args)]
@@ -210,8 +209,8 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Ros2(args) => ros2::ros2(args).await,
         Command::View(args) => view::view(args).await,
         Command::Map(command) => map::map(command).await,
-        Command::Bench(command) => bench::bench(command).await,
-        Command::Reproduce(command) => reproduce::reproduce(command).await,
+        Command::Bench(args) => bench::bench(args).await,
+        Command::Reproduce(args) => reproduce::reproduce(args).await,
     }
 }
 

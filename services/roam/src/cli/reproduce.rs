@@ -3,7 +3,20 @@
 use std::path::PathBuf;
 
 use anyhow::bail;
-use clap::Subcommand;
+use clap::{Args, Subcommand};
+
+use super::progress::Progress;
+
+/// `roam reproduce [--quiet] <experiment>`.
+#[derive(Debug, Args)]
+pub(crate) struct ReproduceArgs {
+    /// Show no progress on stderr (it is drawn only when stderr is a terminal; to a
+    /// pipe or a file, one line per finished stage).
+    #[arg(long, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: ReproduceCommand,
+}
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum ReproduceCommand {
@@ -125,9 +138,10 @@ pub(crate) enum ReproduceCommand {
     },
 }
 
-pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
-    match command {
-        ReproduceCommand::Fleet(args) => super::reproduce_fleet::run(args).await,
+pub(crate) async fn reproduce(args: ReproduceArgs) -> anyhow::Result<()> {
+    let quiet = args.quiet;
+    match args.command {
+        ReproduceCommand::Fleet(args) => super::reproduce_fleet::run(args, quiet).await,
         ReproduceCommand::Mission {
             json,
             days: Some(days),
@@ -150,6 +164,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 seed,
                 generations,
                 w_loc,
+                quiet,
             )
             .await
         }
@@ -172,12 +187,9 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 w_loc,
             };
             let result = tokio::task::spawn_blocking(move || {
-                roam_experiments::reproduce::mission::missions::run(&options, &|done, total| {
-                    eprint!("\rthe papers joined: mission {done}/{total}   ");
-                    if done == total {
-                        eprintln!();
-                    }
-                })
+                let progress = Progress::new("the papers joined", quiet);
+                let shown = progress.callback();
+                roam_experiments::reproduce::mission::missions::run(&options, &shown)
             })
             .await??;
             let report = roam_experiments::reproduce::mission::runner::MissionReport {
@@ -209,6 +221,8 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 bail!("--es1-runs, --es2-runs, --es3-missions and --es3-runs must be at least 1");
             }
             let (result, pictures) = tokio::task::spawn_blocking(move || {
+                let progress = Progress::new("paper 002", quiet);
+                let shown = progress.callback();
                 roam_experiments::reproduce::apf::runner::run(
                     &roam_experiments::reproduce::apf::runner::Sizes {
                         es1_runs,
@@ -218,6 +232,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                         seed,
                         out_dir: out,
                     },
+                    &shown,
                 )
             })
             .await??;
@@ -249,22 +264,14 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             };
             let (result, picture) = tokio::task::spawn_blocking(move || {
                 let scenario = roam_experiments::reproduce::mapper::experiment::grid004()?;
-                let progress = |p: roam_experiments::reproduce::mapper::experiment::Progress| {
-                    eprint!(
-                        "\rpaper 004: run {}/{} ({} #{})   ",
-                        p.done,
-                        p.total,
-                        p.mode.as_str(),
-                        p.repetition + 1
-                    );
-                };
+                let progress = Progress::new("paper 004", quiet);
+                let shown = progress.callback();
                 let result = roam_experiments::reproduce::mapper::experiment::run(
                     roam_experiments::reproduce::mapper::experiment::GRID004_NAME,
                     &scenario,
                     &options,
-                    &progress,
+                    &shown,
                 )?;
-                eprintln!();
                 std::fs::create_dir_all(&out)?;
                 let picture = roam_experiments::reproduce::mapper::plot::write_figure(
                     &scenario, &result, &out,
@@ -315,7 +322,9 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 initializations,
             };
             let result = tokio::task::spawn_blocking(move || {
-                roam_experiments::reproduce::planner::run(&options)
+                let progress = Progress::new("paper 000", quiet);
+                let shown = progress.callback();
+                roam_experiments::reproduce::planner::run(&options, &shown)
             })
             .await??;
             if json {
@@ -341,6 +350,7 @@ async fn reproduce_days(
     seed: u64,
     generations: u32,
     w_loc: f64,
+    quiet: bool,
 ) -> anyhow::Result<()> {
     use roam_experiments::reproduce::mission::days::{self, DaysOptions, Variant};
     let mut options = DaysOptions {
@@ -368,23 +378,20 @@ async fn reproduce_days(
     }
     let started = std::time::Instant::now();
     let run = options.clone();
-    let report = tokio::task::spawn_blocking(move || {
-        days::run(&run, &|done, total| {
-            eprint!("\rthe executive's days: {done}/{total} (variant, day)   ");
-            if done == total {
-                eprintln!();
-            }
-        })
-    })
-    .await??;
+    let progress = std::sync::Arc::new(Progress::new("the executive's", quiet));
+    let reporting = progress.clone();
+    let report =
+        tokio::task::spawn_blocking(move || days::run(&run, &reporting.callback())).await??;
     let wall_s = started.elapsed().as_secs_f64();
-    eprintln!(
-        "{} days x {} variants in {wall_s:.1} s ({:.2} s per day, {} threads)",
-        options.days,
-        report.variants.len(),
-        wall_s / options.days as f64,
-        options.jobs
-    );
+    if progress.speaks() {
+        eprintln!(
+            "{} days x {} variants in {wall_s:.1} s ({:.2} s per day, {} threads)",
+            options.days,
+            report.variants.len(),
+            wall_s / options.days as f64,
+            options.jobs
+        );
+    }
     if json {
         println!("{}", serde_json::to_string(&report)?);
     } else {

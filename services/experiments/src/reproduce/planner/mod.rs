@@ -34,6 +34,7 @@ use roam_world::DEFAULT_MAX_CELLS;
 use serde::Serialize;
 
 use crate::bench::planner::builtin_world;
+use crate::progress::{Done, Progress};
 use crate::ExperimentError;
 
 mod claims;
@@ -142,12 +143,24 @@ fn mean(values: &[f64]) -> f64 {
     values.iter().sum::<f64>() / values.len().max(1) as f64
 }
 
-pub fn run(options: &ReproduceOptions) -> Result<Reproduction, ExperimentError> {
+/// Every configuration with every initialization asked for; `progress` after each plan
+/// (one stage, `plans`, over all of them).
+pub fn run(
+    options: &ReproduceOptions,
+    progress: Progress<'_>,
+) -> Result<Reproduction, ExperimentError> {
     let world = builtin_world()?;
     let mut initializations = Vec::new();
     let mut pictures = Vec::new();
+    let total =
+        options.initializations.len() * GOALS.len() * RATIOS.len() * MODELS.len() * options.runs;
+    let mut done = 0;
+    let mut planned = || {
+        done += 1;
+        progress(Done::of("plans", "plans", done, total));
+    };
     for (n, init) in options.initializations.iter().enumerate() {
-        let (rows, paths) = run_one(&world, options, *init)?;
+        let (rows, paths) = run_one(&world, options, *init, &mut planned)?;
         let prefix = if n == 0 {
             String::new()
         } else {
@@ -186,6 +199,7 @@ fn run_one(
     world: &World,
     options: &ReproduceOptions,
     init: Initialization,
+    planned: &mut dyn FnMut(),
 ) -> Result<(Vec<Row>, Vec<Drawn>), ExperimentError> {
     let never = AtomicBool::new(false);
     let mut rows = Vec::new();
@@ -210,6 +224,7 @@ fn run_one(
                     u.push(outcome.metrics.u_ges);
                     d.push(outcome.metrics.density);
                     info.push(outcome.metrics.distinct_information);
+                    planned();
                     within += usize::from(outcome.within_budget);
                     reached += usize::from(outcome.reaches_goal);
                     if seed == 0 && goal_name == "goal2" && ratio_name == "40/60" {
