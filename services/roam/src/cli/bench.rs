@@ -86,7 +86,8 @@ pub(crate) enum BenchCommand {
         #[arg(long, default_value_t = 4000)]
         updates: u64,
     },
-    /// The GA per curiosity model (2000 generations, population 200) and the service overhead.
+    /// The GA per curiosity model (2000 generations, population 200) and the service
+    /// overhead; with --scaling or --peer, finer maps or the greedy planner instead.
     Planner {
         #[arg(long)]
         json: bool,

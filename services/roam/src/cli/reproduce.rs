@@ -20,7 +20,10 @@ pub(crate) struct ReproduceArgs {
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum ReproduceCommand {
-    /// The papers joined: seeded downtime missions in the built-in world, planned on the
+    /// The papers joined: downtime missions per coupling, or with --days N the
+    /// executive's whole day N times per variant, against the goals.
+    ///
+    /// Without --days: seeded downtime missions in the built-in world, planned on the
     /// static information map, with the PEB localizability cost, and the shortest path.
     /// With --days N: the executive's whole day (tasks::day() on the day world) N times
     /// per variant (the shipped executive, without each coupling, the paper's planner
@@ -60,12 +63,13 @@ pub(crate) enum ReproduceCommand {
         #[arg(long, default_value_t = 2000.0)]
         w_loc: f64,
     },
-    /// A fleet's week in the warehouse: ten robots' shifts repeated --days times, each
-    /// robot driven by the executive's own window machine, objects landing in and
-    /// leaving the aisles and the dock; per variant (tasks only, the operator's patrol,
-    /// independent curiosity, roam's shared news and each part of it off) the late
-    /// windows, how soon the fleet sees each change and how well its map predicts the
-    /// world now, against the goals.
+    /// A fleet's week in the warehouse: ten robots' shifts per variant, the late windows,
+    /// how soon the fleet sees each change and its map now, against the goals.
+    ///
+    /// The shifts are repeated --days times, each robot driven by the executive's own
+    /// window machine, objects landing in and leaving the aisles and the dock; the
+    /// variants are tasks only, the operator's patrol, independent curiosity, roam's
+    /// shared news and each part of it off.
     Fleet(super::reproduce_fleet::FleetArgs),
     /// Paper 002 §4: ES1-ES3 for plain APF and the fixed, cutoff, linear and sinusoidal
     /// information-seeking weights.
