@@ -202,9 +202,9 @@ mod tests {
         // Nothing above or left of the text.
         assert!((0..40).all(|x| *image.get_pixel(x, 0) == white));
         // The glyphs differ: no two printable characters share one.
-        for a in 0..GLYPHS.len() {
-            for b in a + 1..GLYPHS.len() {
-                assert_ne!(GLYPHS[a], GLYPHS[b], "{a} and {b}");
+        for (a, first) in GLYPHS.iter().enumerate() {
+            for (b, second) in GLYPHS.iter().enumerate().skip(a + 1) {
+                assert_ne!(first, second, "{a} and {b}");
             }
         }
         // Outside ASCII: a question mark, and text is clipped, never a panic.
