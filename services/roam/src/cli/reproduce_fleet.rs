@@ -96,7 +96,7 @@ pub(crate) async fn run(args: FleetArgs, quiet: bool) -> anyhow::Result<()> {
     }
     if let Some(dir) = &args.svg {
         let world = fleet::FleetWorld::warehouse()?;
-        for path in fleet::picture::write(dir, &world, &report.weeks)? {
+        for path in fleet::picture::write(dir, &world, &report.weeks, options.seed)? {
             if progress.speaks() {
                 eprintln!("wrote {}", path.display());
             }

@@ -91,6 +91,7 @@ pub fn run(
         &Setup::new(&es1)?,
         &Setup::new(&es2)?,
         &sizes.out_dir,
+        sizes.seed,
     )?;
     Ok((Output::of(result), pictures))
 }

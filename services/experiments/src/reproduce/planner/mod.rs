@@ -29,7 +29,8 @@ use roam_map_server::map_file;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
-use roam_world::render::{draw_marker, draw_path, render_map, MARKER, PATH};
+use roam_world::legend::{framed, Entry, Frame};
+use roam_world::render::{draw_marker, draw_path, render_map, INFORMATION, MARKER, OCCUPIED, PATH};
 use roam_world::DEFAULT_MAX_CELLS;
 use serde::Serialize;
 
@@ -166,7 +167,7 @@ pub fn run(
         } else {
             format!("{}-", init.as_str())
         };
-        pictures.extend(draw(&world, &paths, &options.out_dir, &prefix)?);
+        pictures.extend(draw(&world, &paths, &options.out_dir, &prefix, *init)?);
         initializations.push(InitializationRun {
             initialization: *init,
             comparisons: claims::compare(&rows),
@@ -251,11 +252,34 @@ fn run_one(
     Ok((rows, pictures_paths))
 }
 
+/// The title, legend and scale bar of a model's picture.
+pub fn picture_frame(model: PlannerModel, init: Initialization, pixels_per_metre: f64) -> Frame {
+    Frame {
+        title: vec![
+            format!(
+                "paper 000 sec. III: {}, {} initialization",
+                model.as_str(),
+                init.as_str()
+            ),
+            "goal 2, t_plan/t_exec 40/60, seed 0".into(),
+        ],
+        legend: vec![
+            Entry::fill(INFORMATION, "zone of interest (darker: more)"),
+            Entry::fill(OCCUPIED, "wall"),
+            Entry::line(PATH, "the planned path"),
+            Entry::fill(MARKER, "start and goal"),
+        ],
+        text_scale: 2,
+        pixels_per_metre: Some(pixels_per_metre),
+    }
+}
+
 fn draw(
     world: &World,
     paths: &[Drawn],
     out_dir: &Path,
     prefix: &str,
+    init: Initialization,
 ) -> Result<Vec<PathBuf>, ExperimentError> {
     let content =
         map_file::builtin(DEFAULT_MAX_CELLS).map_err(|e| ExperimentError::Setup(e.to_string()))?;
@@ -272,7 +296,8 @@ fn draw(
             draw_marker(&mut image, world.meta.height, *end, scale, MARKER);
         }
         let file = out_dir.join(format!("{prefix}{}.png", model.as_str()));
-        image
+        let per_metre = f64::from(scale) / content.occupancy.meta.resolution;
+        framed(&image, &picture_frame(*model, init, per_metre))
             .save(&file)
             .map_err(|e| ExperimentError::Setup(format!("{}: {e}", file.display())))?;
         written.push(file);
