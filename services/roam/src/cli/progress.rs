@@ -30,8 +30,11 @@ enum Mode {
 #[derive(Debug)]
 struct Stage {
     name: String,
+    /// When its work began: the end of the stage before it, or the command's start
+    /// (its first report comes only after its first unit is done).
     started: Instant,
-    finished: bool,
+    /// When its last unit was done.
+    ended: Option<Instant>,
     bar: Option<ProgressBar>,
 }
 
@@ -41,6 +44,8 @@ pub(crate) struct Progress {
     /// What the whole command is, e.g. `paper 002`: each stage's label starts with it.
     title: String,
     mode: Mode,
+    /// When the command began, for its first stage's clock.
+    created: Instant,
     stage: Mutex<Option<Stage>>,
 }
 
@@ -57,6 +62,7 @@ impl Progress {
         Progress {
             title: title.to_owned(),
             mode,
+            created: Instant::now(),
             stage: Mutex::new(None),
         }
     }
@@ -79,11 +85,14 @@ impl Progress {
             if let Some(bar) = current.as_ref().and_then(|s| s.bar.as_ref()) {
                 bar.finish();
             }
+            let started = current
+                .as_ref()
+                .map_or(self.created, |s| s.ended.unwrap_or_else(Instant::now));
             *current = Some(Stage {
                 name: done.stage.to_owned(),
-                started: Instant::now(),
-                finished: false,
-                bar: (self.mode == Mode::Bars).then(|| self.bar(&done)),
+                started,
+                ended: None,
+                bar: (self.mode == Mode::Bars).then(|| self.bar(&done, started)),
             });
         }
         let Some(stage) = current.as_mut() else {
@@ -94,8 +103,8 @@ impl Progress {
                 bar.set_position(done.done);
             }
         }
-        if done.done >= done.total && !stage.finished {
-            stage.finished = true;
+        if done.done >= done.total && stage.ended.is_none() {
+            stage.ended = Some(Instant::now());
             match &stage.bar {
                 Some(bar) => {
                     bar.set_style(style(FINISHED));
@@ -122,9 +131,11 @@ impl Progress {
         format!("{} {stage}", self.title)
     }
 
-    fn bar(&self, done: &Done<'_>) -> ProgressBar {
-        // Hidden until it is set up, so its first frame is whole.
-        let bar = ProgressBar::with_draw_target(Some(done.total), ProgressDrawTarget::hidden());
+    fn bar(&self, done: &Done<'_>, started: Instant) -> ProgressBar {
+        // Hidden until it is set up, so its first frame is whole; its clock from when
+        // the stage's work began.
+        let bar = ProgressBar::with_draw_target(Some(done.total), ProgressDrawTarget::hidden())
+            .with_elapsed(started.elapsed());
         bar.set_style(style(RUNNING));
         bar.set_prefix(self.label(done.stage));
         bar.set_message(done.unit);
@@ -167,17 +178,28 @@ mod tests {
         let progress = Progress {
             title: "test".into(),
             mode: Mode::Lines,
+            created: Instant::now(),
             stage: Mutex::new(None),
         };
         progress.report(Done::of("es1", "runs", 1, 2));
         progress.report(Done::of("es1", "runs", 2, 2));
         let finished = |p: &Progress| {
             let stage = roam_runtime::lock(&p.stage);
-            stage.as_ref().map(|s| (s.name.clone(), s.finished))
+            stage.as_ref().map(|s| (s.name.clone(), s.ended.is_some()))
         };
         assert_eq!(finished(&progress), Some(("es1".into(), true)));
+        let es1_ended = roam_runtime::lock(&progress.stage)
+            .as_ref()
+            .and_then(|s| s.ended);
         progress.report(Done::of("es2", "runs", 1, 3));
         assert_eq!(finished(&progress), Some(("es2".into(), false)));
+        // The second stage's clock starts where the first one ended, not at its first
+        // report (after its first run).
+        let es2_started = roam_runtime::lock(&progress.stage)
+            .as_ref()
+            .map(|s| s.started);
+        assert!(es1_ended.is_some());
+        assert_eq!(es2_started, es1_ended);
         assert_eq!(progress.label("es2"), "test es2");
     }
 
