@@ -121,7 +121,11 @@ fn stack_once_fetches_every_layer_and_draws_the_world() {
         );
     }
     assert!(
-        count_colour(&out.path().join("world.png"), roam_world::render::PATH.0) > 100,
+        count_colour(
+            &out.path().join("world.png"),
+            roam_world::render::PATH.0,
+            &roam::report::picture_frame("roam", 40.0)
+        ) > 100,
         "planned paths drawn"
     );
 
@@ -206,10 +210,22 @@ fn help_reads_like_a_manual() {
     }
 }
 
-/// Counts pixels of exactly `colour` in a PNG.
-fn count_colour(path: &std::path::Path, colour: [u8; 3]) -> usize {
+/// Counts pixels of exactly `colour` on the map of a framed 800 x 800 px picture (the
+/// built-in world at 8 px per cell), leaving out its legend, whose swatches have the
+/// same colours.
+fn count_colour(
+    path: &std::path::Path,
+    colour: [u8; 3],
+    frame: &roam_world::legend::Frame,
+) -> usize {
     let picture = image::open(path).expect("png").to_rgb8();
-    picture.pixels().filter(|p| p.0 == colour).count()
+    let (left, top) = roam_world::legend::layout((800, 800), frame).picture;
+    picture
+        .enumerate_pixels()
+        .filter(|(x, y, p)| {
+            p.0 == colour && (left..left + 800).contains(x) && (top..top + 800).contains(y)
+        })
+        .count()
 }
 
 /// A guard that stops a child process however the test ends.
@@ -292,7 +308,11 @@ fn roam_plan_asks_a_running_stack_and_draws_the_path() {
     assert_eq!(plan["reaches_goal"], true);
     assert_eq!(plan["within_budget"], true);
     assert!(
-        count_colour(&png, roam_world::render::PATH.0) > 50,
+        count_colour(
+            &png,
+            roam_world::render::PATH.0,
+            &roam::pictures::plan_frame(vec![String::new(), String::new()], 40.0)
+        ) > 50,
         "the path is drawn"
     );
 

@@ -5,10 +5,22 @@ use std::process::Command;
 
 const ROAM: &str = env!("CARGO_BIN_EXE_roam");
 
-/// Counts pixels of exactly `colour` in a PNG.
-fn count_colour(path: &std::path::Path, colour: [u8; 3]) -> usize {
+/// Counts pixels of exactly `colour` on the map of a framed 800 x 800 px picture (the
+/// built-in world at 8 px per cell), leaving out its legend, whose swatches have the
+/// same colours.
+fn count_colour(
+    path: &std::path::Path,
+    colour: [u8; 3],
+    frame: &roam_world::legend::Frame,
+) -> usize {
     let picture = image::open(path).expect("png").to_rgb8();
-    picture.pixels().filter(|p| p.0 == colour).count()
+    let (left, top) = roam_world::legend::layout((800, 800), frame).picture;
+    picture
+        .enumerate_pixels()
+        .filter(|(x, y, p)| {
+            p.0 == colour && (left..left + 800).contains(x) && (top..top + 800).contains(y)
+        })
+        .count()
 }
 
 #[test]
@@ -82,14 +94,20 @@ fn reproduce_planner_prints_every_row_and_draws_each_model() {
             }
         }
     }
+    // Every model's picture has the same layout (two title lines, one legend).
+    let frame = roam_experiments::reproduce::planner::picture_frame(
+        roam_proto::planner::PlannerModel::Model1,
+        roam_experiments::reproduce::planner::Initialization::Roam,
+        40.0,
+    );
     for model in ["model0", "model1", "model2"] {
         let png = out.path().join(format!("{model}.png"));
         assert!(
-            count_colour(&png, roam_world::render::PATH.0) > 50,
+            count_colour(&png, roam_world::render::PATH.0, &frame) > 50,
             "{model}: the path is drawn"
         );
         assert!(
-            count_colour(&png, roam_world::render::MARKER.0) > 50,
+            count_colour(&png, roam_world::render::MARKER.0, &frame) > 50,
             "{model}: start and goal marked"
         );
     }
