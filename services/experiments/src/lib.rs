@@ -11,12 +11,14 @@
 //!   missions changed between steps ([`closed_loop::stepper`]).
 //! - [`bench`]: `roam bench …`, each printing JSON.
 //! - [`parallel`]: runs spread over threads, put back in order before anything is summed.
+//! - [`progress`]: how a long run reports how far it is (the binary draws it).
 //! - [`error`]: [`ExperimentError`], what a run or a benchmark can fail with.
 
 pub mod bench;
 pub mod closed_loop;
 pub mod error;
 pub mod parallel;
+pub mod progress;
 pub mod reproduce;
 pub mod verdict;
 

@@ -13,6 +13,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use roam_controller::{ApfParams, Scheme};
 use roam_experiments::closed_loop::episode::{load_scenario, Setup};
+use roam_experiments::progress::{silent as quiet, Done};
 use roam_experiments::reproduce::apf::es3::{
     sample_missions, DISK_RADIUS_M, MIN_ANCHOR_CLEARANCE_M, MIN_LEG_M,
 };
@@ -28,8 +29,6 @@ fn scenario(file: &str) -> Scenario {
         .join(file);
     load_scenario(&path).expect("shipped scenario")
 }
-
-fn quiet(_: &str, _: usize, _: usize) {}
 
 fn options<'a>(runs: usize, threads: usize, params: &'a ApfParams) -> RunOptions<'a> {
     RunOptions {
@@ -58,8 +57,8 @@ fn the_output_is_the_same_for_any_thread_count() {
         scenario("es3.yaml"),
     );
     let calls = AtomicUsize::new(0);
-    let progress = |_: &str, done: usize, total: usize| {
-        assert!(done >= 1 && done <= total);
+    let progress = |d: Done<'_>| {
+        assert!(d.done >= 1 && d.done <= d.total, "{d:?}");
         calls.fetch_add(1, Ordering::Relaxed);
     };
     let run = |threads| {

@@ -47,7 +47,7 @@ fn run(world: &FleetWorld, variants: Vec<FleetVariant>, jobs: usize) -> FleetRep
         jobs,
         ..FleetOptions::default()
     };
-    fleet::run_on(world, &options, &|_, _| {}).expect("the fleet's batch")
+    fleet::run_on(world, &options, &roam_experiments::progress::silent).expect("the fleet's batch")
 }
 
 #[test]
@@ -82,7 +82,7 @@ fn a_short_shift_is_on_time_repeatable_and_curious() {
     let information = |s: &fleet::FleetSummary| s.information_per_robot_hour.unwrap_or(0.0);
 
     // The pictures hold what their legends say.
-    let picture = fleet::picture::warehouse_svg(world, news);
+    let picture = fleet::picture::warehouse_svg(world, news, 3);
     let count = |svg: &str, what: &str| svg.matches(what).count();
     assert_eq!(count(&picture, r#"class="change""#), news.events.len());
     let moved = news.paths.iter().filter(|p| p.len() > 1).count();
@@ -91,7 +91,13 @@ fn a_short_shift_is_on_time_repeatable_and_curious() {
     for entry in ["change never seen", "UWB anchor", "robot 1's path"] {
         assert!(picture.contains(entry), "the legend names {entry}");
     }
-    let detection = fleet::picture::detection_svg(&report.weeks);
+    // A title naming the variant and the seed, and a scale bar.
+    assert!(
+        picture.contains(r#"<text id="title""#) && picture.contains("news, first shift, seed 3")
+    );
+    assert!(picture.contains(r#"<g id="scale">"#) && picture.contains(">10 m</text>"));
+    let detection = fleet::picture::detection_svg(&report.weeks, 3);
+    assert!(detection.contains(r#"<text id="title""#) && detection.contains("2 variants, seed 3"));
     assert_eq!(count(&detection, r#"class="variant""#), 2);
     assert!(detection.contains(">tasks_only<") && detection.contains(">news<"));
     assert!(

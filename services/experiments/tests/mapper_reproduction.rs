@@ -81,8 +81,23 @@ fn the_papers_robust_claims_at_a_reduced_size() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = plot::write_figure(&scenario, &r, dir.path()).expect("figure");
     let img = image::open(&path).expect("decode").to_rgb8();
-    let [world, error, quality] = plot::layout(&scenario);
-    assert_eq!(img.width(), quality.x + quality.width + 12);
+    let [world, error, quality] = plot::framed_layout(&scenario, &r);
+    assert!(img.width() > quality.x + quality.width);
+    // The legend, right of the panels: each entry's colour at its swatch.
+    let frame = plot::figure_frame(&r);
+    let unframed = plot::figure(&scenario, &r).dimensions();
+    let at = roam_world::legend::layout(unframed, &frame);
+    assert_eq!(img.dimensions(), at.size);
+    for (entry, &(x, y, w, h)) in frame.legend.iter().zip(&at.swatches) {
+        assert!(x > quality.x + quality.width, "{}", entry.text);
+        assert_eq!(
+            *img.get_pixel(x + w / 2, y + h / 2),
+            entry.colour,
+            "{}",
+            entry.text
+        );
+    }
+    assert!(frame.title[0].contains("seed"), "{:?}", frame.title);
     let count = |c: Rgb<u8>, p: plot::Panel, x0: u32, x1: u32| {
         let mut rows = Vec::new();
         for y in p.y..p.y + p.height {
@@ -149,7 +164,7 @@ fn the_same_output_for_any_thread_count() {
     assert_eq!(a, b);
     assert_eq!(
         seen.into_inner().expect("lock"),
-        (1..=8).collect::<Vec<_>>()
+        (1..=8).collect::<Vec<u64>>()
     );
     // Different base seeds, different runs.
     let other = ExperimentOptions {

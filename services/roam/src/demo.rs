@@ -10,12 +10,11 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use image::{Rgb, RgbImage};
 use roam_controller::params::ApfParams;
-use roam_mission::executive::{self, ExecutiveConfig, Progress, WindowOutcome};
+use roam_mission::executive::{self, ExecutiveConfig, Progress};
 use roam_mission::site::Site;
 use roam_proto::cells::Cells;
-use roam_proto::map::{GridMeta, Layer};
+use roam_proto::map::Layer;
 use roam_proto::map::{
     INFLATED_LAYER as INFLATED, INFORMATION_LAYER as INFORMATION, OCCUPANCY_LAYER as OCCUPANCY,
 };
@@ -24,17 +23,14 @@ use roam_proto::sim::GroundTruth;
 use roam_proto::{decode, keys};
 use roam_runtime::Requester;
 use roam_world::grid::Grid;
-use roam_world::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, PATH};
+use roam_world::legend::framed;
 use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
 use roam_experiments::reproduce::mission::todays_plans::{todays_plans, TodaysPlan};
 use roam_stack::stack::{Stack, StackOptions};
 
-/// The colour of the path the robot drove (its true positions).
-pub const DRIVEN: Rgb<u8> = Rgb([220, 20, 20]);
-/// The colour of the anchors.
-pub const ANCHOR: Rgb<u8> = roam_sim::render::ANCHOR;
+use crate::demo_picture::{self, Day};
 
 /// How the demo runs.
 #[derive(Debug, Clone)]
@@ -319,15 +315,25 @@ async fn drive(
     let anchors: Vec<[f64; 2]> = roam_world::scenario::load_or_builtin(Some(world))
         .map(|(_, s)| s.file.anchors.iter().map(|a| a.at).collect())
         .unwrap_or_default();
-    let image = draw_world(
-        &occupancy,
-        &information,
-        &outcomes,
-        &driven,
-        &config,
-        &anchors,
+    let tasks: Vec<[f64; 2]> = config.tasks.iter().map(|t| t.at).collect();
+    let map = demo_picture::draw_day(&Day {
+        occupancy: &occupancy,
+        information: &information,
+        outcomes: &outcomes,
+        driven: &driven,
+        tasks: &tasks,
+        anchors: &anchors,
+    });
+    let frame = demo_picture::frame(
+        &options.site.name,
+        options.seed,
+        options.rate,
+        outcomes.len(),
+        &occupancy.meta,
     );
-    image.save(&picture).map_err(|e| write_error(&picture, e))?;
+    framed(&map, &frame)
+        .save(&picture)
+        .map_err(|e| write_error(&picture, e))?;
 
     progress("replaying today's executive's plans for comparison");
     let today = {
@@ -386,74 +392,6 @@ fn grid_u8(layer: Layer) -> Grid<u8> {
         meta: layer.meta,
         cells,
     }
-}
-
-/// The grid cell of a world point, clamped onto the map.
-pub fn cell_of(meta: &GridMeta, p: [f64; 2]) -> [u32; 2] {
-    let x = ((p[0] - meta.origin.x) / meta.resolution).floor();
-    let y = ((p[1] - meta.origin.y) / meta.resolution).floor();
-    [
-        x.clamp(0.0, f64::from(meta.width.saturating_sub(1))) as u32,
-        y.clamp(0.0, f64::from(meta.height.saturating_sub(1))) as u32,
-    ]
-}
-
-/// Pixels per cell in the demo's picture of a small world (the built-in day's 100 × 100
-/// cells: 800 pixels).
-pub const SCALE: u32 = 8;
-/// The longer side of the picture, pixels, that a larger world is drawn within (at
-/// least one pixel a cell).
-pub const PICTURE_SIDE: u32 = 800;
-
-/// Pixels per cell for a world of `meta`'s size: [`SCALE`], fewer where the picture
-/// would pass [`PICTURE_SIDE`].
-pub fn picture_scale(meta: &GridMeta) -> u32 {
-    (PICTURE_SIDE / meta.width.max(meta.height).max(1)).clamp(1, SCALE)
-}
-
-fn draw_world(
-    occupancy: &Grid<i8>,
-    information: &Grid<u8>,
-    outcomes: &[WindowOutcome],
-    driven: &[[f64; 2]],
-    config: &ExecutiveConfig,
-    anchors: &[[f64; 2]],
-) -> RgbImage {
-    let meta = occupancy.meta;
-    let cells = |points: &[[f64; 2]]| -> Vec<[u32; 2]> {
-        points.iter().map(|p| cell_of(&meta, *p)).collect()
-    };
-    let scale = picture_scale(&meta);
-    let mut image = render_map(occupancy, Some(information), scale);
-    for o in outcomes {
-        draw_path(
-            &mut image,
-            meta.height,
-            &cells(&o.shortest),
-            scale,
-            BASELINE,
-        );
-        for plan in &o.plans {
-            draw_path(&mut image, meta.height, &cells(plan), scale, PATH);
-        }
-    }
-    draw_path(&mut image, meta.height, &cells(driven), scale, DRIVEN);
-    for a in anchors {
-        draw_marker(&mut image, meta.height, cell_of(&meta, *a), scale, ANCHOR);
-    }
-    for t in &config.tasks {
-        draw_marker(&mut image, meta.height, cell_of(&meta, t.at), scale, MARKER);
-    }
-    if let Some(start) = driven.first() {
-        draw_marker(
-            &mut image,
-            meta.height,
-            cell_of(&meta, *start),
-            scale,
-            MARKER,
-        );
-    }
-    image
 }
 
 fn markdown(r: &DemoReport) -> String {
@@ -529,6 +467,6 @@ fn markdown(r: &DemoReport) -> String {
         r.information_todays_plans,
         r.peb_mean_m.map_or("-".to_owned(), |p| format!("{p:.3} m")),
     ));
-    out.push_str("![the world, the planned (blue), shortest (magenta) and driven (red) paths, anchors (purple), start and tasks (green)](world.png)\n");
+    out.push_str("![the day world with its zones of interest (orange), the curious plans (blue), shortest (magenta) and driven (red) paths, anchors (purple), start and task places (green), each window's number where it began, a legend and a scale bar](world.png)\n");
     out
 }

@@ -12,7 +12,10 @@ use roam_proto::map::{INFORMATION_LAYER as INFORMATION, OCCUPANCY_LAYER as OCCUP
 use roam_proto::planner::{GaOverrides, Plan, PlanRequest, PlannerModel, ShortestPathUse};
 use roam_runtime::{ClientError, Requester};
 use roam_world::grid::Grid;
-use roam_world::render::{draw_marker, draw_path, render_map, BASELINE, MARKER, PATH};
+use roam_world::legend::{framed, Entry, Frame};
+use roam_world::render::{
+    draw_marker, draw_path, render_map, BASELINE, INFORMATION as INTEREST, MARKER, OCCUPIED, PATH,
+};
 use serde::Serialize;
 
 /// One layer as the report shows it.
@@ -149,10 +152,13 @@ pub async fn build(
                     draw_marker(&mut image, occ.meta.height, *end, scale, MARKER);
                 }
             }
-            image.save(&path).map_err(|e| ReportError::Write {
-                path: path.clone(),
-                reason: e.to_string(),
-            })?;
+            let frame = picture_frame(root, f64::from(scale) / occ.meta.resolution);
+            framed(&image, &frame)
+                .save(&path)
+                .map_err(|e| ReportError::Write {
+                    path: path.clone(),
+                    reason: e.to_string(),
+                })?;
             Some(path)
         }
         None => None,
@@ -165,6 +171,25 @@ pub async fn build(
         warnings: list.warnings,
         picture,
     })
+}
+
+/// The title, legend and scale bar of the stack's `world.png`.
+pub fn picture_frame(root: &str, pixels_per_metre: f64) -> Frame {
+    Frame {
+        title: vec![
+            format!("roam stack --once under '{root}': the world and the downtime missions"),
+            format!("Model I (1000 generations, seed {REPORT_SEED}) against the shortest path"),
+        ],
+        legend: vec![
+            Entry::fill(INTEREST, "zone of interest (darker: more)"),
+            Entry::fill(OCCUPIED, "wall"),
+            Entry::line(PATH, "curious plan (Model I)"),
+            Entry::line(BASELINE, "shortest path"),
+            Entry::fill(MARKER, "start and goal"),
+        ],
+        text_scale: 2,
+        pixels_per_metre: Some(pixels_per_metre),
+    }
 }
 
 /// The seed every report plan uses, so the report is the same run after run.

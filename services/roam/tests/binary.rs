@@ -121,20 +121,36 @@ fn stack_once_fetches_every_layer_and_draws_the_world() {
         );
     }
     assert!(
-        count_colour(&out.path().join("world.png"), roam_world::render::PATH.0) > 100,
+        count_colour(
+            &out.path().join("world.png"),
+            roam_world::render::PATH.0,
+            &roam::report::picture_frame("roam", 40.0)
+        ) > 100,
         "planned paths drawn"
     );
 
-    // The built-in world is 100 × 100 cells drawn at 8 px: the border wall is dark,
-    // the lab (score 90, around (-5, 8) m) is orange, open floor (score 5) near white.
+    // The built-in world is 100 × 100 cells drawn at 8 px, framed with a title, a
+    // legend and a scale bar: the border wall is dark, the lab (score 90, around
+    // (-5, 8) m) is orange, open floor (score 5) near white.
     let picture = image::open(out.path().join("world.png"))
         .expect("png")
         .to_rgb8();
-    assert_eq!(picture.dimensions(), (800, 800));
+    let frame = roam::report::picture_frame("roam", 8.0 / 0.2);
+    let layout = roam_world::legend::layout((800, 800), &frame);
+    assert_eq!(picture.dimensions().1, layout.size.1);
+    let (left, top) = layout.picture;
     let px = |x_m: f64, y_m: f64| {
         let (col, row) = (((x_m + 10.0) / 0.2) as u32, ((y_m + 10.0) / 0.2) as u32);
-        *picture.get_pixel(col * 8 + 4, (99 - row) * 8 + 4)
+        *picture.get_pixel(left + col * 8 + 4, top + (99 - row) * 8 + 4)
     };
+    for (entry, &(x, y, w, h)) in frame.legend.iter().zip(&layout.swatches) {
+        assert_eq!(
+            *picture.get_pixel(x + w / 2, y + h / 2),
+            entry.colour,
+            "{}",
+            entry.text
+        );
+    }
     assert_eq!(px(-9.9, 0.0).0, [20, 20, 20], "border wall");
     let lab = px(-5.0, 8.0).0;
     assert!(lab[0] > 200 && lab[2] < 60, "lab tinted orange: {lab:?}");
@@ -194,10 +210,22 @@ fn help_reads_like_a_manual() {
     }
 }
 
-/// Counts pixels of exactly `colour` in a PNG.
-fn count_colour(path: &std::path::Path, colour: [u8; 3]) -> usize {
+/// Counts pixels of exactly `colour` on the map of a framed 800 x 800 px picture (the
+/// built-in world at 8 px per cell), leaving out its legend, whose swatches have the
+/// same colours.
+fn count_colour(
+    path: &std::path::Path,
+    colour: [u8; 3],
+    frame: &roam_world::legend::Frame,
+) -> usize {
     let picture = image::open(path).expect("png").to_rgb8();
-    picture.pixels().filter(|p| p.0 == colour).count()
+    let (left, top) = roam_world::legend::layout((800, 800), frame).picture;
+    picture
+        .enumerate_pixels()
+        .filter(|(x, y, p)| {
+            p.0 == colour && (left..left + 800).contains(x) && (top..top + 800).contains(y)
+        })
+        .count()
 }
 
 /// A guard that stops a child process however the test ends.
@@ -280,7 +308,11 @@ fn roam_plan_asks_a_running_stack_and_draws_the_path() {
     assert_eq!(plan["reaches_goal"], true);
     assert_eq!(plan["within_budget"], true);
     assert!(
-        count_colour(&png, roam_world::render::PATH.0) > 50,
+        count_colour(
+            &png,
+            roam_world::render::PATH.0,
+            &roam::pictures::plan_frame(vec![String::new(), String::new()], 40.0)
+        ) > 50,
         "the path is drawn"
     );
 
@@ -414,12 +446,28 @@ fn every_shipped_scenario_renders_and_es1_shows_anchor_wall_and_robot() {
         );
         assert!(png.exists());
     }
-    // es1: 70 x 50 m at 0.5 m, drawn at 5 px per cell (800 / 140), north up.
+    // es1: 70 x 50 m at 0.5 m, drawn at 5 px per cell (800 / 140), north up, framed
+    // with a title, a legend and a scale bar.
     let picture = image::open(out.path().join("es1.png"))
         .expect("png")
         .to_rgb8();
+    let frame = roam::pictures::scenario_frame("es1", (70.0, 50.0), 0.5, 10.0);
+    let layout = roam_world::legend::layout((700, 500), &frame);
+    assert_eq!(picture.dimensions().1, layout.size.1);
+    for (entry, &(x, y, w, h)) in frame.legend.iter().zip(&layout.swatches) {
+        assert_eq!(
+            *picture.get_pixel(x + w / 2, y + h / 2),
+            entry.colour,
+            "{}",
+            entry.text
+        );
+    }
+    let (left, top) = layout.picture;
     let px = |x: f64, y: f64| {
-        *picture.get_pixel((x / 0.5 * 5.0) as u32, ((50.0 - y) / 0.5 * 5.0) as u32)
+        *picture.get_pixel(
+            left + (x / 0.5 * 5.0) as u32,
+            top + ((50.0 - y) / 0.5 * 5.0) as u32,
+        )
     };
     assert_eq!(px(4.0, 44.0), roam_sim::render::ANCHOR, "anchor a1");
     assert_eq!(px(10.0, 16.0), roam_sim::render::ROBOT, "the robot at A");

@@ -5,10 +5,22 @@ use std::process::Command;
 
 const ROAM: &str = env!("CARGO_BIN_EXE_roam");
 
-/// Counts pixels of exactly `colour` in a PNG.
-fn count_colour(path: &std::path::Path, colour: [u8; 3]) -> usize {
+/// Counts pixels of exactly `colour` on the map of a framed 800 x 800 px picture (the
+/// built-in world at 8 px per cell), leaving out its legend, whose swatches have the
+/// same colours.
+fn count_colour(
+    path: &std::path::Path,
+    colour: [u8; 3],
+    frame: &roam_world::legend::Frame,
+) -> usize {
     let picture = image::open(path).expect("png").to_rgb8();
-    picture.pixels().filter(|p| p.0 == colour).count()
+    let (left, top) = roam_world::legend::layout((800, 800), frame).picture;
+    picture
+        .enumerate_pixels()
+        .filter(|(x, y, p)| {
+            p.0 == colour && (left..left + 800).contains(x) && (top..top + 800).contains(y)
+        })
+        .count()
 }
 
 #[test]
@@ -82,14 +94,20 @@ fn reproduce_planner_prints_every_row_and_draws_each_model() {
             }
         }
     }
+    // Every model's picture has the same layout (two title lines, one legend).
+    let frame = roam_experiments::reproduce::planner::picture_frame(
+        roam_proto::planner::PlannerModel::Model1,
+        roam_experiments::reproduce::planner::Initialization::Roam,
+        40.0,
+    );
     for model in ["model0", "model1", "model2"] {
         let png = out.path().join(format!("{model}.png"));
         assert!(
-            count_colour(&png, roam_world::render::PATH.0) > 50,
+            count_colour(&png, roam_world::render::PATH.0, &frame) > 50,
             "{model}: the path is drawn"
         );
         assert!(
-            count_colour(&png, roam_world::render::MARKER.0) > 50,
+            count_colour(&png, roam_world::render::MARKER.0, &frame) > 50,
             "{model}: start and goal marked"
         );
     }
@@ -392,20 +410,48 @@ fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
     assert!(markdown.contains("| 1 | goal1 |") && markdown.contains("world.png"));
     assert!(markdown.contains("today's plan"), "{markdown}");
 
-    // The built-in world: 100 x 100 cells of 0.2 m from (-10, -10), 8 px per cell.
+    // The built-in world: 100 x 100 cells of 0.2 m from (-10, -10), 8 px per cell,
+    // framed with a title, a legend and a scale bar where the layout puts them.
     let picture = image::open(out.path().join("world.png"))
         .expect("png")
         .to_rgb8();
-    assert_eq!(picture.dimensions(), (800, 800));
-    let pixel = |p: [f64; 2]| {
-        let (x, y) = ((p[0] + 10.0) / 0.2, (p[1] + 10.0) / 0.2);
-        let (px, py) = (x.floor() * 8.0 + 4.0, (99.0 - y.floor()) * 8.0 + 4.0);
-        *picture.get_pixel(px as u32, py as u32)
+    let meta = roam_proto::map::GridMeta {
+        width: 100,
+        height: 100,
+        resolution: 0.2,
+        origin: roam_proto::map::Origin {
+            x: -10.0,
+            y: -10.0,
+            ..Default::default()
+        },
     };
+    let frame = roam::demo_picture::frame(
+        roam_mission::site::BUILTIN_DAY,
+        0,
+        10.0,
+        windows.len(),
+        &meta,
+    );
+    let layout = roam_world::legend::layout((800, 800), &frame);
+    assert_eq!(picture.dimensions(), layout.size);
+    let (left, top) = layout.picture;
+    let pixel_at = |p: [f64; 2]| {
+        let (x, y) = ((p[0] + 10.0) / 0.2, (p[1] + 10.0) / 0.2);
+        (
+            left + (x.floor() * 8.0 + 4.0) as u32,
+            top + ((99.0 - y.floor()) * 8.0 + 4.0) as u32,
+        )
+    };
+    let pixel = |p: [f64; 2]| {
+        let (x, y) = pixel_at(p);
+        *picture.get_pixel(x, y)
+    };
+    legend_and_title_are_drawn(&picture, &frame, &layout);
     let driven: Vec<[f64; 2]> =
         serde_json::from_value(report["driven_path"].clone()).expect("driven path");
     assert!(driven.len() > 50);
-    // Away from the start and task markers, the driven path is red where it was driven.
+    // Away from the start and task places (and the window numbers up and right of
+    // them), the driven path is red where it was driven.
     let markers = [[-8.0, -8.0], [-2.0, 4.0], [6.0, -7.0]];
     let away: Vec<[f64; 2]> = driven
         .iter()
@@ -413,12 +459,12 @@ fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
         .filter(|p| {
             markers
                 .iter()
-                .all(|m| (p[0] - m[0]).hypot(p[1] - m[1]) > 0.8)
+                .all(|m| (p[0] - m[0]).hypot(p[1] - m[1]) > 2.0)
         })
         .collect();
     let red = away
         .iter()
-        .filter(|p| pixel(**p) == image::Rgb([220, 20, 20]))
+        .filter(|p| pixel(**p) == image::Rgb(roam::demo_picture::DRIVEN.0))
         .count();
     assert!(
         red * 10 >= away.len() * 9,
@@ -427,6 +473,71 @@ fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
     );
     // The task places are marked green.
     assert_eq!(pixel([-2.0, 4.0]), image::Rgb([0, 170, 60]));
+    // Window 1's number is up and to the right of the start: the labels' black ink
+    // (nothing else on the map is pure black) within 60 px of it.
+    let (sx, sy) = pixel_at(driven[0]);
+    let ink_near_start = (sx..sx + 60)
+        .flat_map(|x| (sy.saturating_sub(60)..sy).map(move |y| (x, y)))
+        .filter(|&(x, y)| *picture.get_pixel(x, y) == image::Rgb([0, 0, 0]))
+        .count();
+    assert!(ink_near_start > 10, "window 1's number by the start");
+    // 40 px per metre, a bar at most a quarter of the map's 800 px: 5 m.
+    let bar = layout.scale_bar.expect("a scale bar");
+    assert_eq!((bar.metres, bar.pixels), (5.0, 200));
+    assert_eq!(
+        *picture.get_pixel(bar.x + 100, bar.y + 1),
+        image::Rgb([0, 0, 0])
+    );
+}
+
+/// Every legend swatch of `frame` has its colour where `layout` puts it, and every
+/// ink pixel of the title's letters is ink in `picture`.
+fn legend_and_title_are_drawn(
+    picture: &image::RgbImage,
+    frame: &roam_world::legend::Frame,
+    layout: &roam_world::legend::Layout,
+) {
+    assert!(!frame.legend.is_empty());
+    for (entry, &(x, y, w, h)) in frame.legend.iter().zip(&layout.swatches) {
+        let at = match entry.swatch {
+            // A label's border is its colour; inside is paper and text.
+            roam_world::legend::Swatch::Label(_) => (x, y),
+            _ => (x + w / 2, y + h / 2),
+        };
+        assert_eq!(
+            *picture.get_pixel(at.0, at.1),
+            entry.colour,
+            "legend: {}",
+            entry.text
+        );
+    }
+    let mut expected = image::RgbImage::from_pixel(
+        picture.width(),
+        picture.height(),
+        image::Rgb([255, 255, 255]),
+    );
+    let ink = roam_world::legend::INK;
+    for (line, &(x, y)) in frame.title.iter().zip(&layout.title) {
+        roam_world::font::draw_text(
+            &mut expected,
+            i64::from(x),
+            i64::from(y),
+            line,
+            roam_world::legend::TITLE_SCALE,
+            ink,
+        );
+    }
+    let letters: Vec<(u32, u32)> = expected
+        .enumerate_pixels()
+        .filter(|(_, _, p)| **p == ink)
+        .map(|(x, y, _)| (x, y))
+        .collect();
+    assert!(letters.len() > 500, "a title of some length");
+    let missing = letters
+        .iter()
+        .filter(|&&(x, y)| *picture.get_pixel(x, y) != ink)
+        .count();
+    assert_eq!(missing, 0, "title pixels missing: {:?}", frame.title);
 }
 
 #[test]

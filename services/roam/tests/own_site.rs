@@ -108,12 +108,13 @@ fn the_demo_runs_a_day_on_a_generated_nav2_map() {
     );
     let markdown = std::fs::read_to_string(out.join("report.md")).expect("md");
     assert!(markdown.contains("the site `room-day`"), "{markdown}");
-    // 240 × 160 cells drawn at 3 px a cell (800 px on the longer side at most), the
-    // driven path on it.
+    // 240 × 160 cells drawn at 3 px a cell (800 px on the longer side at most) inside
+    // the picture's frame (title, legend, scale bar), the driven path on it (well
+    // beyond the legend's swatch of its colour).
     let picture = image::open(out.join("world.png")).expect("png").to_rgb8();
-    assert_eq!(picture.dimensions(), (720, 480));
+    assert!(picture.width() >= 720 && picture.height() >= 480);
     let driven = picture.pixels().filter(|p| p.0 == DRIVEN).count();
-    assert!(driven > 100, "{driven} driven pixels");
+    assert!(driven > 1000, "{driven} driven pixels");
 }
 
 #[test]

@@ -4,7 +4,8 @@
 //!
 //! - [`grid`]: a grid with its placement in the world; [`distance`]: the exact
 //!   Euclidean distance transform; [`layers`]: the inflated and heuristic layers made
-//!   from an occupancy grid; [`render`]: grids and paths drawn to PNG.
+//!   from an occupancy grid; [`render`]: grids and paths drawn to PNG; [`legend`]: a
+//!   title, a legend and a scale bar around a picture, in the built-in [`font`].
 //! - [`scenario`]: roam's scenario file (the map, zones of interest, places and the sim
 //!   world's sections), its checks and loader, and the built-in world;
 //!   [`ros_map`]: ROS `map_server` maps as Nav2 reads and writes them;
@@ -16,8 +17,10 @@
 
 pub mod distance;
 pub mod epoch;
+pub mod font;
 pub mod grid;
 pub mod layers;
+pub mod legend;
 pub mod load_dirs;
 pub mod noise;
 pub mod render;

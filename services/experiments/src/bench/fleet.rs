@@ -39,6 +39,7 @@ use tokio_util::sync::CancellationToken;
 
 use crate::bench::process::{peak_rss_mib, rss_mib};
 use crate::bench::sim::{run_sim_for, TimedRun};
+use crate::progress::Progress;
 use crate::ExperimentError as BenchError;
 use roam_stack::router::Router;
 use roam_stack::stack::wait_until_live;
@@ -82,7 +83,13 @@ struct Seen {
     late: u64,
 }
 
-pub async fn fleet(robots: usize, rate_hz: f64, seconds: f64) -> Result<FleetBench, BenchError> {
+/// Runs the bench; `progress` each second of the timed run (stage `running`).
+pub async fn fleet(
+    robots: usize,
+    rate_hz: f64,
+    seconds: f64,
+    progress: Progress<'_>,
+) -> Result<FleetBench, BenchError> {
     let router = Router::on_loopback().await.map_err(setup)?;
     let root = "roam-bench-fleet".to_owned();
     let cancel = CancellationToken::new();
@@ -139,7 +146,15 @@ pub async fn fleet(robots: usize, rate_hz: f64, seconds: f64) -> Result<FleetBen
                 .map_err(|e| e.to_string())
         });
     }
-    let result = run(&router, &root, &client_config()?, robots, rate_hz, seconds).await;
+    let result = run(
+        &router,
+        &root,
+        &client_config()?,
+        robots,
+        (rate_hz, seconds),
+        progress,
+    )
+    .await;
     cancel.cancel();
     let _ = tokio::time::timeout(Duration::from_secs(10), async {
         while services.join_next().await.is_some() {}
@@ -154,8 +169,8 @@ async fn run(
     root: &str,
     client_config: &zenoh::Config,
     robots: usize,
-    rate_hz: f64,
-    seconds: f64,
+    (rate_hz, seconds): (f64, f64),
+    progress: Progress<'_>,
 ) -> Result<FleetBench, BenchError> {
     for service in [
         roam_sim::service::SERVICE_NAME,
@@ -317,7 +332,8 @@ async fn run(
             .map_err(setup)?
     };
 
-    let TimedRun { end, wall, cpu } = run_sim_for(&client, &control_key, rate_hz, seconds).await?;
+    let TimedRun { end, wall, cpu } =
+        run_sim_for(&client, &control_key, rate_hz, seconds, progress).await?;
     // The last step's commands.
     tokio::time::sleep(Duration::from_millis(500)).await;
     let rss_after = rss_mib();

@@ -21,6 +21,7 @@ use serde::Serialize;
 
 use crate::bench::planner::{builtin_world, GOAL, START};
 use crate::bench::scaling::{warehouse, WAREHOUSE_GOAL, WAREHOUSE_START};
+use crate::progress::{Done, Progress};
 use crate::ExperimentError as BenchError;
 
 #[derive(Debug, Clone, Serialize)]
@@ -169,14 +170,14 @@ fn depot() -> Result<World, BenchError> {
     World::at_resolution(&inflated, &scenario.information, 0.25, 0.2).map_err(setup)
 }
 
-/// Runs the comparison (see the module doc).
-pub fn peer(runs: usize) -> Result<PeerBench, BenchError> {
+/// Runs the comparison (see the module doc); `progress` after each trip.
+pub fn peer(runs: usize, progress: Progress<'_>) -> Result<PeerBench, BenchError> {
     let builtin = builtin_world()?;
     let depot = depot()?;
     let (inflated, information) = warehouse();
     let warehouse = World::at_resolution(&inflated, &information, 0.25, 0.2).map_err(setup)?;
     let mut trips = Vec::new();
-    for (name, world, start, goal) in [
+    let all = [
         ("built-in, Goal 2", &builtin, START, GOAL),
         ("built-in, Goal 1", &builtin, START, [-2.0, 4.0]),
         ("built-in, round trip", &builtin, START, START),
@@ -189,9 +190,11 @@ pub fn peer(runs: usize) -> Result<PeerBench, BenchError> {
             WAREHOUSE_START,
             WAREHOUSE_GOAL,
         ),
-    ] {
-        eprintln!("peer: {name}");
+    ];
+    progress(Done::of("trips", "trips", 0, all.len()));
+    for (name, world, start, goal) in all {
         trips.push(trip(name, world, start, goal, runs)?);
+        progress(Done::of("trips", "trips", trips.len(), all.len()));
     }
     Ok(PeerBench { trips, runs })
 }

@@ -22,6 +22,7 @@ use roam_world::DEFAULT_MAX_CELLS;
 use serde::Serialize;
 
 use crate::bench::ms;
+use crate::progress::{Done, Progress};
 use crate::ExperimentError;
 use roam_stack::stack::{Stack, StackOptions};
 
@@ -76,10 +77,12 @@ fn spec(model: PlannerModel, t_exec_s: f64, seed: u64, generations: u32) -> Plan
 }
 
 /// Runs the benchmark; `paper_initialization` plans the in-process runs with paper
-/// 000's initialization (no via-point seeds, walks that stop at the goal) to compare.
+/// 000's initialization (no via-point seeds, walks that stop at the goal) to compare;
+/// `progress` after each plan (stage `plans`) and each round trip (`round trips`).
 pub async fn planner(
     runs: usize,
     paper_initialization: bool,
+    progress: Progress<'_>,
 ) -> Result<PlannerBench, ExperimentError> {
     let world = builtin_world()?;
     let never = AtomicBool::new(false);
@@ -92,11 +95,13 @@ pub async fn planner(
     .map_err(|e| ExperimentError::Setup(e.to_string()))?;
     let budget = 2.0 * shortest.t_eta_s;
     let mut models = BTreeMap::new();
-    for model in [
+    let all = [
         PlannerModel::Model0,
         PlannerModel::Model1,
         PlannerModel::Model2,
-    ] {
+    ];
+    let mut planned = 0;
+    for model in all {
         let mut seconds = Vec::new();
         let mut rates = Vec::new();
         let mut gene_rates = Vec::new();
@@ -118,6 +123,8 @@ pub async fn planner(
             cells.push(outcome.path.len() as f64);
             info.push(outcome.metrics.distinct_information);
             generations = outcome.generations;
+            planned += 1;
+            progress(Done::of("plans", "plans", planned, all.len() * runs));
         }
         models.insert(
             model.as_str().to_owned(),
@@ -132,7 +139,7 @@ pub async fn planner(
         );
     }
     let ratio = models["model2"].plan_s_median / models["model1"].plan_s_median;
-    let overhead = zenoh_overhead(&world, budget, runs.max(10)).await?;
+    let overhead = zenoh_overhead(&world, budget, runs.max(10), progress).await?;
     Ok(PlannerBench {
         models,
         model2_over_model1: ratio,
@@ -148,7 +155,12 @@ pub async fn planner(
 }
 
 /// Median service round trip minus median in-process time for the same short plan.
-async fn zenoh_overhead(world: &World, budget: f64, runs: usize) -> Result<f64, ExperimentError> {
+async fn zenoh_overhead(
+    world: &World,
+    budget: f64,
+    runs: usize,
+    progress: Progress<'_>,
+) -> Result<f64, ExperimentError> {
     let stack = Stack::start(
         StackOptions {
             root: Some("roam-bench-planner".into()),
@@ -185,7 +197,7 @@ async fn zenoh_overhead(world: &World, budget: f64, runs: usize) -> Result<f64, 
         };
         let never = AtomicBool::new(false);
         let (mut local, mut remote) = (Vec::new(), Vec::new());
-        for _ in 0..runs {
+        for run in 0..runs {
             let started = Instant::now();
             plan(
                 world,
@@ -198,6 +210,7 @@ async fn zenoh_overhead(world: &World, budget: f64, runs: usize) -> Result<f64, 
             let started = Instant::now();
             client.plan(&request).await?;
             remote.push(ms(started.elapsed()));
+            progress(Done::of("round trips", "round trips", run + 1, runs));
         }
         let _ = session.close().await;
         Ok::<f64, ExperimentError>(median(&mut remote) - median(&mut local))

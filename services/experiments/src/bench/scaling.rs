@@ -32,6 +32,7 @@ use serde::Serialize;
 
 use crate::bench::planner::{builtin_world, GOAL, START};
 use crate::bench::process::{peak_rss_mib, process_cpu_seconds, rss_mib};
+use crate::progress::{Done, Progress};
 use crate::ExperimentError as BenchError;
 
 /// The map resolutions of the built-in world the bench plans on.
@@ -309,8 +310,15 @@ fn memory() -> Result<MemoryBench, BenchError> {
     })
 }
 
-/// Runs the bench (see the module doc).
-pub fn scaling(runs: usize) -> Result<ScalingBench, BenchError> {
+/// Runs the bench (see the module doc); `progress` after each row (a world planned at
+/// one resolution).
+pub fn scaling(runs: usize, progress: Progress<'_>) -> Result<ScalingBench, BenchError> {
+    // Two rows per resolution of the built-in world, three of the warehouse.
+    let rows = 2 * RESOLUTIONS.len() + 3;
+    let tick = |coarse: &[ScalingRow], native: &[ScalingRow]| {
+        progress(Done::of("rows", "rows", coarse.len() + native.len(), rows));
+    };
+    tick(&[], &[]);
     let memory = memory()?;
     let reference = builtin_world()?;
     let never = AtomicBool::new(false);
@@ -327,7 +335,6 @@ pub fn scaling(runs: usize) -> Result<ScalingBench, BenchError> {
     for resolution in RESOLUTIONS {
         let (inflated, information) = builtin_at(resolution)?;
         let name = format!("built-in at {resolution} m");
-        eprintln!("scaling: {name}");
         let (trip, at) = ((START, GOAL), (&inflated, &information));
         coarse.push(row(
             builtin, &name, at, PLANNING_M, trip, budget, &reference, runs,
@@ -335,8 +342,8 @@ pub fn scaling(runs: usize) -> Result<ScalingBench, BenchError> {
         native.push(row(
             builtin, &name, at, resolution, trip, budget, &reference, runs,
         )?);
+        tick(&coarse, &native);
     }
-    eprintln!("scaling: the 1.7-million-cell warehouse");
     let (inflated, information) = warehouse();
     // Its own yardstick: the warehouse's information at 0.2 m.
     let wh_reference = World::at_resolution(&inflated, &information, 0.25, 0.21).map_err(setup)?;
@@ -372,6 +379,7 @@ pub fn scaling(runs: usize) -> Result<ScalingBench, BenchError> {
         &wh_reference,
         runs,
     )?);
+    tick(&coarse, &native);
     coarse.push(row(
         wh,
         at_003,
@@ -382,6 +390,7 @@ pub fn scaling(runs: usize) -> Result<ScalingBench, BenchError> {
         &wh_reference,
         runs,
     )?);
+    tick(&coarse, &native);
     native.push(row(
         wh,
         at_003,
@@ -392,6 +401,7 @@ pub fn scaling(runs: usize) -> Result<ScalingBench, BenchError> {
         &wh_reference,
         runs,
     )?);
+    tick(&coarse, &native);
     for family in [builtin, wh] {
         let Some(paper) = coarse.iter().find(|r| r.family == family).cloned() else {
             continue;

@@ -21,6 +21,7 @@ use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
 use crate::bench::process::process_cpu_seconds;
+use crate::progress::{Done, Progress};
 use crate::ExperimentError;
 use roam_stack::router::Router;
 use roam_stack::stack::wait_until_live;
@@ -42,7 +43,13 @@ fn setup<E: std::fmt::Display>(e: E) -> ExperimentError {
     ExperimentError::Setup(e.to_string())
 }
 
-pub async fn sim(robots: usize, rate_hz: f64, seconds: f64) -> Result<SimBench, ExperimentError> {
+/// Runs the bench; `progress` each second of the timed run (stage `running`).
+pub async fn sim(
+    robots: usize,
+    rate_hz: f64,
+    seconds: f64,
+    progress: Progress<'_>,
+) -> Result<SimBench, ExperimentError> {
     let router = Router::on_loopback().await.map_err(setup)?;
     let root = "roam-bench-sim".to_owned();
     let cancel = CancellationToken::new();
@@ -117,7 +124,7 @@ pub async fn sim(robots: usize, rate_hz: f64, seconds: f64) -> Result<SimBench, 
                 .map_err(setup)?
         };
         let TimedRun { end, wall, cpu } =
-            run_sim_for(&client, &control_key, rate_hz, seconds).await?;
+            run_sim_for(&client, &control_key, rate_hz, seconds, progress).await?;
         // Let the last publications arrive.
         tokio::time::sleep(Duration::from_millis(300)).await;
         drop(subscriber);
@@ -158,11 +165,13 @@ pub(crate) struct TimedRun {
 
 /// Resumes the sim at `rate_hz` steps per wall second, lets it run `seconds`, pauses
 /// it, and says what it did meanwhile: the window every sim-driven benchmark times.
+/// `progress` after each whole second of it (stage `running`, in seconds).
 pub(crate) async fn run_sim_for(
     client: &Requester,
     control_key: &str,
     rate_hz: f64,
     seconds: f64,
+    progress: Progress<'_>,
 ) -> Result<TimedRun, roam_runtime::ClientError> {
     let status: SimStatus = client
         .request(control_key, Some(&SimControl::Status))
@@ -174,7 +183,7 @@ pub(crate) async fn run_sim_for(
     client
         .request::<SimControl, SimStatus>(control_key, Some(&SimControl::Resume { rate: factor }))
         .await?;
-    tokio::time::sleep(Duration::from_secs_f64(seconds)).await;
+    wait_reporting(started, seconds, progress).await;
     let end: SimStatus = client
         .request(control_key, Some(&SimControl::Pause))
         .await?;
@@ -184,4 +193,21 @@ pub(crate) async fn run_sim_for(
         _ => f64::NAN,
     };
     Ok(TimedRun { end, wall, cpu })
+}
+
+/// Sleeps until `seconds` after `started`, waking each second to report the whole
+/// seconds gone: the timed window is the same as one sleep's, to the timer's precision.
+async fn wait_reporting(started: Instant, seconds: f64, progress: Progress<'_>) {
+    let length = Duration::from_secs_f64(seconds);
+    let whole = seconds.ceil() as usize;
+    loop {
+        let left = length.saturating_sub(started.elapsed());
+        if left.is_zero() {
+            break;
+        }
+        tokio::time::sleep(left.min(Duration::from_secs(1))).await;
+        let gone = (started.elapsed().as_secs_f64().floor() as usize).min(whole);
+        progress(Done::of("running", "seconds", gone, whole));
+    }
+    progress(Done::of("running", "seconds", whole, whole));
 }

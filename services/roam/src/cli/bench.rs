@@ -1,10 +1,22 @@
 //! `roam bench`: each benchmark measures one thing on this machine and prints JSON.
 
 use anyhow::bail;
-use clap::Subcommand;
+use clap::{Args, Subcommand};
 use roam_experiments::bench as benches;
 
 use super::print_json;
+use super::progress::Progress;
+
+/// `roam bench [--quiet] <benchmark>`.
+#[derive(Debug, Args)]
+pub(crate) struct BenchArgs {
+    /// Show no progress on stderr (the benchmarks that run longer than a few seconds,
+    /// `planner`, `sim` and `fleet`, draw it when stderr is a terminal).
+    #[arg(long, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: BenchCommand,
+}
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum BenchCommand {
@@ -74,7 +86,8 @@ pub(crate) enum BenchCommand {
         #[arg(long, default_value_t = 4000)]
         updates: u64,
     },
-    /// The GA per curiosity model (2000 generations, population 200) and the service overhead.
+    /// The GA per curiosity model (2000 generations, population 200) and the service
+    /// overhead; with --scaling or --peer, finer maps or the greedy planner instead.
     Planner {
         #[arg(long)]
         json: bool,
@@ -96,8 +109,9 @@ pub(crate) enum BenchCommand {
     },
 }
 
-pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
-    match command {
+pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
+    let quiet = args.quiet;
+    match args.command {
         BenchCommand::Map {
             json,
             side,
@@ -130,7 +144,10 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             seconds,
         } => {
             check_robots_run(robots, rate_hz, seconds)?;
-            let result = roam_experiments::bench::sim::sim(robots, rate_hz, seconds).await?;
+            let progress = Progress::new("bench sim", quiet);
+            let shown = progress.callback();
+            let result =
+                roam_experiments::bench::sim::sim(robots, rate_hz, seconds, &shown).await?;
             print_json(&result, json)
         }
         BenchCommand::Load {
@@ -157,7 +174,10 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             seconds,
         } => {
             check_robots_run(robots, rate_hz, seconds)?;
-            let result = roam_experiments::bench::fleet::fleet(robots, rate_hz, seconds).await?;
+            let progress = Progress::new("bench fleet", quiet);
+            let shown = progress.callback();
+            let result =
+                roam_experiments::bench::fleet::fleet(robots, rate_hz, seconds, &shown).await?;
             print_json(&result, json)
         }
         BenchCommand::Mapper {
@@ -191,18 +211,26 @@ pub(crate) async fn bench(command: BenchCommand) -> anyhow::Result<()> {
             }
             if scaling {
                 let result = tokio::task::spawn_blocking(move || {
-                    roam_experiments::bench::scaling::scaling(runs)
+                    let progress = Progress::new("bench planner --scaling", quiet);
+                    let shown = progress.callback();
+                    roam_experiments::bench::scaling::scaling(runs, &shown)
                 })
                 .await??;
                 return print_json(&result, json);
             }
             if peer {
-                let result =
-                    tokio::task::spawn_blocking(move || roam_experiments::bench::peer::peer(runs))
-                        .await??;
+                let result = tokio::task::spawn_blocking(move || {
+                    let progress = Progress::new("bench planner --peer", quiet);
+                    let shown = progress.callback();
+                    roam_experiments::bench::peer::peer(runs, &shown)
+                })
+                .await??;
                 return print_json(&result, json);
             }
-            let result = roam_experiments::bench::planner::planner(runs, paper_init).await?;
+            let progress = Progress::new("bench planner", quiet);
+            let shown = progress.callback();
+            let result =
+                roam_experiments::bench::planner::planner(runs, paper_init, &shown).await?;
             print_json(&result, json)
         }
     }

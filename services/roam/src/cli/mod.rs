@@ -4,6 +4,7 @@
 mod bench;
 mod map;
 mod plan;
+mod progress;
 mod reproduce;
 mod reproduce_fleet;
 mod roles;
@@ -20,10 +21,10 @@ use roam_proto::keys;
 use roam_runtime::{Requester, SessionArgs};
 use roam_stack::{Role, RoleConfig};
 
-use bench::BenchCommand;
+use bench::BenchArgs;
 use map::MapCommand;
 use plan::PlanArgs;
-use reproduce::ReproduceCommand;
+use reproduce::ReproduceArgs;
 use roles::{MapServerArgs, PlannerArgs, RouterArgs, StackArgs};
 
 const ABOUT: &str = "roam: curious, time-aware robot navigation as Zenoh services.";
@@ -63,9 +64,13 @@ ROLES
                loopback, multicast off. The embedded default world needs no files.
 
 CLIENTS AND TOOLS
+  demo         roam's main job on the demo's day world: one robot's four downtime
+               windows on curious paths; a report directory with a framed picture.
   plan         Ask a running planner for a path; --png draws it.
-  map          Inspect map files offline; list, load and fetch layers of a running stack.
-  bench        Benchmarks that print JSON.
+  map          Inspect map files offline; list and load layers of a running stack.
+  bench        Benchmarks that print JSON; the long ones show progress on stderr.
+  reproduce    The papers' evaluations and roam's own batches, each claim judged;
+               progress on stderr (--quiet: none).
   view         The live view in the Foxglove app (Foxglove WebSocket), MCAP recording.
 
 CONFIG FILE
@@ -115,15 +120,18 @@ enum Command {
     Mapper(roles::MapperArgs),
     /// Run a mission executive: one robot's tasks, curious downtime paths, reports.
     Mission(roles::MissionArgs),
-    /// roam's main job: the whole stack on the built-in world, one robot, two tasks with
-    /// downtime between them; writes a report directory.
+    /// roam's main job: the whole stack on the demo's day world, one robot's four downtime
+    /// windows (one a round trip) on curious paths; writes a report directory (report.md,
+    /// report.json, world.png with a legend).
     Demo(roles::DemoArgs),
     /// Run the sim world (papers 002 and 004), or `sim render` a scenario to a PNG.
     Sim(sim::SimArgs),
     /// Ask a running planner for a curious path (a client).
     Plan(PlanArgs),
-    /// Run a Zenoh router (no separate zenohd needed). It listens on `--listen`, else on
-    /// the endpoints of the `ZENOH_CONFIG` file, else on tcp/0.0.0.0:7447.
+    /// Run a Zenoh router (no separate zenohd needed).
+    ///
+    /// It listens on `--listen`, else on the endpoints of the `ZENOH_CONFIG` file, else on
+    /// tcp/0.0.0.0:7447.
     Router(RouterArgs),
     /// Run every landed service in one process around an in-process router.
     Stack(StackArgs),
@@ -134,12 +142,12 @@ enum Command {
     /// Map files and the map server's layers.
     #[command(subcommand)]
     Map(MapCommand),
-    /// Benchmarks; each prints JSON with --json.
-    #[command(subcommand)]
-    Bench(BenchCommand),
-    /// Reproduce a paper's evaluation and print ours next to its figures.
-    #[command(subcommand)]
-    Reproduce(ReproduceCommand),
+    /// Benchmarks, each measuring one thing on this machine: JSON with --json, progress on
+    /// stderr for the long ones.
+    Bench(BenchArgs),
+    /// Reproduce the papers' evaluations and run roam's own batches (the executive's
+    /// days, the fleet's week): ours next to the figures, each claim judged.
+    Reproduce(ReproduceArgs),
 }
 
 #[derive(Debug, Args)]
@@ -210,8 +218,8 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Ros2(args) => ros2::ros2(args).await,
         Command::View(args) => view::view(args).await,
         Command::Map(command) => map::map(command).await,
-        Command::Bench(command) => bench::bench(command).await,
-        Command::Reproduce(command) => reproduce::reproduce(command).await,
+        Command::Bench(args) => bench::bench(args).await,
+        Command::Reproduce(args) => reproduce::reproduce(args).await,
     }
 }
 

@@ -181,7 +181,24 @@ pub(crate) async fn draw_plan(
     {
         render::draw_marker(&mut image, occ.meta.height, *end, scale, render::MARKER);
     }
-    image
+    let title = vec![
+        format!(
+            "roam plan: {}, ETA {:.1} s, {} the goal",
+            plan.model.as_str(),
+            plan.t_eta_s,
+            if plan.reaches_goal {
+                "reaches"
+            } else {
+                "misses"
+            }
+        ),
+        format!(
+            "distinct information {:.0}, {} generations",
+            plan.distinct_information, plan.generations
+        ),
+    ];
+    let frame = roam::pictures::plan_frame(title, f64::from(scale) / occ.meta.resolution);
+    roam_world::legend::framed(&image, &frame)
         .save(path)
         .with_context(|| format!("writing {}", path.display()))?;
     Ok(())

@@ -3,11 +3,27 @@
 use std::path::PathBuf;
 
 use anyhow::bail;
-use clap::Subcommand;
+use clap::{Args, Subcommand};
+
+use super::progress::Progress;
+
+/// `roam reproduce [--quiet] <experiment>`.
+#[derive(Debug, Args)]
+pub(crate) struct ReproduceArgs {
+    /// Show no progress on stderr (it is drawn only when stderr is a terminal; to a
+    /// pipe or a file, one line per finished stage).
+    #[arg(long, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: ReproduceCommand,
+}
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum ReproduceCommand {
-    /// The papers joined: seeded downtime missions in the built-in world, planned on the
+    /// The papers joined: downtime missions per coupling, or with --days N the
+    /// executive's whole day N times per variant, against the goals.
+    ///
+    /// Without --days: seeded downtime missions in the built-in world, planned on the
     /// static information map, with the PEB localizability cost, and the shortest path.
     /// With --days N: the executive's whole day (tasks::day() on the day world) N times
     /// per variant (the shipped executive, without each coupling, the paper's planner
@@ -53,12 +69,13 @@ pub(crate) enum ReproduceCommand {
         #[arg(long, value_name = "DAY.yaml", requires = "map")]
         tasks: Option<PathBuf>,
     },
-    /// A fleet's week in the warehouse: ten robots' shifts repeated --days times, each
-    /// robot driven by the executive's own window machine, objects landing in and
-    /// leaving the aisles and the dock; per variant (tasks only, the operator's patrol,
-    /// independent curiosity, roam's shared news and each part of it off) the late
-    /// windows, how soon the fleet sees each change and how well its map predicts the
-    /// world now, against the goals.
+    /// A fleet's week in the warehouse: ten robots' shifts per variant, the late windows,
+    /// how soon the fleet sees each change and its map now, against the goals.
+    ///
+    /// The shifts are repeated --days times, each robot driven by the executive's own
+    /// window machine, objects landing in and leaving the aisles and the dock; the
+    /// variants are tasks only, the operator's patrol, independent curiosity, roam's
+    /// shared news and each part of it off.
     Fleet(super::reproduce_fleet::FleetArgs),
     /// Paper 002 §4: ES1-ES3 for plain APF and the fixed, cutoff, linear and sinusoidal
     /// information-seeking weights.
@@ -131,9 +148,10 @@ pub(crate) enum ReproduceCommand {
     },
 }
 
-pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
-    match command {
-        ReproduceCommand::Fleet(args) => super::reproduce_fleet::run(args).await,
+pub(crate) async fn reproduce(args: ReproduceArgs) -> anyhow::Result<()> {
+    let quiet = args.quiet;
+    match args.command {
+        ReproduceCommand::Fleet(args) => super::reproduce_fleet::run(args, quiet).await,
         ReproduceCommand::Mission {
             json,
             days: Some(days),
@@ -163,6 +181,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 generations,
                 w_loc,
                 site,
+                quiet,
             )
             .await
         }
@@ -189,12 +208,9 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 w_loc,
             };
             let result = tokio::task::spawn_blocking(move || {
-                roam_experiments::reproduce::mission::missions::run(&options, &|done, total| {
-                    eprint!("\rthe papers joined: mission {done}/{total}   ");
-                    if done == total {
-                        eprintln!();
-                    }
-                })
+                let progress = Progress::new("the papers joined", quiet);
+                let shown = progress.callback();
+                roam_experiments::reproduce::mission::missions::run(&options, &shown)
             })
             .await??;
             let report = roam_experiments::reproduce::mission::runner::MissionReport {
@@ -226,6 +242,8 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 bail!("--es1-runs, --es2-runs, --es3-missions and --es3-runs must be at least 1");
             }
             let (result, pictures) = tokio::task::spawn_blocking(move || {
+                let progress = Progress::new("paper 002", quiet);
+                let shown = progress.callback();
                 roam_experiments::reproduce::apf::runner::run(
                     &roam_experiments::reproduce::apf::runner::Sizes {
                         es1_runs,
@@ -235,6 +253,7 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                         seed,
                         out_dir: out,
                     },
+                    &shown,
                 )
             })
             .await??;
@@ -266,22 +285,14 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
             };
             let (result, picture) = tokio::task::spawn_blocking(move || {
                 let scenario = roam_experiments::reproduce::mapper::experiment::grid004()?;
-                let progress = |p: roam_experiments::reproduce::mapper::experiment::Progress| {
-                    eprint!(
-                        "\rpaper 004: run {}/{} ({} #{})   ",
-                        p.done,
-                        p.total,
-                        p.mode.as_str(),
-                        p.repetition + 1
-                    );
-                };
+                let progress = Progress::new("paper 004", quiet);
+                let shown = progress.callback();
                 let result = roam_experiments::reproduce::mapper::experiment::run(
                     roam_experiments::reproduce::mapper::experiment::GRID004_NAME,
                     &scenario,
                     &options,
-                    &progress,
+                    &shown,
                 )?;
-                eprintln!();
                 std::fs::create_dir_all(&out)?;
                 let picture = roam_experiments::reproduce::mapper::plot::write_figure(
                     &scenario, &result, &out,
@@ -332,7 +343,9 @@ pub(crate) async fn reproduce(command: ReproduceCommand) -> anyhow::Result<()> {
                 initializations,
             };
             let result = tokio::task::spawn_blocking(move || {
-                roam_experiments::reproduce::planner::run(&options)
+                let progress = Progress::new("paper 000", quiet);
+                let shown = progress.callback();
+                roam_experiments::reproduce::planner::run(&options, &shown)
             })
             .await??;
             if json {
@@ -359,6 +372,7 @@ async fn reproduce_days(
     generations: u32,
     w_loc: f64,
     site: roam_mission::site::Site,
+    quiet: bool,
 ) -> anyhow::Result<()> {
     use roam_experiments::reproduce::mission::days::{self, DaysOptions, Variant};
     let mut options = DaysOptions {
@@ -387,23 +401,20 @@ async fn reproduce_days(
     }
     let started = std::time::Instant::now();
     let run = options.clone();
-    let report = tokio::task::spawn_blocking(move || {
-        days::run(&run, &|done, total| {
-            eprint!("\rthe executive's days: {done}/{total} (variant, day)   ");
-            if done == total {
-                eprintln!();
-            }
-        })
-    })
-    .await??;
+    let progress = std::sync::Arc::new(Progress::new("the executive's", quiet));
+    let reporting = progress.clone();
+    let report =
+        tokio::task::spawn_blocking(move || days::run(&run, &reporting.callback())).await??;
     let wall_s = started.elapsed().as_secs_f64();
-    eprintln!(
-        "{} days x {} variants in {wall_s:.1} s ({:.2} s per day, {} threads)",
-        options.days,
-        report.variants.len(),
-        wall_s / options.days as f64,
-        options.jobs
-    );
+    if progress.speaks() {
+        eprintln!(
+            "{} days x {} variants in {wall_s:.1} s ({:.2} s per day, {} threads)",
+            options.days,
+            report.variants.len(),
+            wall_s / options.days as f64,
+            options.jobs
+        );
+    }
     if json {
         println!("{}", serde_json::to_string(&report)?);
     } else {

@@ -4,6 +4,8 @@
 use roam_experiments::reproduce::fleet::{self, FleetOptions, FleetVariant};
 use roam_proto::planner::PlannerModel;
 
+use super::progress::Progress;
+
 #[derive(Debug, clap::Args)]
 pub(crate) struct FleetArgs {
     /// Print the report as JSON: the variants' figures, the goals with verdicts, and
@@ -49,7 +51,7 @@ fn curious_model(name: &str) -> Option<PlannerModel> {
     .find(|m| m.as_str() == name)
 }
 
-pub(crate) async fn run(args: FleetArgs) -> anyhow::Result<()> {
+pub(crate) async fn run(args: FleetArgs, quiet: bool) -> anyhow::Result<()> {
     let mut options = FleetOptions {
         days: args.days,
         seed: args.seed,
@@ -79,26 +81,25 @@ pub(crate) async fn run(args: FleetArgs) -> anyhow::Result<()> {
     }
     let started = std::time::Instant::now();
     let run = options.clone();
-    let report = tokio::task::spawn_blocking(move || {
-        fleet::run(&run, &|done, total| {
-            eprintln!(
-                "the fleet's week: {done}/{total} variants ({:.0} s)",
-                started.elapsed().as_secs_f64()
-            );
-        })
-    })
-    .await??;
-    eprintln!(
-        "{} shifts x {} variants in {:.1} s ({} threads)",
-        options.days,
-        report.variants.len(),
-        started.elapsed().as_secs_f64(),
-        options.jobs
-    );
+    let progress = std::sync::Arc::new(Progress::new("the fleet's", quiet));
+    let reporting = progress.clone();
+    let report =
+        tokio::task::spawn_blocking(move || fleet::run(&run, &reporting.callback())).await??;
+    if progress.speaks() {
+        eprintln!(
+            "{} shifts x {} variants in {:.1} s ({} threads)",
+            options.days,
+            report.variants.len(),
+            started.elapsed().as_secs_f64(),
+            options.jobs
+        );
+    }
     if let Some(dir) = &args.svg {
         let world = fleet::FleetWorld::warehouse()?;
-        for path in fleet::picture::write(dir, &world, &report.weeks)? {
-            eprintln!("wrote {}", path.display());
+        for path in fleet::picture::write(dir, &world, &report.weeks, options.seed)? {
+            if progress.speaks() {
+                eprintln!("wrote {}", path.display());
+            }
         }
     }
     if args.json {

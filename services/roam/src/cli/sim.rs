@@ -95,7 +95,17 @@ fn render(scenario: PathBuf, png: PathBuf, scale: Option<u32>) -> anyhow::Result
     let (_, loaded) = load_or_builtin(Some(&scenario))?;
     let sim = Sim::new(&loaded, 0)?;
     let scale = scale.unwrap_or_else(|| roam_sim::render::auto_scale(&sim));
-    roam_sim::render::render(&sim, scale)
+    let meta = loaded.occupancy.meta;
+    let frame = roam::pictures::scenario_frame(
+        &loaded.file.name,
+        (
+            f64::from(meta.width) * meta.resolution,
+            f64::from(meta.height) * meta.resolution,
+        ),
+        meta.resolution,
+        f64::from(scale) / meta.resolution,
+    );
+    roam_world::legend::framed(&roam_sim::render::render(&sim, scale), &frame)
         .save(&png)
         .with_context(|| format!("writing {}", png.display()))?;
     println!("picture: {}", png.display());

@@ -23,6 +23,7 @@ use super::{
     run_parallel, run_seed, summarize, ApfError, FailureCauses, RunOptions, RunSummary, Trajectory,
 };
 use crate::closed_loop::episode::{mission_from_waypoints, run_episode, PositionSource, Setup};
+use crate::progress::Done;
 use roam_controller::params::ApfParams;
 use roam_controller::weights::Scheme;
 
@@ -107,7 +108,7 @@ pub fn es1(scenario: &Scenario, options: &RunOptions<'_>) -> Result<Es1Outcome, 
                 (RunSummary::of(&e, &setup), example)
             })
         },
-        |done| (options.progress)("es1", done, total),
+        |done| (options.progress)(Done::of("es1", "runs", done, total)),
     );
     let mut rows = Vec::new();
     let mut trajectories = Vec::new();

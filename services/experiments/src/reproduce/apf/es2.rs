@@ -16,6 +16,7 @@ use serde::Serialize;
 
 use super::{run_parallel, run_seed, summarize, ApfError, RunOptions, RunSummary, Trajectory};
 use crate::closed_loop::episode::{mission_from_waypoints, run_episode, PositionSource, Setup};
+use crate::progress::Done;
 use roam_controller::params::ApfParams;
 use roam_controller::weights::Scheme;
 
@@ -111,7 +112,7 @@ pub fn es2(
                 (RunSummary::of(&e, &setup), example)
             })
         },
-        |done| (options.progress)("es2", done, total),
+        |done| (options.progress)(Done::of("es2", "runs", done, total)),
     );
     let mut rows = Vec::new();
     let mut trajectories = Vec::new();

@@ -33,6 +33,7 @@ use super::{
     run_parallel, run_seed, summarize, ApfError, FailureCauses, RunOptions, RunSummary, Summary,
 };
 use crate::closed_loop::episode::{run_episode, PositionSource, RobotMission, Setup};
+use crate::progress::Done;
 use roam_controller::params::ApfParams;
 use roam_controller::weights::Scheme;
 
@@ -216,7 +217,7 @@ pub fn es3(
             )
             .map(|e| RunSummary::of(&e, &setup))
         },
-        |done| (options.progress)("es3", done, total),
+        |done| (options.progress)(Done::of("es3", "runs", done, total)),
     );
     let mut results = results.into_iter();
     let mut summaries = Vec::new();

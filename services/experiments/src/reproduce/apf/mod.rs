@@ -51,6 +51,7 @@ pub mod runner;
 use roam_world::scenario::Scenario;
 
 use crate::parallel::run_in_order;
+use crate::progress::{Done, Progress};
 use serde::Serialize;
 
 use crate::closed_loop::episode::{Episode, EpisodeError, Setup};
@@ -75,8 +76,9 @@ pub struct RunOptions<'a> {
     /// The controller's parameters; each experiment sets the scheme and z_is (and what
     /// else it says) on top.
     pub params: &'a ApfParams,
-    /// Called after every finished run with (experiment, runs done, runs in total).
-    pub progress: &'a (dyn Fn(&str, usize, usize) + Sync),
+    /// Called after every finished run: the experiment (`es1`, `es2`, `es3`) as the
+    /// stage, runs done and runs in total.
+    pub progress: Progress<'a>,
 }
 
 impl std::fmt::Debug for RunOptions<'_> {
@@ -316,7 +318,9 @@ pub struct ReproduceOptions<'a> {
     pub seed: u64,
     pub threads: usize,
     pub params: &'a ApfParams,
-    pub progress: &'a (dyn Fn(&str, usize, usize) + Sync),
+    /// Each experiment's runs, as [`RunOptions::progress`]; ES1 without the guard is
+    /// its own stage.
+    pub progress: Progress<'a>,
 }
 
 impl std::fmt::Debug for ReproduceOptions<'_> {
@@ -358,10 +362,17 @@ pub fn reproduce(
         max_peb_m: f64::INFINITY,
         ..options.params.clone()
     };
+    let no_guard_progress = |d: Done<'_>| {
+        (options.progress)(Done {
+            stage: "es1 without the guard",
+            ..d
+        })
+    };
     let no_guard = es1(
         es1_scenario,
         &RunOptions {
             params: &unguarded,
+            progress: &no_guard_progress,
             ..run(options.es1_runs)
         },
     )?;

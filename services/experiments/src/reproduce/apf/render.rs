@@ -1,4 +1,6 @@
-//! Pictures of the reproduction (no text in them; [`SCHEME_COLOURS`] is the legend):
+//! Pictures of the reproduction, each framed with a title (which figure, which seed), a
+//! legend ([`SCHEME_COLOURS`] and the map's colours) and, on maps, a scale bar
+//! (`roam_world::legend`):
 //!
 //! - like paper 002's Fig. 2: the ES1 map shaded by how many anchors cover each cell,
 //!   the anchors, the waypoints and one trajectory per scheme;
@@ -10,6 +12,8 @@
 use std::path::{Path, PathBuf};
 
 use image::{Rgb, RgbImage};
+use roam_world::font::{draw_text, text_height, text_width};
+use roam_world::legend::{framed, Entry, Frame};
 use roam_world::scenario::is_blocked;
 
 use crate::closed_loop::episode::Setup;
@@ -236,6 +240,7 @@ pub fn render_chart(rows: &[Es2Row], metric: Metric) -> RgbImage {
     let origin = (m, f64::from(h) - m);
     canvas.line(origin, (f64::from(w) - m, origin.1), 0, AXIS);
     canvas.line(origin, (m, m), 0, AXIS);
+    axis_labels(canvas.image, z_range, v_max);
     for (scheme, colour, _) in SCHEME_COLOURS {
         let mut points: Vec<(f64, f64)> = rows
             .iter()
@@ -257,6 +262,75 @@ pub fn render_chart(rows: &[Es2Row], metric: Metric) -> RgbImage {
     image
 }
 
+/// The axes' end values in the margins: z_is under the x axis's ends, 0 and the top
+/// value left of the y axis.
+fn axis_labels(image: &mut RgbImage, z_range: (f64, f64), v_max: f64) {
+    let (w, h) = CHART_SIZE;
+    let m = CHART_MARGIN;
+    let below = i64::from(h - m + 4);
+    for (z, text) in [
+        (z_range.0, format!("{:.1}", z_range.0)),
+        (z_range.1, format!("{:.1}", z_range.1)),
+    ] {
+        let (x, _) = chart_pixel(z, 0.0, z_range, v_max);
+        let half = i64::from(text_width(&text, 1) / 2);
+        draw_text(image, x as i64 - half, below, &text, 1, AXIS);
+    }
+    let name = "z_is";
+    draw_text(
+        image,
+        i64::from(w / 2) - i64::from(text_width(name, 1) / 2),
+        below + i64::from(text_height(1)) + 2,
+        name,
+        1,
+        AXIS,
+    );
+    for v in [0.0, v_max] {
+        let text = format!("{v:.0}");
+        let (_, y) = chart_pixel(z_range.0, v, z_range, v_max);
+        let x = i64::from(m) - 3 - i64::from(text_width(&text, 1));
+        draw_text(image, x.max(0), y as i64 - 3, &text, 1, AXIS);
+    }
+}
+
+/// The legend of the map pictures: each scheme's trajectory, then the map's colours.
+pub fn map_legend() -> Vec<Entry> {
+    let mut legend: Vec<Entry> = SCHEME_COLOURS
+        .iter()
+        .map(|(scheme, colour, _)| Entry::line(*colour, &format!("{} trajectory", scheme.name())))
+        .collect();
+    legend.extend([
+        Entry::fill(ANCHOR, "anchor"),
+        Entry::fill(WAYPOINT, "waypoint"),
+        Entry::fill(WALL, "wall"),
+        Entry::fill(COVERAGE[0], "no anchor in range"),
+        Entry::fill(COVERAGE[1], "1 anchor in range"),
+        Entry::fill(COVERAGE[2], "2 anchors in range"),
+        Entry::fill(COVERAGE[3], "3 or more in range"),
+    ]);
+    legend
+}
+
+/// The legend of a chart of `rows`: the line of each scheme in them.
+pub fn chart_legend(rows: &[Es2Row]) -> Vec<Entry> {
+    SCHEME_COLOURS
+        .iter()
+        .filter(|(scheme, _, _)| rows.iter().any(|r| r.scheme == *scheme))
+        .map(|(scheme, colour, _)| Entry::line(*colour, scheme.name()))
+        .collect()
+}
+
+/// The frame of a map picture of `setup` at `scale` pixels per cell.
+pub fn map_frame(title: Vec<String>, setup: &Setup, scale: u32) -> Frame {
+    let resolution = setup.scenario.occupancy.meta.resolution;
+    Frame {
+        title,
+        legend: map_legend(),
+        text_scale: 1,
+        pixels_per_metre: Some(f64::from(scale) / resolution),
+    }
+}
+
 fn save(image: &RgbImage, path: &Path) -> Result<(), RenderError> {
     image.save(path).map_err(|e| RenderError::Encode {
         path: path.to_owned(),
@@ -266,34 +340,64 @@ fn save(image: &RgbImage, path: &Path) -> Result<(), RenderError> {
 
 /// Writes the four pictures into `dir` (created if missing) and returns their paths:
 /// `es1_trajectories.png` (Fig. 2), `es2_trajectories.png` (Fig. 3 left),
-/// `es2_steps.png` and `es2_distance.png` (Fig. 3 middle and right).
+/// `es2_steps.png` and `es2_distance.png` (Fig. 3 middle and right); `seed` is the
+/// run's base seed, for the titles.
 pub fn write_figures(
     reproduction: &Reproduction,
     es1: &Setup,
     es2: &Setup,
     dir: &Path,
+    seed: u64,
 ) -> Result<Vec<PathBuf>, RenderError> {
     std::fs::create_dir_all(dir).map_err(|e| RenderError::Io {
         path: dir.to_owned(),
         reason: e.to_string(),
     })?;
     let mut written = Vec::new();
-    for (name, setup, trajectories) in [
-        ("es1_trajectories.png", es1, &reproduction.es1_trajectories),
-        ("es2_trajectories.png", es2, &reproduction.es2_trajectories),
+    for (name, setup, trajectories, title) in [
+        (
+            "es1_trajectories.png",
+            es1,
+            &reproduction.es1_trajectories,
+            "paper 002 ES1 (Fig. 2): a trajectory per scheme",
+        ),
+        (
+            "es2_trajectories.png",
+            es2,
+            &reproduction.es2_trajectories,
+            "paper 002 ES2 (Fig. 3 left): true positions",
+        ),
     ] {
         let mut image = render_map(setup, MAP_SCALE);
         draw_trajectories(&mut image, setup, trajectories, MAP_SCALE);
+        let frame = map_frame(vec![title.into(), format!("seed {seed}")], setup, MAP_SCALE);
         let path = dir.join(name);
-        save(&image, &path)?;
+        save(&framed(&image, &frame), &path)?;
         written.push(path);
     }
-    for (name, metric) in [
-        ("es2_steps.png", Metric::Steps),
-        ("es2_distance.png", Metric::Distance),
+    for (name, metric, title) in [
+        (
+            "es2_steps.png",
+            Metric::Steps,
+            "ES2: mean steps against z_is",
+        ),
+        (
+            "es2_distance.png",
+            Metric::Distance,
+            "ES2: mean distance (m) against z_is",
+        ),
     ] {
+        let frame = Frame {
+            title: vec![title.into(), format!("paper 002 Fig. 3, seed {seed}")],
+            legend: chart_legend(&reproduction.es2),
+            text_scale: 1,
+            pixels_per_metre: None,
+        };
         let path = dir.join(name);
-        save(&render_chart(&reproduction.es2, metric), &path)?;
+        save(
+            &framed(&render_chart(&reproduction.es2, metric), &frame),
+            &path,
+        )?;
         written.push(path);
     }
     Ok(written)
@@ -461,13 +565,28 @@ robots:
             }],
             es2_trajectories: Vec::new(),
         };
-        let written = write_figures(&r, &s, &s, &dir).expect("written");
+        let written = write_figures(&r, &s, &s, &dir, 4).expect("written");
         assert_eq!(written.len(), 4);
         let es1 = image::open(&written[0]).expect("decodes").to_rgb8();
+        let (map_w, map_h) = render_map(&s, MAP_SCALE).dimensions();
+        let frame = map_frame(vec!["t".into(), "seed 4".into()], &s, MAP_SCALE);
+        let layout = roam_world::legend::layout((map_w, map_h), &frame);
+        let (left, top) = layout.picture;
+        let (x, y) = map_pixel(&s, [10.0, 3.0], MAP_SCALE);
         assert_eq!(
-            pixel(&es1, map_pixel(&s, [10.0, 3.0], MAP_SCALE)),
+            pixel(&es1, (x + f64::from(left), y + f64::from(top))),
             colour_of(Scheme::Sinusoidal)
         );
+        // The legend: each entry's colour at its swatch's centre.
+        for (entry, &(x, y, w, h)) in frame.legend.iter().zip(&layout.swatches) {
+            assert_eq!(
+                *es1.get_pixel(x + w / 2, y + h / 2),
+                entry.colour,
+                "{}",
+                entry.text
+            );
+        }
+        assert!(layout.scale_bar.is_some());
         for path in &written[1..] {
             assert!(image::open(path).is_ok(), "{}", path.display());
         }

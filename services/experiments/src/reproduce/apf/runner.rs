@@ -1,8 +1,7 @@
 //! `roam reproduce apf`: paper 002 §4's ES1–ES3 on the shipped scenarios (built into the
-//! binary, so it runs from anywhere), with progress on stderr, the pictures, and the
+//! binary, so it runs from anywhere), with progress reported to the caller, the pictures, and the
 //! paper's claims judged from the figures ([`claims`]).
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::closed_loop::episode::Setup;
@@ -11,6 +10,7 @@ use roam_world::scenario::{self, Scenario};
 use roam_world::DEFAULT_MAX_CELLS;
 use serde::Serialize;
 
+use crate::progress::Progress;
 use crate::verdict::Comparison;
 use crate::ExperimentError;
 
@@ -63,28 +63,15 @@ impl Output {
 }
 
 /// Runs the three experiments with the paper's parameters, writes the pictures and
-/// judges the claims.
-pub fn run(sizes: &Sizes) -> Result<(Output, Vec<PathBuf>), ExperimentError> {
+/// judges the claims; `progress` after each run, one stage per experiment.
+pub fn run(
+    sizes: &Sizes,
+    progress: Progress<'_>,
+) -> Result<(Output, Vec<PathBuf>), ExperimentError> {
     let es1 = shipped("es1.yaml", ES1)?;
     let es2 = shipped("es2.yaml", ES2)?;
     let es3 = shipped("es3.yaml", ES3)?;
     let params = paper::paper_params();
-    // Every whole percent, so a log file does not get a line per run.
-    let progress = |experiment: &str, done: usize, total: usize| {
-        let percent = |n: usize| n * 100 / total.max(1);
-        if done != total && done > 1 && percent(done) == percent(done - 1) {
-            return;
-        }
-        let mut err = std::io::stderr().lock();
-        let _ = write!(
-            err,
-            "\rpaper 002 {experiment}: {done}/{total} runs ({}%)   ",
-            percent(done)
-        );
-        if done == total {
-            let _ = writeln!(err);
-        }
-    };
     let options = ReproduceOptions {
         es1_runs: sizes.es1_runs,
         es2_runs: sizes.es2_runs,
@@ -93,7 +80,7 @@ pub fn run(sizes: &Sizes) -> Result<(Output, Vec<PathBuf>), ExperimentError> {
         seed: sizes.seed,
         threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
         params: &params,
-        progress: &progress,
+        progress,
     };
     let result = reproduce(&es1, &es2, &es3, &options)?;
     std::fs::create_dir_all(&sizes.out_dir).map_err(|e| {
@@ -104,6 +91,7 @@ pub fn run(sizes: &Sizes) -> Result<(Output, Vec<PathBuf>), ExperimentError> {
         &Setup::new(&es1)?,
         &Setup::new(&es2)?,
         &sizes.out_dir,
+        sizes.seed,
     )?;
     Ok((Output::of(result), pictures))
 }

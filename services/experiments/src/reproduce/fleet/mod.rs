@@ -32,6 +32,7 @@ use roam_proto::planner::PlannerModel;
 use serde::Serialize;
 
 use crate::parallel::run_in_order;
+use crate::progress::{Done, Progress};
 
 pub use goals::FleetGoal;
 pub use summary::FleetSummary;
@@ -162,12 +163,8 @@ fn check(o: &FleetOptions) -> Result<(), FleetError> {
     Ok(())
 }
 
-/// Runs the batch on the built-in warehouse; `progress(done, total)` after each
-/// variant's week.
-pub fn run(
-    options: &FleetOptions,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<FleetReport, FleetError> {
+/// Runs the batch on the built-in warehouse; `progress` after each variant's week.
+pub fn run(options: &FleetOptions, progress: Progress<'_>) -> Result<FleetReport, FleetError> {
     check(options)?;
     let world = FleetWorld::warehouse()?;
     run_on(&world, options, progress)
@@ -177,7 +174,7 @@ pub fn run(
 pub fn run_on(
     world: &FleetWorld,
     options: &FleetOptions,
-    progress: &(dyn Fn(usize, usize) + Sync),
+    progress: Progress<'_>,
 ) -> Result<FleetReport, FleetError> {
     check(options)?;
     let mut variants = options.variants.clone();
@@ -188,7 +185,7 @@ pub fn run_on(
         options.jobs,
         |&v| week::run_week(world, v, options),
         Result::is_err,
-        |done, _| progress(done, variants.len()),
+        |done, _| progress(Done::of("week", "variants", done, variants.len())),
     );
     let mut weeks = Vec::with_capacity(variants.len());
     for slot in slots.into_iter().flatten() {

@@ -1,4 +1,5 @@
-//! The fleet's week as pictures, in SVG (legends as text, no font to ship):
+//! The fleet's week as pictures, in SVG (title, legend and scale bar as `<text>` and
+//! shapes: no font to ship):
 //!
 //! - `warehouse-<variant>.svg`: the warehouse (racks and walls), its change zones
 //!   shaded by how often objects land there, the anchors, each robot's true path
@@ -47,8 +48,9 @@ fn escape(text: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// The warehouse with `week`'s first-shift paths and its changes.
-pub fn warehouse_svg(world: &FleetWorld, week: &WeekRecord) -> String {
+/// The warehouse with `week`'s first-shift paths and its changes; `seed` is the batch's,
+/// for the title.
+pub fn warehouse_svg(world: &FleetWorld, week: &WeekRecord, seed: u64) -> String {
     let scenario = &world.setup.scenario;
     let meta = scenario.occupancy.meta;
     let (w_m, h_m) = (
@@ -175,8 +177,11 @@ pub fn warehouse_svg(world: &FleetWorld, week: &WeekRecord) -> String {
     let lx = w_m * PX_PER_M + 16.0;
     let _ = writeln!(
         svg,
-        r#"<text x="{lx:.1}" y="20" font-weight="bold">{}</text>"#,
-        escape(&format!("roam fleet: {}", week.variant.name()))
+        r#"<text id="title" x="{lx:.1}" y="20" font-weight="bold">{}</text>"#,
+        escape(&format!(
+            "roam fleet: {}, first shift, seed {seed}",
+            week.variant.name()
+        ))
     );
     let mut entries: Vec<(Mark, String, String)> = vec![
         (
@@ -232,13 +237,22 @@ pub fn warehouse_svg(world: &FleetWorld, week: &WeekRecord) -> String {
             escape(text)
         );
     }
+    // Scale bar: 10 m, under the legend.
+    let (sy, bar) = (44.0 + 20.0 * entries.len() as f64 + 10.0, 10.0 * PX_PER_M);
+    let _ = writeln!(
+        svg,
+        r##"<g id="scale"><rect x="{lx:.1}" y="{sy:.1}" width="{bar:.1}" height="4" fill="#000000"/><text x="{:.1}" y="{:.1}">10 m</text></g>"##,
+        lx + bar + 8.0,
+        sy + 6.0
+    );
     svg.push_str("</svg>\n");
     svg
 }
 
-/// The share of each variant's changes seen within t minutes, t from 0 to an hour.
-pub fn detection_svg(weeks: &[WeekRecord]) -> String {
-    let (left, top, plot_w, plot_h) = (60.0, 30.0, 520.0, 320.0);
+/// The share of each variant's changes seen within t minutes, t from 0 to an hour;
+/// `seed` is the batch's, for the title.
+pub fn detection_svg(weeks: &[WeekRecord], seed: u64) -> String {
+    let (left, top, plot_w, plot_h) = (60.0, 50.0, 520.0, 320.0);
     let (width, height) = (left + plot_w + 230.0, top + plot_h + 60.0);
     let x_of = |minutes: f64| left + plot_w * (minutes / HORIZON_MIN).clamp(0.0, 1.0);
     let y_of = |share: f64| top + plot_h * (1.0 - share.clamp(0.0, 1.0));
@@ -281,7 +295,15 @@ pub fn detection_svg(weeks: &[WeekRecord]) -> String {
     );
     let _ = writeln!(
         svg,
-        r#"<text x="{left}" y="18">share of the week's changes seen</text>"#
+        r#"<text id="title" x="{left}" y="20" font-weight="bold">{}</text>"#,
+        escape(&format!(
+            "roam fleet: how soon the changes were seen, {} variants, seed {seed}",
+            weeks.len()
+        ))
+    );
+    let _ = writeln!(
+        svg,
+        r#"<text x="{left}" y="40">share of the week's changes seen</text>"#
     );
     for (i, week) in weeks.iter().enumerate() {
         let colour = VARIANT_COLOURS[i % VARIANT_COLOURS.len()];
@@ -340,15 +362,16 @@ pub fn write(
     dir: &Path,
     world: &FleetWorld,
     weeks: &[WeekRecord],
+    seed: u64,
 ) -> std::io::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir)?;
     let mut written = Vec::new();
     let detection = dir.join("detection.svg");
-    std::fs::write(&detection, detection_svg(weeks))?;
+    std::fs::write(&detection, detection_svg(weeks, seed))?;
     written.push(detection);
     for week in weeks {
         let path = dir.join(format!("warehouse-{}.svg", week.variant.name()));
-        std::fs::write(&path, warehouse_svg(world, week))?;
+        std::fs::write(&path, warehouse_svg(world, week, seed))?;
         written.push(path);
     }
     Ok(written)

@@ -41,6 +41,7 @@
 use std::path::Path;
 
 use crate::parallel::run_in_order;
+use crate::progress::{Done, Progress};
 
 use roam_sim::{Command, Sim, SimError};
 use roam_world::scenario::{self, Scenario};
@@ -172,16 +173,6 @@ pub enum MappingError {
     Io { path: String, reason: String },
 }
 
-/// A run finished.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Progress {
-    /// Runs finished so far, this one included.
-    pub done: usize,
-    pub total: usize,
-    pub mode: Mode,
-    pub repetition: usize,
-}
-
 /// One mode's summary: the JSON's `strategies` entries.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StrategySummary {
@@ -255,12 +246,12 @@ struct RunResult {
 }
 
 /// Runs the experiment on `scenario` (grid004 for the paper's); `progress` is called
-/// after each run, from the worker threads.
+/// after each run (mode and repetition, one stage `runs`), from the worker threads.
 pub fn run(
     scenario_name: &str,
     scenario: &Scenario,
     options: &ExperimentOptions,
-    progress: &(dyn Fn(Progress) + Sync),
+    progress: Progress<'_>,
 ) -> Result<Reproduction, MappingError> {
     options.check()?;
     let step_s = scenario.file.time.step_s;
@@ -280,14 +271,7 @@ pub fn run(
         threads,
         |&(mode, repetition)| run_one(scenario, &truth, options, mode, repetition, &mut |_| {}),
         Result::is_err,
-        |done, &(mode, repetition)| {
-            progress(Progress {
-                done,
-                total: jobs.len(),
-                mode,
-                repetition,
-            })
-        },
+        |done, _| progress(Done::of("runs", "runs", done, jobs.len())),
     );
     let mut results = Vec::with_capacity(jobs.len());
     for slot in slots {

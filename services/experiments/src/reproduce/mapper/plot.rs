@@ -1,8 +1,9 @@
 //! The reproduction's figure, laid out like paper 004's Fig. 3: the world with the
 //! blocks' paths (left), the rate-estimate error over time (middle) and the map quality
-//! over time (right). No text: the axes start at 0, time runs to the last sample, the
-//! error axis to the largest mean error, the quality axis to 1; light grid lines mark
-//! quarters.
+//! over time (right), framed with a title (what, which seed and sizes) and a legend
+//! (`roam_world::legend`). The axes start at 0 (each axis's end value is written at
+//! it), time runs to the last sample, the error axis to the largest mean error, the
+//! quality axis to 1; light grid lines mark quarters.
 //!
 //! Colours: curious [`CURIOUS`] red, the uniform mix [`UNIFORM`] grey, recency
 //! [`RECENCY`] blue, Poisson [`POISSON`] green (drawn in that order reversed, so curious
@@ -14,6 +15,8 @@ use std::path::{Path, PathBuf};
 
 use image::{Rgb, RgbImage};
 use roam_sim::world::World;
+use roam_world::font::{draw_text, text_width};
+use roam_world::legend::{framed, Entry, Frame};
 use roam_world::scenario::{is_blocked, Scenario};
 
 use crate::reproduce::mapper::experiment::{MappingError, Reproduction};
@@ -113,13 +116,61 @@ pub fn figure(scenario: &Scenario, r: &Reproduction) -> RgbImage {
         curve_panel(&r.time_s, &series_quality, 1.0, cw, ch),
     ];
     let places = layout(scenario);
-    let width = places[2].x + cw + MARGIN;
-    let height = ch.max(places[0].height) + 2 * MARGIN;
+    let (width, height) = figure_size(scenario);
     let mut out = RgbImage::from_pixel(width, height, BACKGROUND);
     for (panel, place) in panels.iter().zip(places) {
         paste(&mut out, panel, place.x, place.y);
     }
     out
+}
+
+/// The title and legend around [`figure`].
+pub fn figure_frame(r: &Reproduction) -> Frame {
+    let o = &r.options;
+    let mut legend: Vec<Entry> = Mode::ALL
+        .iter()
+        .map(|&m| Entry::line(colour(m), m.as_str()))
+        .collect();
+    legend.extend([
+        Entry::fill(WALL, "wall"),
+        Entry::fill(BLOCK_PATHS[0], "block 1: its path, cells"),
+        Entry::fill(BLOCK_PATHS[1], "block 2: its path, cells"),
+        Entry::fill(START, "robot's start"),
+    ]);
+    Frame {
+        title: vec![
+            format!(
+                "paper 004 Fig. 3 on {}: seed {}, runs per strategy {}, {} s each",
+                r.scenario, o.seed, o.repetitions, o.steps
+            ),
+            "left: the world; middle: rate-estimate error; right: map quality".into(),
+        ],
+        legend,
+        text_scale: 1,
+        pixels_per_metre: None,
+    }
+}
+
+/// The panels' places in the written (framed) figure.
+pub fn framed_layout(scenario: &Scenario, r: &Reproduction) -> [Panel; 3] {
+    let places = layout(scenario);
+    let size = figure_size(scenario);
+    let (dx, dy) = roam_world::legend::layout(size, &figure_frame(r)).picture;
+    places.map(|p| Panel {
+        x: p.x + dx,
+        y: p.y + dy,
+        ..p
+    })
+}
+
+/// The size of [`figure`]'s image.
+fn figure_size(scenario: &Scenario) -> (u32, u32) {
+    let (cw, ch) = CURVE_PANEL;
+    let places = layout(scenario);
+    (
+        places[2].x + cw + MARGIN,
+        ch.max(places[0].height) + 2 * MARGIN,
+    )
 }
 
 /// Writes the figure as `FIGURE_FILE` in `out_dir` (created if missing).
@@ -134,7 +185,9 @@ pub fn write_figure(
     };
     std::fs::create_dir_all(out_dir).map_err(|e| io(&e, out_dir))?;
     let path = out_dir.join(FIGURE_FILE);
-    figure(scenario, r).save(&path).map_err(|e| io(&e, &path))?;
+    framed(&figure(scenario, r), &figure_frame(r))
+        .save(&path)
+        .map_err(|e| io(&e, &path))?;
     Ok(path)
 }
 
@@ -265,6 +318,16 @@ pub fn curve_panel(
     }
     line(&mut img, (left, top), (left, top + ph), AXIS, 2);
     line(&mut img, (left, top + ph), (left + pw, top + ph), AXIS, 2);
+    // The axes' end values: 0 and the top value left of the y axis, the last time under
+    // the x axis's end.
+    let top_value = format!("{y_max:.2}");
+    for (text, y) in [("0".to_owned(), top + ph - 3.0), (top_value, top)] {
+        let x = left - 4.0 - f64::from(text_width(&text, 1));
+        draw_text(&mut img, x.max(0.0) as i64, y as i64, &text, 1, AXIS);
+    }
+    let end = format!("{:.0} s", t1 - t0);
+    let x = left + pw - f64::from(text_width(&end, 1));
+    draw_text(&mut img, x as i64, (top + ph + 6.0) as i64, &end, 1, AXIS);
     for &(c, values) in series {
         let points: Vec<(f64, f64)> = time
             .iter()

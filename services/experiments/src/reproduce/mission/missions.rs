@@ -24,6 +24,7 @@
 use std::sync::atomic::AtomicBool;
 
 use crate::closed_loop::episode::{run_episode, PositionSource, RobotMission, Setup};
+use crate::progress::{Done, Progress};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use roam_controller::params::ApfParams;
@@ -149,10 +150,10 @@ fn change_information(
     Ok(map.change_scores(f64::from(seconds)))
 }
 
-/// Runs the comparison; `progress(done, total)` after each mission.
+/// Runs the comparison; `progress` after each mission.
 pub fn run(
     options: &MissionExperiment,
-    progress: &dyn Fn(usize, usize),
+    progress: Progress<'_>,
 ) -> Result<MissionReproduction, MissionExperimentError> {
     let scenario = builtin()?;
     let inflated = inflate(
@@ -279,7 +280,12 @@ pub fn run(
                 driven_over_planned: (planned > 0.0).then(|| driven / planned),
             });
         }
-        progress(mission + 1, options.missions);
+        progress(Done::of(
+            "missions",
+            "missions",
+            mission + 1,
+            options.missions,
+        ));
     }
     let n = options.missions.max(1) as f64;
     Ok(MissionReproduction {

@@ -29,11 +29,13 @@ use roam_map_server::map_file;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
-use roam_world::render::{draw_marker, draw_path, render_map, MARKER, PATH};
+use roam_world::legend::{framed, Entry, Frame};
+use roam_world::render::{draw_marker, draw_path, render_map, INFORMATION, MARKER, OCCUPIED, PATH};
 use roam_world::DEFAULT_MAX_CELLS;
 use serde::Serialize;
 
 use crate::bench::planner::builtin_world;
+use crate::progress::{Done, Progress};
 use crate::ExperimentError;
 
 mod claims;
@@ -142,18 +144,30 @@ fn mean(values: &[f64]) -> f64 {
     values.iter().sum::<f64>() / values.len().max(1) as f64
 }
 
-pub fn run(options: &ReproduceOptions) -> Result<Reproduction, ExperimentError> {
+/// Every configuration with every initialization asked for; `progress` after each plan
+/// (one stage, `plans`, over all of them).
+pub fn run(
+    options: &ReproduceOptions,
+    progress: Progress<'_>,
+) -> Result<Reproduction, ExperimentError> {
     let world = builtin_world()?;
     let mut initializations = Vec::new();
     let mut pictures = Vec::new();
+    let total =
+        options.initializations.len() * GOALS.len() * RATIOS.len() * MODELS.len() * options.runs;
+    let mut done = 0;
+    let mut planned = || {
+        done += 1;
+        progress(Done::of("plans", "plans", done, total));
+    };
     for (n, init) in options.initializations.iter().enumerate() {
-        let (rows, paths) = run_one(&world, options, *init)?;
+        let (rows, paths) = run_one(&world, options, *init, &mut planned)?;
         let prefix = if n == 0 {
             String::new()
         } else {
             format!("{}-", init.as_str())
         };
-        pictures.extend(draw(&world, &paths, &options.out_dir, &prefix)?);
+        pictures.extend(draw(&world, &paths, &options.out_dir, &prefix, *init)?);
         initializations.push(InitializationRun {
             initialization: *init,
             comparisons: claims::compare(&rows),
@@ -186,6 +200,7 @@ fn run_one(
     world: &World,
     options: &ReproduceOptions,
     init: Initialization,
+    planned: &mut dyn FnMut(),
 ) -> Result<(Vec<Row>, Vec<Drawn>), ExperimentError> {
     let never = AtomicBool::new(false);
     let mut rows = Vec::new();
@@ -210,6 +225,7 @@ fn run_one(
                     u.push(outcome.metrics.u_ges);
                     d.push(outcome.metrics.density);
                     info.push(outcome.metrics.distinct_information);
+                    planned();
                     within += usize::from(outcome.within_budget);
                     reached += usize::from(outcome.reaches_goal);
                     if seed == 0 && goal_name == "goal2" && ratio_name == "40/60" {
@@ -236,11 +252,34 @@ fn run_one(
     Ok((rows, pictures_paths))
 }
 
+/// The title, legend and scale bar of a model's picture.
+pub fn picture_frame(model: PlannerModel, init: Initialization, pixels_per_metre: f64) -> Frame {
+    Frame {
+        title: vec![
+            format!(
+                "paper 000 sec. III: {}, {} initialization",
+                model.as_str(),
+                init.as_str()
+            ),
+            "goal 2, t_plan/t_exec 40/60, seed 0".into(),
+        ],
+        legend: vec![
+            Entry::fill(INFORMATION, "zone of interest (darker: more)"),
+            Entry::fill(OCCUPIED, "wall"),
+            Entry::line(PATH, "the planned path"),
+            Entry::fill(MARKER, "start and goal"),
+        ],
+        text_scale: 2,
+        pixels_per_metre: Some(pixels_per_metre),
+    }
+}
+
 fn draw(
     world: &World,
     paths: &[Drawn],
     out_dir: &Path,
     prefix: &str,
+    init: Initialization,
 ) -> Result<Vec<PathBuf>, ExperimentError> {
     let content =
         map_file::builtin(DEFAULT_MAX_CELLS).map_err(|e| ExperimentError::Setup(e.to_string()))?;
@@ -257,7 +296,8 @@ fn draw(
             draw_marker(&mut image, world.meta.height, *end, scale, MARKER);
         }
         let file = out_dir.join(format!("{prefix}{}.png", model.as_str()));
-        image
+        let per_metre = f64::from(scale) / content.occupancy.meta.resolution;
+        framed(&image, &picture_frame(*model, init, per_metre))
             .save(&file)
             .map_err(|e| ExperimentError::Setup(format!("{}: {e}", file.display())))?;
         written.push(file);

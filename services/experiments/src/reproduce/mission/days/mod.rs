@@ -42,6 +42,7 @@ pub mod world;
 mod tests;
 
 use crate::parallel::run_in_order;
+use crate::progress::{Done, Progress};
 
 use serde::Serialize;
 
@@ -183,11 +184,8 @@ fn check(o: &DaysOptions) -> Result<(), DaysError> {
     Ok(())
 }
 
-/// Runs the batch; `progress(done, total)` after each (variant, day).
-pub fn run(
-    options: &DaysOptions,
-    progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<DaysReport, DaysError> {
+/// Runs the batch; `progress` after each (variant, day), counted in days.
+pub fn run(options: &DaysOptions, progress: Progress<'_>) -> Result<DaysReport, DaysError> {
     check(options)?;
     let world = DayWorld::new(&options.site)?;
     let mut variants = options.variants.clone();
@@ -201,7 +199,7 @@ pub fn run(
         options.jobs,
         |&(variant, d)| day::run_day(&world, variant, options, d),
         Result::is_err,
-        |done, _| progress(done, units.len()),
+        |done, _| progress(Done::of("days", "variant days", done, units.len())),
     );
     let mut results = Vec::with_capacity(units.len());
     for slot in slots {

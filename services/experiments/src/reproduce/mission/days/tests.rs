@@ -9,6 +9,7 @@ use super::goals::{goals, Verdict};
 use super::measure::WindowResult;
 use super::summary::{paired, variant_summary};
 use super::*;
+use crate::progress::silent;
 
 /// A small batch that stays fast in debug builds: two days, three variants (plain, the
 /// executive, the fastest path), a few GA generations.
@@ -26,7 +27,7 @@ fn small(jobs: usize) -> DaysOptions {
 /// The small batch on one thread, run once for the tests that read it.
 fn one_thread() -> &'static DaysReport {
     static REPORT: OnceLock<DaysReport> = OnceLock::new();
-    REPORT.get_or_init(|| run(&small(1), &|_, _| {}).expect("the small batch runs"))
+    REPORT.get_or_init(|| run(&small(1), &silent).expect("the small batch runs"))
 }
 
 /// Everything a report holds, bit for bit: its JSON (floats printed exactly) and the
@@ -44,7 +45,7 @@ fn bits(r: &DaysReport) -> (String, Vec<Vec<u64>>) {
 #[test]
 fn the_same_options_give_the_same_report_bit_for_bit_on_one_or_two_threads() {
     let once = one_thread();
-    let two = run(&small(2), &|_, _| {}).expect("runs on two threads");
+    let two = run(&small(2), &silent).expect("runs on two threads");
     assert_eq!(bits(once), bits(&two));
     // Every (variant, day) is in the report, in order, and the day was driven.
     let units: Vec<(usize, Variant)> = once.results.iter().map(|d| (d.day, d.variant)).collect();
@@ -221,7 +222,7 @@ fn synthetic_figures_short_of_every_goal_do_not_hold_and_good_ones_hold() {
 
 #[test]
 fn bad_options_are_refused_naming_the_field_and_its_limit() {
-    let refused = |options: DaysOptions| match run(&options, &|_, _| {}) {
+    let refused = |options: DaysOptions| match run(&options, &silent) {
         Err(DaysError::Invalid { field, limit, .. }) => (field, limit),
         other => panic!("not refused: {other:?}"),
     };
