@@ -48,7 +48,7 @@ async fn the_live_executive_and_the_batch_make_the_same_day() {
     let config = config(seed);
 
     // The batch.
-    let world = DayWorld::new().expect("the day world");
+    let world = DayWorld::new(&roam_mission::site::Site::builtin_day()).expect("the day world");
     let options = DaysOptions {
         plan_wall_s: 0.0,
         ..DaysOptions::default()
