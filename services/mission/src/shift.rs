@@ -29,6 +29,8 @@ use crate::tasks::{self, Task, TaskError};
 
 /// The most robots a shift takes (the sim's limit).
 pub const MAX_SHIFT_ROBOTS: usize = 1000;
+/// The most corners a patrol loop has.
+pub const MAX_PATROL_CORNERS: usize = 1000;
 /// The longest shift, seconds (a day).
 pub const MAX_SHIFT_S: f64 = 86_400.0;
 
@@ -44,6 +46,11 @@ pub struct ShiftFile {
     /// How long one shift is, seconds: the next shift's tasks are these, this much later.
     pub length_s: f64,
     pub robots: Vec<RobotShiftFile>,
+    /// The operator's patrol (`roam reproduce fleet`'s `patrol` variant): the corners
+    /// of a loop, world metres, driven in order and back to the first. The built-in
+    /// warehouse has its own (through every aisle); elsewhere the variant needs it.
+    #[serde(default)]
+    pub patrol: Vec<[f64; 2]>,
 }
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -71,6 +78,8 @@ pub struct ShiftTask {
 pub struct Shift {
     pub length_s: f64,
     pub robots: Vec<RobotShift>,
+    /// The patrol's corners (empty: none given).
+    pub patrol: Vec<[f64; 2]>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -197,9 +206,26 @@ impl Shift {
                 tasks,
             });
         }
+        if file.patrol.len() == 1 || file.patrol.len() > MAX_PATROL_CORNERS {
+            return Err(field(
+                "patrol",
+                format!(
+                    "{} corners; give none or 2..={MAX_PATROL_CORNERS}",
+                    file.patrol.len()
+                ),
+            ));
+        }
+        if let Some(i) = file
+            .patrol
+            .iter()
+            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
+            return Err(field(format!("patrol[{i}]"), "give a finite point"));
+        }
         Ok(Shift {
             length_s: file.length_s,
             robots: out,
+            patrol: file.patrol,
         })
     }
 
@@ -312,5 +338,10 @@ mod tests {
             "length_s: 100\nrobots: [{robot: r1, tasks: [{name: a, at: [3, 31], start_s: 99, duration_s: 5}]}]\n",
             "after the shift",
         );
+        let one = "length_s: 100\nrobots: [{robot: r1, tasks: [{name: a, at: [3, 31], start_s: 10, duration_s: 5}]}]\n";
+        refused(&format!("{one}patrol: [[1, 2]]\n"), "patrol");
+        refused(&format!("{one}patrol: [[1, 2], [.nan, 3]]\n"), "patrol[1]");
+        let loop_ = parse(&format!("{one}patrol: [[1, 2], [3, 4]]\n")).expect("a loop");
+        assert_eq!(loop_.patrol, vec![[1.0, 2.0], [3.0, 4.0]]);
     }
 }

@@ -265,16 +265,25 @@ impl Site {
 /// The planner's grid for a scenario as the planner service builds it (inflated by the
 /// robot's radius, the static information map), without the PEB field.
 pub fn planning_world(scenario: &Scenario) -> Result<World, SiteError> {
-    let inflated = inflate(
+    World::new(
+        &inflated_map(scenario),
+        &scenario.information,
+        HEURISTIC_COMPRESSION,
+    )
+    .map_err(|e| SiteError::Scenario(e.to_string()))
+}
+
+/// The scenario's map inflated by the robot's radius, as the map server's `inflated`
+/// layer.
+pub fn inflated_map(scenario: &Scenario) -> Grid<i8> {
+    inflate(
         &scenario.occupancy,
         scenario
             .file
             .robot_radius_m
             .unwrap_or(DEFAULT_ROBOT_RADIUS_M),
         INFLATED_COST,
-    );
-    World::new(&inflated, &scenario.information, HEURISTIC_COMPRESSION)
-        .map_err(|e| SiteError::Scenario(e.to_string()))
+    )
 }
 
 /// A free cell of a ROS occupancy grid (0 free … 100 occupied, −1 unknown), as the map

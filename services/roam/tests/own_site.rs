@@ -232,3 +232,91 @@ fn bad_files_are_refused_naming_what_to_fix() {
     assert!(!output.status.success());
     assert!(String::from_utf8_lossy(&output.stderr).contains("--tasks"));
 }
+
+/// The room as a fleet's site: two robots, anchors at its corners, pallets that come and
+/// go by the east wall.
+const FLEET_SCENARIO: &str = "
+name: room-fleet
+map:
+  ros: room.yaml
+robot_radius_m: 0.2
+information:
+  default_score: 10
+anchors:
+  - { name: sw, at: [0.2, 0.2] }
+  - { name: se, at: [11.8, 0.2] }
+  - { name: ne, at: [11.8, 7.8] }
+  - { name: nw, at: [0.2, 7.8] }
+robots:
+  - { name: r1, at: [1.5, 1.5] }
+  - { name: r2, at: [1.5, 6.5] }
+changes:
+  - { name: east-wall, rect: [10.5, 2.0, 11.5, 7.0], size_m: [0.6, 0.6], appear_per_hour: 30.0, mean_stay_s: 200.0, max_present: 2 }
+";
+
+const FLEET_SHIFT: &str = "
+length_s: 300.0
+robots:
+  - robot: r1
+    tasks:
+      - { name: east, at: [10.0, 1.5], start_s: 80.0, duration_s: 10.0 }
+      - { name: home, at: [1.5, 1.5], start_s: 200.0, duration_s: 10.0 }
+  - robot: r2
+    tasks:
+      - { name: north-east, at: [10.0, 6.5], start_s: 90.0, duration_s: 10.0 }
+      - { name: home, at: [1.5, 6.5], start_s: 210.0, duration_s: 10.0 }
+patrol: [[2.0, 7.0], [10.5, 7.0], [10.5, 1.0], [7.0, 1.0], [7.0, 6.0], [2.0, 6.0]]
+";
+
+#[test]
+fn the_fleets_week_runs_on_a_site_of_ones_own() {
+    let dir = tempfile::tempdir().expect("tmp");
+    room_map(dir.path());
+    let scenario = write(dir.path(), "room-fleet.yaml", FLEET_SCENARIO);
+    let shift = write(dir.path(), "room-shift.yaml", FLEET_SHIFT);
+    let run = |variants: &str, shift: &Path| {
+        Command::new(ROAM)
+            .args([
+                "reproduce",
+                "fleet",
+                "--json",
+                "--days",
+                "1",
+                "--variants",
+                variants,
+            ])
+            .arg("--scenario")
+            .arg(&scenario)
+            .arg("--shift")
+            .arg(shift)
+            .env("RUST_LOG", "warn")
+            .output()
+            .expect("run")
+    };
+    let output = run("tasks_only,patrol,news", &shift);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
+    let names: Vec<&str> = report["variants"]
+        .as_array()
+        .expect("variants")
+        .iter()
+        .filter_map(|v| v["variant"].as_str())
+        .collect();
+    assert_eq!(names.len(), 3, "{report}");
+    for name in ["tasks_only", "patrol", "news"] {
+        assert!(names.contains(&name), "{name} in {names:?}");
+    }
+    // Without the operator's loop the patrol is refused, saying what to add.
+    let no_patrol = write(
+        dir.path(),
+        "no-patrol.yaml",
+        &FLEET_SHIFT.replace("patrol: [[2.0", "# patrol: [[2.0"),
+    );
+    let output = run("patrol", &no_patrol);
+    assert!(!output.status.success());
+    assert!(String::from_utf8_lossy(&output.stderr).contains("patrol: [[x, y]"));
+}

@@ -37,6 +37,14 @@ pub(crate) struct FleetArgs {
     /// changes, zones, anchors).
     #[arg(long)]
     svg: Option<std::path::PathBuf>,
+    /// Your own site instead of the built-in warehouse: a scenario file (map, robots,
+    /// anchors, zones, changes; services/world/README.md), with --shift.
+    #[arg(long, value_name = "SCENARIO.yaml", requires = "shift")]
+    scenario: Option<std::path::PathBuf>,
+    /// Your own site: its robots' shift file (roam_mission::shift; `patrol:` corners
+    /// for the patrol variant), with --scenario.
+    #[arg(long, value_name = "SHIFT.yaml", requires = "scenario")]
+    shift: Option<std::path::PathBuf>,
 }
 
 /// The curious planner named `name`.
@@ -80,11 +88,17 @@ pub(crate) async fn run(args: FleetArgs, quiet: bool) -> anyhow::Result<()> {
         options.jobs = jobs;
     }
     let started = std::time::Instant::now();
+    let world = std::sync::Arc::new(match (&args.scenario, &args.shift) {
+        (Some(scenario), Some(shift)) => fleet::FleetWorld::from_files(scenario, shift)?,
+        _ => fleet::FleetWorld::warehouse()?,
+    });
     let run = options.clone();
     let progress = std::sync::Arc::new(Progress::new("the fleet's", quiet));
     let reporting = progress.clone();
+    let on = world.clone();
     let report =
-        tokio::task::spawn_blocking(move || fleet::run(&run, &reporting.callback())).await??;
+        tokio::task::spawn_blocking(move || fleet::run_on(&on, &run, &reporting.callback()))
+            .await??;
     if progress.speaks() {
         eprintln!(
             "{} shifts x {} variants in {:.1} s ({} threads)",
@@ -95,7 +109,6 @@ pub(crate) async fn run(args: FleetArgs, quiet: bool) -> anyhow::Result<()> {
         );
     }
     if let Some(dir) = &args.svg {
-        let world = fleet::FleetWorld::warehouse()?;
         for path in fleet::picture::write(dir, &world, &report.weeks, options.seed)? {
             if progress.speaks() {
                 eprintln!("wrote {}", path.display());

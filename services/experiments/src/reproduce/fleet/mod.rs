@@ -177,6 +177,11 @@ pub fn run_on(
     progress: Progress<'_>,
 ) -> Result<FleetReport, FleetError> {
     check(options)?;
+    if world.patrol.is_none() && options.variants.contains(&FleetVariant::Patrol) {
+        return Err(FleetError::World(
+            "the patrol variant needs the operator's loop: give patrol: [[x, y], ...] in the shift file, or leave the variant out (--variants)".into(),
+        ));
+    }
     let mut variants = options.variants.clone();
     variants.sort();
     variants.dedup();

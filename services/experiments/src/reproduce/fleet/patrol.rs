@@ -67,6 +67,12 @@ impl Patrol {
             }
         }
         corners.extend([[EAST_X, NORTH_Y], [EAST_X, SOUTH_Y]]);
+        Patrol::through(world, corners)
+    }
+
+    /// A loop through `corners` in order and back to the first, each leg the planner's
+    /// fastest path on `world` (a shift file's `patrol:`).
+    pub fn through(world: &World, corners: Vec<[f64; 2]>) -> Result<Patrol, FleetError> {
         let params = GaParams::default();
         let legs = (0..corners.len())
             .map(|i| {

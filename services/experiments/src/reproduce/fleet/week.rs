@@ -129,7 +129,7 @@ impl FleetIo<'_, '_> {
             v_lin: params.v_lin,
             v_ang: params.v_ang,
         };
-        let route = self.world.patrol.route(
+        let route = self.world.patrol.as_ref()?.route(
             world,
             model,
             request.start,

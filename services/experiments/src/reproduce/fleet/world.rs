@@ -56,7 +56,9 @@ pub struct FleetWorld {
     pub scored: Vec<usize>,
     /// How many of `scored` are cells objects can cover.
     pub zone_cells: usize,
-    pub patrol: Patrol,
+    /// The operator's loop (`None`: the site gives none, and the `patrol` variant is
+    /// refused).
+    pub patrol: Option<Patrol>,
     pub step_s: f64,
 }
 
@@ -70,14 +72,31 @@ impl FleetWorld {
         FleetWorld::new(WAREHOUSE_SCENARIO, WAREHOUSE_SHIFT)
     }
 
-    /// A fleet's world from a scenario's and a shift's text.
+    /// The built-in warehouse with another shift's text; the patrol goes through every
+    /// aisle unless the shift gives its own.
     pub fn new(scenario_text: &str, shift_text: &str) -> Result<FleetWorld, FleetError> {
-        let scenario: Scenario = scenario::parse(
-            Path::new("warehouse.yaml"),
-            scenario_text,
-            DEFAULT_MAX_CELLS,
-        )
-        .map_err(|e| world_error(&e))?;
+        FleetWorld::build(Path::new("warehouse.yaml"), scenario_text, shift_text, true)
+    }
+
+    /// A user's site: a scenario file (its map, robots, anchors, zones and changes) and
+    /// a shift file; the patrol is the shift's `patrol:` loop (the `patrol` variant is
+    /// refused without one).
+    pub fn from_files(scenario: &Path, shift: &Path) -> Result<FleetWorld, FleetError> {
+        let read = |path: &Path| {
+            std::fs::read_to_string(path)
+                .map_err(|e| FleetError::World(format!("cannot read {}: {e}", path.display())))
+        };
+        FleetWorld::build(scenario, &read(scenario)?, &read(shift)?, false)
+    }
+
+    fn build(
+        scenario_path: &Path,
+        scenario_text: &str,
+        shift_text: &str,
+        aisle_patrol: bool,
+    ) -> Result<FleetWorld, FleetError> {
+        let scenario: Scenario = scenario::parse(scenario_path, scenario_text, DEFAULT_MAX_CELLS)
+            .map_err(|e| world_error(&e))?;
         let shift = Shift::parse(shift_text, &scenario.file.places, &scenario.file.robots)
             .map_err(|e| world_error(&e))?;
         let meta = scenario.occupancy.meta;
@@ -114,7 +133,13 @@ impl FleetWorld {
         let setup = Setup::new(&scenario).map_err(|e| world_error(&e))?;
         let sim_params = Stepper::observing(&setup);
         let (scored, zone_cells) = scored_cells(&scenario, &static_coarse);
-        let patrol = Patrol::through_aisles(&planning)?;
+        let patrol = if !shift.patrol.is_empty() {
+            Some(Patrol::through(&planning, shift.patrol.clone())?)
+        } else if aisle_patrol {
+            Some(Patrol::through_aisles(&planning)?)
+        } else {
+            None
+        };
         Ok(FleetWorld {
             step_s: scenario.file.time.step_s,
             setup,

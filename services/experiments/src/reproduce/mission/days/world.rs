@@ -11,12 +11,11 @@ use roam_localization::{FimOptions, RangingModel};
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
 use roam_world::grid::Grid;
-use roam_world::layers::inflate;
 use roam_world::scenario::Scenario;
 
 use super::DaysError;
 use roam_mission::calibration::TimeModel;
-use roam_mission::site::{Site, DEFAULT_ROBOT_RADIUS_M, HEURISTIC_COMPRESSION, INFLATED_COST};
+use roam_mission::site::{inflated_map, Site, HEURISTIC_COMPRESSION};
 use roam_mission::tasks::Task;
 
 /// What every day shares.
@@ -56,14 +55,7 @@ impl DayWorld {
                 "the site's scenario has no robot {robot:?}"
             )));
         }
-        let inflated = inflate(
-            &scenario.occupancy,
-            scenario
-                .file
-                .robot_radius_m
-                .unwrap_or(DEFAULT_ROBOT_RADIUS_M),
-            INFLATED_COST,
-        );
+        let inflated = inflated_map(&scenario);
         let mut planning = World::new(&inflated, &scenario.information, HEURISTIC_COMPRESSION)
             .map_err(|e| world(&e))?;
         let anchors: Vec<[f64; 2]> = scenario.file.anchors.iter().map(|a| a.at).collect();
