@@ -5,7 +5,9 @@ For each key given, sends AT_ONCE queries of BYTES bytes at once from one sessio
 for their replies, then asks the service a small query from a new session (a client that
 did nothing wrong), again until it answers or AFTER_S have passed. Prints one JSON
 object: for each key, how many of the big queries were answered (with the refusals'
-messages), whether the small query was answered and after how many seconds.
+messages), how many ended with no reply before their timeout (a router that drops an
+oversized query ends it with Zenoh's final reply), the slowest query's seconds, whether
+the small query was answered and after how many seconds.
 
     python3 oversized.py --connect tcp/127.0.0.1:7447 --bytes 48000000 KEY...
 """
@@ -22,11 +24,16 @@ AFTER_S = 5.0
 
 
 def ask(session, key, payload):
+    """The first reply ({'ok': ...}), or {'ended': True} when the query ended without
+    one before its timeout, or None when it timed out; with the seconds it took."""
+    started = time.monotonic()
     for reply in session.get(key, payload=payload, timeout=TIMEOUT_S):
+        took = time.monotonic() - started
         if reply.ok is not None:
-            return {'ok': True}
-        return {'ok': False, 'error': reply.err.payload.to_string()[:300]}
-    return None
+            return {'ok': True, 's': took}
+        return {'ok': False, 'error': reply.err.payload.to_string()[:300], 's': took}
+    took = time.monotonic() - started
+    return {'ended': True, 's': took} if took < TIMEOUT_S - 1.0 else None
 
 
 def open_session(endpoint):
@@ -81,8 +88,11 @@ def main():
         for t in threads:
             t.join()
         after_s = answered_after(args.connect, key)
-        out[key] = {'sent': AT_ONCE, 'answered': sum(a is not None for a in answers),
-                    'refusals': [a['error'] for a in answers if a and not a['ok']],
+        replies = [a for a in answers if a is not None and 'ended' not in a]
+        out[key] = {'sent': AT_ONCE, 'answered': len(replies),
+                    'ended_without_reply': sum(a is not None and 'ended' in a for a in answers),
+                    'slowest_s': max((a['s'] for a in answers if a is not None), default=None),
+                    'refusals': [a['error'] for a in replies if not a['ok']],
                     'answered_after': after_s is not None, 'after_s': after_s}
     session.close()
     print(json.dumps(out))

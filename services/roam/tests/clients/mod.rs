@@ -20,7 +20,11 @@ pub const READY_TIMEOUT: Duration = Duration::from_secs(60);
 /// A `roam` process, stopped on every way out of the test, a failed assertion
 /// included: SIGTERM, up to 10 s for it to exit, then SIGKILL.
 #[derive(Debug)]
-pub struct RoamProcess(Child);
+pub struct RoamProcess {
+    child: Child,
+    /// The stderr lines after the ready line, for [`RoamProcess::stderr_tail`].
+    lines: mpsc::Receiver<String>,
+}
 
 impl RoamProcess {
     /// Starts `roam <args>` under the key root `root` and returns once a stderr line
@@ -49,17 +53,24 @@ impl RoamProcess {
             .spawn()
             .expect("spawn roam");
         let stderr = child.stderr.take().expect("stderr");
-        let process = RoamProcess(child);
         let (lines_tx, lines_rx) = mpsc::channel::<String>();
         thread::spawn(move || {
             for line in BufReader::new(stderr).lines().map_while(Result::ok) {
                 let _ = lines_tx.send(line);
             }
         });
+        // Stopped on every way out from here, a panic included.
+        let process = RoamProcess {
+            child,
+            lines: lines_rx,
+        };
         let started = Instant::now();
         let mut seen = Vec::new();
         loop {
-            match lines_rx.recv_timeout(READY_TIMEOUT.saturating_sub(started.elapsed())) {
+            match process
+                .lines
+                .recv_timeout(READY_TIMEOUT.saturating_sub(started.elapsed()))
+            {
                 Ok(line) if line.contains(ready) => return process,
                 Ok(line) => seen.push(line),
                 Err(mpsc::RecvTimeoutError::Timeout) => panic!(
@@ -74,26 +85,39 @@ impl RoamProcess {
         }
     }
 
+    /// The last `max` lines the process wrote to stderr since it was ready (for a
+    /// failure's message: what Zenoh and the services logged).
+    pub fn stderr_tail(&self, max: usize) -> String {
+        let mut tail = std::collections::VecDeque::with_capacity(max);
+        while let Ok(line) = self.lines.try_recv() {
+            if tail.len() == max {
+                tail.pop_front();
+            }
+            tail.push_back(line);
+        }
+        Vec::from(tail).join("\n")
+    }
+
     /// SIGTERM, then SIGKILL after 10 s; the exit status when it exited.
     pub fn stop(&mut self) -> Option<ExitStatus> {
         let _ = Command::new("kill")
-            .args(["-TERM", &self.0.id().to_string()])
+            .args(["-TERM", &self.child.id().to_string()])
             .status();
         let started = Instant::now();
         while started.elapsed() < Duration::from_secs(10) {
-            if let Ok(Some(status)) = self.0.try_wait() {
+            if let Ok(Some(status)) = self.child.try_wait() {
                 return Some(status);
             }
             thread::sleep(Duration::from_millis(50));
         }
-        let _ = self.0.kill();
-        self.0.wait().ok()
+        let _ = self.child.kill();
+        self.child.wait().ok()
     }
 }
 
 impl Drop for RoamProcess {
     fn drop(&mut self) {
-        if let Ok(None) = self.0.try_wait() {
+        if let Ok(None) = self.child.try_wait() {
             self.stop();
         }
     }

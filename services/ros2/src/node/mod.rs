@@ -23,7 +23,9 @@ use crate::names::{self, NodeInfo};
 
 pub use output::Output;
 /// What every call to the node's services is promised (see `services`).
-pub use services::{GET_PLAN_ANSWER_S, MAX_CONCURRENT_CALLS, MAX_REQUEST_BYTES};
+pub use services::{
+    GET_PLAN, GET_PLAN_ANSWER_S, MAX_CONCURRENT_CALLS, MAX_REQUEST_BYTES, PLAN_DOWNTIME,
+};
 
 /// The role's name in `<root>/@live/ros2/<instance>`.
 pub const SERVICE_NAME: &str = "ros2";
