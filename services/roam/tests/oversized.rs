@@ -7,7 +7,7 @@
 //! - The map server takes requests up to 96 MiB (`max_request_bytes`): each of its four
 //!   is answered, a refusal naming what to fix.
 //! - Every other service takes small requests (64 KiB to 4 MiB): the router stops a
-//!   query above `roam_stack::router::EDGE_QUERY_BYTES` (8 MiB) with Zenoh's final reply,
+//!   query above `roam_stack::router::EDGE_QUERY_BYTES` (16 MiB) with Zenoh's final reply,
 //!   so each of the four ends at once with no answer and no service's link carries it.
 //!   A 1 MB query (above their caps, under the router's) still reaches each service and
 //!   is refused there by name (the mapper's status ignores its payload and answers).

@@ -9,15 +9,15 @@ use roam_runtime::{session, SessionArgs, SessionError};
 /// The largest query, in bytes, a roam router passes on to a service whose requests are
 /// small (every queryable but the map server's): above the largest such cap
 /// (localization's 4 MiB; the planner's and the sim's are 64 KiB, the ROS 2 node's
-/// 16 KiB), so a request up to this size still reaches its service and is refused there
-/// by name. A larger one ends at the router with Zenoh's final reply and no answer: the
+/// 16 KiB, and the attack test's 8 MiB of CDR to a ROS 2 service), so a request up to
+/// this size still reaches its service and is refused there by name. A larger one ends at the router with Zenoh's final reply and no answer: the
 /// client's `get` returns at once, empty, and no service's link carries it. Without
 /// this, a stranger's 48 MB queries streamed through the router to a service whose
 /// requests are at most 64 KiB, and on a loaded machine the service's link could stall
 /// behind them (`services/roam/tests/oversized.rs`). The map server's keys are not
 /// filtered: its cap (`max_request_bytes`, 96 MiB by default) is its own, under
 /// `roam_runtime::session::MAX_MESSAGE_BYTES`.
-pub const EDGE_QUERY_BYTES: usize = 8 * 1024 * 1024;
+pub const EDGE_QUERY_BYTES: usize = 16 * 1024 * 1024;
 
 /// The key expressions of every roam queryable that takes small requests, for any root
 /// (`**`): what [`edge_filter`] covers.
@@ -150,7 +150,7 @@ mod tests {
             .expect("Zenoh accepts the filter");
         let back = config.get_json("low_pass_filter").expect("read back");
         assert!(
-            back.contains("roam-edge") && back.contains("8388608"),
+            back.contains("roam-edge") && back.contains("16777216"),
             "{back}"
         );
     }
