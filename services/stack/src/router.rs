@@ -9,13 +9,14 @@ use roam_runtime::{session, SessionArgs, SessionError};
 /// The largest query, in bytes, a roam router passes on to a service whose requests are
 /// small (every queryable but the map server's): above the largest such cap
 /// (localization's 4 MiB; the planner's and the sim's are 64 KiB, the ROS 2 node's
-/// 16 KiB, and the attack test's 8 MiB of CDR to a ROS 2 service), so a request up to
-/// this size still reaches its service and is refused there by name. A larger one ends at the router with Zenoh's final reply and no answer: the
-/// client's `get` returns at once, empty, and no service's link carries it. Without
-/// this, a stranger's 48 MB queries streamed through the router to a service whose
-/// requests are at most 64 KiB, and on a loaded machine the service's link could stall
-/// behind them (`services/roam/tests/oversized.rs`). The map server's keys are not
-/// filtered: its cap (`max_request_bytes`, 96 MiB by default) is its own, under
+/// 16 KiB) and the attack test's 8 MiB of CDR to a ROS 2 service, so a request up to
+/// this size still reaches its service and is refused there by name. A larger one ends
+/// at the router with Zenoh's final reply and no answer: the client's `get` returns at
+/// once, empty, and no service's link carries it. Without this, a stranger's 48 MB
+/// queries streamed through the router to a service whose requests are at most 64 KiB,
+/// and on a loaded machine the service's link could stall behind them
+/// (`services/roam/tests/oversized.rs`). The map server's keys are not filtered: its cap
+/// (`max_request_bytes`, 96 MiB by default) is its own, under
 /// `roam_runtime::session::MAX_MESSAGE_BYTES`.
 pub const EDGE_QUERY_BYTES: usize = 16 * 1024 * 1024;
 
@@ -83,18 +84,10 @@ impl Router {
     pub async fn start(args: &SessionArgs, endpoint: String) -> Result<Router, SessionError> {
         let mut args = args.clone();
         args.mode = Some("router".into());
-        let mut config = args.zenoh_config(None)?;
-        // A filter the user configured (a file, `ZENOH_CONFIG`, `--cfg`) stays as given.
-        let configured = config.get_json("low_pass_filter").unwrap_or_default();
-        if configured.trim() == "[]" {
-            config
-                .insert_json5("low_pass_filter", &edge_filter().to_string())
-                .map_err(|e| SessionError::Insert {
-                    key: "low_pass_filter".into(),
-                    value: edge_filter().to_string(),
-                    reason: e.to_string(),
-                })?;
-        }
+        // The edge filter is the router's own layer, under `ZENOH_CONFIG` and `--cfg`: a
+        // `low_pass_filter` the user gives there replaces it.
+        let defaults = serde_json::json!({ "low_pass_filter": edge_filter() });
+        let config = args.zenoh_config(Some(&defaults))?;
         let session = session::open(config).await?;
         Ok(Router { session, endpoint })
     }
@@ -153,5 +146,22 @@ mod tests {
             back.contains("roam-edge") && back.contains("16777216"),
             "{back}"
         );
+    }
+
+    #[test]
+    fn a_users_own_filter_replaces_the_edge() {
+        let defaults = serde_json::json!({ "low_pass_filter": edge_filter() });
+        let mut args = SessionArgs::router_on("tcp/127.0.0.1:0");
+        let config = args
+            .zenoh_config_with(Some(&defaults), None)
+            .expect("config");
+        let ours = config.get_json("low_pass_filter").expect("filter");
+        assert!(ours.contains("roam-edge"), "{ours}");
+        args.cfg = vec!["low_pass_filter:[]".into()];
+        let config = args
+            .zenoh_config_with(Some(&defaults), None)
+            .expect("config");
+        let theirs = config.get_json("low_pass_filter").expect("filter");
+        assert!(!theirs.contains("roam-edge"), "{theirs}");
     }
 }
