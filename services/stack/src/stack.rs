@@ -119,8 +119,16 @@ pub enum StackError {
     },
     #[error("watching liveliness failed: {0}")]
     Liveliness(String),
+    /// The scenario's error is in the message and not a `source`: the binary prints the
+    /// whole chain (`{:#}`), which would say it twice.
     #[error("the stack's world cannot be read: {0}")]
-    World(#[from] roam_world::scenario::ScenarioError),
+    World(roam_world::scenario::ScenarioError),
+}
+
+impl From<roam_world::scenario::ScenarioError> for StackError {
+    fn from(e: roam_world::scenario::ScenarioError) -> Self {
+        StackError::World(e)
+    }
 }
 
 type ServiceTasks = JoinSet<(&'static str, Result<(), String>)>;

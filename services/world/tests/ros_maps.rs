@@ -172,3 +172,38 @@ fn a_fifo_is_refused_not_read() {
         roam_world::ros_map::read_bounded(std::path::Path::new("/dev/zero")).expect_err("a device");
     assert!(err.to_string().contains("not a regular file"), "{err}");
 }
+
+/// A ROS map at 3 cm loads as a scenario: the observation radius it did not set is the
+/// default cut to the limit in cells (128 cells, 3.84 m), while a scenario that sets 5 m
+/// on the same map is refused naming the field.
+#[test]
+fn a_fine_ros_map_loads_with_an_observation_radius_that_fits_it() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let mut pgm = b"P5\n200 150\n255\n".to_vec();
+    pgm.extend(std::iter::repeat_n(254u8, 200 * 150));
+    std::fs::write(dir.path().join("fine.pgm"), pgm).expect("pgm");
+    let yaml = dir.path().join("fine.yaml");
+    std::fs::write(
+        &yaml,
+        "image: fine.pgm\nresolution: 0.03\norigin: [0.0, 0.0, 0.0]\n\
+         occupied_thresh: 0.65\nfree_thresh: 0.196\n",
+    )
+    .expect("yaml");
+    let scenario = roam_world::scenario::load_any(&yaml, MAX).expect("a 3 cm map loads");
+    assert!((scenario.file.sensing.observation_radius_m - 3.84).abs() < 1e-9);
+    assert_eq!(roam_world::scenario::default_observation_radius_m(0.2), 5.0);
+    let own = dir.path().join("site.yaml");
+    std::fs::write(
+        &own,
+        format!(
+            "name: site\nmap: {{ ros: {} }}\nsensing: {{ observation_radius_m: 5.0 }}\n",
+            yaml.file_name().and_then(|n| n.to_str()).expect("name")
+        ),
+    )
+    .expect("site");
+    let refused = roam_world::scenario::load(&own, MAX).expect_err("5 m at 3 cm is refused");
+    assert!(
+        refused.to_string().contains("sensing.observation_radius_m"),
+        "{refused}"
+    );
+}

@@ -31,7 +31,7 @@ use roam_proto::mission::WindowReport;
 use roam_proto::sim::RobotCommand;
 use roam_proto::{decode, encode, keys, ErrorCode};
 use roam_ros2::node::Ros2Config;
-use roam_runtime::ClientError;
+use roam_runtime::{ClientError, Requester};
 use roam_tests::{within, RunningService};
 
 mod intrusion;
@@ -207,6 +207,24 @@ async fn only_the_controller_drives_and_only_map_writers_change_the_map() {
     harness.close().await;
 }
 
+/// Waits (at most 30 s) until `client`, a session just opened, has an answer from the
+/// map server's index: on a loaded machine a new session's first query can end without
+/// a reply before its routes are in place, which says nothing about the rule under test.
+async fn answered_by_the_map_server(client: &Requester) {
+    let started = std::time::Instant::now();
+    loop {
+        match client
+            .request::<LayerList, LayerList>(&keys::map_index(ROOT), None)
+            .await
+        {
+            Err(ClientError::NoReply { .. }) if started.elapsed().as_secs() < 30 => {
+                tokio::time::sleep(std::time::Duration::from_millis(200)).await;
+            }
+            _ => return,
+        }
+    }
+}
+
 async fn stop(service: RunningService) {
     service.stop().await.1.expect("the service stops cleanly");
 }
@@ -226,6 +244,7 @@ async fn a_map_writer_cannot_read_the_routers_secrets_through_a_load() {
         })
         .await;
     let operator = harness.client_as("operator").await;
+    answered_by_the_map_server(&operator).await;
     let users = secrets.users.display().to_string();
     let relative = format!("../../../../../../../../..{users}");
     for requested in [users.as_str(), relative.as_str(), "/etc/passwd"] {

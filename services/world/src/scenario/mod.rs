@@ -304,6 +304,26 @@ pub fn load_any(path: &Path, max_cells: u64) -> Result<Scenario, ScenarioError> 
     parse(path, &text, max_cells)
 }
 
+/// The observation radius of a scenario that does not set one: the default
+/// ([`DEFAULT_OBSERVATION_RADIUS_M`]), cut to the limit in cells on a fine
+/// map (3.84 m at 3 cm), so a Nav2 map at any resolution loads; a radius the user wrote
+/// is checked against the limit instead, naming the field.
+pub fn default_observation_radius_m(resolution: f64) -> f64 {
+    sim_sections::DEFAULT_OBSERVATION_RADIUS_M
+        .min(sim_sections::MAX_OBSERVATION_RADIUS_CELLS * resolution)
+}
+
+/// Whether the scenario's text sets `sensing.observation_radius_m` itself.
+fn sets_observation_radius(text: &str) -> bool {
+    serde_yaml_ng::from_str::<serde_yaml_ng::Value>(text)
+        .ok()
+        .and_then(|v| {
+            v.get("sensing")
+                .map(|s| s.get("observation_radius_m").is_some())
+        })
+        .unwrap_or(false)
+}
+
 impl Scenario {
     /// Whether the scenario has a sim world (robots or anchors), or is a map alone.
     pub fn has_sim_world(&self) -> bool {
@@ -346,10 +366,11 @@ pub fn parse_with(
     max_cells: u64,
     access: Access<'_>,
 ) -> Result<Scenario, ScenarioError> {
-    let file: ScenarioFile = serde_yaml_ng::from_str(text).map_err(|e| ScenarioError::Invalid {
-        path: path.to_owned(),
-        reason: file_parse_reason(&e.to_string()),
-    })?;
+    let mut file: ScenarioFile =
+        serde_yaml_ng::from_str(text).map_err(|e| ScenarioError::Invalid {
+            path: path.to_owned(),
+            reason: file_parse_reason(&e.to_string()),
+        })?;
     let field = |field: &str, reason: String| ScenarioError::Field {
         path: path.to_owned(),
         field: field.to_owned(),
@@ -369,6 +390,9 @@ pub fn parse_with(
             build_grid(spec, max_cells).map_err(|reason| field("map.grid", reason))?
         }
     };
+    if !sets_observation_radius(text) {
+        file.sensing.observation_radius_m = default_observation_radius_m(occupancy.meta.resolution);
+    }
     if let Some(r) = file.robot_radius_m {
         if !(r.is_finite() && r >= 0.0) {
             return Err(field(
