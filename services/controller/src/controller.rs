@@ -393,7 +393,7 @@ impl Controller {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::weights::Scheme;
     use roam_localization::fim::FimOptions;
@@ -404,7 +404,7 @@ mod tests {
 
     /// An empty 40 × 40 m map (0.5 m cells, origin 0) with four anchors around the
     /// middle: covered everywhere near it.
-    fn fields() -> (Arc<ObstacleField>, Arc<InformationField>) {
+    pub(crate) fn fields() -> (Arc<ObstacleField>, Arc<InformationField>) {
         let meta = GridMeta {
             width: 80,
             height: 80,

@@ -68,6 +68,9 @@ pub mod service;
 pub mod status;
 pub mod weights;
 
+#[cfg(test)]
+mod goal_tolerance_tests;
+
 pub use controller::{Controller, Decision, MissionStatus};
 pub use information::InformationField;
 pub use obstacle_field::ObstacleField;

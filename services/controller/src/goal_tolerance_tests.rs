@@ -6,18 +6,12 @@
 //! Seeded: the same figures on every run.
 
 use std::f64::consts::TAU;
-use std::sync::Arc;
 
-use roam_controller::params::INDOOR_G_THRES_M;
-use roam_controller::{
-    ApfParams, Controller, InformationField, MissionStatus, ObstacleField, Scheme,
-};
-use roam_localization::fim::FimOptions;
-use roam_localization::model::RangingModel;
-use roam_localization::ToaNoise;
-use roam_proto::map::{GridMeta, Origin};
-use roam_world::grid::{occupancy, Grid};
 use roam_world::seed::splitmix64;
+
+use crate::controller::tests::fields;
+use crate::params::INDOOR_G_THRES_M;
+use crate::{ApfParams, Controller, MissionStatus, Scheme};
 
 /// The built-in world's step: μ·|u| = 0.2 m at most (the sim's top speed per step).
 const STEP_M: f64 = 0.2;
@@ -27,22 +21,8 @@ const SIGMA_M: f64 = 0.085;
 const MAX_UPDATES: usize = 200;
 
 fn controller(params: ApfParams) -> Controller {
-    let meta = GridMeta {
-        width: 80,
-        height: 80,
-        resolution: 0.5,
-        origin: Origin::default(),
-    };
-    let obstacles = ObstacleField::new(&Grid::filled(meta, occupancy::FREE));
-    let noise = ToaNoise {
-        sigma_m: 0.1,
-        d0_m: 15.0,
-        k: 2.0,
-    };
-    let anchors = [[5.0, 5.0], [35.0, 5.0], [35.0, 35.0], [5.0, 35.0]];
-    let model = RangingModel::new(&anchors, 30.0, noise).expect("model");
-    let information = InformationField::new(model, FimOptions::default());
-    Controller::new(params, Arc::new(obstacles), Arc::new(information))
+    let (obstacles, information) = fields();
+    Controller::new(params, obstacles, information)
 }
 
 /// A uniform draw in (0, 1] from a splitmix64 stream.
