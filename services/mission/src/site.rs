@@ -25,7 +25,7 @@
 //! - `sensing`: the scenario's defaults for what it leaves out (paper 002's sensor, 30
 //!   m of range), but the observation radius: the day world's,
 //!   [`DEFAULT_OBSERVATION_RADIUS_M`], cut to what the sim's limit allows at the map's
-//!   resolution ([`MAX_OBSERVATION_RADIUS_CELLS`] cells), so that any Nav2 map boots.
+//!   resolution ([`scenario::MAX_OBSERVATION_RADIUS_CELLS`] cells), so that any Nav2 map boots.
 //! - `anchors`: placed by [`lattice_anchors`], a square lattice over the map's free
 //!   cells whose spacing puts every point within range of the four corners of its
 //!   lattice square. Whatever the anchors, the free cells with fewer than three in range
@@ -44,7 +44,7 @@ use roam_planner::world::World;
 use roam_world::grid::{cell_center, Grid, DEFAULT_MAX_CELLS};
 use roam_world::layers::inflate;
 use roam_world::ros_map;
-use roam_world::scenario::{self, Scenario, MAX_OBSERVATION_RADIUS_CELLS};
+use roam_world::scenario::{self, Scenario};
 use serde::Deserialize;
 use serde_yaml_ng::{Mapping, Value};
 
@@ -215,8 +215,10 @@ impl Site {
             None => Mapping::new(),
         };
         if !sensing.contains_key("observation_radius_m") {
-            let radius = DEFAULT_OBSERVATION_RADIUS_M
-                .min(MAX_OBSERVATION_RADIUS_CELLS * occupancy.meta.resolution);
+            let radius = scenario::fitted_observation_radius_m(
+                DEFAULT_OBSERVATION_RADIUS_M,
+                occupancy.meta.resolution,
+            );
             sensing.insert("observation_radius_m".into(), radius.into());
         }
         yaml.insert("sensing".into(), Value::Mapping(sensing));

@@ -191,7 +191,10 @@ fn a_fine_ros_map_loads_with_an_observation_radius_that_fits_it() {
     .expect("yaml");
     let scenario = roam_world::scenario::load_any(&yaml, MAX).expect("a 3 cm map loads");
     assert!((scenario.file.sensing.observation_radius_m - 3.84).abs() < 1e-9);
-    assert_eq!(roam_world::scenario::default_observation_radius_m(0.2), 5.0);
+    assert_eq!(
+        roam_world::scenario::fitted_observation_radius_m(5.0, 0.2),
+        5.0
+    );
     let own = dir.path().join("site.yaml");
     std::fs::write(
         &own,

@@ -304,13 +304,12 @@ pub fn load_any(path: &Path, max_cells: u64) -> Result<Scenario, ScenarioError> 
     parse(path, &text, max_cells)
 }
 
-/// The observation radius of a scenario that does not set one: the default
-/// ([`DEFAULT_OBSERVATION_RADIUS_M`]), cut to the limit in cells on a fine
-/// map (3.84 m at 3 cm), so a Nav2 map at any resolution loads; a radius the user wrote
-/// is checked against the limit instead, naming the field.
-pub fn default_observation_radius_m(resolution: f64) -> f64 {
-    sim_sections::DEFAULT_OBSERVATION_RADIUS_M
-        .min(sim_sections::MAX_OBSERVATION_RADIUS_CELLS * resolution)
+/// The observation radius of a scenario that does not set one: `radius_m` (the sim's
+/// [`DEFAULT_OBSERVATION_RADIUS_M`], or a site's own default) cut to the limit in cells
+/// on a fine map (3.84 m at 3 cm), so a Nav2 map at any resolution loads; a radius the
+/// user wrote is checked against the limit instead, naming the field.
+pub fn fitted_observation_radius_m(radius_m: f64, resolution: f64) -> f64 {
+    radius_m.min(MAX_OBSERVATION_RADIUS_CELLS * resolution)
 }
 
 /// Whether the scenario's text sets `sensing.observation_radius_m` itself.
@@ -391,7 +390,8 @@ pub fn parse_with(
         }
     };
     if !sets_observation_radius(text) {
-        file.sensing.observation_radius_m = default_observation_radius_m(occupancy.meta.resolution);
+        file.sensing.observation_radius_m =
+            fitted_observation_radius_m(DEFAULT_OBSERVATION_RADIUS_M, occupancy.meta.resolution);
     }
     if let Some(r) = file.robot_radius_m {
         if !(r.is_finite() && r >= 0.0) {
