@@ -4,12 +4,14 @@
 //! did not write is checked against the map's resolution), and every layer the map
 //! server lists is on the map's grid (the heuristic on its coarser blocks).
 
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 use roam_stack::router::free_loopback_port;
+
+mod clients;
+use clients::RoamProcess;
 
 const ROAM: &str = env!("CARGO_BIN_EXE_roam");
 
@@ -41,45 +43,6 @@ fn write_room(dir: &Path, resolution: f64) -> PathBuf {
     )
     .expect("yaml");
     yaml
-}
-
-/// The stack's process, killed when dropped.
-struct Stack(Child);
-
-impl Drop for Stack {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-/// Starts `roam stack --map map` and waits (at most 90 s) for "roam stack up"; on an
-/// early exit, fails with its stderr.
-fn start_stack(map: &Path, endpoint: &str, root: &str) -> Stack {
-    let mut child = Command::new(ROAM)
-        .args(["stack", "--listen", endpoint, "--root", root, "--map"])
-        .arg(map)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("spawn stack");
-    let stderr = child.stderr.take().expect("stderr");
-    let (tx, rx) = std::sync::mpsc::channel();
-    std::thread::spawn(move || {
-        let mut lines = Vec::new();
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            if line.contains("roam stack up") {
-                let _ = tx.send(Ok(()));
-            }
-            lines.push(line);
-        }
-        let _ = tx.send(Err(lines.join("\n")));
-    });
-    match rx.recv_timeout(Duration::from_secs(90)) {
-        Ok(Ok(())) => Stack(child),
-        Ok(Err(stderr)) => panic!("the stack on {} exited:\n{stderr}", map.display()),
-        Err(_) => panic!("the stack on {} did not come up in 90 s", map.display()),
-    }
 }
 
 /// `roam map layers` through `endpoint`, asked again (for at most 60 s) until it
@@ -122,7 +85,12 @@ fn the_stack_boots_on_nav2_maps_at_3_5_and_10_cm_with_every_layer_on_the_map() {
             (resolution * 100.0).round(),
             std::process::id()
         );
-        let _stack = start_stack(&map, &endpoint, &root);
+        let map_arg = map.display().to_string();
+        let _stack = RoamProcess::start(
+            &["stack", "--listen", &endpoint, "--map", &map_arg],
+            &root,
+            "roam stack up",
+        );
         // The map server's four, and the mapper's layers once it has published them.
         let listed = layers(&endpoint, &root, 8);
         let (w, h) = (
