@@ -71,6 +71,10 @@ pub struct GaOverrides {
     /// W_loc: weight of the localizability cost (roam, not paper 000).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub w_loc: Option<f64>,
+    /// The PEB (m) the localizability cost forgives: each cell costs
+    /// W_loc · max(0, PEB − peb_free_m) (roam, not paper 000); default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peb_free_m: Option<f64>,
     /// Share of the first population built through via-points drawn from the
     /// information layer (roam, not paper 000); 0..=1, default 0.25.
     #[serde(default, skip_serializing_if = "Option::is_none")]

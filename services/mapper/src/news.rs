@@ -39,16 +39,20 @@ use crate::poisson::CellProcess;
 use crate::prior::RatePrior;
 use crate::reserve::{ReserveParams, TimedCell};
 
-/// The news value's prior by default: α = 1 pseudo-event over β = 86,400 s, a change per
-/// cell per day. It errs toward looking: a robot that has not watched a cell for a day
+/// The news value's prior by default: α = 1 pseudo-event over β = 3,600 s, a change per
+/// cell per hour. It errs toward looking: a robot that has not watched a cell for an hour
 /// cannot say it is static, so every cell is news in proportion to how long nobody looked
-/// (after an hour 4%, after a day 63%), and a cell's first watched change already
-/// doubles its rate. A site that changes less often wants a larger β; a short world of
-/// fast changes (paper 004's grid world, where a changing cell is watched a few hundred
-/// seconds in a run) a β of seconds, or the prior outweighs its events.
+/// (after 10 minutes 15%, after an hour 63%), and each change a visit finds
+/// ([`RatePrior::change_rate`]) raises the cell's rate against the hours it was watched.
+/// One hour and not a day (the default until the warehouse was measured): under a day's
+/// prior a 1-hour shift's news stays below 4% everywhere, which the planner's 0–100
+/// scores round to 0–4 (every cell seen in the last 20 minutes worth nothing, the rest
+/// in four steps), and a week of shifts (7 hours of span) cannot outweigh it. A site that
+/// changes less often wants a larger β; a short world of fast changes (paper 004's grid
+/// world) a β of seconds, or the prior outweighs its events.
 pub const DEFAULT_NEWS_PRIOR: RatePrior = RatePrior {
     alpha: 1.0,
-    beta_s: 86_400.0,
+    beta_s: 3_600.0,
 };
 
 /// The news value's parameters (the mapper's `news:` config).
@@ -397,9 +401,10 @@ mod tests {
         let map = seen_once(1);
         let news = NewsMap::for_map(&map, DEFAULT_NEWS_PRIOR).expect("news");
         let at = |t: f64| news.probabilities(&map, t, None).expect("p").cells[0];
-        // The prior's rate, one change a day: after an hour 4%, after a day 1 − 1/e.
-        assert!(close(at(3600.0), 1.0 - (-1.0f64 / 24.0).exp()));
-        assert!(close(at(86_400.0), 1.0 - (-1.0f64).exp()));
+        // The prior's rate, one change an hour: after 10 minutes 15%, after an hour
+        // 1 − 1/e.
+        assert!(close(at(600.0), 1.0 - (-1.0f64 / 6.0).exp()));
+        assert!(close(at(3600.0), 1.0 - (-1.0f64).exp()));
         assert!(at(3600.0) < at(7200.0));
     }
 

@@ -95,6 +95,10 @@ pub struct CellProcess {
     n_block: u32,
     /// Blocked→free events seen.
     n_free: u32,
+    /// Changes found after a gap (the state differs across a sighting gap longer than
+    /// the period), which are not events of paper 004's processes: the news rate counts
+    /// them ([`CellProcess::changes_seen`]).
+    n_gap_changes: u32,
     /// The state at the latest sighting; `None` before the first.
     last: Option<CellState>,
 }
@@ -114,6 +118,7 @@ impl CellProcess {
         t_occupied: 0.0,
         n_block: 0,
         n_free: 0,
+        n_gap_changes: 0,
         last: None,
     };
 
@@ -144,7 +149,11 @@ impl CellProcess {
         self.t_occupied += watched_time * f64::from(occupied_ends) / 2.0;
         self.t_last = self.t_last.max(t);
         self.last = Some(state);
-        if previous == state || gap <= 0.0 || !(watched || watch.events_across_gaps) {
+        if previous == state || gap <= 0.0 {
+            return None;
+        }
+        if !(watched || watch.events_across_gaps) {
+            self.n_gap_changes = self.n_gap_changes.saturating_add(1);
             return None;
         }
         Some(match state {
@@ -190,6 +199,22 @@ impl CellProcess {
 
     pub fn n_free(&self) -> u32 {
         self.n_free
+    }
+
+    /// Every change the cell was seen to make since its first sighting, watched (the
+    /// events) or found after a gap (at least one change happened in it), over which
+    /// [`CellProcess::seen_span`] is the exposure: the news value's count
+    /// ([`crate::prior::RatePrior::change_rate`]).
+    pub fn changes_seen(&self) -> u32 {
+        self.n_block
+            .saturating_add(self.n_free)
+            .saturating_add(self.n_gap_changes)
+    }
+
+    /// t_last − t_init: the time over which [`CellProcess::changes_seen`] were counted,
+    /// seconds (0 before the second sighting).
+    pub fn seen_span(&self) -> f64 {
+        (self.t_last - self.t_init).max(0.0)
     }
 
     /// Whether any event was seen (the cell has a rate above zero).
@@ -298,6 +323,27 @@ mod tests {
 
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() < 1e-12
+    }
+
+    #[test]
+    fn a_change_found_after_a_gap_is_no_event_but_counts_for_the_news() {
+        // Free at 0 and 1 (watched), occupied at 100 (after a gap), free at 101
+        // (watched: an event), free again at 500.
+        let c = seen(&[
+            (0.0, false),
+            (1.0, false),
+            (100.0, true),
+            (101.0, false),
+            (500.0, false),
+        ]);
+        assert_eq!((c.n_block(), c.n_free()), (0, 1));
+        assert_eq!(c.changes_seen(), 2);
+        assert!(close(c.seen_span(), 500.0));
+        // Counted as events across gaps, it is not counted twice.
+        let across = seen_with(ACROSS, &[(0.0, false), (100.0, true)]);
+        assert_eq!((across.n_block(), across.changes_seen()), (1, 1));
+        assert_eq!(CellProcess::UNOBSERVED.changes_seen(), 0);
+        assert!(close(CellProcess::UNOBSERVED.seen_span(), 0.0));
     }
 
     #[test]

@@ -61,12 +61,20 @@ impl RatePrior {
         (f64::from(events) + self.alpha) / (watched_s.max(0.0) + self.beta_s)
     }
 
-    /// The rate at which the cell changes at all, either way: n = its free→blocked and
-    /// blocked→free events together over its watched time D (the news value's rate).
-    /// α/β for a cell never seen.
+    /// The rate at which the cell changes at all, either way (the news value's rate):
+    /// every change seen since the first sighting, watched or found after a gap
+    /// ([`CellProcess::changes_seen`]), over the whole span since then
+    /// ([`CellProcess::seen_span`]). α/β for a cell never seen.
+    ///
+    /// Not paper 004's Eq. 1, which counts only watched events over the watched time D:
+    /// that is unbiased, but a fleet watches a cell only while a robot passes (seconds a
+    /// visit), so a warehouse's pallets, which land while nobody looks, are almost never
+    /// events and every cell keeps its prior rate. Counting a change found after a gap as
+    /// one change over the gap's whole length undercounts a cell that changed several
+    /// times in one gap (a lower bound of its rate for gaps long against 1/λ), but it
+    /// learns from every visit, which is what the news needs: which cells change more.
     pub fn change_rate(&self, cell: &CellProcess) -> f64 {
-        let events = cell.n_block().saturating_add(cell.n_free());
-        self.rate(events, cell.observed_time())
+        self.rate(cell.changes_seen(), cell.seen_span())
     }
 
     /// λ_b, free→blocked: the free→blocked events over the time watched free.
@@ -110,6 +118,12 @@ mod tests {
         // D_free = 1 + 0.5 + 0.5 = 2, D_occ = 0.5 + 1 + 0.5 = 2.
         assert!((prior.block_rate(&c) - 3.0 / 102.0).abs() < 1e-15);
         assert!((prior.free_rate(&c) - 3.0 / 102.0).abs() < 1e-15);
+        // Seen blocked at 100 after a gap: a change the news counts over the whole span
+        // (3 in 100 s), which paper 004's processes do not (D grows by one period).
+        c.observe(100.0, true, Watch::every(1.0));
+        assert!((prior.change_rate(&c) - 5.0 / 200.0).abs() < 1e-15);
+        // Its one period of watched time splits between the states at its ends.
+        assert!((prior.block_rate(&c) - 3.0 / 102.5).abs() < 1e-15);
     }
 
     #[test]

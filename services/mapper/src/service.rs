@@ -81,7 +81,7 @@ const MAX_CLOCK_BYTES: usize = 1024;
 /// publish_period_s: 1.0                     # the layers go to the map server at most this often
 /// seed: 0
 /// news:                                     # the news value (crate::news)
-///   prior: { alpha: 1.0, beta_s: 86400.0 }  # λ̂ = (n + α)/(D + β)
+///   prior: { alpha: 1.0, beta_s: 3600.0 }  # λ̂ = (c + α)/(S + β), news.rs
 ///   reserve: { s_per_m: 2.0 }               # radius_m: default the scenario's observation radius
 /// belief:                                   # the map now (crate::belief)
 ///   prior: { alpha: 0.0001, beta_s: 60.0 }

@@ -33,6 +33,9 @@ pub struct ExecutiveConfig {
     /// The planner's localizability cost W_loc (paper 002's PEB in paper 000's fitness;
     /// see the planner's `w_loc`). `None`: the planner's default, off.
     pub w_loc: Option<f64>,
+    /// The PEB the localizability cost forgives, metres (the planner's `peb_free_m`).
+    /// `None`: the planner's default, 0.
+    pub peb_free_m: Option<f64>,
     pub seed: u64,
     /// Waypoints are at most this far apart along the planned path, metres.
     pub waypoint_spacing_m: f64,
@@ -238,6 +241,7 @@ impl Default for ExecutiveConfig {
             plan_deadline_s: 1.0,
             max_generations: Some(1000),
             w_loc: None,
+            peb_free_m: None,
             seed: 0,
             waypoint_spacing_m: 1.0,
             off_path_m: 1.5,

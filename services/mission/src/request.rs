@@ -27,6 +27,7 @@ pub fn plan_request(config: &ExecutiveConfig, ask: &PlanAsk, time_model: TimeMod
         params: GaOverrides {
             max_generations: config.max_generations,
             w_loc: config.w_loc,
+            peb_free_m: config.peb_free_m,
             ..time_model.overrides()
         },
         seed: config.seed,

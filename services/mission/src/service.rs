@@ -27,6 +27,7 @@ pub const SERVICE_NAME: &str = "mission";
 ///   model: model1        # model0 | model1 | model2 | greedy | shortest
 ///   plan_deadline_s: 1.0
 ///   w_loc: 2000          # the PEB localizability cost in the planner's fitness (default off)
+///   peb_free_m: 0.5      # the PEB (m) that cost forgives (default 0: every decimetre costs)
 /// ```
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]

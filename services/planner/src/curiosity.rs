@@ -180,8 +180,8 @@ impl<'a> Evaluator<'a> {
             }
             let (x, y) = (cx as i32, cy as i32);
             if costed {
-                localizability +=
-                    f64::from(self.world.localizability[cy * self.world.width() + cx]);
+                let peb = f64::from(self.world.localizability[cy * self.world.width() + cx]);
+                localizability += (peb - self.params.peb_free_m).max(0.0);
             }
             let count = moved.map_or(self.window.len(), |dir| self.entering[dir].len());
             for k in 0..count {
@@ -208,6 +208,7 @@ impl<'a> Evaluator<'a> {
         let f3 = if reaches_goal { p.w3 } else { 0.0 };
         let f4 = -p.w4 * (t - self.t_exec).max(0.0);
         let f5 = -p.w5 * (self.t_exec - t).max(0.0);
+        // roam's localizability cost (GaParams::w_loc, peb_free_m), not paper 000's.
         let f6 = -p.w_loc * localizability;
         Evaluation {
             fitness: FitnessTerms {

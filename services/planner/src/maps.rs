@@ -335,7 +335,8 @@ pub(crate) mod tests {
             .expect("a new world for the news layer");
         assert_eq!(coupled.change, Some(2));
         let (_, world) = cache.world(None).expect("world");
-        assert_eq!(world.information, vec![10, 0, 15, 10]);
+        // I · N = 1000, 0, 1500, 1000, the best (1500) worth the best interest (40).
+        assert_eq!(world.information, vec![27, 0, 40, 27]);
     }
 
     #[test]

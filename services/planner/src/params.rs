@@ -52,6 +52,14 @@ pub struct GaParams {
     /// have to fight for its position costs more. 0 (off) by default: Table I has no
     /// such term.
     pub w_loc: f64,
+    /// The PEB the localizability cost forgives, metres: each gene costs
+    /// W_loc · max(0, PEB − `peb_free_m`). 0 (every decimetre costs) by default, the
+    /// rule the single-robot day was measured with. Where anchors cover the floor the
+    /// PEB is a few decimetres everywhere, so with 0 the cost is mostly a tax on length,
+    /// which a fleet planning on news (little information a metre) cannot pay: a
+    /// threshold below the controller's hold (`max_peb_m`, 2 m) keeps the cost where
+    /// the anchor gaps are (`roam reproduce fleet` uses 0.5 m; its README).
+    pub peb_free_m: f64,
     /// Share of the first population built through via-points ([`crate::seeds`]): paths
     /// S → v₁ → … → G through cells drawn from the information layer, joined by shortest
     /// paths and kept only within the budget (Eq. 2). roam's, not paper 000's, whose
@@ -100,6 +108,7 @@ impl Default for GaParams {
             perception_diameter: 3,
             coverage_gain: 1.0,
             w_loc: 0.0,
+            peb_free_m: 0.0,
             via_share: DEFAULT_VIA_SHARE,
             walk_end_share: DEFAULT_WALK_END_SHARE,
             random_walks_only: false,
@@ -166,6 +175,7 @@ impl GaParams {
             heuristic_compression,
             coverage_gain,
             w_loc,
+            peb_free_m,
             via_share,
             walk_end_share
         );
@@ -233,6 +243,12 @@ impl GaParams {
                 "a magnitude in 0..=1e12 (penalties are subtracted)",
             )?;
         }
+        check(
+            "peb_free_m",
+            self.peb_free_m,
+            (0.0..=1000.0).contains(&self.peb_free_m),
+            "0..=1000 metres",
+        )?;
         check(
             "heuristic_compression",
             self.heuristic_compression,

@@ -324,6 +324,59 @@ fn the_localizability_cost_keeps_plans_out_of_poorly_covered_cells() {
     );
 }
 
+/// `peb_free_m` forgives the PEB below it: a plan costs W_loc · Σ max(0, PEB −
+/// peb_free_m), nothing where the floor is covered (0.1 m < 0.5 m), the capped PEB
+/// less 0.5 m in the band without a fix; a negative value is refused.
+#[test]
+fn the_forgiven_peb_costs_nothing_where_the_floor_is_covered() {
+    let mut world = common::open_world(60, 40);
+    let (w, h) = (world.width(), world.height());
+    let mut peb = vec![0.1f32; w * h];
+    for y in 0..h - 6 {
+        for x in 25..35 {
+            peb[y * w + x] = f32::INFINITY;
+        }
+    }
+    world.set_localizability(&peb);
+    let mut s = spec(PlannerModel::Model1, [1.0, 2.0], [11.0, 2.0], 60.0, 5, 800);
+    s.params.w_loc = 20_000.0;
+    s.params.peb_free_m = 0.5;
+    let forgiven = run(&world, &s);
+    check_geometry(&world, &s, &forgiven);
+    let excess: f64 = forgiven
+        .path
+        .iter()
+        .map(|&c| (f64::from(world.localizability[c as usize]) - 0.5).max(0.0))
+        .sum();
+    assert!(
+        (forgiven.fitness.f6_localizability + 20_000.0 * excess).abs() < 1e-6 * excess.max(1.0),
+        "f6 {} against -W_loc * {excess}",
+        forgiven.fitness.f6_localizability
+    );
+    // Only the band's cells cost, each its capped PEB less the forgiven 0.5 m; the
+    // covered cells (0.1 m) nothing.
+    let capped = f64::from(roam_planner::world::MAX_LOCALIZABILITY_COST_M);
+    let in_band = forgiven
+        .path
+        .iter()
+        .filter(|&&c| f64::from(world.localizability[c as usize]) > 0.5)
+        .count();
+    assert!(
+        (excess - in_band as f64 * (capped - 0.5)).abs() < 1e-9,
+        "{excess} m over {in_band} cells in the band"
+    );
+    assert!(
+        forgiven.path.len() > in_band,
+        "covered cells on the path too"
+    );
+    let mut bad = s.params.clone();
+    bad.peb_free_m = -1.0;
+    assert!(
+        bad.validate().is_err(),
+        "a negative forgiven PEB is refused"
+    );
+}
+
 /// `GaParams::random_walks_only` (paper 000 §II.A.1 to the letter) seeds nothing and
 /// falls back on nothing: the plan is the GA's own, and still a legal path from S.
 /// Without the shortest path the first population's walks reach G (12 m away) only

@@ -32,6 +32,13 @@ pub(crate) struct FleetArgs {
     /// model2).
     #[arg(long, default_value = "greedy")]
     model: String,
+    /// W_loc, the weight of the PEB cost in the curious variants' plans (0 turns it off;
+    /// the larger, the wider the berth around the anchor gaps).
+    #[arg(long, default_value_t = FleetOptions::default().w_loc)]
+    w_loc: f64,
+    /// The PEB (metres) the PEB cost forgives: a cell costs W_loc · max(0, PEB − this).
+    #[arg(long, default_value_t = FleetOptions::default().peb_free_m)]
+    peb_free_m: f64,
     /// Write the week's pictures into this directory: detection.svg (the share of the
     /// changes seen within t minutes, per variant) and warehouse-<variant>.svg (paths,
     /// changes, zones, anchors).
@@ -64,6 +71,8 @@ pub(crate) async fn run(args: FleetArgs, quiet: bool) -> anyhow::Result<()> {
         days: args.days,
         seed: args.seed,
         generations: args.generations,
+        w_loc: args.w_loc,
+        peb_free_m: args.peb_free_m,
         model: curious_model(&args.model).ok_or_else(|| {
             anyhow::anyhow!(
                 "no planner model {:?}; give greedy, model0, model1 or model2",

@@ -56,6 +56,11 @@ pub struct FleetOptions {
     pub generations: u32,
     /// W_loc of the PEB cost for the curious variants.
     pub w_loc: f64,
+    /// The PEB (m) that cost forgives (the planner's `peb_free_m`). 0 by default: every
+    /// decimetre costs. Measured (README "The fleet's week"): forgiving 0.3 or 0.5 m
+    /// sends the news into the anchor gaps, where the controller holds the robots, and
+    /// 35–42 windows of 114 end late.
+    pub peb_free_m: f64,
     /// What a curious plan costs, wall seconds, before its deadline cuts it.
     pub plan_wall_s: f64,
     /// The clock's rate the executives assume, mission seconds per wall second.
@@ -72,6 +77,7 @@ impl Default for FleetOptions {
             model: PlannerModel::Greedy,
             generations: 200,
             w_loc: 2000.0,
+            peb_free_m: 0.0,
             plan_wall_s: 0.2,
             // A fleet runs on the wall clock: a plan's computing time is its cost.
             rate: 1.0,
@@ -138,6 +144,9 @@ fn check(o: &FleetOptions) -> Result<(), FleetError> {
             &o.generations,
             format!("1 to {max_generations}"),
         );
+    }
+    if !(o.peb_free_m.is_finite() && o.peb_free_m >= 0.0) {
+        return invalid("peb_free_m", &o.peb_free_m, "a finite 0 or more".into());
     }
     if !(o.w_loc.is_finite() && o.w_loc >= 0.0) {
         return invalid("w_loc", &o.w_loc, "a finite 0 or more".into());

@@ -174,6 +174,7 @@ pub fn run_week(
                 tasks: shift.repeated(r, options.days),
                 max_generations: Some(options.generations),
                 seed: plan_seed(options.seed, i),
+                peb_free_m: Some(options.peb_free_m),
                 planning_cost_s: Some(options.plan_wall_s * options.rate),
                 ..ExecutiveConfig::default()
             };
