@@ -283,14 +283,10 @@ fn a_walled_in_goal_has_no_path() {
     assert_eq!(outcome.expect_err("must be refused"), PlanError::NoPath);
 }
 
-/// roam's coupling of paper 002 into paper 000: with W_loc > 0 the fitness pays for the
-/// PEB along the path (f6 = −W_loc · Σ PEB over the genes' cells), so the plan keeps out
-/// of a band where localization is poor; with W_loc = 0 nothing changes.
-#[test]
-fn the_localizability_cost_keeps_plans_out_of_poorly_covered_cells() {
+/// An open 60 × 40 world with a band of unbounded PEB (no fix) across the middle, 2 m
+/// wide, except a gap at the top; elsewhere 0.1 m.
+fn world_with_a_band_without_a_fix() -> World {
     let mut world = common::open_world(60, 40);
-    // A band of unbounded PEB (no fix) across the middle, 2 m wide, except a gap at the
-    // top; elsewhere 0.1 m.
     let (w, h) = (world.width(), world.height());
     let mut peb = vec![0.1f32; w * h];
     for y in 0..h - 6 {
@@ -299,6 +295,15 @@ fn the_localizability_cost_keeps_plans_out_of_poorly_covered_cells() {
         }
     }
     world.set_localizability(&peb);
+    world
+}
+
+/// roam's coupling of paper 002 into paper 000: with W_loc > 0 the fitness pays for the
+/// PEB along the path (f6 = −W_loc · Σ PEB over the genes' cells), so the plan keeps out
+/// of a band where localization is poor; with W_loc = 0 nothing changes.
+#[test]
+fn the_localizability_cost_keeps_plans_out_of_poorly_covered_cells() {
+    let world = world_with_a_band_without_a_fix();
     let cost_along = |path: &[u32]| -> f64 {
         path.iter()
             .map(|&c| f64::from(world.localizability[c as usize]))
@@ -329,15 +334,7 @@ fn the_localizability_cost_keeps_plans_out_of_poorly_covered_cells() {
 /// less 0.5 m in the band without a fix; a negative value is refused.
 #[test]
 fn the_forgiven_peb_costs_nothing_where_the_floor_is_covered() {
-    let mut world = common::open_world(60, 40);
-    let (w, h) = (world.width(), world.height());
-    let mut peb = vec![0.1f32; w * h];
-    for y in 0..h - 6 {
-        for x in 25..35 {
-            peb[y * w + x] = f32::INFINITY;
-        }
-    }
-    world.set_localizability(&peb);
+    let world = world_with_a_band_without_a_fix();
     let mut s = spec(PlannerModel::Model1, [1.0, 2.0], [11.0, 2.0], 60.0, 5, 800);
     s.params.w_loc = 20_000.0;
     s.params.peb_free_m = 0.5;
