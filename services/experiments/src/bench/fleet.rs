@@ -229,6 +229,18 @@ async fn run(
             [x, y]
         })
         .collect();
+    // The built-in world's own robots leave first: the fleet is the bench's robots
+    // alone, so `--robots` may be the sim's whole `max_robots` (1000).
+    for start in &scenario.file.robots {
+        client
+            .request::<SimControl, SimStatus>(
+                &control_key,
+                Some(&SimControl::RemoveRobot {
+                    name: start.name.clone(),
+                }),
+            )
+            .await?;
+    }
     for (k, &at) in places.iter().enumerate() {
         client
             .request::<SimControl, SimStatus>(
