@@ -111,8 +111,8 @@ pub fn news_product(information: &[u8], news: &[u8]) -> Vec<u8> {
     let top_product = products.iter().copied().max().unwrap_or(0);
     let top_interest = information
         .iter()
-        .zip(news)
-        .map(|(&i, _)| u32::from(i))
+        .take(products.len())
+        .map(|&i| u32::from(i))
         .max()
         .unwrap_or(0);
     if top_product == 0 {
@@ -121,8 +121,7 @@ pub fn news_product(information: &[u8], news: &[u8]) -> Vec<u8> {
     products
         .iter()
         .map(|&p| {
-            // Exact in integers (p · top_interest < 2^32), halves rounded up; at most
-            // top_interest, so within u8.
+            // Exact in integers, halves rounded up; at most top_interest, so within u8.
             let scaled = (u64::from(p) * u64::from(top_interest) * 2 + u64::from(top_product))
                 / (2 * u64::from(top_product));
             u8::try_from(scaled).unwrap_or(u8::MAX)
