@@ -252,6 +252,13 @@ pub fn sim_clock(root: &str) -> String {
     format!("{root}/sim/clock")
 }
 
+/// `<root>/sim/objects`: the sim publishes the semi-static objects landed now
+/// ([`ObjectsTruth`](crate::sim::ObjectsTruth)) in every step where one lands or leaves,
+/// for evaluation only.
+pub fn sim_objects(root: &str) -> String {
+    format!("{root}/sim/objects")
+}
+
 /// `<root>/robot/<robot>/cmd`: a controller puts a
 /// [`RobotCommand`](crate::sim::RobotCommand); the sim applies it at its next step.
 pub fn robot_command(root: &str, robot: &str) -> String {

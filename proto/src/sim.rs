@@ -175,6 +175,39 @@ impl Message for GroundTruth {
     const KIND: &'static str = "ground_truth";
 }
 
+/// The most objects an [`ObjectsTruth`] lists (a scenario's zones hold far fewer).
+pub const MAX_OBJECTS_TRUTH: usize = 65_536;
+
+/// The semi-static objects (the scenario's `changes`: pallets, obstacles) landed now, on
+/// `<root>/sim/objects` in every step where one lands or leaves: for evaluation only,
+/// as a robot's [`GroundTruth`] (how soon a fleet sees a change, how well its map
+/// predicts the world now). Objects waiting for a robot to move off their place are
+/// not in it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectsTruth {
+    pub step: u64,
+    pub time_s: f64,
+    #[serde(deserialize_with = "crate::bounded::vec::<_, MAX_OBJECTS_TRUTH, _>")]
+    pub objects: Vec<ObjectTruth>,
+}
+
+/// One landed object.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectTruth {
+    /// Unique over the sim's run (since its last load or reset), in order of start.
+    pub id: u64,
+    /// Its zone's index in the scenario's `changes`.
+    pub zone: u32,
+    /// The map cells it covers, inclusive: `[x0, y0, x1, y1]`.
+    pub cells: [i64; 4],
+}
+
+impl Message for ObjectsTruth {
+    const KIND: &'static str = "objects_truth";
+}
+
 /// Something that happened to a robot in a step.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]

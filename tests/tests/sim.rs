@@ -415,3 +415,62 @@ async fn the_status_names_the_scenario_file_not_its_path() {
     assert_eq!(status.scenario, "es1.yaml");
     stop(harness, sim).await;
 }
+
+/// The semi-static objects on `sim/objects` are the sim's own, message for message: the
+/// warehouse (its robots taken out, so nothing but the zones' stream decides) stepped
+/// 2,000 times in lock-step through the service sends one message in each step where an
+/// object landed or left, listing what an in-process `Sim` of the same scenario and seed
+/// has landed in that step (`semi_static::landed_truth`), and nothing in the others.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn the_objects_on_the_wire_are_the_sims_own() {
+    const STEPS: u32 = 2000;
+    let harness = Harness::start().await;
+    let path = "config/scenarios/warehouse.yaml";
+    let sim = harness.start_role(harness.sim_config(Some(path))).await;
+    let client = harness.client().await;
+    let root = harness.root.clone();
+    let scenario =
+        roam_world::scenario::load(&roam_tests::repo_path(path), roam_world::DEFAULT_MAX_CELLS)
+            .expect("the warehouse loads");
+    let mut local = roam_sim::sim::Sim::new(&scenario, 0).expect("sim");
+    for robot in &scenario.file.robots {
+        control(
+            &client,
+            &root,
+            SimControl::RemoveRobot {
+                name: robot.name.clone(),
+            },
+        )
+        .await
+        .expect("the robot leaves");
+        local.remove_robot(&robot.name).expect("the robot leaves");
+    }
+    let objects = subscribe(&client, keys::sim_objects(&root)).await;
+    control(&client, &root, SimControl::Step { n: STEPS })
+        .await
+        .expect("steps");
+    let mut expected = Vec::new();
+    let mut before: Vec<u64> = Vec::new();
+    for _ in 0..STEPS {
+        let report = local.step(&[]).expect("a step");
+        let landed = roam_sim::semi_static::landed_truth(local.world().objects());
+        let ids: Vec<u64> = landed.iter().map(|o| o.id).collect();
+        if ids != before {
+            expected.push((report.step, landed));
+            before = ids;
+        }
+    }
+    assert!(
+        expected.len() >= 2,
+        "the warehouse's zones land and clear objects within {STEPS} steps"
+    );
+    let mut heard = Vec::new();
+    for _ in 0..expected.len() {
+        let m: roam_proto::sim::ObjectsTruth = next(&objects).await;
+        heard.push((m.step, m.objects));
+    }
+    assert_eq!(heard, expected);
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    assert!(drain::<roam_proto::sim::ObjectsTruth>(&objects).is_empty());
+    stop(harness, sim).await;
+}

@@ -106,6 +106,13 @@ pub enum Progress {
         window: usize,
         task: String,
     },
+    /// A plan came back: the model that made it and the wall seconds from the request
+    /// to the answer (what a fleet's plan latency is measured by).
+    Answered {
+        window: usize,
+        model: PlannerModel,
+        took_s: f64,
+    },
 }
 
 /// A curious plan is expected to take this times the slowest recent one, plus
@@ -428,6 +435,7 @@ impl Executive<'_> {
                         match reply {
                             Ok(plan) => {
                                 self.took(&plan, took_s);
+                                progress(Progress::Answered { window, model: plan.model, took_s });
                                 WindowEvent::PlanReply { id, plan: Box::new(plan) }
                             }
                             Err(e) => {

@@ -8,6 +8,7 @@ use roam_runtime::lock;
 use std::time::{Duration, Instant};
 
 use roam_planner::params::GaParams;
+use roam_planner::resolution::PAPER_RESOLUTION_M;
 use roam_planner::world::World;
 use roam_proto::cells::Cells;
 use roam_proto::controller::ControllerStatus;
@@ -85,7 +86,12 @@ async fn fetch_world(requester: &Requester, root: &str) -> Result<World, Executi
     let Cells::U8(info) = information.cells else {
         return Err(ExecutiveError::Layer(INFORMATION, "not u8 cells".into()));
     };
-    World::new(
+    // The planner's grid, not the map's: a 5 cm warehouse map has 864,000 cells, and
+    // the window's own fastest path from here (its last-safe-moment check, every few
+    // seconds per robot) searched them by the dozen in a fleet, where the planner's
+    // 0.2 m grid has 54,000. The batch's executive plans on that grid too.
+    let planning = PAPER_RESOLUTION_M.max(inflated.meta.resolution);
+    World::at_resolution(
         &Grid {
             meta: inflated.meta,
             cells: occ,
@@ -95,6 +101,7 @@ async fn fetch_world(requester: &Requester, root: &str) -> Result<World, Executi
             cells: info,
         },
         GaParams::default().heuristic_compression,
+        planning,
     )
     .map_err(|e| ExecutiveError::Layer(INFORMATION, e.to_string()))
 }

@@ -92,6 +92,11 @@ fn log(p: Progress) {
         Progress::Skipped { window, task } => {
             tracing::warn!(window, %task, "skipped: the task was over before its window began")
         }
+        Progress::Answered {
+            window,
+            model,
+            took_s,
+        } => tracing::debug!(window, model = model.as_str(), took_s, "plan answered"),
     }
 }
 

@@ -51,8 +51,9 @@ pub struct PlannerConfig {
     /// ([`crate::coupling`]). Off by default.
     pub change_layer: Option<String>,
     /// How the change layer is coupled ([`crate::coupling`]): `max` (default),
-    /// max(I_xy, C_xy); or `news`, round(I_xy × N_xy / 100), interest × the probability
-    /// of news, with the mapper's `news` layer as `change_layer` (required).
+    /// max(I_xy, C_xy); or `news`, interest × the probability of news scaled to the
+    /// best interest ([`crate::coupling::news_product`]), with the mapper's `news` layer
+    /// as `change_layer` (required).
     pub coupling: Coupling,
     /// The resolution the planner plans at, metres ([`crate::resolution`]): planning
     /// cells of a whole number of map cells, the path driven on the map's cells. Absent:

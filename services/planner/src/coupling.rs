@@ -60,7 +60,7 @@ pub enum Coupling {
     /// I' = max(I, C) (default).
     #[default]
     Max,
-    /// I' = round(I · N / 100), N the news scores.
+    /// I' = round(I · N · max(I) / max(I · N)), N the news scores ([`news_product`]).
     News,
 }
 

@@ -41,12 +41,8 @@ pub struct DemoOptions {
     pub seed: u64,
     /// The key root (a unique one lets several demos share a machine).
     pub root: Option<String>,
-    /// Serve the live view (a Foxglove WebSocket server) here while the demo runs.
-    pub view: Option<std::net::SocketAddr>,
-    /// Record the run to this MCAP file.
-    pub record: Option<PathBuf>,
-    /// Who may connect to the live view.
-    pub view_access: roam_view::Access,
+    /// The live view and the recording.
+    pub view: LiveView,
     /// Offer the demo to ROS 2 (`roam ros2` in the stack).
     pub ros2: Option<roam_ros2::node::Ros2Config>,
     /// The stack router's endpoint, where other processes connect (a ROS 2 system
@@ -64,14 +60,23 @@ impl Default for DemoOptions {
             rate: 20.0,
             seed: 0,
             root: None,
-            view: None,
-            record: None,
-            view_access: roam_view::Access::default(),
+            view: LiveView::default(),
             ros2: None,
             listen: None,
             site: Site::builtin_day(),
         }
     }
+}
+
+/// The live view of a demo, and its recording.
+#[derive(Debug, Clone, Default)]
+pub struct LiveView {
+    /// Serve the live view (a Foxglove WebSocket server) here while the demo runs.
+    pub listen: Option<std::net::SocketAddr>,
+    /// Record the run to this MCAP file.
+    pub record: Option<PathBuf>,
+    /// Who may connect to the live view.
+    pub access: roam_view::Access,
 }
 
 /// The PEB cost the demo's executive plans with (the planner's W_loc, as in `roam
@@ -127,9 +132,17 @@ pub enum DemoError {
     View(#[from] roam_view::ViewError),
     #[error("cannot write {path}: {reason}")]
     Write { path: PathBuf, reason: String },
+    #[error("{field} is {value}; give {limit}")]
+    Invalid {
+        field: &'static str,
+        value: String,
+        limit: String,
+    },
+    #[error("the fleet: {0}")]
+    Fleet(String),
 }
 
-fn write_error(path: &Path, e: impl std::fmt::Display) -> DemoError {
+pub(crate) fn write_error(path: &Path, e: impl std::fmt::Display) -> DemoError {
     DemoError::Write {
         path: path.to_owned(),
         reason: e.to_string(),
@@ -172,7 +185,7 @@ pub async fn run(
         ));
     }
     let view_cancel = CancellationToken::new();
-    let view = match start_view(&stack, options, &view_cancel, progress).await {
+    let view = match start_view(&stack, &options.view, &view_cancel, progress).await {
         Ok(view) => view,
         Err(e) => {
             let _ = stack.shutdown().await;
@@ -193,20 +206,20 @@ pub async fn run(
 
 /// Starts the live view on the stack's router session when `--view` or `--record` asks
 /// for it (`roam_view`: maps, robots, anchors, planned and driven paths).
-async fn start_view(
+pub(crate) async fn start_view(
     stack: &Stack,
-    options: &DemoOptions,
+    view: &LiveView,
     cancel: &CancellationToken,
     progress: &(dyn Fn(&str) + Sync),
 ) -> Result<Option<roam_view::ViewHandle>, DemoError> {
-    if options.view.is_none() && options.record.is_none() {
+    if view.listen.is_none() && view.record.is_none() {
         return Ok(None);
     }
     let config = roam_view::ViewConfig {
         root: stack.root.clone(),
-        listen: options.view,
-        mcap: options.record.clone(),
-        access: options.view_access.clone(),
+        listen: view.listen,
+        mcap: view.record.clone(),
+        access: view.access.clone(),
     };
     let view = roam_view::run(stack.router.session.clone(), config, cancel.clone()).await?;
     if let Some(url) = view.websocket_url() {
@@ -305,6 +318,7 @@ async fn drive(
             "window {}: {task} was over before the window began",
             window + 1
         )),
+        Progress::Answered { .. } => {}
     }
     };
     let cancel = CancellationToken::new();

@@ -1,4 +1,5 @@
-//! The library behind the `roam` binary: roam's main job (`roam demo`) and its picture
+//! The library behind the `roam` binary: roam's main job (`roam demo`, the fleet's with
+//! `--fleet`) and its picture
 //! (`demo_picture`), the report `roam stack --once` writes, the PEB picture and the
 //! frames of the other pictures (`pictures`).
 //! `main.rs` only parses arguments and calls in here, so the integration tests boot
@@ -6,6 +7,7 @@
 //! benchmarks are `roam_experiments`.
 
 pub mod demo;
+pub mod demo_fleet;
 pub mod demo_picture;
 pub mod peb_picture;
 pub mod pictures;

@@ -14,6 +14,7 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use roam_proto::map::GridMeta;
+use roam_proto::sim::ObjectTruth;
 use roam_world::grid::world_to_cell;
 use roam_world::noise;
 use roam_world::scenario::changes::ChangeZoneSpec;
@@ -83,6 +84,28 @@ impl SemiStatic {
     pub fn leaves_step(&self) -> Option<u64> {
         self.landed_step.map(|s| s + self.stay_steps)
     }
+
+    /// The map cells it covers, inclusive: `[x0, y0, x1, y1]`.
+    pub fn cell_bounds(&self) -> [i64; 4] {
+        let mut cells = self.footprint.cells(self.centre);
+        let first = cells.next().unwrap_or(self.centre);
+        let last = cells.last().unwrap_or(first);
+        [first.0, first.1, last.0, last.1]
+    }
+}
+
+/// The objects of `objects` that have landed, as the sim publishes them on
+/// `<root>/sim/objects` ([`ObjectTruth`]): what a batch and a live run score against.
+pub fn landed_truth(objects: &[SemiStatic]) -> Vec<ObjectTruth> {
+    objects
+        .iter()
+        .filter(|o| o.landed_step.is_some())
+        .map(|o| ObjectTruth {
+            id: o.id,
+            zone: u32::try_from(o.zone).unwrap_or(u32::MAX),
+            cells: o.cell_bounds(),
+        })
+        .collect()
 }
 
 /// Every zone's objects and the stream that schedules them.

@@ -19,7 +19,9 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
-use roam_proto::sim::{PendingCommand, RobotCommand, SimClock, SimControl, SimStatus};
+use roam_proto::sim::{
+    ObjectsTruth, PendingCommand, RobotCommand, SimClock, SimControl, SimStatus,
+};
 use roam_proto::{decode, keys, ErrorCode, ErrorReply, Message};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::world_check::{self, WorldMismatch};
@@ -33,6 +35,7 @@ use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
 
 use crate::messages::{points, robot_messages, RobotMessages};
+use crate::semi_static::landed_truth;
 use crate::sim::{Command, Sim, SimError};
 use crate::snapshot::{self, SnapshotError};
 
@@ -130,6 +133,9 @@ struct Control {
     pending: BTreeMap<String, RobotCommand>,
     late_steps: u64,
     free_steps: u64,
+    /// The ids of the objects landed at the last `sim/objects` message: the next goes
+    /// out when they differ.
+    objects_published: Vec<u64>,
 }
 
 /// What the sim's control queryable, command subscriber and free run share.
@@ -241,6 +247,7 @@ pub async fn run(
             pending: BTreeMap::new(),
             late_steps: 0,
             free_steps: 0,
+            objects_published: Vec::new(),
         }),
         load_dirs,
         stepper: tokio::sync::Mutex::new(()),
@@ -382,8 +389,16 @@ fn take_command(state: &SimShared, key: &str, payload: &[u8]) {
     }
 }
 
+/// What one step has to publish once the lock is released.
+struct Stepped {
+    clock: SimClock,
+    robots: Vec<RobotMessages>,
+    /// The landed objects, when one landed or left in the step.
+    objects: Option<ObjectsTruth>,
+}
+
 /// One step under the lock; returns the messages to publish after it is released.
-fn step_once(state: &SimShared) -> Result<(SimClock, Vec<RobotMessages>), ErrorReply> {
+fn step_once(state: &SimShared) -> Result<Stepped, ErrorReply> {
     let mut control = state.control();
     let commands: Vec<Command> = std::mem::take(&mut control.pending)
         .into_iter()
@@ -399,7 +414,24 @@ fn step_once(state: &SimShared) -> Result<(SimClock, Vec<RobotMessages>), ErrorR
         .iter()
         .map(|r| robot_messages(&control.sim, report.step, report.time_s, r))
         .collect();
-    Ok((clock, messages))
+    let landed = landed_truth(control.sim.world().objects());
+    let objects = (!landed
+        .iter()
+        .map(|o| o.id)
+        .eq(control.objects_published.iter().copied()))
+    .then(|| {
+        control.objects_published = landed.iter().map(|o| o.id).collect();
+        ObjectsTruth {
+            step: report.step,
+            time_s: report.time_s,
+            objects: landed,
+        }
+    });
+    Ok(Stepped {
+        clock,
+        robots: messages,
+        objects,
+    })
 }
 
 /// Every reading of a step is delivered: a robot's localization and controller run in
@@ -408,8 +440,16 @@ async fn put<T: Message>(state: &SimShared, key: &str, message: &T) {
     roam_runtime::publish(&state.session, key, message, Delivery::Reliable).await;
 }
 
-async fn publish(state: &SimShared, clock: SimClock, robots: Vec<RobotMessages>) {
+async fn publish(state: &SimShared, stepped: Stepped) {
     let root = &state.root;
+    let Stepped {
+        clock,
+        robots,
+        objects,
+    } = stepped;
+    if let Some(objects) = &objects {
+        put(state, &keys::sim_objects(root), objects).await;
+    }
     for m in robots {
         let robot = m.truth.robot.clone();
         put(state, &keys::robot_ranges(root, &robot), &m.ranges).await;
@@ -450,7 +490,7 @@ async fn free_run(state: Arc<SimShared>, cancel: CancellationToken) {
                 continue;
             }
             match step_once(&state) {
-                Ok((clock, messages)) => publish(&state, clock, messages).await,
+                Ok(stepped) => publish(&state, stepped).await,
                 Err(e) => tracing::warn!("step failed: {e}"),
             }
         }
@@ -598,8 +638,8 @@ async fn control(state: &Arc<SimShared>, request: SimControl) -> Result<(), Erro
                 if state.control().running {
                     break;
                 }
-                let (clock, messages) = step_once(state)?;
-                publish(state, clock, messages).await;
+                let stepped = step_once(state)?;
+                publish(state, stepped).await;
             }
         }
         SimControl::Pause => state.control().running = false,

@@ -16,6 +16,7 @@ use roam_controller::service::ControllerConfig;
 use roam_localization::service::LocalizationConfig;
 use roam_map_server::MapServerConfig;
 use roam_mapper::service::MapperConfig;
+use roam_planner::coupling::Coupling;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
 use roam_runtime::{wait_for_liveliness, LivelinessWait, SessionArgs};
@@ -44,6 +45,10 @@ pub struct StackOptions {
     pub sim_rate: Option<f64>,
     /// The controller's parameters (default: paper 002's).
     pub apf: Option<roam_controller::params::ApfParams>,
+    /// How the planners couple the mapper's layers into the information map: `max`
+    /// (default; the change coupling, on `change_information`) or `news` (interest × the
+    /// probability of news, on the mapper's `news` layer: a fleet's).
+    pub coupling: Coupling,
     /// Run the ROS 2 node too (`roam ros2`: roam's topics and services on rmw_zenoh's
     /// keys, through the stack's router); its `root` is the stack's.
     pub ros2: Option<roam_ros2::node::Ros2Config>,
@@ -66,7 +71,14 @@ impl StackOptions {
             Role::from(PlannerConfig {
                 root: root.to_owned(),
                 instance: Some(format!("planner-{index}")),
-                change_layer: Some(roam_proto::mapper::CHANGE_INFORMATION_LAYER.to_owned()),
+                change_layer: Some(
+                    match self.coupling {
+                        Coupling::Max => roam_proto::mapper::CHANGE_INFORMATION_LAYER,
+                        Coupling::News => roam_proto::mapper::NEWS_LAYER,
+                    }
+                    .to_owned(),
+                ),
+                coupling: self.coupling,
                 ..PlannerConfig::default()
             })
         }));

@@ -316,12 +316,29 @@ pub(crate) async fn mission(args: MissionArgs) -> anyhow::Result<()> {
 
 #[derive(Debug, Args)]
 pub(crate) struct DemoArgs {
-    /// Where the report goes (world.png, report.json, report.md).
-    #[arg(long, default_value = "roam-demo")]
-    out: PathBuf,
-    /// The sim's real-time factor.
-    #[arg(long, default_value_t = 20.0)]
-    rate: f64,
+    /// Where the report goes (world.png, report.json, report.md); default roam-demo, or
+    /// roam-demo-fleet with --fleet.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// The sim's real-time factor; default 20, or 10 with --fleet.
+    #[arg(long)]
+    rate: Option<f64>,
+    /// The warehouse fleet instead of the day: every robot of the warehouse's shift with
+    /// its own mission executive, the planners on the fleet's news, live through Zenoh
+    /// for the first --shift-s seconds; the report measures it as `roam reproduce
+    /// fleet` measures a week (services/experiments/README.md, "The fleet live").
+    #[arg(long, conflicts_with_all = ["map", "tasks"])]
+    fleet: bool,
+    /// With --fleet: the first N robots of the shift (1 to 10).
+    #[arg(long, default_value_t = 10, requires = "fleet")]
+    robots: usize,
+    /// With --fleet: how much of the shift to run, sim seconds (the tasks that start
+    /// within it).
+    #[arg(long, default_value_t = 900.0, requires = "fleet")]
+    shift_s: f64,
+    /// With --fleet: planner instances.
+    #[arg(long, default_value_t = 2, requires = "fleet")]
+    planners: usize,
     /// The planner's seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -369,20 +386,16 @@ pub(crate) fn site(
 }
 
 pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
-    if !(args.rate.is_finite() && args.rate > 0.0 && args.rate <= 100.0) {
+    let rate = args.rate.unwrap_or(if args.fleet { 10.0 } else { 20.0 });
+    if !(rate.is_finite() && rate > 0.0 && rate <= 100.0) {
         anyhow::bail!("--rate must be more than 0 and at most 100 (times real time)");
     }
-    let site = site(args.map.as_deref(), args.tasks.as_deref())?;
-    let options = roam::demo::DemoOptions {
-        out_dir: args.out,
-        rate: args.rate,
-        seed: args.seed,
-        root: None,
-        view: args.view,
-        record: args.record,
+    let view = roam::demo::LiveView {
+        listen: args.view,
+        record: args.record.clone(),
         // Read (and checked) only when there is a live view to guard, and before the
         // stack boots.
-        view_access: match args.view {
+        access: match args.view {
             Some(addr) => {
                 let access = args.view_access.access()?;
                 roam_view::check_exposure(addr, &access)?;
@@ -390,6 +403,17 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
             }
             None => roam_view::Access::default(),
         },
+    };
+    if args.fleet {
+        return fleet_demo(args, rate, view).await;
+    }
+    let site = site(args.map.as_deref(), args.tasks.as_deref())?;
+    let options = roam::demo::DemoOptions {
+        out_dir: args.out.unwrap_or_else(|| PathBuf::from("roam-demo")),
+        rate,
+        seed: args.seed,
+        root: None,
+        view,
         ros2: args.ros2.then(|| args.ros.config()),
         listen: args.listen,
         site,
@@ -419,6 +443,51 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
             .peb_mean_m
             .map_or("-".to_owned(), |p| format!("{p:.3} m"))
     );
+    println!("report: {}", options.out_dir.display());
+    Ok(())
+}
+
+async fn fleet_demo(args: DemoArgs, rate: f64, view: roam::demo::LiveView) -> anyhow::Result<()> {
+    let options = roam::demo_fleet::FleetDemoOptions {
+        out_dir: args.out.unwrap_or_else(|| PathBuf::from("roam-demo-fleet")),
+        rate,
+        seed: args.seed,
+        robots: args.robots,
+        shift_s: args.shift_s,
+        planners: args.planners,
+        root: None,
+        listen: args.listen,
+        view,
+        ros2: args.ros2.then(|| args.ros.config()),
+    };
+    let say = |line: &str| eprintln!("roam demo --fleet: {line}");
+    let report = roam::demo_fleet::run(&options, &say).await?;
+    let s = &report.summary;
+    let num = |x: Option<f64>, unit: &str| x.map_or("-".to_owned(), |v| format!("{v:.0}{unit}"));
+    println!(
+        "{} robots, {} windows, late: {}   detection median: {}   Brier: {}   plan p50/p99: {} / {}   wall: {:.0} s",
+        report.robots,
+        s.windows,
+        s.late,
+        num(s.detection_median_s, " s"),
+        s.brier.map_or("-".to_owned(), |b| format!("{b:.4}")),
+        num(s.plan_p50_ms, " ms"),
+        num(s.plan_p99_ms, " ms"),
+        report.wall_s
+    );
+    for g in &report.goals {
+        println!(
+            "  {:<24} {:>10} <= {:<8} {}",
+            g.goal,
+            g.figure.map_or("-".to_owned(), |f| format!("{f:.1}")),
+            g.at_most,
+            match g.met {
+                Some(true) => "met",
+                Some(false) => "missed",
+                None => "no figure",
+            }
+        );
+    }
     println!("report: {}", options.out_dir.display());
     Ok(())
 }

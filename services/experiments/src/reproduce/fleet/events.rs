@@ -6,8 +6,7 @@
 use std::collections::BTreeMap;
 
 use roam_proto::cells::Cells;
-use roam_proto::sim::LocalObservation;
-use roam_sim::semi_static::SemiStatic;
+use roam_proto::sim::{LocalObservation, ObjectTruth};
 use serde::Serialize;
 
 /// An object landed or left.
@@ -61,16 +60,10 @@ impl ChangeLog {
 
     /// The objects now (the sim's); each that landed or left since the last update is
     /// an event at `t`.
-    pub fn update(&mut self, objects: &[SemiStatic], t: f64) {
-        let now: BTreeMap<u64, (usize, [i64; 4])> = objects
+    pub fn update(&mut self, landed: &[ObjectTruth], t: f64) {
+        let now: BTreeMap<u64, (usize, [i64; 4])> = landed
             .iter()
-            .filter(|o| o.landed_step.is_some())
-            .map(|o| {
-                let mut cells = o.footprint.cells(o.centre);
-                let first = cells.next().unwrap_or(o.centre);
-                let last = cells.last().unwrap_or(first);
-                (o.id, (o.zone, [first.0, first.1, last.0, last.1]))
-            })
+            .map(|o| (o.id, (o.zone as usize, o.cells)))
             .collect();
         for (id, &(zone, bounds)) in &now {
             if !self.landed.contains_key(id) {
@@ -135,10 +128,11 @@ impl ChangeLog {
 mod tests {
     use super::*;
     use roam_proto::map::{GridMeta, Origin};
+    use roam_sim::semi_static::{landed_truth, SemiStatic};
     use roam_sim::world::Footprint;
 
-    fn object(id: u64, centre: (i64, i64)) -> SemiStatic {
-        SemiStatic {
+    fn object(id: u64, centre: (i64, i64)) -> Vec<ObjectTruth> {
+        landed_truth(&[SemiStatic {
             id,
             zone: 0,
             centre,
@@ -148,7 +142,7 @@ mod tests {
             },
             stay_steps: 10,
             landed_step: Some(1),
-        }
+        }])
     }
 
     fn window(x0: u32, y0: u32, seen: bool) -> LocalObservation {
@@ -172,7 +166,7 @@ mod tests {
     #[test]
     fn a_change_is_seen_when_a_window_shows_one_of_its_cells() {
         let mut log = ChangeLog::default();
-        log.update(&[object(7, (10, 10))], 5.0);
+        log.update(&object(7, (10, 10)), 5.0);
         assert_eq!(log.events().len(), 1);
         assert_eq!(log.events()[0].kind, ChangeKind::Appeared);
         // A window elsewhere, then one over its cells that saw nothing, then one that did.

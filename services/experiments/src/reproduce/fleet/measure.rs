@@ -3,6 +3,8 @@
 
 use roam_controller::controller::{Decision, MissionStatus};
 use roam_mapper::brier::brier;
+use roam_mission::information::gathered;
+use roam_proto::mission::WindowReport;
 use serde::Serialize;
 
 use crate::reproduce::executive::track::Track;
@@ -49,6 +51,37 @@ impl WindowRecord {
             },
             driven_information: track.information(&world.planning, &world.params),
             ga_plans: w.log.ga_plans,
+        }
+    }
+}
+
+impl WindowRecord {
+    /// A window a live executive reported (`roam demo --fleet`): `truth` the robot's
+    /// true positions through the window. The share is counted from the window's
+    /// beginning to the arrival (the live report does not say when the first mission
+    /// left; the batch counts from it, which differs by the first plan's time).
+    pub fn live(
+        world: &FleetWorld,
+        robot: usize,
+        shift_s: f64,
+        report: &WindowReport,
+        truth: &[[f64; 2]],
+    ) -> WindowRecord {
+        let window_s = report.task_start_s - report.began_s;
+        let driving_s = report.arrival_s.map_or(0.0, |a| a - report.began_s);
+        WindowRecord {
+            robot,
+            day: (report.task_start_s / shift_s).floor().max(0.0) as usize,
+            task: report.task.clone(),
+            window_s,
+            late: !report.on_time,
+            share: if window_s > 0.0 {
+                driving_s / window_s
+            } else {
+                0.0
+            },
+            driven_information: gathered(&world.planning, &world.params, truth),
+            ga_plans: report.asks.iter().filter(|a| a.curious).count() as u32,
         }
     }
 }

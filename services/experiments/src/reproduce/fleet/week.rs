@@ -14,6 +14,7 @@ use roam_planner::coupling::news_product;
 use roam_planner::params::GaParams;
 use roam_proto::controller::Mission;
 use roam_proto::planner::{Plan, PlanRequest, PlannerModel};
+use roam_sim::semi_static::landed_truth;
 use roam_world::seed::splitmix64;
 
 use crate::closed_loop::episode::{EpisodeError, PositionSource};
@@ -34,7 +35,7 @@ pub const MAP_SAMPLE_S: f64 = 60.0;
 const SIM_STREAM: u64 = 0x46_4C_45_45_54_5F_53_49;
 
 /// A robot's plan seed (common to every variant).
-fn plan_seed(seed: u64, robot: usize) -> u64 {
+pub fn plan_seed(seed: u64, robot: usize) -> u64 {
     splitmix64(seed ^ splitmix64(0x504C_414E ^ robot as u64))
 }
 
@@ -213,7 +214,8 @@ pub fn run_week(
     while executives.iter().any(|e| !e.done()) && stepper.sim().time_s() < end_s {
         let out = stepper.step()?;
         let t = out.time_s;
-        changes.update(stepper.sim().world().objects(), t);
+        let landed = landed_truth(stepper.sim().world().objects());
+        changes.update(&landed, t);
         for r in &out.robots {
             let Some(i) = names.iter().position(|n| *n == r.robot) else {
                 continue;
@@ -257,7 +259,7 @@ pub fn run_week(
         if t >= next_sample_s {
             next_sample_s += MAP_SAMPLE_S;
             let belief = mapper.belief(world, t)?;
-            let truth = world.semi_static_truth(stepper.sim().world().objects());
+            let truth = world.semi_static_truth(&landed);
             record
                 .maps
                 .push(MapSample::score(world, t, &belief, &truth)?);

@@ -160,12 +160,15 @@ impl FleetWorld {
     /// every object that has landed (occupied when any of its map cells is). Carts and
     /// people are left out: they are gone before a map could send a robot around
     /// them, and no map predicts where a walker steps next.
-    pub fn semi_static_truth(&self, objects: &[roam_sim::semi_static::SemiStatic]) -> Vec<bool> {
+    pub fn semi_static_truth(&self, landed: &[roam_proto::sim::ObjectTruth]) -> Vec<bool> {
         let mut truth: Vec<bool> = self.static_coarse.cells.iter().map(|&v| v >= 50).collect();
-        for o in objects.iter().filter(|o| o.landed_step.is_some()) {
-            for (x, y) in o.footprint.cells(o.centre) {
-                if let Some(i) = self.coarse_index(x, y) {
-                    truth[i] = true;
+        for o in landed {
+            let [x0, y0, x1, y1] = o.cells;
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    if let Some(i) = self.coarse_index(x, y) {
+                        truth[i] = true;
+                    }
                 }
             }
         }
