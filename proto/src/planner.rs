@@ -45,6 +45,11 @@ pub struct MapVersion {
     /// and once it has one; absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub change: Option<u64>,
+    /// The layer of what the fleet has seen that the plan went around (the planner's
+    /// `obstacles_layer`, the mapper's `occupied_now`), on a planner that follows one and
+    /// once it has one; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub obstacles: Option<u64>,
 }
 
 /// Overrides of the GA parameters (paper 000 Table I); every field is optional.

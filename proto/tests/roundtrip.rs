@@ -271,13 +271,18 @@ mod planner_messages {
     }
 
     fn version() -> impl Strategy<Value = MapVersion> {
-        (any::<u64>(), any::<u64>(), any::<Option<u64>>()).prop_map(
-            |(inflated, information, change)| MapVersion {
+        (
+            any::<u64>(),
+            any::<u64>(),
+            any::<Option<u64>>(),
+            any::<Option<u64>>(),
+        )
+            .prop_map(|(inflated, information, change, obstacles)| MapVersion {
                 inflated,
                 information,
                 change,
-            },
-        )
+                obstacles,
+            })
     }
 
     fn overrides() -> impl Strategy<Value = GaOverrides> {

@@ -131,6 +131,7 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
             inflated: 1,
             information: 1,
             change: None,
+            obstacles: None,
         }
     );
     assert_eq!(remote.points.len(), remote.cells.len());

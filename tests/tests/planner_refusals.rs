@@ -187,6 +187,7 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
                 inflated: 99,
                 information: 1,
                 change: None,
+                obstacles: None,
             }),
             ..ok.clone()
         },
@@ -257,6 +258,7 @@ async fn every_refusal_is_structured_and_says_what_to_change() {
             inflated: 2,
             information: 1,
             change: None,
+            obstacles: None,
         }),
         ..ok.clone()
     };

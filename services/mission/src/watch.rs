@@ -9,7 +9,8 @@
 //! - **lost mission**: no status on the current mission for `controller_silence_s` (wall
 //!   time): the mission is sent again (a fresh plan from where the robot is), however
 //!   many replans the window already had;
-//! - **blocked**: the controller reports the robot stuck: replan the shortest way;
+//! - **blocked**: the controller reports the robot stuck: replan the shortest way (once
+//!   its budget is spent, try the way again, uncounted, once per `slack_interval_s`);
 //! - **late**: the ETA (distance left at the robot's speed) slips past the task's start:
 //!   replan the shortest way, once, and never curious again in this window;
 //! - **behind**: at the robot's own progress along the path (once it has driven a few
@@ -36,9 +37,25 @@
 //! Slack and behind replans need `min_replan_window_s` left to the task: a short
 //! replan near a window's end is the one a time model gets most wrong.
 //!
-//! Replans other than resending a lost mission count toward `max_replans`.
+//! Curious replans (slack, behind, pushed off before slipping) count toward
+//! `max_replans`; the shortest-way ones (blocked, late, pushed off after slipping) toward
+//! a budget of their own of the same size; resending a lost mission toward neither. A
+//! window that spent its curious replans can still get a stuck robot moving: with one
+//! budget, the warehouse fleet live had a robot stuck after five slack replans stay
+//! stuck until it gave up on its task.
 
 use crate::path::{eta_slips, off_path_m};
+
+/// Which budget a new plan came out of ([`Watch::replanned`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Replanned {
+    /// A curious replan: `max_replans`.
+    Curious,
+    /// A shortest-way replan: a budget of its own of the same size.
+    Shortest,
+    /// A lost mission sent again, or a recovery: not counted.
+    Resend,
+}
 
 /// The policy's parameters (the executive's config, in the units it uses).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -174,6 +191,7 @@ pub struct Watch {
     path: Vec<[f64; 2]>,
     slipped: bool,
     replans: u32,
+    shortest_replans: u32,
     resends: u32,
     /// Wall seconds (executive's clock) when the controller was last heard on the
     /// current mission.
@@ -204,6 +222,7 @@ impl Watch {
             path,
             slipped: false,
             replans: 0,
+            shortest_replans: 0,
             resends: 0,
             heard_at_wall_s: wall_s,
             planned_at_s: now_s,
@@ -211,9 +230,14 @@ impl Watch {
         }
     }
 
-    /// Replans so far (lost missions resent not counted).
+    /// Curious replans so far.
     pub fn replans(&self) -> u32 {
         self.replans
+    }
+
+    /// Shortest-way replans so far.
+    pub fn shortest_replans(&self) -> u32 {
+        self.shortest_replans
     }
 
     /// Lost missions resent so far.
@@ -258,7 +282,23 @@ impl Watch {
         self.heard_at_wall_s = wall_s;
         match status {
             Status::Completed => Decision::Arrived { at_s: now_s },
-            Status::Stuck => self.replan(Reason::Stuck, false),
+            Status::Stuck => {
+                let decision = self.replan(Reason::Stuck, false);
+                if decision == Decision::Keep
+                    && now_s - self.planned_at_s >= self.params.slack_interval_s
+                {
+                    // Out of budget, a stuck robot is held until a new mission, and what
+                    // blocks one in a fleet moves (a tug, a cart, a person): the way is
+                    // tried again from where it is, uncounted, at most once per
+                    // `slack_interval_s`, until the window gives up.
+                    return Decision::Replan {
+                        reason: Reason::Stuck,
+                        curious: false,
+                        resend: true,
+                    };
+                }
+                decision
+            }
             Status::Active { distance_left_m } if !self.slipped => {
                 let (t0, d0) = *self.progress_from.get_or_insert((now_s, distance_left_m));
                 let progress_speed = (d0 - distance_left_m) / (now_s - t0);
@@ -298,15 +338,15 @@ impl Watch {
 
     /// The executive made a new plan at mission time `now_s` (wall `wall_s`): the robot
     /// should now be on `path`.
-    pub fn replanned(&mut self, path: Vec<[f64; 2]>, resend: bool, now_s: f64, wall_s: f64) {
+    pub fn replanned(&mut self, path: Vec<[f64; 2]>, kind: Replanned, now_s: f64, wall_s: f64) {
         self.path = path;
         self.planned_at_s = now_s;
         self.progress_from = None;
         self.heard_at_wall_s = wall_s;
-        if resend {
-            self.resends += 1;
-        } else {
-            self.replans += 1;
+        match kind {
+            Replanned::Curious => self.replans += 1,
+            Replanned::Shortest => self.shortest_replans += 1,
+            Replanned::Resend => self.resends += 1,
         }
     }
 
@@ -314,7 +354,7 @@ impl Watch {
     /// curious again, as after the ETA slipped.
     pub fn straight(&mut self, path: Vec<[f64; 2]>, now_s: f64, wall_s: f64) {
         self.slipped = true;
-        self.replanned(path, true, now_s, wall_s);
+        self.replanned(path, Replanned::Resend, now_s, wall_s);
     }
 
     /// Whether the robot was sent the shortest way for good (the ETA slipped, or the
@@ -324,7 +364,12 @@ impl Watch {
     }
 
     fn replan(&self, reason: Reason, curious: bool) -> Decision {
-        if self.replans >= self.params.max_replans {
+        let used = if curious {
+            self.replans
+        } else {
+            self.shortest_replans
+        };
+        if used >= self.params.max_replans {
             return Decision::Keep;
         }
         Decision::Replan {
@@ -388,7 +433,7 @@ mod tests {
                 resend: false
             }
         );
-        w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], false, 6.0, 1.0);
+        w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], Replanned::Curious, 6.0, 1.0);
         // Right after the replan: not again before slack_interval_s.
         assert_eq!(
             w.on_status(
@@ -490,7 +535,12 @@ mod tests {
             resend: false,
         };
         assert_eq!(w.on_status(active(20.0), 30.0, 0.2, 1.0), behind);
-        w.replanned(vec![[20.0, 0.0], [40.0, 0.0]], false, 30.0, 0.2);
+        w.replanned(
+            vec![[20.0, 0.0], [40.0, 0.0]],
+            Replanned::Curious,
+            30.0,
+            0.2,
+        );
         // Not again before slack_interval_s, and not on a pace that arrives in time.
         assert_eq!(w.on_status(active(19.0), 31.0, 0.3, 1.0), Decision::Keep);
         assert_eq!(w.on_status(active(18.0), 34.0, 0.4, 1.0), Decision::Keep);
@@ -519,7 +569,12 @@ mod tests {
                 resend: false
             }
         );
-        w.replanned(vec![[10.0, 0.0], [20.0, 0.0]], false, 70.0, 1.0);
+        w.replanned(
+            vec![[10.0, 0.0], [20.0, 0.0]],
+            Replanned::Curious,
+            70.0,
+            1.0,
+        );
         // After slipping, slack never fires, and a push replans the shortest way.
         assert_eq!(
             w.on_status(
@@ -543,10 +598,55 @@ mod tests {
     }
 
     #[test]
+    fn a_stuck_robot_is_replanned_after_the_curious_replans_are_spent() {
+        let mut w = watch();
+        for _ in 0..params().max_replans {
+            w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], Replanned::Curious, 1.0, 0.0);
+        }
+        assert_eq!(
+            w.on_estimate([0.0, 9.0]),
+            Decision::Keep,
+            "no curious replan left"
+        );
+        // Blocked: the shortest way, from a budget of its own, until that is spent too.
+        for _ in 0..params().max_replans {
+            assert_eq!(
+                w.on_status(Status::Stuck, 2.0, 0.5, 10.0),
+                Decision::Replan {
+                    reason: Reason::Stuck,
+                    curious: false,
+                    resend: false
+                }
+            );
+            w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], Replanned::Shortest, 2.0, 0.5);
+        }
+        assert_eq!(w.on_status(Status::Stuck, 3.0, 0.6, 10.0), Decision::Keep);
+        assert_eq!(
+            (w.replans(), w.shortest_replans()),
+            (params().max_replans, params().max_replans)
+        );
+        // Then the way is tried again, uncounted, once per slack interval.
+        let later = 2.0 + params().slack_interval_s;
+        let retry = Decision::Replan {
+            reason: Reason::Stuck,
+            curious: false,
+            resend: true,
+        };
+        assert_eq!(w.on_status(Status::Stuck, later, 0.7, 10.0), retry);
+        w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], Replanned::Resend, later, 0.7);
+        assert_eq!(
+            w.on_status(Status::Stuck, later + 1.0, 0.8, 10.0),
+            Decision::Keep
+        );
+        let again = later + params().slack_interval_s;
+        assert_eq!(w.on_status(Status::Stuck, again, 0.9, 10.0), retry);
+    }
+
+    #[test]
     fn a_silent_controller_gets_the_mission_again_beyond_the_replan_limit() {
         let mut w = watch();
         for _ in 0..params().max_replans {
-            w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], false, 1.0, 0.0);
+            w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], Replanned::Curious, 1.0, 0.0);
         }
         assert_eq!(
             w.on_estimate([0.0, 9.0]),
@@ -561,7 +661,7 @@ mod tests {
                 resend: true
             }
         );
-        w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], true, 2.0, 3.5);
+        w.replanned(vec![[0.0, 0.0], [20.0, 0.0]], Replanned::Resend, 2.0, 3.5);
         assert_eq!((w.replans(), w.resends()), (3, 1));
     }
 

@@ -74,7 +74,7 @@ use crate::information::InformationScale;
 use crate::margin::ArrivalMargin;
 use crate::path::{distance, mission_waypoints};
 use crate::tasks::Task;
-use crate::watch::{Decision, Reason, Status, Watch, WatchParams};
+use crate::watch::{Decision, Reason, Replanned, Status, Watch, WatchParams};
 
 /// A window's plan made ahead is used when the robot sets off at most this far from
 /// where it starts, metres.
@@ -216,8 +216,8 @@ enum DriveAsk {
 /// How the watch takes a new route.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Follows {
-    /// A replan (`resend`: a lost mission sent again, not counted).
-    Replan { resend: bool },
+    /// A replan, counted as `Replanned` says.
+    Replan(Replanned),
     /// Straight to the task, curious no more.
     Straight,
 }
@@ -705,7 +705,7 @@ impl<'a> DowntimeWindow<'a> {
         let (t, wall) = (now.mission_s, now.wall_s);
         match follows {
             Follows::Straight => drive.watch.straight(path.clone(), t, wall),
-            Follows::Replan { resend } => drive.watch.replanned(path.clone(), resend, t, wall),
+            Follows::Replan(kind) => drive.watch.replanned(path.clone(), kind, t, wall),
         }
         drive.reasons.push(reason.as_str().to_owned());
         drive.waypoints = mission_waypoints(&route.points, spacing);

@@ -38,6 +38,7 @@ pub fn answer(world: &World, request: &PlanRequest, threads: usize) -> Result<Pl
         inflated: 0,
         information: 0,
         change: None,
+        obstacles: None,
     };
     let id = request.request_id.clone().unwrap_or_default();
     Ok(to_message(

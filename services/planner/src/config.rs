@@ -8,7 +8,9 @@
 //! map_history: 4               # map versions kept for requests that name one
 //! information_layer: information  # or change_information: plan on the mapper's P(E>0)
 //! change_layer: change_information # optional: plan on max(information, change) (crate::coupling)
-//! coupling: max                # or news: plan on round(information × change / 100), with change_layer: news
+//! coupling: max                # or news: interest × the probability of news (crate::coupling::news_product), with change_layer: news
+//! obstacles_layer: occupied_now # optional: plan around what the fleet saw occupied (crate::seen)
+//! obstacle_inflation_m: 0.3    # how far around each such cell, metres (0..=5)
 //! planning_resolution_m: 0.2   # optional; default 0.2 (paper 000), or the map's if coarser (crate::resolution)
 //! # What one plan may cost, checked before any work (crate::limits):
 //! max_population_cells: 4000000   # population × longest path the budget allows
@@ -55,6 +57,13 @@ pub struct PlannerConfig {
     /// best interest ([`crate::coupling::news_product`]), with the mapper's `news` layer
     /// as `change_layer` (required).
     pub coupling: Coupling,
+    /// An i8 layer of the world now (the mapper's `occupied_now`): cells it believes
+    /// occupied where the static map is free are planned around ([`crate::seen`]). Off
+    /// by default.
+    pub obstacles_layer: Option<String>,
+    /// How far around each such cell the plan keeps off, metres (the robot's radius and
+    /// a margin; at most [`crate::seen::MAX_OBSTACLE_INFLATION_M`]).
+    pub obstacle_inflation_m: f64,
     /// The resolution the planner plans at, metres ([`crate::resolution`]): planning
     /// cells of a whole number of map cells, the path driven on the map's cells. Absent:
     /// paper 000's 0.2 m, or the map's resolution where that is coarser. Finer than the
@@ -90,6 +99,8 @@ impl Default for PlannerConfig {
             information_layer: crate::maps::INFORMATION.to_owned(),
             change_layer: None,
             coupling: Coupling::Max,
+            obstacles_layer: None,
+            obstacle_inflation_m: 0.3,
             planning_resolution_m: None,
             max_population_cells: limits.max_population_cells,
             max_plan_cost: limits.max_plan_cost,

@@ -55,6 +55,7 @@ pub mod resolution;
 pub mod scope;
 pub mod search;
 pub mod seeds;
+pub mod seen;
 #[cfg(feature = "zenoh")]
 pub mod service;
 pub mod token;

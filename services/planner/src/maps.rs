@@ -54,6 +54,11 @@ pub struct MapCache {
     change: Option<Layer>,
     /// How it is coupled ([`crate::coupling`]).
     coupling: Coupling,
+    /// The layer of what the fleet has seen, planned around ([`crate::seen`]), if any,
+    /// its latest, and how far its obstacles are inflated, metres.
+    obstacles_layer: Option<String>,
+    obstacles: Option<Layer>,
+    obstacle_inflation_m: f64,
     /// The planning resolution ([`crate::resolution`]); `None`: paper 000's 0.2 m, or
     /// the map's resolution where that is coarser.
     planning_resolution_m: Option<f64>,
@@ -94,6 +99,14 @@ impl MapCache {
         self
     }
 
+    /// This cache planning around what `layer` (the mapper's `occupied_now`) believes
+    /// occupied, inflated by `inflation_m` ([`crate::seen`]).
+    pub fn avoiding_seen(mut self, layer: Option<&str>, inflation_m: f64) -> Self {
+        self.obstacles_layer = layer.map(str::to_owned);
+        self.obstacle_inflation_m = inflation_m;
+        self
+    }
+
     /// The planning resolution for a map of `map_resolution` metres.
     pub fn planning_resolution(&self, map_resolution: f64) -> f64 {
         self.planning_resolution_m
@@ -110,6 +123,7 @@ impl MapCache {
     pub fn layers(&self) -> Vec<String> {
         let mut names = vec![INFLATED, self.information_layer.as_str(), PEB];
         names.extend(self.change_layer.as_deref());
+        names.extend(self.obstacles_layer.as_deref());
         names.into_iter().map(str::to_owned).collect()
     }
 
@@ -123,6 +137,7 @@ impl MapCache {
             INFLATED => &mut self.inflated,
             name if name == self.information_layer => &mut self.information,
             name if Some(name) == self.change_layer.as_deref() => &mut self.change,
+            name if Some(name) == self.obstacles_layer.as_deref() => &mut self.obstacles,
             _ => return DeltaOutcome::NotFollowed,
         };
         let Some(mut layer) = slot.take() else {
@@ -152,6 +167,7 @@ impl MapCache {
             INFLATED => &mut self.inflated,
             name if name == self.information_layer => &mut self.information,
             name if Some(name) == self.change_layer.as_deref() => &mut self.change,
+            name if Some(name) == self.obstacles_layer.as_deref() => &mut self.obstacles,
             _ => return None,
         };
         if slot
@@ -178,10 +194,15 @@ impl MapCache {
             .change
             .as_ref()
             .and_then(|c| coupling::usable(c, information));
+        let obstacles = self
+            .obstacles
+            .as_ref()
+            .filter(|o| o.meta == inflated.meta && matches!(o.cells, Cells::I8(_)));
         let version = MapVersion {
             inflated: inflated.version,
             information: information.version,
             change: change.map(|c| c.version),
+            obstacles: obstacles.map(|o| o.version),
         };
         if self.worlds.iter().any(|(v, _)| *v == version) {
             return None;
@@ -190,10 +211,13 @@ impl MapCache {
             tracing::warn!("the map server's layers have unexpected types; not planning on them");
             return None;
         };
-        let occ = Grid {
+        let mut occ = Grid {
             meta: inflated.meta,
             cells: occ.clone(),
         };
+        if let Some(seen) = obstacles {
+            crate::seen::block_seen(&mut occ, seen, self.obstacle_inflation_m);
+        }
         let info = Grid {
             meta: information.meta,
             cells: match change.map(|c| &c.cells) {

@@ -212,6 +212,36 @@ impl PlanError {
     }
 }
 
+/// How far a start inside an obstacle or its inflation moves to the nearest free cell,
+/// metres. A robot pushed aside by a cart or a walker, or standing beside what the fleet
+/// saw ([`crate::seen`]), is in inflation it can drive out of, and a plan from there
+/// was refused (seen in the warehouse fleet live); a start farther in is refused.
+pub const START_SNAP_M: f64 = 0.5;
+
+/// The free cell nearest (by distance, ties to the lower index) to `at` within `radius`
+/// cells on a `width × height` grid indexed `y · width + x`.
+fn nearest_free(
+    width: usize,
+    height: usize,
+    radius: usize,
+    at: usize,
+    is_free: impl Fn(usize) -> bool,
+) -> Option<usize> {
+    let (ax, ay) = ((at % width) as i64, (at / width) as i64);
+    let r = radius as i64;
+    let mut best: Option<(i64, usize)> = None;
+    for y in (ay - r).max(0)..=(ay + r).min(height as i64 - 1) {
+        for x in (ax - r).max(0)..=(ax + r).min(width as i64 - 1) {
+            let d2 = (x - ax).pow(2) + (y - ay).pow(2);
+            let c = (y * width as i64 + x) as usize;
+            if d2 <= r * r && is_free(c) && best.is_none_or(|(b, i)| (d2, c) < (b, i)) {
+                best = Some((d2, c));
+            }
+        }
+    }
+    best.map(|(_, c)| c)
+}
+
 /// Where a start or goal is: its planning cell, and on a world at a coarser planning
 /// resolution how its map cell joins that cell ([`crate::resolution::locate`]).
 fn locate(
@@ -229,16 +259,28 @@ fn locate(
         y0: meta.origin.y,
         y1: meta.origin.y + f64::from(meta.height) * meta.resolution,
     };
+    let blocked = || PlanError::Blocked { which, x, y };
+    // Only a start moves: a goal in an obstacle is the task's to fix.
+    let snap_m = if which == "start" { START_SNAP_M } else { 0.0 };
     let Some(fine) = &world.fine else {
-        let cell = world.cell_at(x, y).ok_or_else(off)?;
+        let mut cell = world.cell_at(x, y).ok_or_else(off)?;
         if !world.is_traversable(cell) {
-            return Err(PlanError::Blocked { which, x, y });
+            let (w, h) = (world.width(), world.height());
+            let radius = (snap_m / world.meta.resolution).floor() as usize;
+            cell = nearest_free(w, h, radius, cell as usize, |c| {
+                world.is_traversable(c as Cell)
+            })
+            .ok_or_else(blocked)? as Cell;
         }
         return Ok((cell, None));
     };
-    let cell = fine.cell_at(x, y).ok_or_else(off)?;
+    let mut cell = fine.cell_at(x, y).ok_or_else(off)?;
     if !fine.is_free(cell) {
-        return Err(PlanError::Blocked { which, x, y });
+        let radius = (snap_m / fine.meta.resolution).floor() as usize;
+        cell = nearest_free(fine.width(), fine.height(), radius, cell as usize, |c| {
+            fine.is_free(c as FineCell)
+        })
+        .ok_or_else(blocked)? as FineCell;
     }
     let anchor = resolution::locate(fine, world, cell).ok_or(PlanError::Pocket { which, x, y })?;
     Ok((anchor.cell, Some(anchor)))

@@ -171,6 +171,20 @@ pub fn check_config(config: &PlannerConfig) -> Result<(), PlannerError> {
             config.coupling.as_str()
         )));
     }
+    if let Some(obstacles) = &config.obstacles_layer {
+        keys::check_name("obstacles_layer", obstacles)
+            .map_err(|e| PlannerError::Config(e.to_string()))?;
+    }
+    let inflation = config.obstacle_inflation_m;
+    let most = crate::seen::MAX_OBSTACLE_INFLATION_M;
+    if !(inflation.is_finite() && (0.0..=most).contains(&inflation)) {
+        return Err(SettingError {
+            name: "obstacle_inflation_m",
+            value: inflation.to_string(),
+            allowed: format!("0 to {most} metres"),
+        }
+        .into());
+    }
     if let Some(change) = &config.change_layer {
         keys::check_name("change_layer", change)
             .map_err(|e| PlannerError::Config(e.to_string()))?;
@@ -206,6 +220,10 @@ pub async fn run(
             MapCache::with_information(config.map_history, &config.information_layer)
                 .coupling_change(config.change_layer.as_deref())
                 .coupled_by(config.coupling)
+                .avoiding_seen(
+                    config.obstacles_layer.as_deref(),
+                    config.obstacle_inflation_m,
+                )
                 .planning_at(config.planning_resolution_m),
         ),
         queue: PlanQueue::new(QueueConfig {

@@ -8,7 +8,7 @@ use std::sync::atomic::AtomicBool;
 use common::check_geometry;
 use proptest::prelude::*;
 use roam_planner::best::PlanSource;
-use roam_planner::plan::{plan, PlanError, PlanOutcome, PlanSpec};
+use roam_planner::plan::{plan, PlanError, PlanOutcome, PlanSpec, START_SNAP_M};
 use roam_planner::world::World;
 use roam_proto::planner::{PlannerModel, ShortestPathUse, StopReason};
 
@@ -540,4 +540,57 @@ fn a_deadline_bounds_the_work_a_plan_is_sized_by() {
         outcome.generations
     );
     assert!(outcome.reaches_goal && outcome.within_budget);
+}
+
+/// A start inside an obstacle's edge (a robot pushed aside, or beside what the fleet
+/// saw) plans from the nearest free cell within `START_SNAP_M`; one deeper inside is
+/// refused, naming the start, and a goal is never moved.
+#[test]
+fn a_start_at_an_obstacles_edge_moves_to_the_nearest_free_cell() {
+    let world = common::open_world(30, 30);
+    let meta = world.meta;
+    let mut occupancy = roam_world::grid::Grid::filled(meta, 0i8);
+    for y in 10..=20 {
+        for x in 10..=20 {
+            occupancy.cells[y * 30 + x] = 100;
+        }
+    }
+    let information = roam_world::grid::Grid {
+        meta,
+        cells: world.information.clone(),
+    };
+    let world = World::new(&occupancy, &information, 0.25).expect("world");
+    let centre = |x: usize, y: usize| roam_world::grid::cell_center(&meta, x, y);
+    let (ex, ey) = centre(10, 15);
+    let edge = run(
+        &world,
+        &spec(PlannerModel::Shortest, [ex, ey], [0.5, 0.5], 100.0, 1, 5),
+    );
+    let first = edge.points[0];
+    assert_eq!(first, {
+        let (x, y) = centre(9, 15);
+        [x, y]
+    });
+    assert!(((first[0] - ex).powi(2) + (first[1] - ey).powi(2)).sqrt() <= START_SNAP_M);
+    let (cx, cy) = centre(15, 15);
+    let deep = plan(
+        &world,
+        &spec(PlannerModel::Shortest, [cx, cy], [0.5, 0.5], 100.0, 1, 5),
+        &AtomicBool::new(false),
+        |_, _| {},
+    );
+    assert!(
+        matches!(deep, Err(PlanError::Blocked { which: "start", .. })),
+        "{deep:?}"
+    );
+    let goal = plan(
+        &world,
+        &spec(PlannerModel::Shortest, [0.5, 0.5], [ex, ey], 100.0, 1, 5),
+        &AtomicBool::new(false),
+        |_, _| {},
+    );
+    assert!(
+        matches!(goal, Err(PlanError::Blocked { which: "goal", .. })),
+        "{goal:?}"
+    );
 }

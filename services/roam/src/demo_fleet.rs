@@ -3,7 +3,8 @@
 //! the fleet's news (`coupling: news`, the mapper's `news` layer), and every robot of
 //! the shift (`config/shifts/warehouse.yaml`) gets its own mission executive, all
 //! through Zenoh as separate executives would, for the first `shift_s` seconds of the
-//! shift. Each executive is configured as `roam reproduce fleet`'s `news` variant
+//! shift (with `avoid_seen`, the planners also plan around what the fleet has seen
+//! occupied: `roam_planner::seen`). Each executive is configured as `roam reproduce fleet`'s `news` variant
 //! configures it, with the same plan seeds; the run is measured as the batch measures a
 //! week ([`roam_experiments::reproduce::fleet`]: late windows, how soon the fleet sees
 //! each change, the map now against the world every sim minute, plan latency) from
@@ -65,6 +66,10 @@ pub struct FleetDemoOptions {
     pub shift_s: f64,
     /// Planner instances.
     pub planners: usize,
+    /// The planners plan around what the fleet has seen occupied (`roam_planner::seen`).
+    /// Off by default: measured (services/experiments/README.md, "The fleet live"), it
+    /// blocks where carts, the tug and people were last seen, and robots were late.
+    pub avoid_seen: bool,
     pub root: Option<String>,
     pub listen: Option<String>,
     pub view: LiveView,
@@ -80,6 +85,7 @@ impl Default for FleetDemoOptions {
             robots: MAX_FLEET_DEMO_ROBOTS,
             shift_s: 900.0,
             planners: 2,
+            avoid_seen: false,
             root: None,
             listen: None,
             view: LiveView::default(),
@@ -179,6 +185,9 @@ struct Recorder {
     /// Each robot's path for the picture, every [`PATH_EVERY_STEPS`]th step.
     paths: Vec<Vec<[f64; 2]>>,
     halted_steps: Vec<u64>,
+    /// Each robot's last controller state and distance left: said when a window is
+    /// given up.
+    last_status: Vec<Option<(MissionState, Option<f64>)>>,
     plan_latencies_s: Vec<f64>,
     maps: Vec<MapSample>,
 }
@@ -271,11 +280,12 @@ async fn listen(
             .declare_subscriber(format!("{root}/robot/*/controller"))
             .callback(move |s| {
                 if let Some(c) = decoded::<ControllerStatus>(&s) {
-                    if c.state == MissionState::HaltedPeb {
-                        let mut r = lock(&r);
-                        if let Some(i) = r.robot(&c.robot) {
+                    let mut r = lock(&r);
+                    if let Some(i) = r.robot(&c.robot) {
+                        if c.state == MissionState::HaltedPeb {
                             r.halted_steps[i] += 1;
                         }
+                        r.last_status[i] = Some((c.state, c.distance_left_m));
                     }
                 }
             })
@@ -363,6 +373,7 @@ pub async fn run(
             sim_rate: Some(options.rate),
             apf: Some(indoor_apf()),
             coupling: Coupling::News,
+            avoid_seen: options.avoid_seen,
             ros2: options.ros2.clone(),
             listen: options.listen.clone(),
             ..StackOptions::default()
@@ -449,6 +460,7 @@ async fn drive(
         truth: vec![Vec::new(); robots],
         paths: vec![Vec::new(); robots],
         halted_steps: vec![0; robots],
+        last_status: vec![None; robots],
         plan_latencies_s: Vec::new(),
         maps: Vec::new(),
     }));
@@ -490,9 +502,14 @@ async fn drive(
                     ));
                 }
                 Progress::GaveUp { window, task } => {
+                    let last = lock(&recorder).last_status[index];
                     let _ = lines.send(format!(
-                        "{robot} window {}: gave up on reaching {task}",
-                        window + 1
+                        "{robot} window {}: gave up on reaching {task} (the controller: {})",
+                        window + 1,
+                        last.map_or("nothing heard".to_owned(), |(state, left)| format!(
+                            "{state:?}, {} m left",
+                            left.map_or("?".to_owned(), |d| format!("{d:.1}"))
+                        ))
                     ));
                 }
                 _ => {}

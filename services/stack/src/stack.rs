@@ -49,6 +49,9 @@ pub struct StackOptions {
     /// (default; the change coupling, on `change_information`) or `news` (interest × the
     /// probability of news, on the mapper's `news` layer: a fleet's).
     pub coupling: Coupling,
+    /// The planners plan around what the fleet has seen occupied (the mapper's
+    /// `occupied_now`; `roam_planner::seen`).
+    pub avoid_seen: bool,
     /// Run the ROS 2 node too (`roam ros2`: roam's topics and services on rmw_zenoh's
     /// keys, through the stack's router); its `root` is the stack's.
     pub ros2: Option<roam_ros2::node::Ros2Config>,
@@ -79,6 +82,9 @@ impl StackOptions {
                     .to_owned(),
                 ),
                 coupling: self.coupling,
+                obstacles_layer: self
+                    .avoid_seen
+                    .then(|| roam_proto::mapper::OCCUPIED_NOW_LAYER.to_owned()),
                 ..PlannerConfig::default()
             })
         }));

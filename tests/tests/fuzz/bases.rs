@@ -184,6 +184,7 @@ pub(crate) fn plan_bases() -> Vec<Vec<u8>> {
             inflated: u64::MAX,
             information: 0,
             change: None,
+            obstacles: None,
         }),
         ..ok
     }));

@@ -5,6 +5,7 @@
 
 use super::{straight, DowntimeWindow, Now, Phase, WindowAction};
 use crate::path::mission_waypoints;
+use crate::watch::Replanned;
 
 impl DowntimeWindow<'_> {
     /// A status that the PEB guard holds the robot on the current mission.
@@ -35,7 +36,7 @@ impl DowntimeWindow<'_> {
         drive.held_since_s = None;
         drive
             .watch
-            .replanned(back.clone(), true, now.mission_s, now.wall_s);
+            .replanned(back.clone(), Replanned::Resend, now.mission_s, now.wall_s);
         drive.path = back;
         drive.waypoints = waypoints.clone();
         let mission = self.ids.next(waypoints, true);

@@ -8,7 +8,7 @@ use super::{
     routes, AheadAsk, DowntimeWindow, DriveAsk, Follows, Now, Phase, PlanAsk, PlannedAhead, Route,
     WindowAction, FALLBACK_AFTER_FAILURES, PLAN_RETRY_S,
 };
-use crate::watch::Reason;
+use crate::watch::{Reason, Replanned};
 
 impl DowntimeWindow<'_> {
     pub(super) fn on_reply(&mut self, id: u64, plan: Option<Plan>, now: Now) -> Vec<WindowAction> {
@@ -59,7 +59,12 @@ impl DowntimeWindow<'_> {
                 if reason == Reason::SetOff {
                     self.took_set_off_plan(&route, ask.t_exec_s, now);
                 }
-                self.send_route(ask.from, route, reason, Follows::Replan { resend }, now)
+                let kind = match (resend, ask.curious) {
+                    (true, _) => Replanned::Resend,
+                    (false, true) => Replanned::Curious,
+                    (false, false) => Replanned::Shortest,
+                };
+                self.send_route(ask.from, route, reason, Follows::Replan(kind), now)
             }
         }
     }

@@ -227,6 +227,7 @@ fn plan(model: PlannerModel, points: Vec<[f64; 2]>, t_eta_s: f64) -> Plan {
             inflated: 1,
             information: 1,
             change: None,
+            obstacles: None,
         },
         instance: "planner".into(),
         shortest: None,
