@@ -184,15 +184,29 @@ pub async fn run(
             stack.router.endpoint, stack.root, stack.router.endpoint
         ));
     }
+    with_live_view(stack, &options.view, progress, async |stack| {
+        drive(stack, options, &world, progress, started).await
+    })
+    .await
+}
+
+/// Serves the live view (when asked for) while `drive` runs on `stack`, then stops the
+/// view and the stack whatever `drive` returned.
+pub(crate) async fn with_live_view<T>(
+    stack: Stack,
+    view: &LiveView,
+    progress: &(dyn Fn(&str) + Sync),
+    drive: impl AsyncFnOnce(&Stack) -> Result<T, DemoError>,
+) -> Result<T, DemoError> {
     let view_cancel = CancellationToken::new();
-    let view = match start_view(&stack, &options.view, &view_cancel, progress).await {
+    let view = match start_view(&stack, view, &view_cancel, progress).await {
         Ok(view) => view,
         Err(e) => {
             let _ = stack.shutdown().await;
             return Err(e);
         }
     };
-    let result = drive(&stack, options, &world, progress, started).await;
+    let result = drive(&stack).await;
     view_cancel.cancel();
     let viewed = match view {
         Some(view) => view.join().await.map(|_| ()),
@@ -206,7 +220,7 @@ pub async fn run(
 
 /// Starts the live view on the stack's router session when `--view` or `--record` asks
 /// for it (`roam_view`: maps, robots, anchors, planned and driven paths).
-pub(crate) async fn start_view(
+async fn start_view(
     stack: &Stack,
     view: &LiveView,
     cancel: &CancellationToken,

@@ -43,7 +43,7 @@ use tokio::task::JoinSet;
 use tokio_util::sync::CancellationToken;
 use zenoh::pubsub::Subscriber;
 
-use crate::demo::{indoor_apf, start_view, write_error, DemoError, LiveView, DEMO_W_LOC};
+use crate::demo::{indoor_apf, with_live_view, write_error, DemoError, LiveView, DEMO_W_LOC};
 
 /// The most robots the live fleet runs: the warehouse shift's ten.
 pub const MAX_FLEET_DEMO_ROBOTS: usize = 10;
@@ -142,6 +142,15 @@ pub struct LiveGoal {
 }
 
 impl LiveGoal {
+    /// `met`, `missed`, or `no figure`.
+    pub fn verdict(&self) -> &'static str {
+        match self.met {
+            Some(true) => "met",
+            Some(false) => "missed",
+            None => "no figure",
+        }
+    }
+
     fn at_most(goal: &'static str, figure: Option<f64>, at_most: f64) -> LiveGoal {
         LiveGoal {
             goal,
@@ -381,24 +390,10 @@ pub async fn run(
         Duration::from_secs(60),
     )
     .await?;
-    let view_cancel = CancellationToken::new();
-    let view = match start_view(&stack, &options.view, &view_cancel, progress).await {
-        Ok(view) => view,
-        Err(e) => {
-            let _ = stack.shutdown().await;
-            return Err(e);
-        }
-    };
-    let result = drive(&stack, options, &world, progress, started).await;
-    view_cancel.cancel();
-    let viewed = match view {
-        Some(view) => view.join().await.map(|_| ()),
-        None => Ok(()),
-    };
-    let _ = stack.shutdown().await;
-    let report = result?;
-    viewed?;
-    Ok(report)
+    with_live_view(stack, &options.view, progress, async |stack| {
+        drive(stack, options, &world, progress, started).await
+    })
+    .await
 }
 
 /// The executive's configuration for robot `index` of the shift: the batch's `news`
@@ -637,11 +632,7 @@ fn markdown(r: &FleetDemoReport, table: &str) -> String {
             g.goal,
             g.figure.map_or("-".to_owned(), |f| format!("{f:.1}")),
             g.at_most,
-            match g.met {
-                Some(true) => "met",
-                Some(false) => "missed",
-                None => "no figure",
-            }
+            g.verdict()
         ));
     }
     out.push_str("\n| robot | window | task | task starts s | arrived s | on time | replans | holds |\n|---|---|---|---|---|---|---|---|\n");

@@ -487,11 +487,7 @@ async fn fleet_demo(args: DemoArgs, rate: f64, view: roam::demo::LiveView) -> an
             g.goal,
             g.figure.map_or("-".to_owned(), |f| format!("{f:.1}")),
             g.at_most,
-            match g.met {
-                Some(true) => "met",
-                Some(false) => "missed",
-                None => "no figure",
-            }
+            g.verdict()
         );
     }
     println!("report: {}", options.out_dir.display());
