@@ -40,6 +40,8 @@ pub const DEFAULT_CUTOFF_KEEP: f64 = 0.0;
 pub const DEFAULT_MAX_PEB_M: f64 = 2.0;
 /// roam's stuck window, updates (not in paper 002).
 pub const DEFAULT_STUCK_WINDOW_STEPS: u64 = 300;
+/// The stuck window of [`ApfParams::fleet`], updates: 10 s at a 0.4 s step.
+pub const FLEET_STUCK_WINDOW_STEPS: u64 = 25;
 /// roam's least progress over the stuck window, metres (not in paper 002).
 pub const DEFAULT_STUCK_MIN_PROGRESS_M: f64 = 0.25;
 /// Paper 002 §4's step size μ = 0.2 m (Eq. 1), also the built-in world's (roam-sim's
@@ -197,6 +199,19 @@ impl ApfParams {
         }
     }
 
+    /// [`ApfParams::indoor`] for a fleet's shift: a robot that makes no progress for
+    /// [`FLEET_STUCK_WINDOW_STEPS`] updates is stuck. The default window (300 updates,
+    /// 120 s at the warehouse's 0.4 s step) outlasts a fleet's downtime windows (30 s to
+    /// 4 minutes) and the executive's 60 s grace after a task's start: in the warehouse
+    /// fleet live, robots pushing against a pallet the static map does not have were
+    /// `Active` until their window was given up, never stuck, so never replanned.
+    pub fn fleet() -> ApfParams {
+        ApfParams {
+            stuck_window_steps: FLEET_STUCK_WINDOW_STEPS,
+            ..ApfParams::indoor()
+        }
+    }
+
     /// Refuses a value the controller cannot work with, naming it and its range.
     pub fn check(&self) -> Result<(), ParamError> {
         let weight = |v: f64| (0.0..=MAX_WEIGHT).contains(&v);
@@ -279,6 +294,20 @@ impl ApfParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_fleets_parameters_are_indoor_with_a_short_stuck_window() {
+        let fleet = ApfParams::fleet();
+        assert_eq!(fleet.check(), Ok(()));
+        assert_eq!(fleet.stuck_window_steps, FLEET_STUCK_WINDOW_STEPS);
+        assert_eq!(
+            ApfParams {
+                stuck_window_steps: DEFAULT_STUCK_WINDOW_STEPS,
+                ..fleet
+            },
+            ApfParams::indoor()
+        );
+    }
 
     #[test]
     fn the_defaults_are_paper_002s_and_pass() {

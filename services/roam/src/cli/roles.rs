@@ -339,11 +339,11 @@ pub(crate) struct DemoArgs {
     /// With --fleet: planner instances.
     #[arg(long, default_value_t = 2, requires = "fleet")]
     planners: usize,
-    /// With --fleet: the planners plan around what the fleet has seen occupied (the
-    /// mapper's occupied_now); off by default (measured: carts and people leave cells
-    /// believed occupied, and robots were late).
+    /// With --fleet: the planners plan on the static map only, not around what the
+    /// fleet has seen occupied (the mapper's occupied_now); measured: robots drove into
+    /// pallets on the dock lanes after every replan, and were late.
     #[arg(long, requires = "fleet")]
-    avoid_seen: bool,
+    static_map: bool,
     /// The planner's seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -460,7 +460,7 @@ async fn fleet_demo(args: DemoArgs, rate: f64, view: roam::demo::LiveView) -> an
         robots: args.robots,
         shift_s: args.shift_s,
         planners: args.planners,
-        avoid_seen: args.avoid_seen,
+        avoid_seen: !args.static_map,
         root: None,
         listen: args.listen,
         view,

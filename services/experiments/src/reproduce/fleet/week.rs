@@ -199,7 +199,7 @@ pub fn run_week(
     let mut stepper = Stepper::new(
         &world.setup,
         world.sim_params,
-        &ApfParams::indoor(),
+        &ApfParams::fleet(),
         PositionSource::Estimate,
         splitmix64(options.seed ^ SIM_STREAM),
     )?;
