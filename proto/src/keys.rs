@@ -289,11 +289,21 @@ pub fn robot_truth(root: &str, robot: &str) -> String {
     format!("{root}/robot/{robot}/truth")
 }
 
+/// `<root>/robot/*/truth`: every robot's, for a subscriber that follows the fleet.
+pub fn robot_truth_any(root: &str) -> String {
+    format!("{root}/robot/*/truth")
+}
+
 /// `<root>/robot/<robot>/events`: the sim publishes
 /// [`RobotEvents`](crate::sim::RobotEvents) in the steps that have some (collisions,
 /// clipped speed, displacement).
 pub fn robot_events(root: &str, robot: &str) -> String {
     format!("{root}/robot/{robot}/events")
+}
+
+/// `<root>/robot/*/events`: every robot's, for a subscriber that follows the fleet.
+pub fn robot_events_any(root: &str) -> String {
+    format!("{root}/robot/*/events")
 }
 
 /// `<root>/robot/<robot>/estimate`: the localization service publishes a
@@ -336,6 +346,11 @@ pub fn robot_estimate_any(root: &str) -> String {
 /// whenever the mission's state changes.
 pub fn robot_controller(root: &str, robot: &str) -> String {
     format!("{root}/robot/{robot}/controller")
+}
+
+/// `<root>/robot/*/controller`: every robot's, for a subscriber that follows the fleet.
+pub fn robot_controller_any(root: &str) -> String {
+    format!("{root}/robot/*/controller")
 }
 
 /// `<root>/robot/*/observation`: what the mapper subscribes to.

@@ -202,9 +202,9 @@ impl ApfParams {
     /// [`ApfParams::indoor`] for a fleet's shift: a robot that makes no progress for
     /// [`FLEET_STUCK_WINDOW_STEPS`] updates is stuck. The default window (300 updates,
     /// 120 s at the warehouse's 0.4 s step) outlasts a fleet's downtime windows (30 s to
-    /// 4 minutes) and the executive's 60 s grace after a task's start: in the warehouse
-    /// fleet live, robots pushing against a pallet the static map does not have were
-    /// `Active` until their window was given up, never stuck, so never replanned.
+    /// 4 minutes) and the executive's 60 s grace after a task's start, so a robot pushing
+    /// against a pallet the static map does not have would stay `Active`, never stuck,
+    /// never replanned, until its task is given up.
     pub fn fleet() -> ApfParams {
         ApfParams {
             stuck_window_steps: FLEET_STUCK_WINDOW_STEPS,

@@ -86,10 +86,10 @@ async fn fetch_world(requester: &Requester, root: &str) -> Result<World, Executi
     let Cells::U8(info) = information.cells else {
         return Err(ExecutiveError::Layer(INFORMATION, "not u8 cells".into()));
     };
-    // The planner's grid, not the map's: a 5 cm warehouse map has 864,000 cells, and
-    // the window's own fastest path from here (its last-safe-moment check, every few
-    // seconds per robot) searched them by the dozen in a fleet, where the planner's
-    // 0.2 m grid has 54,000. The batch's executive plans on that grid too.
+    // The planner's grid, not the map's: the window's own fastest path from here (its
+    // last-safe-moment check, every few seconds per robot) would search all 864,000
+    // cells of a 5 cm warehouse map, where the planner's 0.2 m grid has 54,000. The
+    // batch's executive works on that grid too, so live and batch decide alike.
     let planning = PAPER_RESOLUTION_M.max(inflated.meta.resolution);
     World::at_resolution(
         &Grid {

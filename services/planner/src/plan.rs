@@ -213,9 +213,9 @@ impl PlanError {
 }
 
 /// How far a start inside an obstacle or its inflation moves to the nearest free cell,
-/// metres. A robot pushed aside by a cart or a walker, or standing beside what the fleet
-/// saw ([`crate::seen`]), is in inflation it can drive out of, and a plan from there
-/// was refused (seen in the warehouse fleet live); a start farther in is refused.
+/// metres. A robot pushed aside by a cart or a walker, or stopped beside what the fleet
+/// saw ([`crate::seen`]), stands in inflation it can drive out of; refusing to plan from
+/// there would leave it where it is. A start farther in is refused.
 pub const START_SNAP_M: f64 = 0.5;
 
 /// The free cell nearest (by distance, ties to the lower index) to `at` within `radius`

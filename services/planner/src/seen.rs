@@ -1,8 +1,7 @@
 //! Planning around what the fleet has seen (roam's, not paper 000's). The map server's
 //! `inflated` layer is the static map: a pallet left in an aisle is not in it, and a
-//! planner on it alone sends a robot into that aisle again after every replan (the
-//! warehouse fleet live: robots stuck a metre and a half from their pick, their task
-//! given up). A planner with `obstacles_layer` set (the mapper's `occupied_now`, ROS
+//! planner on it alone sends a robot into that pallet again after every replan, until
+//! its task is given up. A planner with `obstacles_layer` set (the mapper's `occupied_now`, ROS
 //! occupancy 0..=100 on the map's grid) also blocks every cell within
 //! `obstacle_inflation_m` of a cell that layer believes occupied
 //! (≥ [`OBSTACLE_AT`]) where the static map has it free. Cells the static map has

@@ -54,11 +54,11 @@ pub(crate) async fn attack(session: &zenoh::Session, root: &str) -> usize {
     // What the controller sends for any robot from now on: nothing, since none of these
     // missions was taken.
     let commands = session
-        .declare_subscriber(format!("{root}/robot/*/cmd"))
+        .declare_subscriber(keys::robot_command_any(root))
         .await
         .expect("subscriber");
     let statuses = session
-        .declare_subscriber(format!("{root}/robot/*/controller"))
+        .declare_subscriber(keys::robot_controller_any(root))
         .await
         .expect("subscriber");
     tokio::time::sleep(Duration::from_secs(3)).await;

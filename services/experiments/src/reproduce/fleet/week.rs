@@ -35,8 +35,30 @@ pub const MAP_SAMPLE_S: f64 = 60.0;
 const SIM_STREAM: u64 = 0x46_4C_45_45_54_5F_53_49;
 
 /// A robot's plan seed (common to every variant).
-pub fn plan_seed(seed: u64, robot: usize) -> u64 {
+fn plan_seed(seed: u64, robot: usize) -> u64 {
     splitmix64(seed ^ splitmix64(0x504C_414E ^ robot as u64))
+}
+
+/// What robot `index` of the shift runs under `variant` with `tasks`: the executive's
+/// configuration the batch and `roam demo --fleet` both give it (its plan seed from the
+/// batch's `seed`, the variant's rules, the PEB cost `w_loc` forgiving `peb_free_m`),
+/// so the two make the same decisions from the same inputs.
+pub fn robot_config(
+    variant: FleetVariant,
+    robot: &str,
+    index: usize,
+    tasks: Vec<roam_mission::tasks::Task>,
+    options: &FleetOptions,
+) -> ExecutiveConfig {
+    let base = ExecutiveConfig {
+        robot: robot.to_owned(),
+        tasks,
+        max_generations: Some(options.generations),
+        seed: plan_seed(options.seed, index),
+        peb_free_m: Some(options.peb_free_m),
+        ..ExecutiveConfig::default()
+    };
+    variant.config(base, options.w_loc, options.model)
 }
 
 /// The planner, the patrol and the mapper as one robot's executive asks them.
@@ -169,17 +191,16 @@ pub fn run_week(
         .robots
         .iter()
         .enumerate()
-        .map(|(i, r)| {
-            let base = ExecutiveConfig {
-                robot: r.robot.clone(),
-                tasks: shift.repeated(r, options.days),
-                max_generations: Some(options.generations),
-                seed: plan_seed(options.seed, i),
-                peb_free_m: Some(options.peb_free_m),
-                planning_cost_s: Some(options.plan_wall_s * options.rate),
-                ..ExecutiveConfig::default()
-            };
-            variant.config(base, options.w_loc, options.model)
+        .map(|(i, r)| ExecutiveConfig {
+            // The batch has no wall clock: a plan costs what the options say.
+            planning_cost_s: Some(options.plan_wall_s * options.rate),
+            ..robot_config(
+                variant,
+                &r.robot,
+                i,
+                shift.repeated(r, options.days),
+                options,
+            )
         })
         .collect();
     let scale = InformationScale {

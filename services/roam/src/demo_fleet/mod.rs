@@ -13,45 +13,39 @@
 //! robots' observations, the controller's status and the mapper's `occupied_now`
 //! layer.
 
-use std::path::{Path, PathBuf};
+mod record;
+mod report;
+
+use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use roam_experiments::reproduce::fleet::events::ChangeLog;
-use roam_experiments::reproduce::fleet::measure::{
-    MapSample, WeekRecord, WindowRecord, PATH_EVERY_STEPS,
-};
+use roam_experiments::reproduce::fleet::measure::{WeekRecord, WindowRecord};
 use roam_experiments::reproduce::fleet::summary::summarize;
-use roam_experiments::reproduce::fleet::week::{plan_seed, MAP_SAMPLE_S};
+use roam_experiments::reproduce::fleet::week::robot_config;
 use roam_experiments::reproduce::fleet::FleetWorld;
-use roam_experiments::reproduce::fleet::{picture, FleetReport, FleetSummary, FleetVariant};
+use roam_experiments::reproduce::fleet::{picture, FleetOptions, FleetReport, FleetVariant};
 use roam_mission::config::ExecutiveConfig;
 use roam_mission::executive::{self, Progress};
 use roam_planner::coupling::Coupling;
-use roam_proto::cells::Cells;
-use roam_proto::controller::{ControllerStatus, MissionState};
-use roam_proto::map::Layer;
-use roam_proto::mapper::OCCUPIED_NOW_LAYER;
+use roam_proto::keys;
 use roam_proto::mission::WindowReport;
 use roam_proto::planner::PlannerModel;
-use roam_proto::sim::SimStatus;
-use roam_proto::sim::{
-    GroundTruth, LocalObservation, ObjectTruth, ObjectsTruth, RobotEventKind, RobotEvents,
-    SimControl,
-};
-use roam_proto::{decode, keys, Message};
+use roam_proto::sim::{SimControl, SimStatus};
 use roam_runtime::{lock, Requester};
 use roam_stack::stack::{Stack, StackOptions};
-use serde::Serialize;
 use tokio::task::JoinSet;
 use tokio_util::sync::CancellationToken;
-use zenoh::pubsub::Subscriber;
 
 use crate::demo::{with_live_view, write_error, DemoError, LiveView, DEMO_W_LOC};
+use record::{listen, sample_maps, Recorder, Shared};
+use report::write_reports;
+pub use report::{FleetDemoReport, LiveGoal};
 
 /// The most robots the live fleet runs: the warehouse shift's ten.
 pub const MAX_FLEET_DEMO_ROBOTS: usize = 10;
-/// The wall time the fleet demo should end within after the build (issue 27).
+/// The wall time the fleet demo should end within once built, seconds.
 pub const FLEET_DEMO_WALL_GOAL_S: f64 = 180.0;
 /// The plan latency p99 the fleet should keep, ms.
 pub const FLEET_DEMO_P99_GOAL_MS: f64 = 1000.0;
@@ -138,260 +132,6 @@ impl FleetDemoOptions {
     }
 }
 
-/// A goal of the live fleet, judged from its figure.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct LiveGoal {
-    pub goal: &'static str,
-    pub figure: Option<f64>,
-    pub at_most: f64,
-    pub met: Option<bool>,
-}
-
-impl LiveGoal {
-    /// `met`, `missed`, or `no figure`.
-    pub fn verdict(&self) -> &'static str {
-        match self.met {
-            Some(true) => "met",
-            Some(false) => "missed",
-            None => "no figure",
-        }
-    }
-
-    fn at_most(goal: &'static str, figure: Option<f64>, at_most: f64) -> LiveGoal {
-        LiveGoal {
-            goal,
-            figure,
-            at_most,
-            met: figure.map(|f| f <= at_most),
-        }
-    }
-}
-
-/// `report.json`.
-#[derive(Debug, Clone, Serialize)]
-pub struct FleetDemoReport {
-    pub robots: usize,
-    pub shift_s: f64,
-    pub sim_rate: f64,
-    pub planners: usize,
-    pub seed: u64,
-    /// Every task of every robot reached no later than its start.
-    pub on_time: bool,
-    /// The run in the batch's figures (variant `news`).
-    pub summary: FleetSummary,
-    pub goals: Vec<LiveGoal>,
-    /// Every window, as each robot's executive reported it.
-    pub windows: Vec<WindowReport>,
-    pub wall_s: f64,
-    pub pictures: Vec<PathBuf>,
-}
-
-/// What the run records from the wire while the executives drive.
-struct Recorder {
-    names: Vec<String>,
-    shift_s: f64,
-    step_s: f64,
-    /// The newest sim time heard.
-    now_s: f64,
-    changes: ChangeLog,
-    landed: Vec<ObjectTruth>,
-    /// Each robot's true positions with their times (the windows' information).
-    truth: Vec<Vec<(f64, [f64; 2])>>,
-    /// Each robot's path for the picture, every [`PATH_EVERY_STEPS`]th step.
-    paths: Vec<Vec<[f64; 2]>>,
-    halted_steps: Vec<u64>,
-    /// Each robot's last controller state and distance left: said when a window is
-    /// given up.
-    last_status: Vec<Option<(MissionState, Option<f64>)>>,
-    /// Each robot's last event from the sim (a collision, a push by a moving obstacle)
-    /// and its step: said with the controller's state when a window is given up.
-    last_event: Vec<Option<(u64, String)>>,
-    plan_latencies_s: Vec<f64>,
-    maps: Vec<MapSample>,
-}
-
-impl Recorder {
-    fn robot(&self, name: &str) -> Option<usize> {
-        self.names.iter().position(|n| n == name)
-    }
-
-    fn truth(&mut self, t: &GroundTruth) {
-        let Some(i) = self.robot(&t.robot) else {
-            return;
-        };
-        self.now_s = self.now_s.max(t.time_s);
-        // A shift's steps at most: the sim runs a little past the last task.
-        let most = (self.shift_s / self.step_s).ceil() as usize + 1024;
-        if self.truth[i].len() < most {
-            self.truth[i].push((t.time_s, t.at));
-        }
-        if t.time_s <= self.shift_s && t.step.is_multiple_of(PATH_EVERY_STEPS) {
-            self.paths[i].push(t.at);
-        }
-    }
-
-    fn window_truth(&self, robot: usize, report: &WindowReport) -> Vec<[f64; 2]> {
-        let end = report.arrival_s.unwrap_or(report.task_start_s);
-        self.truth[robot]
-            .iter()
-            .filter(|(t, _)| *t >= report.began_s && *t <= end)
-            .map(|(_, at)| *at)
-            .collect()
-    }
-}
-
-type Shared = Arc<Mutex<Recorder>>;
-
-fn decoded<T: Message>(sample: &zenoh::sample::Sample) -> Option<T> {
-    decode::<T>(&sample.payload().to_bytes()).ok()
-}
-
-/// A sim event in a few words.
-fn event_name(e: &RobotEventKind) -> String {
-    match e {
-        RobotEventKind::SpeedClipped { .. } => "speed clipped".to_owned(),
-        RobotEventKind::Collision { obstacle, .. } => format!("collision with {obstacle}"),
-        RobotEventKind::Displaced { by, .. } => format!("pushed by {by}"),
-        RobotEventKind::Trapped { by } => format!("trapped by {by}"),
-    }
-}
-
-/// The subscribers that feed the recorder; dropped, they stop.
-async fn listen(
-    session: &zenoh::Session,
-    root: &str,
-    recorder: &Shared,
-) -> Result<Vec<Subscriber<()>>, DemoError> {
-    let zenoh_error = |e: zenoh::Error| DemoError::Zenoh(e.to_string());
-    let mut subscribers = Vec::new();
-    let r = recorder.clone();
-    subscribers.push(
-        session
-            .declare_subscriber(format!("{root}/robot/*/truth"))
-            .callback(move |s| {
-                if let Some(t) = decoded::<GroundTruth>(&s) {
-                    lock(&r).truth(&t);
-                }
-            })
-            .await
-            .map_err(zenoh_error)?,
-    );
-    let r = recorder.clone();
-    subscribers.push(
-        session
-            .declare_subscriber(keys::robot_observation_any(root))
-            .callback(move |s| {
-                if let Some(o) = decoded::<LocalObservation>(&s) {
-                    lock(&r).changes.observe(&o, o.time_s);
-                }
-            })
-            .await
-            .map_err(zenoh_error)?,
-    );
-    let r = recorder.clone();
-    subscribers.push(
-        session
-            .declare_subscriber(keys::sim_objects(root))
-            .callback(move |s| {
-                if let Some(o) = decoded::<ObjectsTruth>(&s) {
-                    let mut r = lock(&r);
-                    r.changes.update(&o.objects, o.time_s);
-                    r.landed = o.objects;
-                }
-            })
-            .await
-            .map_err(zenoh_error)?,
-    );
-    let r = recorder.clone();
-    subscribers.push(
-        session
-            .declare_subscriber(format!("{root}/robot/*/events"))
-            .callback(move |s| {
-                if let Some(e) = decoded::<RobotEvents>(&s) {
-                    let mut r = lock(&r);
-                    if let (Some(i), Some(last)) = (r.robot(&e.robot), e.events.last()) {
-                        r.last_event[i] = Some((e.step, event_name(last)));
-                    }
-                }
-            })
-            .await
-            .map_err(zenoh_error)?,
-    );
-    let r = recorder.clone();
-    subscribers.push(
-        session
-            .declare_subscriber(format!("{root}/robot/*/controller"))
-            .callback(move |s| {
-                if let Some(c) = decoded::<ControllerStatus>(&s) {
-                    let mut r = lock(&r);
-                    if let Some(i) = r.robot(&c.robot) {
-                        if c.state == MissionState::HaltedPeb {
-                            r.halted_steps[i] += 1;
-                        }
-                        r.last_status[i] = Some((c.state, c.distance_left_m));
-                    }
-                }
-            })
-            .await
-            .map_err(zenoh_error)?,
-    );
-    Ok(subscribers)
-}
-
-/// Every sim minute, the mapper's `occupied_now` layer scored against the sim's
-/// objects, as the batch scores its mapper's belief ([`MapSample::score`]).
-async fn sample_maps(
-    requester: Requester,
-    root: String,
-    world: Arc<FleetWorld>,
-    recorder: Shared,
-    cancel: CancellationToken,
-) {
-    let mut next_s = MAP_SAMPLE_S;
-    let key = keys::map_layer(&root, OCCUPIED_NOW_LAYER);
-    loop {
-        tokio::select! {
-            _ = cancel.cancelled() => return,
-            _ = tokio::time::sleep(Duration::from_millis(50)) => {}
-        }
-        let now_s = lock(&recorder).now_s;
-        if now_s < next_s {
-            continue;
-        }
-        next_s += MAP_SAMPLE_S;
-        let Ok(layer) = requester.request::<Layer, Layer>(&key, None).await else {
-            continue;
-        };
-        let belief = belief_on_coarse(&world, &layer);
-        let truth = world.semi_static_truth(&lock(&recorder).landed);
-        if let Ok(sample) = MapSample::score(&world, now_s, &belief, &truth) {
-            lock(&recorder).maps.push(sample);
-        }
-    }
-}
-
-/// The layer's P(occupied now) at each coarse cell's centre (0..=100 → 0..1); a cell
-/// the layer does not cover is 1/2.
-fn belief_on_coarse(world: &FleetWorld, layer: &Layer) -> Vec<f64> {
-    let coarse = world.coarse;
-    let Cells::I8(cells) = &layer.cells else {
-        return vec![0.5; coarse.cell_count() as usize];
-    };
-    let (w, h) = (coarse.width as usize, coarse.height as usize);
-    let mut belief = Vec::with_capacity(w * h);
-    for cy in 0..h {
-        for cx in 0..w {
-            let x = coarse.origin.x + (cx as f64 + 0.5) * coarse.resolution;
-            let y = coarse.origin.y + (cy as f64 + 0.5) * coarse.resolution;
-            let p = roam_world::grid::world_to_cell(&layer.meta, x, y)
-                .and_then(|(lx, ly)| cells.get(ly * layer.meta.width as usize + lx))
-                .map_or(0.5, |&v| f64::from(v.clamp(0, 100)) / 100.0);
-            belief.push(p);
-        }
-    }
-    belief
-}
-
 /// Runs the fleet demo and writes `report.json`, `report.md` and the pictures.
 pub async fn run(
     options: &FleetDemoOptions,
@@ -431,26 +171,27 @@ pub async fn run(
 }
 
 /// The executive's configuration for robot `index` of the shift: the batch's `news`
-/// variant, its seed and PEB cost, the tasks that start within `shift_s`.
+/// variant's ([`robot_config`], W_loc [`DEMO_W_LOC`], the greedy planner), for the tasks
+/// that start within `shift_s`.
 fn executive_config(
     world: &FleetWorld,
     options: &FleetDemoOptions,
     index: usize,
 ) -> ExecutiveConfig {
     let robot = &world.shift.robots[index];
-    let base = ExecutiveConfig {
-        robot: robot.robot.clone(),
-        tasks: robot
-            .tasks
-            .iter()
-            .filter(|t| t.start_s <= options.shift_s)
-            .cloned()
-            .collect(),
-        seed: plan_seed(options.seed, index),
-        peb_free_m: Some(0.0),
-        ..ExecutiveConfig::default()
+    let tasks = robot
+        .tasks
+        .iter()
+        .filter(|t| t.start_s <= options.shift_s)
+        .cloned()
+        .collect();
+    let batch = FleetOptions {
+        seed: options.seed,
+        w_loc: DEMO_W_LOC,
+        model: PlannerModel::Greedy,
+        ..FleetOptions::default()
     };
-    FleetVariant::News.config(base, DEMO_W_LOC, PlannerModel::Greedy)
+    robot_config(FleetVariant::News, &robot.robot, index, tasks, &batch)
 }
 
 async fn drive(
@@ -564,11 +305,15 @@ async fn drive(
                     Ok((index, Ok(outcomes))) => {
                         reports.extend(outcomes.into_iter().map(|o| (index, o.report)));
                     }
+                    // One executive failing fails the run: the others stop now
+                    // rather than drive on for a report that will not be written.
                     Ok((index, Err(e))) => {
                         failed.get_or_insert(format!("{}: {e}", names[index]));
+                        cancel.cancel();
                     }
                     Err(e) => {
                         failed.get_or_insert(format!("an executive stopped: {e}"));
+                        cancel.cancel();
                     }
                 }
             }
@@ -648,50 +393,6 @@ async fn drive(
     Ok(report)
 }
 
-fn write_reports(dir: &Path, report: &FleetDemoReport, table: &str) -> Result<(), DemoError> {
-    let json_path = dir.join("report.json");
-    let json = serde_json::to_string_pretty(report).map_err(|e| write_error(&json_path, e))?;
-    std::fs::write(&json_path, json).map_err(|e| write_error(&json_path, e))?;
-    let md_path = dir.join("report.md");
-    std::fs::write(&md_path, markdown(report, table)).map_err(|e| write_error(&md_path, e))?;
-    Ok(())
-}
-
-fn markdown(r: &FleetDemoReport, table: &str) -> String {
-    let mut out = format!(
-        "# roam demo --fleet\n\n{} robots in the warehouse (`world.yaml`), each with its own mission executive, the first {:.0} s of their shift, the sim at {}x, {} planners on the fleet's news (seed {}), {:.1} s of wall time.\n\n",
-        r.robots, r.shift_s, r.sim_rate, r.planners, r.seed, r.wall_s
-    );
-    out.push_str("Measured as `roam reproduce fleet` measures a week (its `news` variant):\n\n");
-    out.push_str(table);
-    out.push_str("\n| goal | figure | at most | verdict |\n|---|---|---|---|\n");
-    for g in &r.goals {
-        out.push_str(&format!(
-            "| {} | {} | {} | {} |\n",
-            g.goal,
-            g.figure.map_or("-".to_owned(), |f| format!("{f:.1}")),
-            g.at_most,
-            g.verdict()
-        ));
-    }
-    out.push_str("\n| robot | window | task | task starts s | arrived s | on time | replans | holds |\n|---|---|---|---|---|---|---|---|\n");
-    for w in &r.windows {
-        out.push_str(&format!(
-            "| {} | {} | {} | {:.1} | {} | {} | {} | {} |\n",
-            w.robot,
-            w.window + 1,
-            w.task,
-            w.task_start_s,
-            w.arrival_s.map_or("-".to_owned(), |a| format!("{a:.1}")),
-            if w.on_time { "yes" } else { "no" },
-            w.replans,
-            w.holds,
-        ));
-    }
-    out.push_str("\n![the warehouse with each robot's driven path](warehouse-news.svg)\n\n![detection latency over the run](detection.svg)\n");
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -749,27 +450,5 @@ mod tests {
                 other => panic!("{field}: {other:?}"),
             }
         }
-    }
-
-    #[test]
-    fn the_belief_is_read_at_each_coarse_cells_centre() {
-        let Ok(world) = FleetWorld::warehouse() else {
-            panic!("the built-in warehouse loads");
-        };
-        let meta = world.coarse;
-        let n = meta.cell_count() as usize;
-        let mut cells = vec![0i8; n];
-        cells[n - 1] = 100;
-        let layer = Layer {
-            name: OCCUPIED_NOW_LAYER.into(),
-            version: 1,
-            meta,
-            derived_from: None,
-            cells: Cells::I8(cells),
-        };
-        let belief = belief_on_coarse(&world, &layer);
-        assert_eq!(belief.len(), n);
-        assert_eq!(belief[n - 1], 1.0);
-        assert_eq!(belief[0], 0.0);
     }
 }
