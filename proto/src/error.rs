@@ -83,6 +83,27 @@ pub struct ErrorReply {
     /// instance or retry then.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub expected_wait_s: Option<f64>,
+    /// What in the request the refusal is about, where a client may branch on it (a
+    /// plan's start or goal off the map or blocked): the message says it to a person,
+    /// this says it to a program (roam's ROS 2 node maps it to Nav2's error codes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cause: Option<Cause>,
+}
+
+/// What a refused plan request is wrong about ([`ErrorReply::cause`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Cause {
+    /// The start is outside the map (or not a finite position).
+    StartOffMap,
+    /// The goal is outside the map (or not a finite position).
+    GoalOffMap,
+    /// The start is in an obstacle, its inflation or unknown space.
+    StartBlocked,
+    /// The goal is in an obstacle, its inflation or unknown space.
+    GoalBlocked,
+    /// Both ends are free, but no path joins them.
+    NoPath,
 }
 
 impl ErrorReply {
@@ -92,7 +113,14 @@ impl ErrorReply {
             message: message.into(),
             limit: None,
             expected_wait_s: None,
+            cause: None,
         }
+    }
+
+    /// The same reply with what in the request it is about (see `cause`).
+    pub fn with_cause(mut self, cause: Cause) -> Self {
+        self.cause = Some(cause);
+        self
     }
 
     /// The same reply with another code (e.g. `busy` for a limit on work in flight).
@@ -122,6 +150,7 @@ impl ErrorReply {
                 actual,
             }),
             expected_wait_s: None,
+            cause: None,
         }
     }
 }

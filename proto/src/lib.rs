@@ -22,5 +22,5 @@ pub mod planner;
 pub mod sim;
 
 pub use codec::{decode, encode, DecodeError, Message, PROTOCOL_VERSION};
-pub use error::{ErrorCode, ErrorReply, LimitHit};
+pub use error::{Cause, ErrorCode, ErrorReply, LimitHit};
 pub use excerpt::{excerpt, number, Excerpt, Number};

@@ -7,7 +7,7 @@ use roam_proto::map::{
     CellWrite, DeleteLayer, GridMeta, Layer, LayerChange, LayerDeleted, LayerInfo, LayerList,
     LayerUpdate, LoadMap, Origin, UpdateAck,
 };
-use roam_proto::{decode, encode, DecodeError, ErrorCode, ErrorReply, LimitHit, Message};
+use roam_proto::{decode, encode, Cause, DecodeError, ErrorCode, ErrorReply, LimitHit, Message};
 
 fn finite() -> impl Strategy<Value = f64> {
     -1.0e6..1.0e6f64
@@ -105,12 +105,20 @@ fn error_reply() -> impl Strategy<Value = ErrorReply> {
             actual,
         }),
     );
-    (code, ".{0,80}", limit, prop::option::of(0.0..1e6f64)).prop_map(
-        |(code, message, limit, expected_wait_s)| ErrorReply {
+    let cause = prop::option::of(prop::sample::select(vec![
+        Cause::StartOffMap,
+        Cause::GoalOffMap,
+        Cause::StartBlocked,
+        Cause::GoalBlocked,
+        Cause::NoPath,
+    ]));
+    (code, ".{0,80}", limit, prop::option::of(0.0..1e6f64), cause).prop_map(
+        |(code, message, limit, expected_wait_s, cause)| ErrorReply {
             code,
             message,
             limit,
             expected_wait_s,
+            cause,
         },
     )
 }

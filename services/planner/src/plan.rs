@@ -23,7 +23,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use roam_proto::planner::{FitnessTerms, PlannerModel, ShortestPathUse, StopReason};
-use roam_proto::{number, ErrorCode, ErrorReply};
+use roam_proto::{number, Cause, ErrorCode, ErrorReply};
 
 use crate::best::{ranked, PlanSource, Scored};
 use crate::curiosity::{Evaluation, Evaluator, Model};
@@ -187,8 +187,20 @@ pub enum PlanError {
 impl PlanError {
     pub fn to_reply(&self) -> ErrorReply {
         let message = self.to_string();
+        let end = |which: &str, start: Cause, goal: Cause| {
+            let cause = if which == "start" { start } else { goal };
+            ErrorReply::new(ErrorCode::InvalidRequest, message.clone()).with_cause(cause)
+        };
         match self {
-            PlanError::NoPath => ErrorReply::new(ErrorCode::NotFound, message),
+            PlanError::NoPath => {
+                ErrorReply::new(ErrorCode::NotFound, message).with_cause(Cause::NoPath)
+            }
+            PlanError::OffMap { which, .. } => end(which, Cause::StartOffMap, Cause::GoalOffMap),
+            PlanError::Blocked { which, .. } => end(which, Cause::StartBlocked, Cause::GoalBlocked),
+            // Free, but joined to nothing: no path, whichever end it is.
+            PlanError::Pocket { .. } | PlanError::Enclosed { .. } => {
+                ErrorReply::new(ErrorCode::InvalidRequest, message).with_cause(Cause::NoPath)
+            }
             PlanError::Limit(limit) => {
                 let (max, actual) = limit.max_actual();
                 ErrorReply::limit(limit.name(), max, actual, message)

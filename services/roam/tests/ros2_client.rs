@@ -236,3 +236,71 @@ fn a_ros2_client_follows_the_demos_robot() {
         "{seen}"
     );
 }
+
+/// Nav2's side of `roam stack --ros2`: the independent client sends
+/// `nav2_msgs/action/ComputePathToPose` goals the way rcl_action does (on keys it builds
+/// from rosbags' hashes) and checks Nav2's statuses and error codes (a good goal, the
+/// fastest path, one from the robot's pose, one in a wall, off the map, NaN, in another
+/// frame, to an unknown planner, a cancelled one), the latched status topic, and `/tf`
+/// against the robot's estimates. roam's side: the cancel reached the planner.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_nav2_client_computes_paths_and_finds_the_robot_on_tf() {
+    if !python_has(
+        "zenoh, zenoh.ext, rosbags",
+        "a_nav2_client_computes_paths_and_finds_the_robot_on_tf",
+        "eclipse-zenoh==1.10.2 rosbags==0.11.9",
+    ) {
+        return;
+    }
+    let port = free_loopback_port().expect("port");
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let root = format!("nav2-{}", std::process::id());
+    let _stack = RoamProcess::start(
+        &["stack", "--ros2", "--listen", &endpoint],
+        &root,
+        "roam stack up",
+    );
+    let session = roam_runtime::session::open(
+        SessionArgs::client_of(&endpoint)
+            .zenoh_config(None)
+            .expect("config"),
+    )
+    .await
+    .expect("session");
+    let cancels = session
+        .declare_subscriber(keys::planner_cancel_any(&root))
+        .await
+        .expect("cancel subscriber");
+
+    let connect = endpoint.clone();
+    let run = tokio::task::spawn_blocking(move || {
+        python(&["nav2", "--connect", &connect, "--robot", "robot"])
+    })
+    .await
+    .expect("python");
+    assert!(run.status.success(), "ros2_client.py nav2 failed: {run:?}");
+    let out: serde_json::Value = serde_json::from_str(&run.stdout).expect("json");
+    eprintln!("nav2 client: {out}");
+    let goals = &out["goals"];
+    for succeeded in ["curious", "grid_based", "from_the_robot"] {
+        assert!(goals[succeeded]["poses"].as_u64() >= Some(2), "{out}");
+    }
+    for (aborted, code) in [
+        ("in_a_wall", "GOAL_OCCUPIED"),
+        ("off_the_map", "GOAL_OUTSIDE_MAP"),
+        ("start_off_the_map", "START_OUTSIDE_MAP"),
+        ("nan", "GOAL_OUTSIDE_MAP"),
+        ("other_frame", "TF_ERROR"),
+        ("unknown_planner", "INVALID_PLANNER"),
+    ] {
+        assert_eq!(goals[aborted]["error_code"], code, "{out}");
+    }
+    assert!(out["tf"]["matched"].as_u64() >= Some(1), "{out}");
+    // The cancelled goal's plan was cancelled at the planner, on roam's own key.
+    let cancel = cancels.try_recv().expect("subscriber");
+    assert!(
+        cancel.is_some(),
+        "no cancel reached <root>/planner/cancel/*"
+    );
+    let _ = session.close().await;
+}

@@ -13,7 +13,7 @@ use roam_proto::{ErrorCode, ErrorReply};
 use crate::msg::{
     Covariance, Header, MapMetaData, OccupancyGrid, Path, PlanDowntimeRequest,
     PlanDowntimeResponse, Point, Pose, PoseStamped, PoseWithCovariance, PoseWithCovarianceStamped,
-    Quaternion, Time,
+    Quaternion, TfMessage, Time, Transform, TransformStamped, Vector3,
 };
 
 /// The one frame roam publishes in.
@@ -301,30 +301,73 @@ pub fn estimate_pose(estimate: &PositionEstimate, stamp: Time) -> PoseWithCovari
     }
 }
 
-/// A pose's position, checked: finite, and in frame `map` (or no frame).
-fn position(what: &str, pose: &PoseStamped) -> Result<[f64; 2], ErrorReply> {
+/// A robot's body frame under `/tf`: `<robot>/base_link` (REP-105's name, prefixed by
+/// the robot as multi-robot Nav2 setups do).
+pub fn base_link(robot: &str) -> String {
+    format!("{robot}/base_link")
+}
+
+/// An estimate as the transform `map → <robot>/base_link`: the position, z 0, and the
+/// identity rotation (roam's estimates are positions; the heading is not estimated).
+pub fn estimate_transform(robot: &str, estimate: &PositionEstimate, stamp: Time) -> TfMessage {
+    TfMessage {
+        transforms: vec![TransformStamped {
+            header: header(stamp),
+            child_frame_id: base_link(robot),
+            transform: Transform {
+                translation: Vector3 {
+                    x: estimate.position[0],
+                    y: estimate.position[1],
+                    z: 0.0,
+                },
+                rotation: Quaternion::default(),
+            },
+        }],
+    }
+}
+
+/// Why a pose from ROS 2 is not a position roam can plan with.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum PoseError {
+    /// In a frame other than `map`.
+    Frame(String),
+    /// Not finite coordinates.
+    NotFinite(String),
+}
+
+impl PoseError {
+    pub fn message(&self) -> &str {
+        match self {
+            PoseError::Frame(m) | PoseError::NotFinite(m) => m,
+        }
+    }
+}
+
+/// A pose's position, checked: finite, and in frame `map` (or no frame); `what` names
+/// it in the error (`start`, `goal`).
+pub fn pose_position(what: &str, pose: &PoseStamped) -> Result<[f64; 2], PoseError> {
     let frame = pose.header.frame_id.as_str();
     if !(frame.is_empty() || frame == FRAME || frame == "/map") {
-        return Err(ErrorReply::new(
-            ErrorCode::InvalidRequest,
-            format!(
-                "{what} is in frame '{}'; roam plans in frame 'map' (give poses in 'map')",
-                roam_proto::excerpt::excerpt_n(frame, 64)
-            ),
-        ));
+        return Err(PoseError::Frame(format!(
+            "{what} is in frame '{}'; roam plans in frame 'map' (give poses in 'map')",
+            roam_proto::excerpt::excerpt_n(frame, 64)
+        )));
     }
     let p = pose.pose.position;
     if !(p.x.is_finite() && p.y.is_finite()) {
-        return Err(ErrorReply::new(
-            ErrorCode::InvalidRequest,
-            format!(
-                "{what} must be finite coordinates in metres, got ({}, {})",
-                roam_proto::number(p.x),
-                roam_proto::number(p.y)
-            ),
-        ));
+        return Err(PoseError::NotFinite(format!(
+            "{what} must be finite coordinates in metres, got ({}, {})",
+            roam_proto::number(p.x),
+            roam_proto::number(p.y)
+        )));
     }
     Ok([p.x, p.y])
+}
+
+/// [`pose_position`], refused as an invalid request.
+fn position(what: &str, pose: &PoseStamped) -> Result<[f64; 2], ErrorReply> {
+    pose_position(what, pose)
+        .map_err(|e| ErrorReply::new(ErrorCode::InvalidRequest, e.message().to_owned()))
 }
 
 /// The deadline a PlanDowntime request without one (0) gets, seconds.

@@ -29,6 +29,7 @@ fn type_id(field: &OwnedField) -> u32 {
         Base::Nested(_) => 1,
         Base::Int8 => 2,
         Base::Uint8 => 3,
+        Base::Uint16 => 5,
         Base::Int32 => 6,
         Base::Uint32 => 7,
         Base::Int64 => 8,

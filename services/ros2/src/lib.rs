@@ -10,10 +10,12 @@
 //!   33-byte attachment;
 //! - [`convert`]: roam's layers, plans and estimates as ROS messages, and a ROS map and
 //!   plan request as roam's;
-//! - [`bag`]: a rosbag2 recording (MCAP, profile `ros2`).
+//! - [`bag`]: a rosbag2 recording (MCAP, profile `ros2`);
+//! - [`action`]: an action server's goals, states and cancel rules.
 //!
 //! With the default feature `zenoh`, [`node`] is the thin adapter: the `roam ros2` role.
 
+pub mod action;
 pub mod attachment;
 pub mod bag;
 pub mod cdr;

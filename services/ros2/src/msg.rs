@@ -217,6 +217,186 @@ pub struct PlanDowntimeResponse {
     pub error_message: String,
 }
 
+/// builtin_interfaces/msg/Duration.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Duration {
+    pub sec: i32,
+    pub nanosec: u32,
+}
+
+impl Duration {
+    /// A duration from seconds (negative and NaN as 0; saturating at `i32::MAX` s).
+    pub fn from_secs_f64(seconds: f64) -> Duration {
+        let ns = (seconds.max(0.0) * 1e9).min(f64::from(i32::MAX) * 1e9);
+        let ns = if ns.is_finite() { ns as i64 } else { 0 };
+        Duration {
+            sec: (ns / 1_000_000_000) as i32,
+            nanosec: (ns % 1_000_000_000) as u32,
+        }
+    }
+}
+
+/// unique_identifier_msgs/msg/UUID: an action goal's id.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct Uuid {
+    pub uuid: [u8; 16],
+}
+
+/// action_msgs/msg/GoalInfo.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct GoalInfo {
+    pub goal_id: Uuid,
+    pub stamp: Time,
+}
+
+/// action_msgs/msg/GoalStatus.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct GoalStatus {
+    pub goal_info: GoalInfo,
+    /// One of [`GoalState`]'s values.
+    pub status: i8,
+}
+
+/// action_msgs/msg/GoalStatus's `status` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(i8)]
+pub enum GoalState {
+    Unknown = 0,
+    Accepted = 1,
+    Executing = 2,
+    Canceling = 3,
+    Succeeded = 4,
+    Canceled = 5,
+    Aborted = 6,
+}
+
+impl GoalState {
+    /// Succeeded, canceled or aborted: the goal's result is final.
+    pub fn is_terminal(self) -> bool {
+        matches!(
+            self,
+            GoalState::Succeeded | GoalState::Canceled | GoalState::Aborted
+        )
+    }
+}
+
+/// action_msgs/msg/GoalStatusArray: an action server's `_action/status` topic.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct GoalStatusArray {
+    pub status_list: Vec<GoalStatus>,
+}
+
+/// action_msgs/srv/CancelGoal's request: a goal id, a stamp, both or neither (all).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CancelGoalRequest {
+    pub goal_info: GoalInfo,
+}
+
+/// action_msgs/srv/CancelGoal's response.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CancelGoalResponse {
+    /// One of the `CANCEL_*` codes.
+    pub return_code: i8,
+    pub goals_canceling: Vec<GoalInfo>,
+}
+
+/// CancelGoal's return codes (action_msgs/srv/CancelGoal's constants).
+pub const CANCEL_NONE: i8 = 0;
+pub const CANCEL_REJECTED: i8 = 1;
+pub const CANCEL_UNKNOWN_GOAL_ID: i8 = 2;
+pub const CANCEL_GOAL_TERMINATED: i8 = 3;
+
+/// nav2_msgs/action/ComputePathToPose's goal.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ComputePathGoal {
+    pub goal: PoseStamped,
+    pub start: PoseStamped,
+    pub planner_id: String,
+    /// False: plan from the robot's current pose.
+    pub use_start: bool,
+}
+
+/// nav2_msgs/action/ComputePathToPose's result.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ComputePathResult {
+    pub path: Path,
+    pub planning_time: Duration,
+    /// 0, or one of [`Nav2Error`]'s codes.
+    pub error_code: u16,
+    pub error_msg: String,
+}
+
+/// nav2_msgs/action/ComputePathToPose's error codes (Jazzy's Result constants).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u16)]
+pub enum Nav2Error {
+    Unknown = 200,
+    InvalidPlanner = 201,
+    TfError = 202,
+    StartOutsideMap = 203,
+    GoalOutsideMap = 204,
+    StartOccupied = 205,
+    GoalOccupied = 206,
+    Timeout = 207,
+    NoValidPath = 208,
+}
+
+/// The action's `_action/send_goal` request.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ComputePathSendGoalRequest {
+    pub goal_id: Uuid,
+    pub goal: ComputePathGoal,
+}
+
+/// The action's `_action/send_goal` response.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SendGoalResponse {
+    pub accepted: bool,
+    pub stamp: Time,
+}
+
+/// The action's `_action/get_result` request.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct GetResultRequest {
+    pub goal_id: Uuid,
+}
+
+/// The action's `_action/get_result` response.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ComputePathGetResultResponse {
+    pub status: i8,
+    pub result: ComputePathResult,
+}
+
+/// geometry_msgs/msg/Vector3.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Vector3 {
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+}
+
+/// geometry_msgs/msg/Transform.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Transform {
+    pub translation: Vector3,
+    pub rotation: Quaternion,
+}
+
+/// geometry_msgs/msg/TransformStamped: `child_frame_id` in `header.frame_id`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TransformStamped {
+    pub header: Header,
+    pub child_frame_id: String,
+    pub transform: Transform,
+}
+
+/// tf2_msgs/msg/TFMessage: what `/tf` and `/tf_static` carry.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct TfMessage {
+    pub transforms: Vec<TransformStamped>,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -226,6 +406,19 @@ mod tests {
         for yaw in [0.0, 0.5, -1.2, 3.0] {
             assert!((Quaternion::from_yaw(yaw).yaw() - yaw).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn durations_are_seconds_and_nanoseconds() {
+        assert_eq!(
+            Duration::from_secs_f64(1.25),
+            Duration {
+                sec: 1,
+                nanosec: 250_000_000
+            }
+        );
+        assert_eq!(Duration::from_secs_f64(f64::NAN), Duration::default());
+        assert_eq!(Duration::from_secs_f64(-3.0), Duration::default());
     }
 
     #[test]

@@ -95,6 +95,12 @@ impl Qos {
     };
     /// A service (rmw's services profile): reliable, volatile, depth 10.
     pub const SERVICE: Qos = Qos::STREAM;
+    /// `/tf` (tf2_ros' `DynamicBroadcasterQoS`): reliable, volatile, depth 100.
+    pub const TF: Qos = Qos {
+        reliability: Reliability::Reliable,
+        durability: Durability::Volatile,
+        depth: 100,
+    };
 
     /// The token's QoS field.
     pub fn keyexpr(&self) -> String {

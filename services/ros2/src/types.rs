@@ -14,6 +14,7 @@
 pub enum Base {
     Int8,
     Uint8,
+    Uint16,
     Int32,
     Uint32,
     Int64,
@@ -64,7 +65,9 @@ const fn shaped(name: &'static str, base: Base, shape: Shape) -> Field {
     Field { name, base, shape }
 }
 
-use Base::{Bool, Char, Float32, Float64, Int32, Int64, Int8, Nested, Uint32, Uint64, Uint8};
+use Base::{
+    Bool, Char, Float32, Float64, Int32, Int64, Int8, Nested, Uint16, Uint32, Uint64, Uint8,
+};
 
 pub const TIME: &str = "builtin_interfaces/msg/Time";
 pub const HEADER: &str = "std_msgs/msg/Header";
@@ -80,6 +83,27 @@ pub const PATH: &str = "nav_msgs/msg/Path";
 pub const SERVICE_EVENT_INFO: &str = "service_msgs/msg/ServiceEventInfo";
 pub const GET_PLAN: &str = "nav_msgs/srv/GetPlan";
 pub const PLAN_DOWNTIME: &str = "roam_interfaces/srv/PlanDowntime";
+pub const DURATION: &str = "builtin_interfaces/msg/Duration";
+pub const UUID: &str = "unique_identifier_msgs/msg/UUID";
+pub const GOAL_INFO: &str = "action_msgs/msg/GoalInfo";
+pub const GOAL_STATUS: &str = "action_msgs/msg/GoalStatus";
+pub const GOAL_STATUS_ARRAY: &str = "action_msgs/msg/GoalStatusArray";
+pub const CANCEL_GOAL: &str = "action_msgs/srv/CancelGoal";
+pub const VECTOR3: &str = "geometry_msgs/msg/Vector3";
+pub const TRANSFORM: &str = "geometry_msgs/msg/Transform";
+pub const TRANSFORM_STAMPED: &str = "geometry_msgs/msg/TransformStamped";
+pub const TF_MESSAGE: &str = "tf2_msgs/msg/TFMessage";
+/// Nav2's planner action, and the parts rosidl generates for it: the goal, result and
+/// feedback messages, the feedback message with its goal id, and the two services
+/// (`_SendGoal`, `_GetResult`) an action is made of on the wire.
+pub const COMPUTE_PATH_TO_POSE: &str = "nav2_msgs/action/ComputePathToPose";
+pub const COMPUTE_PATH_GOAL: &str = "nav2_msgs/action/ComputePathToPose_Goal";
+pub const COMPUTE_PATH_RESULT: &str = "nav2_msgs/action/ComputePathToPose_Result";
+pub const COMPUTE_PATH_FEEDBACK: &str = "nav2_msgs/action/ComputePathToPose_Feedback";
+pub const COMPUTE_PATH_FEEDBACK_MESSAGE: &str =
+    "nav2_msgs/action/ComputePathToPose_FeedbackMessage";
+pub const COMPUTE_PATH_SEND_GOAL: &str = "nav2_msgs/action/ComputePathToPose_SendGoal";
+pub const COMPUTE_PATH_GET_RESULT: &str = "nav2_msgs/action/ComputePathToPose_GetResult";
 
 /// Every message definition, dependencies included.
 pub const MESSAGES: &[MsgDef] = &[
@@ -155,6 +179,115 @@ pub const MESSAGES: &[MsgDef] = &[
         ],
     },
     MsgDef {
+        name: DURATION,
+        fields: &[f("sec", Int32), f("nanosec", Uint32)],
+    },
+    MsgDef {
+        name: UUID,
+        fields: &[shaped("uuid", Uint8, Shape::Array(16))],
+    },
+    MsgDef {
+        name: GOAL_INFO,
+        fields: &[f("goal_id", Nested(UUID)), f("stamp", Nested(TIME))],
+    },
+    MsgDef {
+        name: GOAL_STATUS,
+        fields: &[f("goal_info", Nested(GOAL_INFO)), f("status", Int8)],
+    },
+    MsgDef {
+        name: GOAL_STATUS_ARRAY,
+        fields: &[shaped("status_list", Nested(GOAL_STATUS), Shape::Unbounded)],
+    },
+    MsgDef {
+        name: "action_msgs/srv/CancelGoal_Request",
+        fields: &[f("goal_info", Nested(GOAL_INFO))],
+    },
+    MsgDef {
+        name: "action_msgs/srv/CancelGoal_Response",
+        fields: &[
+            f("return_code", Int8),
+            shaped("goals_canceling", Nested(GOAL_INFO), Shape::Unbounded),
+        ],
+    },
+    MsgDef {
+        name: VECTOR3,
+        fields: &[f("x", Float64), f("y", Float64), f("z", Float64)],
+    },
+    MsgDef {
+        name: TRANSFORM,
+        fields: &[
+            f("translation", Nested(VECTOR3)),
+            f("rotation", Nested(QUATERNION)),
+        ],
+    },
+    MsgDef {
+        name: TRANSFORM_STAMPED,
+        fields: &[
+            f("header", Nested(HEADER)),
+            f("child_frame_id", Base::String),
+            f("transform", Nested(TRANSFORM)),
+        ],
+    },
+    MsgDef {
+        name: TF_MESSAGE,
+        fields: &[shaped(
+            "transforms",
+            Nested(TRANSFORM_STAMPED),
+            Shape::Unbounded,
+        )],
+    },
+    // nav2_msgs/action/ComputePathToPose (Jazzy), less its error-code constants.
+    MsgDef {
+        name: COMPUTE_PATH_GOAL,
+        fields: &[
+            f("goal", Nested(POSE_STAMPED)),
+            f("start", Nested(POSE_STAMPED)),
+            f("planner_id", Base::String),
+            f("use_start", Bool),
+        ],
+    },
+    MsgDef {
+        name: COMPUTE_PATH_RESULT,
+        fields: &[
+            f("path", Nested(PATH)),
+            f("planning_time", Nested(DURATION)),
+            f("error_code", Uint16),
+            f("error_msg", Base::String),
+        ],
+    },
+    // An empty feedback: rosidl gives every empty structure this one member, and the
+    // type description (so the hash) and the CDR both carry it.
+    MsgDef {
+        name: COMPUTE_PATH_FEEDBACK,
+        fields: &[f("structure_needs_at_least_one_member", Uint8)],
+    },
+    MsgDef {
+        name: COMPUTE_PATH_FEEDBACK_MESSAGE,
+        fields: &[
+            f("goal_id", Nested(UUID)),
+            f("feedback", Nested(COMPUTE_PATH_FEEDBACK)),
+        ],
+    },
+    MsgDef {
+        name: "nav2_msgs/action/ComputePathToPose_SendGoal_Request",
+        fields: &[
+            f("goal_id", Nested(UUID)),
+            f("goal", Nested(COMPUTE_PATH_GOAL)),
+        ],
+    },
+    MsgDef {
+        name: "nav2_msgs/action/ComputePathToPose_SendGoal_Response",
+        fields: &[f("accepted", Bool), f("stamp", Nested(TIME))],
+    },
+    MsgDef {
+        name: "nav2_msgs/action/ComputePathToPose_GetResult_Request",
+        fields: &[f("goal_id", Nested(UUID))],
+    },
+    MsgDef {
+        name: "nav2_msgs/action/ComputePathToPose_GetResult_Response",
+        fields: &[f("status", Int8), f("result", Nested(COMPUTE_PATH_RESULT))],
+    },
+    MsgDef {
         name: SERVICE_EVENT_INFO,
         fields: &[
             f("event_type", Uint8),
@@ -203,7 +336,13 @@ pub const MESSAGES: &[MsgDef] = &[
 /// The services: their full names; each has `<name>_Request` and `<name>_Response` in
 /// [`MESSAGES`], and rosidl's `<name>_Event` and the service's own description are
 /// built from them ([`crate::hash::service_type_hash`]).
-pub const SERVICES: &[&str] = &[GET_PLAN, PLAN_DOWNTIME];
+pub const SERVICES: &[&str] = &[
+    GET_PLAN,
+    PLAN_DOWNTIME,
+    CANCEL_GOAL,
+    COMPUTE_PATH_SEND_GOAL,
+    COMPUTE_PATH_GET_RESULT,
+];
 
 /// The definition of message `name`, if roam knows it.
 pub fn message(name: &str) -> Option<&'static MsgDef> {
@@ -228,6 +367,7 @@ fn msg_type_text(field: &Field) -> String {
     let base = match field.base {
         Int8 => "int8".to_owned(),
         Uint8 => "uint8".to_owned(),
+        Uint16 => "uint16".to_owned(),
         Int32 => "int32".to_owned(),
         Uint32 => "uint32".to_owned(),
         Int64 => "int64".to_owned(),

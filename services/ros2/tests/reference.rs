@@ -116,3 +116,50 @@ fn the_service_hashes_are_rosbags_s() {
         Ok("RIHS01_234f7aff100f5edb8150366601687b027bcdc253db47decb88fff846193fe5e8")
     );
 }
+
+/// Nav2's planner action and tf2's message, hashed by rosbags (the action's services
+/// built as rosidl builds them, as for roam's own services above).
+/// `action_msgs/msg/GoalStatusArray`'s hash is also the one ROS 2 Jazzy publishes.
+#[test]
+fn the_action_and_tf_hashes_are_rosbags_s() {
+    for (service, rosbags) in [
+        (
+            types::COMPUTE_PATH_SEND_GOAL,
+            "RIHS01_e800806a220935f225495784663dfdd78b509335309a5127ed1112f6ce6b9dbc",
+        ),
+        (
+            types::COMPUTE_PATH_GET_RESULT,
+            "RIHS01_386ab12c2f62a441596ef1140b3beca654a957eaac87e769c10de01b0e28208f",
+        ),
+        (
+            types::CANCEL_GOAL,
+            "RIHS01_573d8b0a534451d7bc2ac8c5ffde8ac14b8593b7001175d0cd6516dcbeb8689a",
+        ),
+    ] {
+        assert_eq!(
+            hash::service_type_hash(service).as_deref(),
+            Ok(rosbags),
+            "{service}"
+        );
+    }
+    for (message, rosbags) in [
+        (
+            types::COMPUTE_PATH_FEEDBACK_MESSAGE,
+            "RIHS01_a086c8f040554ab5883b433bded128a1d1a732d21ca57596b7fdbe7ad2d0b64a",
+        ),
+        (
+            types::GOAL_STATUS_ARRAY,
+            "RIHS01_6c1684b00f177d37438febe6e709fc4e2b0d4248dca4854946f9ed8b30cda83e",
+        ),
+        (
+            types::TF_MESSAGE,
+            "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087",
+        ),
+    ] {
+        assert_eq!(
+            hash::message_type_hash(message).as_deref(),
+            Ok(rosbags),
+            "{message}"
+        );
+    }
+}

@@ -4,6 +4,7 @@ message implementation: CDR, RIHS01 hashes, rosbag2 reading).
 
     python3 ros2_client.py live --connect tcp/127.0.0.1:7447 --robot r1 --waypoints '[[..]]'
     python3 ros2_client.py watch --connect tcp/127.0.0.1:7447 --robot robot
+    python3 ros2_client.py nav2 --connect tcp/127.0.0.1:7447 --robot r1
     python3 ros2_client.py bag DIR
 
 `live` finds roam's liveliness tokens, subscribes to /map and /<robot>/plan as
@@ -12,7 +13,11 @@ publishers' caches), checks the attachments, calls /roam/plan_downtime and
 /roam/get_plan with rmw_zenoh's query conventions (good and bad requests), and prints
 one JSON object (the map's cells in hex, for the caller to compare with the map
 server's layer). `watch` follows a robot that roam drives (the demo): /map, the
-robot's /<robot>/plan and its /<robot>/pose with the CRB as covariance. `bag` reads a
+robot's /<robot>/plan and its /<robot>/pose with the CRB as covariance. `nav2` is a Nav2
+client: it sends nav2_msgs/action/ComputePathToPose goals (good ones, and ones in a wall,
+off the map, in another frame, to an unknown planner, cancelled) with rcl_action's
+services on keys built from rosbags' hashes, checks Nav2's status and error codes, the
+latched status topic, and /tf against the robot's estimates. `bag` reads a
 rosbag2 directory and prints its topics and counts.
 Exit code 0 when every check passed; 1 with the failed check on stderr otherwise.
 """
@@ -291,6 +296,248 @@ def live(args):
     print(json.dumps(out))
 
 
+NAV2 = 'nav2_msgs/action/ComputePathToPose'
+STATUS = {'unknown': 0, 'accepted': 1, 'executing': 2, 'canceling': 3, 'succeeded': 4,
+          'canceled': 5, 'aborted': 6}
+NAV2_ERRORS = {'NONE': 0, 'UNKNOWN': 200, 'INVALID_PLANNER': 201, 'TF_ERROR': 202,
+               'START_OUTSIDE_MAP': 203, 'GOAL_OUTSIDE_MAP': 204, 'START_OCCUPIED': 205,
+               'GOAL_OCCUPIED': 206, 'TIMEOUT': 207, 'NO_VALID_PATH': 208}
+
+
+def action_store():
+    """nav2_msgs/action/ComputePathToPose from Nav2 Jazzy's .action text, with the parts
+    rosidl generates for an action (SendGoal and GetResult services, FeedbackMessage) and
+    action_msgs/srv/CancelGoal, in a type store where services hash as rosidl hashes
+    them (ServiceEventInfo's char[16] as uint8)."""
+    base = get_typestore(Stores.ROS2_JAZZY)
+    store = get_typestore(Stores.EMPTY)
+    store.register({k: base.fielddefs[k] for k in [
+        'builtin_interfaces/msg/Time', 'builtin_interfaces/msg/Duration', 'std_msgs/msg/Header',
+        'geometry_msgs/msg/Point', 'geometry_msgs/msg/Quaternion', 'geometry_msgs/msg/Pose',
+        'geometry_msgs/msg/PoseStamped', 'nav_msgs/msg/Path', 'unique_identifier_msgs/msg/UUID',
+        'action_msgs/msg/GoalInfo', 'action_msgs/msg/GoalStatus', 'action_msgs/msg/GoalStatusArray',
+        'geometry_msgs/msg/Vector3', 'geometry_msgs/msg/Transform',
+        'geometry_msgs/msg/TransformStamped', 'tf2_msgs/msg/TFMessage']})
+    types = {}
+    types.update(get_types_from_msg(
+        'uint8 event_type\nbuiltin_interfaces/Time stamp\nuint8[16] client_gid\nint64 sequence_number',
+        'service_msgs/msg/ServiceEventInfo'))
+    P = NAV2
+    types.update(get_types_from_msg('geometry_msgs/PoseStamped goal\ngeometry_msgs/PoseStamped start\n'
+                                    'string planner_id\nbool use_start', P + '_Goal'))
+    types.update(get_types_from_msg('nav_msgs/Path path\nbuiltin_interfaces/Duration planning_time\n'
+                                    'uint16 error_code\nstring error_msg', P + '_Result'))
+    types.update(get_types_from_msg('uint8 structure_needs_at_least_one_member', P + '_Feedback'))
+    types.update(get_types_from_msg(f'unique_identifier_msgs/UUID goal_id\n{P}_Feedback feedback',
+                                    P + '_FeedbackMessage'))
+    for srv, req, resp in [
+            (P + '_SendGoal', f'unique_identifier_msgs/UUID goal_id\n{P}_Goal goal',
+             'bool accepted\nbuiltin_interfaces/Time stamp'),
+            (P + '_GetResult', 'unique_identifier_msgs/UUID goal_id', f'int8 status\n{P}_Result result'),
+            ('action_msgs/srv/CancelGoal', 'action_msgs/GoalInfo goal_info',
+             'int8 return_code\naction_msgs/GoalInfo[] goals_canceling')]:
+        types.update(get_types_from_msg(req, srv + '_Request'))
+        types.update(get_types_from_msg(resp, srv + '_Response'))
+        types.update(get_types_from_msg(
+            f'service_msgs/ServiceEventInfo info\n{srv}_Request[<=1] request\n{srv}_Response[<=1] response',
+            srv + '_Event'))
+        types.update(get_types_from_msg(
+            f'{srv}_Request request_message\n{srv}_Response response_message\n{srv}_Event event_message', srv))
+
+    def fix(o):
+        if isinstance(o, str):
+            return o.replace('/srv/msg/', '/srv/').replace('/action/msg/', '/action/')
+        if isinstance(o, (tuple, list)):
+            return type(o)(fix(x) for x in o)
+        return o
+    store.register({fix(k): fix(v) for k, v in types.items()})
+    return store
+
+
+def nav2(args):
+    """Nav2's side: ComputePathToPose as a Nav2 client sends it (rcl_action's services
+    and topics on rmw_zenoh's keys, every key built here from rosbags' hashes), and /tf."""
+    A = action_store()
+    T = A.types
+    domain = args.domain
+    session = open_client(args.connect)
+    out = {}
+    action = f'/{args.action}/_action'
+
+    def key_of(name, ros_type, service=False):
+        return topic_key(domain, name, ros_type, A.hash_rihs01(ros_type))
+
+    # The graph: the action's services and topics, and /tf, on rmw_zenoh's tokens.
+    want = {
+        ('SS', f'%{args.action}%_action%send_goal', dds(NAV2 + '_SendGoal'),
+         A.hash_rihs01(NAV2 + '_SendGoal'), '::,10:,:,:,,'),
+        ('SS', f'%{args.action}%_action%get_result', dds(NAV2 + '_GetResult'),
+         A.hash_rihs01(NAV2 + '_GetResult'), '::,10:,:,:,,'),
+        ('SS', f'%{args.action}%_action%cancel_goal', 'action_msgs::srv::dds_::CancelGoal_',
+         A.hash_rihs01('action_msgs/srv/CancelGoal'), '::,10:,:,:,,'),
+        ('MP', f'%{args.action}%_action%status', 'action_msgs::msg::dds_::GoalStatusArray_',
+         A.hash_rihs01('action_msgs/msg/GoalStatusArray'), ':1:,1:,:,:,,'),
+        ('MP', f'%{args.action}%_action%feedback', dds(NAV2 + '_FeedbackMessage'),
+         A.hash_rihs01(NAV2 + '_FeedbackMessage'), '::,10:,:,:,,'),
+        ('MP', '%tf', 'tf2_msgs::msg::dds_::TFMessage_', A.hash_rihs01('tf2_msgs/msg/TFMessage'),
+         '::,100:,:,:,,'),
+    }
+    deadline = time.time() + 60
+    missing = want
+    while time.time() < deadline:
+        tokens = [str(r.ok.key_expr).split('/') for r in
+                  session.liveliness().get(f'@ros2_lv/{domain}/**') if r.ok is not None]
+        missing = {w for w in want if not any(
+            len(p) == 13 and (p[5], p[9], p[10], p[11], p[12]) == w for p in tokens)}
+        if not missing:
+            break
+        time.sleep(0.3)
+    check(not missing, f'endpoint tokens for the action and /tf: missing {missing}')
+    out['tokens'] = len(want)
+
+    # /map: a cell of a wall, for a goal in one.
+    grid = STORE.deserialize_cdr(latest(session, topic_key(
+        domain, '/map', 'nav_msgs/msg/OccupancyGrid', STORE.hash_rihs01('nav_msgs/msg/OccupancyGrid')),
+        30).payload.to_bytes(), 'nav_msgs/msg/OccupancyGrid')
+    w, h, res = int(grid.info.width), int(grid.info.height), float(grid.info.resolution)
+    data = np.asarray(grid.data, dtype=np.int8).reshape(h, w)
+    walls = [(r, c) for r in range(2, h - 2) for c in range(2, w - 2) if (data[r - 1:r + 2, c - 1:c + 2] == 100).all()]
+    check(walls, 'the map has a wall away from its edge')
+    r, c = walls[len(walls) // 2]
+    wall = (grid.info.origin.position.x + (c + 0.5) * res, grid.info.origin.position.y + (r + 0.5) * res)
+
+    # The robot's estimate, for a goal from its current pose.
+    pose_key = topic_key(domain, f'/{args.robot}/pose', 'geometry_msgs/msg/PoseWithCovarianceStamped',
+                         STORE.hash_rihs01('geometry_msgs/msg/PoseWithCovarianceStamped'))
+    estimate = STORE.deserialize_cdr(latest(session, pose_key, 30).payload.to_bytes(),
+                                     'geometry_msgs/msg/PoseWithCovarianceStamped').pose.pose.position
+
+    gid = os.urandom(16)
+    send = Caller(session, key_of(action + '/send_goal', NAV2 + '_SendGoal'), gid)
+    result = Caller(session, key_of(action + '/get_result', NAV2 + '_GetResult'), gid)
+    cancel = Caller(session, key_of(action + '/cancel_goal', 'action_msgs/srv/CancelGoal'), gid)
+
+    def stamped(x, y, frame='map'):
+        return T['geometry_msgs/msg/PoseStamped'](
+            header=T['std_msgs/msg/Header'](stamp=T['builtin_interfaces/msg/Time'](sec=0, nanosec=0),
+                                            frame_id=frame),
+            pose=T['geometry_msgs/msg/Pose'](
+                position=T['geometry_msgs/msg/Point'](x=x, y=y, z=0.0),
+                orientation=T['geometry_msgs/msg/Quaternion'](x=0.0, y=0.0, z=0.0, w=1.0)))
+
+    def uuid(raw):
+        return T['unique_identifier_msgs/msg/UUID'](uuid=np.frombuffer(raw, dtype=np.uint8).copy())
+
+    def send_goal(goal_id, goal, start=(-8.0, -8.0), planner_id='', use_start=True, frame='map'):
+        msg = T[NAV2 + '_SendGoal_Request'](goal_id=uuid(goal_id), goal=T[NAV2 + '_Goal'](
+            goal=stamped(goal[0], goal[1], frame), start=stamped(start[0], start[1]),
+            planner_id=planner_id, use_start=use_start))
+        data = send.call_raw(A.serialize_cdr(msg, NAV2 + '_SendGoal_Request'))
+        return A.deserialize_cdr(data, NAV2 + '_SendGoal_Response')
+
+    def get_result(goal_id):
+        data = result.call_raw(A.serialize_cdr(T[NAV2 + '_GetResult_Request'](goal_id=uuid(goal_id)),
+                                               NAV2 + '_GetResult_Request'))
+        return A.deserialize_cdr(data, NAV2 + '_GetResult_Response')
+
+    def cancel_goal(goal_id):
+        info = T['action_msgs/msg/GoalInfo'](goal_id=uuid(goal_id),
+                                             stamp=T['builtin_interfaces/msg/Time'](sec=0, nanosec=0))
+        data = cancel.call_raw(A.serialize_cdr(T['action_msgs/srv/CancelGoal_Request'](goal_info=info),
+                                               'action_msgs/srv/CancelGoal_Request'))
+        return A.deserialize_cdr(data, 'action_msgs/srv/CancelGoal_Response')
+
+    def run(name, goal, **kw):
+        goal_id = os.urandom(16)
+        accepted = send_goal(goal_id, goal, **kw)
+        check(accepted.accepted, f'{name}: the goal is accepted')
+        r = get_result(goal_id)
+        return goal_id, r
+
+    goals = {}
+    cases = [
+        ('curious', (6.0, -7.0), {}, 'succeeded', 'NONE'),
+        ('grid_based', (6.0, -7.0), {'planner_id': 'GridBased'}, 'succeeded', 'NONE'),
+        ('from_the_robot', (6.0, -7.0), {'use_start': False}, 'succeeded', 'NONE'),
+        ('in_a_wall', wall, {}, 'aborted', 'GOAL_OCCUPIED'),
+        ('off_the_map', (500.0, 500.0), {}, 'aborted', 'GOAL_OUTSIDE_MAP'),
+        ('start_off_the_map', (6.0, -7.0), {'start': (-500.0, 3.0)}, 'aborted', 'START_OUTSIDE_MAP'),
+        ('nan', (float('nan'), -7.0), {}, 'aborted', 'GOAL_OUTSIDE_MAP'),
+        ('other_frame', (6.0, -7.0), {'frame': 'odom'}, 'aborted', 'TF_ERROR'),
+        ('unknown_planner', (6.0, -7.0), {'planner_id': 'navfn'}, 'aborted', 'INVALID_PLANNER'),
+    ]
+    for name, goal, kw, status, code in cases:
+        goal_id, r = run(name, goal, **kw)
+        got = (r.status, int(r.result.error_code))
+        check(got == (STATUS[status], NAV2_ERRORS[code]),
+              f'{name}: status {status} and error {code}, got {got}: {r.result.error_msg!r}')
+        check(r.result.path.header.frame_id == 'map', f'{name}: the path is in frame map')
+        if status == 'succeeded':
+            poses = [(p.pose.position.x, p.pose.position.y) for p in r.result.path.poses]
+            check(len(poses) >= 2, f'{name}: a path')
+            check(math.hypot(poses[-1][0] - goal[0], poses[-1][1] - goal[1]) < 0.5,
+                  f'{name}: the path ends at the goal')
+            start = (estimate.x, estimate.y) if kw.get('use_start') is False else kw.get('start', (-8.0, -8.0))
+            check(math.hypot(poses[0][0] - start[0], poses[0][1] - start[1]) < 0.5,
+                  f'{name}: the path starts at {start}, got {poses[0]}')
+            planning = r.result.planning_time.sec + r.result.planning_time.nanosec * 1e-9
+            check(planning > 0.0, f'{name}: a planning time')
+            goals[name] = {'poses': len(poses), 'planning_time_s': round(planning, 3)}
+        else:
+            check(len(r.result.path.poses) == 0 and r.result.error_msg, f'{name}: an empty path and why')
+            goals[name] = {'error_code': code, 'error_msg': r.result.error_msg}
+    out['goals'] = goals
+
+    # Cancel: a curious plan cancelled as soon as it is accepted ends canceled, at once.
+    goal_id = os.urandom(16)
+    check(send_goal(goal_id, (6.0, 8.0), planner_id='model2').accepted, 'the goal to cancel is accepted')
+    started = time.time()
+    c = cancel_goal(goal_id)
+    check(c.return_code == 0 and len(c.goals_canceling) == 1
+          and bytes(c.goals_canceling[0].goal_id.uuid) == goal_id,
+          f'the cancel names the goal (return code {c.return_code})')
+    r = get_result(goal_id)
+    check(r.status == STATUS['canceled'], f'a cancelled goal ends canceled (status {r.status})')
+    out['cancel'] = {'seconds': round(time.time() - started, 3)}
+    c = cancel_goal(goal_id)
+    check(c.return_code == 3, f'cancelling it again: GOAL_TERMINATED (got {c.return_code})')
+    c = cancel_goal(os.urandom(16))
+    check(c.return_code == 2, f'cancelling an unknown goal: UNKNOWN_GOAL_ID (got {c.return_code})')
+    check(get_result(os.urandom(16)).status == STATUS['unknown'], 'the result of an unknown goal: UNKNOWN')
+
+    # The latched status: every goal above with its final state.
+    status = A.deserialize_cdr(latest(session, key_of(action + '/status', 'action_msgs/msg/GoalStatusArray'),
+                                      10).payload.to_bytes(), 'action_msgs/msg/GoalStatusArray')
+    states = {bytes(s.goal_info.goal_id.uuid): s.status for s in status.status_list}
+    check(states.get(goal_id) == STATUS['canceled'], 'the status topic has the cancelled goal')
+    check(len(states) >= len(cases) + 1, f'the status topic has every goal ({len(states)})')
+    out['status_goals'] = len(states)
+
+    # /tf: map → <robot>/base_link at the robot's estimate.
+    tfs, poses = [], []
+    sub_tf = session.declare_subscriber(key_of('/tf', 'tf2_msgs/msg/TFMessage'),
+                                        lambda s: tfs.append(s.payload.to_bytes()))
+    sub_pose = session.declare_subscriber(pose_key, lambda s: poses.append(s.payload.to_bytes()))
+    deadline = time.time() + 20
+    while (len(tfs) < 5 or len(poses) < 5) and time.time() < deadline:
+        time.sleep(0.1)
+    sub_tf.undeclare()
+    sub_pose.undeclare()
+    check(tfs and poses, f'/tf and /{args.robot}/pose samples ({len(tfs)}, {len(poses)})')
+    transforms = [t for raw in tfs for t in A.deserialize_cdr(raw, 'tf2_msgs/msg/TFMessage').transforms]
+    mine = [t for t in transforms if t.child_frame_id == f'{args.robot}/base_link']
+    check(mine and all(t.header.frame_id == 'map' for t in mine),
+          f'/tf has map -> {args.robot}/base_link ({[t.child_frame_id for t in transforms][:5]})')
+    at = {(t.transform.translation.x, t.transform.translation.y) for t in mine}
+    estimates = [STORE.deserialize_cdr(raw, 'geometry_msgs/msg/PoseWithCovarianceStamped').pose.pose.position
+                 for raw in poses]
+    matched = sum((e.x, e.y) in at for e in estimates)
+    check(matched >= len(estimates) // 2, f'the frames are at the estimates ({matched} of {len(estimates)})')
+    out['tf'] = {'transforms': len(mine), 'estimates': len(estimates), 'matched': matched}
+    session.close()
+    print(json.dumps(out))
+
+
 def open_client(endpoint):
     conf = zenoh.Config()
     conf.insert_json5('mode', '"client"')
@@ -360,10 +607,15 @@ def main():
     p.add_argument('--connect', required=True)
     p.add_argument('--domain', type=int, default=0)
     p.add_argument('--robot', default='robot')
+    p = sub.add_parser('nav2')
+    p.add_argument('--connect', required=True)
+    p.add_argument('--domain', type=int, default=0)
+    p.add_argument('--robot', default='r1')
+    p.add_argument('--action', default='compute_path_to_pose')
     p = sub.add_parser('bag')
     p.add_argument('dir')
     args = parser.parse_args()
-    {'live': live, 'watch': watch, 'bag': bag}[args.command](args)
+    {'live': live, 'watch': watch, 'nav2': nav2, 'bag': bag}[args.command](args)
 
 
 if __name__ == '__main__':

@@ -7,7 +7,8 @@
 //! `<root>/map/layers`, fetching any layer whose version was not published yet (a node
 //! started after the map server catches up). Robots: their
 //! estimates (`/<robot>/pose`), missions (`/<robot>/plan`) and true positions (the path
-//! driven, `/<robot>/driven`, at most every [`DRIVEN_PERIOD`]).
+//! driven, `/<robot>/driven`, at most every [`DRIVEN_PERIOD`]); each estimate is also
+//! the transform `map → <robot>/base_link` on `/tf`.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -25,6 +26,7 @@ use tokio_util::sync::CancellationToken;
 use zenoh::sample::Sample;
 use zenoh::Session;
 
+use super::poses::RobotPoses;
 use super::Output;
 use crate::convert::{self, LAYER_TOPICS};
 use crate::msg::Time;
@@ -40,6 +42,9 @@ pub const DRIVEN_PERIOD: Duration = Duration::from_millis(250);
 /// The most points kept per driven path, and the least distance between two of them.
 pub const DRIVEN_POINTS: usize = 4096;
 pub const DRIVEN_STEP_M: f64 = 0.05;
+/// tf2's topic, relative to the node's namespace as tf2_ros resolves it (`/tf` in the
+/// root namespace).
+pub const TF_TOPIC: &str = "tf";
 /// The most robots published.
 pub const MAX_ROBOTS: usize = 256;
 /// The largest layer read: the map server's largest (16,777,216 f32 cells in base64)
@@ -85,6 +90,7 @@ pub(super) async fn run(
     root: String,
     subscriptions: FleetStreams,
     out: Arc<Output>,
+    poses: Arc<RobotPoses>,
     cancel: CancellationToken,
 ) {
     let FleetStreams {
@@ -103,6 +109,7 @@ pub(super) async fn run(
     let robots = Robots {
         out,
         root,
+        poses,
         driven: BTreeMap::new(),
     };
     tokio::join!(
@@ -265,6 +272,8 @@ impl Driven {
 struct Robots {
     out: Arc<Output>,
     root: String,
+    /// The latest estimates, for ComputePathToPose goals from the robot's pose.
+    poses: Arc<RobotPoses>,
     driven: BTreeMap<String, Driven>,
 }
 
@@ -323,6 +332,11 @@ impl Robots {
         {
             return self.out.refuse(key, &format!("a mission of at most {MAX_WAYPOINTS} finite waypoints is published; this one is not"));
         }
+        // A mission without waypoints (the executive's "stay") is not a plan: published,
+        // it would be the latched sample a late subscriber gets instead of the last path.
+        if m.waypoints.is_empty() {
+            return;
+        }
         let path = convert::path(&m.waypoints, now());
         self.out
             .publish(&format!("{robot}/plan"), types::PATH, Qos::LATCHED, &path)
@@ -343,7 +357,8 @@ impl Robots {
                 .out
                 .refuse(key, "an estimate that is not a finite position");
         }
-        let pose = convert::estimate_pose(&e, now());
+        let stamp = now();
+        let pose = convert::estimate_pose(&e, stamp);
         self.out
             .publish(
                 &format!("{robot}/pose"),
@@ -352,6 +367,11 @@ impl Robots {
                 &pose,
             )
             .await;
+        let transform = convert::estimate_transform(robot, &e, stamp);
+        self.out
+            .publish(TF_TOPIC, types::TF_MESSAGE, Qos::TF, &transform)
+            .await;
+        self.poses.record(robot, e.position);
     }
 
     fn on_truth(&mut self, sample: &Sample) {

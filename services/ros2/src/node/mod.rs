@@ -1,6 +1,7 @@
 //! The Zenoh adapter: the `roam ros2` role. One rmw_zenoh node (`/roam` by default) that
-//! publishes roam's maps, plans, estimates and driven paths as ROS 2 topics, serves the
-//! planner as two ROS 2 services, optionally takes its occupancy map from a ROS 2
+//! publishes roam's maps, plans, estimates and driven paths as ROS 2 topics (and the
+//! robots' frames on `/tf`), serves the planner as two ROS 2 services and Nav2's
+//! `ComputePathToPose` action, optionally takes its occupancy map from a ROS 2
 //! publisher, and optionally records everything it publishes as a rosbag2.
 //!
 //! It talks to roam's services through roam's own keys, as any client would, and to
@@ -8,9 +9,11 @@
 //! from either side is trusted: payloads are capped before they are read, names are
 //! checked, and each refusal is logged, rate-limited, naming the limit.
 
+mod compute_path;
 mod follow;
 mod map_input;
 mod output;
+mod poses;
 mod services;
 
 use std::path::PathBuf;
@@ -21,6 +24,9 @@ use tokio_util::sync::CancellationToken;
 
 use crate::names::{self, NodeInfo};
 
+pub use compute_path::{
+    DEFAULT_ACTION as COMPUTE_PATH_ACTION, MAX_GOALS, MAX_RUNNING_GOALS, PLANNER_IDS,
+};
 pub use output::Output;
 /// What every call to the node's services is promised (see `services`).
 pub use services::{
@@ -48,6 +54,12 @@ pub struct Ros2Config {
     pub offer: bool,
     /// Take the map server's occupancy from this ROS 2 topic (nav_msgs/msg/OccupancyGrid).
     pub map_input: Option<String>,
+    /// Serve `nav2_msgs/action/ComputePathToPose` under this name (Nav2's own,
+    /// `compute_path_to_pose`, by default; `null`: not served).
+    pub compute_path_action: Option<String>,
+    /// The robot whose latest estimate starts a ComputePathToPose goal without
+    /// `use_start` (default: the only robot localized, if there is one).
+    pub robot: Option<String>,
     /// The map server's `max_layer_cells`: a received map above it is refused.
     pub max_layer_cells: u64,
     /// Record every message published to this new rosbag2 directory.
@@ -66,6 +78,8 @@ impl Default for Ros2Config {
             node_name: "roam".to_owned(),
             offer: true,
             map_input: None,
+            compute_path_action: Some(compute_path::DEFAULT_ACTION.to_owned()),
+            robot: None,
             max_layer_cells: MAX_LAYER_CELLS,
             rosbag: None,
             zenoh: None,
@@ -153,14 +167,33 @@ pub async fn run(
         None
     };
     let subscriptions = roam_runtime::FleetStreams::declare(&session, &config.root).await?;
+    let poses = Arc::new(poses::RobotPoses::default());
     if config.offer {
         services::declare(&service, output.clone(), &config.root).await?;
+        if let Some(action) = &config.compute_path_action {
+            compute_path::declare(
+                &service,
+                output.clone(),
+                &config.root,
+                action,
+                config.robot.clone(),
+                poses.clone(),
+            )
+            .await?;
+        }
     }
     if let Some(topic) = &config.map_input {
         map_input::declare(&service, output.clone(), &config, topic).await?;
     }
     let (root, out, stop) = (config.root.clone(), output.clone(), service.cancel_token());
-    service.spawn(follow::run(session.clone(), root, subscriptions, out, stop));
+    service.spawn(follow::run(
+        session.clone(),
+        root,
+        subscriptions,
+        out,
+        poses,
+        stop,
+    ));
     service.announce().await?;
     if config.offer {
         tracing::info!(

@@ -168,6 +168,48 @@ impl Output {
         })
     }
 
+    /// Declares topic `name`'s publisher (and its token) before its first message: an
+    /// action server's feedback and status publishers are part of what tells a ROS 2
+    /// client the server is there (`rcl_action_server_is_available`).
+    pub(crate) async fn declare(
+        &self,
+        name: &str,
+        ros_type: &'static str,
+        qos: Qos,
+    ) -> Result<(), Ros2Error> {
+        if !self.offer {
+            return Ok(());
+        }
+        let mut publishers = self.publishers.lock().await;
+        self.ensure_publisher(&mut publishers, name, ros_type, qos)
+            .await
+            .map_err(|reason| Ros2Error::Declare {
+                what: "publisher",
+                key: name.to_owned(),
+                reason,
+            })
+    }
+
+    /// Topic `name`'s publisher, declared if it is not yet (up to [`MAX_TOPICS`]).
+    async fn ensure_publisher(
+        &self,
+        publishers: &mut BTreeMap<String, RosPublisher>,
+        name: &str,
+        ros_type: &'static str,
+        qos: Qos,
+    ) -> Result<(), String> {
+        if publishers.contains_key(name) {
+            return Ok(());
+        }
+        if publishers.len() >= MAX_TOPICS {
+            return Err(format!("more than {MAX_TOPICS} topics; not published"));
+        }
+        let publisher = self.declare_publisher(name, ros_type, qos).await?;
+        tracing::debug!(topic = name, key = %publisher.endpoint.key, "roam ros2: publisher declared");
+        publishers.insert(name.to_owned(), publisher);
+        Ok(())
+    }
+
     /// Sends `message` on topic `name` (relative to the node's namespace) and records it;
     /// the publisher is declared at the first message. Failures are logged, never fatal.
     pub(crate) async fn publish<T: Serialize>(
@@ -186,20 +228,11 @@ impl Output {
             self.taken.is_some() && names::qualify(&self.node.namespace, name).ok() == self.taken;
         if self.offer && !taken {
             let mut publishers = self.publishers.lock().await;
-            if !publishers.contains_key(name) {
-                if publishers.len() >= MAX_TOPICS {
-                    return self.refuse(
-                        name,
-                        &format!("more than {MAX_TOPICS} topics; not published"),
-                    );
-                }
-                match self.declare_publisher(name, ros_type, qos).await {
-                    Ok(publisher) => {
-                        tracing::debug!(topic = name, key = %publisher.endpoint.key, "roam ros2: publisher declared");
-                        publishers.insert(name.to_owned(), publisher);
-                    }
-                    Err(e) => return self.refuse(name, &e),
-                }
+            if let Err(e) = self
+                .ensure_publisher(&mut publishers, name, ros_type, qos)
+                .await
+            {
+                return self.refuse(name, &e);
             }
             if let Some(p) = publishers.get_mut(name) {
                 p.sequence += 1;

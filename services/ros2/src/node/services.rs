@@ -29,8 +29,8 @@
 use std::sync::Arc;
 
 use roam_planner::client::PlannerClient;
-use roam_proto::planner::{PlanRequest, PlannerModel, ShortestPathUse};
-use roam_proto::{ErrorCode, ErrorReply};
+use roam_proto::planner::{Plan, PlanRequest, PlannerModel, ShortestPathUse};
+use roam_proto::{Cause, ErrorCode, ErrorReply};
 use roam_runtime::{ClientError, Service};
 use serde::Serialize;
 use zenoh::query::Query;
@@ -125,7 +125,11 @@ pub(super) async fn declare(
 }
 
 /// The request's attachment, or a Zenoh error reply saying why it cannot be answered.
-async fn request_attachment(out: &Output, query: &Query, key: &str) -> Option<Attachment> {
+pub(super) async fn request_attachment(
+    out: &Output,
+    query: &Query,
+    key: &str,
+) -> Option<Attachment> {
     let parsed = match query.attachment() {
         Some(bytes) => Attachment::parse(&bytes.to_bytes()).map_err(|e| e.to_string()),
         None => Err("no attachment".to_owned()),
@@ -142,7 +146,7 @@ async fn request_attachment(out: &Output, query: &Query, key: &str) -> Option<At
 }
 
 /// Replies with `response` on the service's key, the request's sequence number and GID.
-async fn reply<T: Serialize>(
+pub(super) async fn reply<T: Serialize>(
     out: &Output,
     query: &Query,
     key: &str,
@@ -167,18 +171,18 @@ async fn reply<T: Serialize>(
     }
 }
 
-fn payload(query: &Query) -> Vec<u8> {
+pub(super) fn payload(query: &Query) -> Vec<u8> {
     query
         .payload()
         .map(|p| p.to_bytes().to_vec())
         .unwrap_or_default()
 }
 
-fn now() -> Time {
+pub(super) fn now() -> Time {
     Time::from_nanos(attachment::now_ns())
 }
 
-fn client_error(e: ClientError) -> ErrorReply {
+pub(super) fn client_error(e: ClientError) -> ErrorReply {
     match e {
         ClientError::Refused(reply) => reply,
         other => ErrorReply::new(
@@ -218,12 +222,15 @@ async fn plan_downtime(state: State, query: Query, key: String) {
     reply(out, &query, &key, &att, &response).await;
 }
 
-/// GetPlan's plan: the shortest path's ETA sets the budget of a Model I plan.
-async fn get_plan_path(
-    state: &State,
-    request: &GetPlanRequest,
-) -> Result<Vec<[f64; 2]>, ErrorReply> {
-    let (start, goal) = convert::get_plan_ends(request)?;
+/// GetPlan's budget rule, shared with ComputePathToPose: the shortest path's ETA (a
+/// probe with the planner's `shortest` model) times [`GET_PLAN_BUDGET_FACTOR`] is the
+/// budget of a `model` plan; `shortest` is the probe itself.
+pub(super) async fn plan_by_budget_rule(
+    planner: &PlannerClient,
+    start: [f64; 2],
+    goal: [f64; 2],
+    model: PlannerModel,
+) -> Result<Plan, ErrorReply> {
     let probe = PlanRequest {
         request_id: None,
         cancel_token: None,
@@ -237,19 +244,31 @@ async fn get_plan_path(
         map_version: None,
         shortest: ShortestPathUse::Omit,
     };
-    let shortest = state.planner.plan(&probe).await.map_err(client_error)?;
+    let shortest = planner.plan(&probe).await.map_err(client_error)?;
     if !shortest.reaches_goal {
-        return Err(ErrorReply::new(
-            ErrorCode::NotFound,
-            "no path reaches the goal",
-        ));
+        return Err(
+            ErrorReply::new(ErrorCode::NotFound, "no path reaches the goal")
+                .with_cause(Cause::NoPath),
+        );
+    }
+    if model == PlannerModel::Shortest {
+        return Ok(shortest);
     }
     let curious = PlanRequest {
         t_exec_s: (shortest.t_eta_s * GET_PLAN_BUDGET_FACTOR).max(shortest.t_eta_s + 1.0),
-        model: PlannerModel::Model1,
+        model,
         ..probe
     };
-    let plan = state.planner.plan(&curious).await.map_err(client_error)?;
+    planner.plan(&curious).await.map_err(client_error)
+}
+
+/// GetPlan's plan: a Model I plan by the budget rule.
+async fn get_plan_path(
+    state: &State,
+    request: &GetPlanRequest,
+) -> Result<Vec<[f64; 2]>, ErrorReply> {
+    let (start, goal) = convert::get_plan_ends(request)?;
+    let plan = plan_by_budget_rule(&state.planner, start, goal, PlannerModel::Model1).await?;
     Ok(plan.points)
 }
 

@@ -3,7 +3,9 @@ an implementation of ROS 2 messages independent of roam's:
 
     pip install rosbags==0.11.9 && python3 services/ros2/tests/reference/rosbags_reference.py
 
-prints the CDR bytes of three messages and the RIHS01 hashes of roam's two services.
+prints the CDR bytes of three messages and the RIHS01 hashes of roam's two services, of
+Nav2's ComputePathToPose action (its services, built as rosidl builds them, and its
+feedback message), action_msgs's CancelGoal and GoalStatusArray, and tf2's TFMessage.
 rosbags' own service_msgs/ServiceEventInfo reads `char[16]` as FIELD_TYPE_CHAR, which
 disagrees with the AddTwoInts hash rmw_zenoh publishes; rosidl reads it as uint8, so the
 services are hashed here in a type store that says uint8.
@@ -70,3 +72,27 @@ ts.register(srv)
 for s in ['roam_interfaces/srv/PlanDowntime','nav_msgs/srv/GetPlan']:
     print('HASH', s, ts.hash_rihs01(s))
 print('HASH OG', ts.hash_rihs01('nav_msgs/msg/OccupancyGrid'))
+# Nav2's planner action (its services built as rosidl builds them) and tf2's message.
+P = 'nav2_msgs/action/ComputePathToPose'
+act = {}
+act.update(get_types_from_msg('geometry_msgs/PoseStamped goal\ngeometry_msgs/PoseStamped start\nstring planner_id\nbool use_start', P + '_Goal'))
+act.update(get_types_from_msg('nav_msgs/Path path\nbuiltin_interfaces/Duration planning_time\nuint16 error_code\nstring error_msg', P + '_Result'))
+act.update(get_types_from_msg('uint8 structure_needs_at_least_one_member', P + '_Feedback'))
+act.update(get_types_from_msg(f'unique_identifier_msgs/UUID goal_id\n{P}_Feedback feedback', P + '_FeedbackMessage'))
+for s, req, resp in [
+        (P + '_SendGoal', f'unique_identifier_msgs/UUID goal_id\n{P}_Goal goal', 'bool accepted\nbuiltin_interfaces/Time stamp'),
+        (P + '_GetResult', 'unique_identifier_msgs/UUID goal_id', f'int8 status\n{P}_Result result'),
+        ('action_msgs/srv/CancelGoal', 'action_msgs/GoalInfo goal_info', 'int8 return_code\naction_msgs/GoalInfo[] goals_canceling')]:
+    act.update(get_types_from_msg(req, s + '_Request'))
+    act.update(get_types_from_msg(resp, s + '_Response'))
+    act.update(get_types_from_msg(f'service_msgs/ServiceEventInfo info\n{s}_Request[<=1] request\n{s}_Response[<=1] response', s + '_Event'))
+    act.update(get_types_from_msg(f'{s}_Request request_message\n{s}_Response response_message\n{s}_Event event_message', s))
+def fix_action(o):
+    if isinstance(o, str): return fix(o).replace('/action/msg/', '/action/')
+    if isinstance(o, tuple): return tuple(fix_action(x) for x in o)
+    if isinstance(o, list): return [fix_action(x) for x in o]
+    return o
+ts.register({k: base.fielddefs[k] for k in ['builtin_interfaces/msg/Duration', 'unique_identifier_msgs/msg/UUID', 'action_msgs/msg/GoalInfo', 'action_msgs/msg/GoalStatus', 'action_msgs/msg/GoalStatusArray', 'geometry_msgs/msg/Vector3', 'geometry_msgs/msg/Transform', 'geometry_msgs/msg/TransformStamped', 'tf2_msgs/msg/TFMessage']})
+ts.register({fix_action(k): fix_action(v) for k, v in act.items()})
+for s in [P + '_SendGoal', P + '_GetResult', P + '_FeedbackMessage', 'action_msgs/srv/CancelGoal', 'action_msgs/msg/GoalStatusArray', 'tf2_msgs/msg/TFMessage']:
+    print('HASH', s, ts.hash_rihs01(s))
