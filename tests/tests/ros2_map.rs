@@ -169,3 +169,115 @@ async fn a_ros2_map_becomes_occupancy_and_bad_maps_are_refused() {
     );
     assert!(text.contains("RIHS01_0000"), "another type hash:\n{text}");
 }
+
+/// A map from ROS 2 of another size than the stack's reaches every service: the map
+/// server holds it as a new world and forgets the layers of the old grid; the mapper
+/// maps the new world afresh and sends its layers on the new grid; the planner plans
+/// on it. No layer is left on the old grid (checked on the map server's index, through
+/// Zenoh as any client reads it).
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_ros2_map_of_another_size_reaches_every_service() {
+    let h = Harness::start().await;
+    let _map_server = h.start_role(h.map_server_config()).await;
+    let _mapper = h.start_role(h.mapper_config()).await;
+    let _planner = h.start_role(h.planner_config("p1")).await;
+    let ros2 = Ros2Config {
+        root: h.root.clone(),
+        map_input: Some("/map".into()),
+        ..Ros2Config::default()
+    };
+    let _ros2 = h.start_role(ros2).await;
+    let client = h.client().await;
+    let index = |client: roam_runtime::Requester, root: String| async move {
+        client
+            .request::<LayerList, LayerList>(&keys::map_index(&root), None)
+            .await
+            .expect("layers")
+    };
+    // The built-in world, with the mapper's layers on its grid.
+    let before = within("the mapper's layers on the built-in grid", async {
+        loop {
+            let list = index(client.clone(), h.root.clone()).await;
+            if list.layers.iter().any(|l| l.name == "news") {
+                return list;
+            }
+            tokio::time::sleep(Duration::from_millis(100)).await;
+        }
+    })
+    .await;
+    let old_world = before.world.clone().expect("a world");
+
+    // A 40 × 30 map of 0.5 m from ROS 2 (the built-in world is 100 × 100 of 0.2 m).
+    let hash = hash::message_type_hash(types::OCCUPANCY_GRID).expect("hash");
+    let dds = types::dds_type_name(types::OCCUPANCY_GRID).expect("dds");
+    let key = names::entity_key(0, "/map", &dds, &hash);
+    let map = grid(40, 30, vec![0; 1200]);
+    let attachment = Attachment {
+        sequence_number: 1,
+        source_timestamp_ns: roam_ros2::attachment::now_ns(),
+        gid: [9; 16],
+    };
+    client
+        .session()
+        .put(key, cdr::encode(&map).expect("cdr"))
+        .attachment(attachment.to_bytes().to_vec())
+        .await
+        .expect("put");
+
+    let after = within("every layer on the new grid", async {
+        loop {
+            let list = index(client.clone(), h.root.clone()).await;
+            let on_new_grid = |l: &roam_proto::map::LayerInfo| {
+                l.name == "heuristic" || (l.meta.width, l.meta.height) == (40, 30)
+            };
+            let news = list.layers.iter().any(|l| l.name == "news");
+            if news && list.layers.iter().all(on_new_grid) {
+                return list;
+            }
+            tokio::time::sleep(Duration::from_millis(100)).await;
+        }
+    })
+    .await;
+    let new_world = after.world.clone().expect("a world");
+    assert_ne!(new_world.hash, old_world.hash, "a new grid is a new world");
+    for name in [
+        "occupancy",
+        "inflated",
+        "information",
+        "news",
+        "occupied_now",
+        "change_rate",
+    ] {
+        let layer = after.layers.iter().find(|l| l.name == name);
+        assert!(
+            layer.is_some_and(|l| l.meta.resolution == 0.5),
+            "{name}: {after:?}"
+        );
+    }
+
+    // The planner plans on the new map: from one corner of it to the other.
+    let planner = roam_planner::client::PlannerClient::new(client.session().clone(), &h.root);
+    let request = roam_proto::planner::PlanRequest {
+        request_id: None,
+        cancel_token: None,
+        start: [1.0, 1.0],
+        goal: [16.0, 13.0],
+        t_exec_s: 600.0,
+        deadline_s: 5.0,
+        model: roam_proto::planner::PlannerModel::Shortest,
+        params: Default::default(),
+        seed: 0,
+        map_version: None,
+        shortest: roam_proto::planner::ShortestPathUse::Omit,
+    };
+    let plan = within("a plan on the new map", async {
+        loop {
+            match planner.plan(&request).await {
+                Ok(plan) => return plan,
+                Err(_) => tokio::time::sleep(Duration::from_millis(200)).await,
+            }
+        }
+    })
+    .await;
+    assert!(plan.reaches_goal, "{plan:?}");
+}

@@ -377,3 +377,55 @@ fn the_budget_foresees_a_load_exactly() {
         assert_eq!(outcome.is_ok(), fits, "max {max}: {outcome:?}");
     }
 }
+
+fn replace(base_version: u64, meta: GridMeta, cells: Cells) -> LayerUpdate {
+    LayerUpdate {
+        base_version,
+        change: LayerChange::Replace { meta, cells },
+        world: None,
+    }
+}
+
+/// A map of another size (a new map from ROS 2, a new map file) is a new world: the free
+/// layers on the old grid are forgotten, the base layers follow the new grid, the world
+/// id changes; a new map on the same grid changes none of that.
+#[test]
+fn occupancy_on_another_grid_forgets_the_layers_of_the_old_one() {
+    let mut store = store_with_map(DEFAULT_LIMITS);
+    store
+        .set_world(roam_world::world_id::world_id(
+            "site",
+            &Grid::filled(meta(20, 10), occupancy::FREE),
+        ))
+        .expect("world");
+    let before = store.world().cloned().expect("world");
+    store
+        .apply("news", &replace(0, meta(20, 10), Cells::U8(vec![7; 200])))
+        .expect("news");
+    let same_grid = Cells::I8(vec![occupancy::OCCUPIED; 200]);
+    store
+        .apply(OCCUPANCY, &replace(1, meta(20, 10), same_grid))
+        .expect("same grid");
+    assert_eq!(store.version("news"), 1, "a map on the same grid keeps it");
+    assert_eq!(store.world(), Some(&before));
+
+    let bigger = Cells::I8(vec![occupancy::FREE; 30 * 12]);
+    store
+        .apply(OCCUPANCY, &replace(2, meta(30, 12), bigger))
+        .expect("bigger");
+    assert!(store.get("news").is_none(), "the old grid's layer is gone");
+    // (heuristic is information compressed by c_h: on its own coarser grid.)
+    for name in [OCCUPANCY, INFLATED, INFORMATION] {
+        let layer = store.get(name).expect(name);
+        assert_eq!((layer.meta.width, layer.meta.height), (30, 12), "{name}");
+    }
+    assert_eq!(store.version(HEURISTIC), 2);
+    let after = store.world().cloned().expect("world");
+    assert_ne!(after.hash, before.hash, "another grid is another world");
+    assert_eq!(after.name, "site");
+    // Written again on the new grid, the layer goes on from its last version.
+    let (ack, _) = store
+        .apply("news", &replace(0, meta(30, 12), Cells::U8(vec![1; 360])))
+        .expect("news again");
+    assert_eq!(ack.version, 2);
+}

@@ -38,9 +38,10 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
 use roam_proto::cells::Cells;
-use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
+use roam_proto::map::{
+    GridMeta, Layer, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck, OCCUPANCY_LAYER,
+};
 
-type MapMeta = GridMeta;
 use roam_proto::controller::{Mission, MAX_MISSION_BYTES};
 use roam_proto::mapper::{
     ExplorationGoal, ExplorerStatus, MapperStatus, ReservationStatus, CHANGE_INFORMATION_LAYER,
@@ -136,8 +137,14 @@ pub enum MapperServiceError {
     World(#[from] WorldMismatch),
 }
 
-/// What observations and missions change.
+/// What observations and missions change, on one world's grid.
 struct Mapping {
+    /// The world the layers are of, sent with their updates.
+    world: roam_proto::map::WorldId,
+    /// Its grid.
+    meta: GridMeta,
+    /// Its static occupancy: the map now's prior for cells never seen.
+    static_map: Grid<i8>,
     map: ChangeMap,
     /// The robots' reservations (their current missions).
     news: NewsMap,
@@ -165,18 +172,67 @@ struct Mapping {
 struct MapperShared {
     root: String,
     session: zenoh::Session,
-    meta: MapMeta,
     mapping: Mutex<Mapping>,
+    /// What a world's mapping is made of, for the world the map server moves to.
+    spec: MappingSpec,
     /// Refused observations, logged a few per key and window.
     warnings: WarnLimiter,
-    /// The world this service works on, sent with its layer updates.
-    world: roam_proto::map::WorldId,
-    /// The scenario's static occupancy: the map now's prior for cells never seen.
-    static_map: Grid<i8>,
     belief: BeliefParams,
     /// How far a robot sees along its mission's path, metres, and how fast it drives it.
     reserve_radius_m: f64,
     reserve_s_per_m: f64,
+}
+
+/// What a world's mapping is made of besides its grid.
+struct MappingSpec {
+    map: MapParams,
+    news: NewsParams,
+    explorer: ExplorerParams,
+    seed: u64,
+    explore: BTreeSet<String>,
+}
+
+impl MappingSpec {
+    /// A fresh mapping of `world`, whose static occupancy is `static_map`.
+    fn build(
+        &self,
+        world: roam_proto::map::WorldId,
+        static_map: Grid<i8>,
+    ) -> Result<Mapping, MapperServiceError> {
+        let meta = static_map.meta;
+        let config = |e: crate::error::MapperError| MapperServiceError::Config(e.to_string());
+        let explorers = self
+            .explore
+            .iter()
+            .map(|robot| {
+                // Seeded by the robot's name, not its place in the list: a robot explores
+                // the same way whichever other robots are explored beside it.
+                let seed = crate::seed::labelled(self.seed, &format!("explore/{robot}"));
+                Explorer::new(self.explorer, Mode::Curious, seed)
+                    .map(|e| (robot.clone(), e))
+                    .map_err(config)
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Mapping {
+            world,
+            meta,
+            static_map,
+            map: ChangeMap::new(meta, self.map).map_err(config)?,
+            news: NewsMap::new(meta, self.news.prior).map_err(config)?,
+            positions: BTreeMap::new(),
+            explorers,
+            published_goals: BTreeMap::new(),
+            observations: 0,
+            map_changes: 0,
+            features: (0.0, 0.0),
+            now_s: 0.0,
+            // Sent at once: the layers exist at the map's size before the first
+            // observation, so a planner on the change coupling has one to plan on.
+            dirty: true,
+            layers_sent: 0,
+            epochs: Epochs::default(),
+        })
+    }
 }
 
 impl MapperShared {
@@ -191,7 +247,7 @@ impl MapperShared {
 }
 
 /// Why an observation cannot be merged (logged; a subscriber has no one to answer).
-fn check_observation(meta: &MapMeta, o: &LocalObservation) -> Result<(), String> {
+fn check_observation(meta: &GridMeta, o: &LocalObservation) -> Result<(), String> {
     if (o.meta.resolution - meta.resolution).abs() > 1e-9 * meta.resolution {
         return Err(format!(
             "its resolution {} m differs from the map's {} m",
@@ -223,7 +279,7 @@ fn check_observation(meta: &MapMeta, o: &LocalObservation) -> Result<(), String>
     }
 }
 
-fn cell_centre(meta: &MapMeta, (x, y): (u32, u32)) -> [f64; 2] {
+fn cell_centre(meta: &GridMeta, (x, y): (u32, u32)) -> [f64; 2] {
     [
         meta.origin.x + (f64::from(x) + 0.5) * meta.resolution,
         meta.origin.y + (f64::from(y) + 0.5) * meta.resolution,
@@ -235,7 +291,8 @@ fn on_observation(state: &MapperShared, key: &str, o: LocalObservation) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "ignoring an observation: {e}"),
     };
-    if let Err(e) = check_observation(&state.meta, &o) {
+    let meta = state.mapping().meta;
+    if let Err(e) = check_observation(&meta, &o) {
         return limited_warn!(state.warnings, robot, %robot, step = o.step, "ignoring an observation: {e}");
     }
     let Cells::I8(cells) = &o.cells else {
@@ -251,6 +308,10 @@ fn on_observation(state: &MapperShared, key: &str, o: LocalObservation) {
     let out = {
         let mut guard = state.mapping();
         let m = &mut *guard;
+        if m.meta != meta {
+            // The map server moved to another world meanwhile.
+            return;
+        }
         let t = match m.epochs.observation_time(o.time_s) {
             Ok(t) => t,
             Err(e) => {
@@ -277,7 +338,7 @@ fn on_observation(state: &MapperShared, key: &str, o: LocalObservation) {
             (Some(explorer), Some(cell)) => {
                 match explorer.on_update(&mut m.map, &update, cell, t) {
                     Ok(step) => {
-                        let at = cell_centre(&state.meta, step.episode_goal);
+                        let at = cell_centre(&m.meta, step.episode_goal);
                         let strategy = step.strategy.as_str().to_owned();
                         let episodes = explorer.episodes_ended();
                         let fresh = m.published_goals.get(robot).is_none_or(|last| {
@@ -338,16 +399,16 @@ fn on_mission(state: &MapperShared, key: &str, mission: Mission) {
     }
     // The path's cells are found outside the lock: a long path on a large map takes a
     // while, and observations keep merging meanwhile.
-    let (start_s, position) = {
+    let (start_s, position, meta) = {
         let m = state.mapping();
-        (m.now_s, m.positions.get(robot).copied())
+        (m.now_s, m.positions.get(robot).copied(), m.meta)
     };
     let path: Vec<[f64; 2]> = position
         .into_iter()
         .chain(mission.waypoints.iter().copied())
         .collect();
     let reserved = cells_along(
-        &state.meta,
+        &meta,
         &path,
         start_s,
         state.reserve_s_per_m,
@@ -356,6 +417,9 @@ fn on_mission(state: &MapperShared, key: &str, mission: Mission) {
     )
     .and_then(|cells| {
         let mut m = state.mapping();
+        if m.meta != meta {
+            return Ok(0);
+        }
         let count = m.news.reserve(robot, cells)?;
         m.dirty = true;
         Ok(count)
@@ -402,9 +466,16 @@ async fn answer_status(state: Arc<MapperShared>, query: Query) {
     reply::send_result(&query, result).await;
 }
 
+/// The layers to send, with the world and grid they are of.
+struct LayersToSend {
+    world: roam_proto::map::WorldId,
+    meta: GridMeta,
+    layers: Vec<(&'static str, Cells)>,
+}
+
 /// The layers at the newest observation's time, if anything was observed (or a mission
 /// heard) since they were last sent.
-fn layers_to_send(state: &MapperShared) -> Option<Vec<(&'static str, Cells)>> {
+fn layers_to_send(state: &MapperShared) -> Option<LayersToSend> {
     let mut m = state.mapping();
     if !m.dirty {
         return None;
@@ -431,11 +502,63 @@ fn layers_to_send(state: &MapperShared) -> Option<Vec<(&'static str, Cells)>> {
         Ok(news) => layers.push((NEWS_LAYER, Cells::U8(news.cells))),
         Err(e) => tracing::error!("no news layer: {e}"),
     }
-    match occupied_now(&m.map, now, &state.belief, Some(&state.static_map)) {
+    match occupied_now(&m.map, now, &state.belief, Some(&m.static_map)) {
         Ok(belief) => layers.push((OCCUPIED_NOW_LAYER, Cells::I8(belief.cells))),
         Err(e) => tracing::error!("no occupied_now layer: {e}"),
     }
-    Some(layers)
+    Some(LayersToSend {
+        world: m.world.clone(),
+        meta: m.meta,
+        layers,
+    })
+}
+
+/// Moves the mapping to the world the map server holds when it is another than the
+/// mapping's (the map server took a map of another grid: `--ros2-map`, `map/load`):
+/// what was learnt of the old world's cells means nothing on the new one, so the
+/// mapping starts afresh on the new occupancy, and its layers go out on the new grid
+/// for the new world. The map server has forgotten the old grid's layers by then.
+async fn follow_world(state: &MapperShared, list: &LayerList, requester: &Requester) {
+    let Some(theirs) = &list.world else {
+        return;
+    };
+    if state.mapping().world.hash == theirs.hash {
+        return;
+    }
+    let key = keys::map_layer(&state.root, OCCUPANCY_LAYER);
+    let occupancy = match requester.request::<Layer, Layer>(&key, None).await {
+        Ok(layer) => layer,
+        Err(e) => return tracing::debug!("the new world's occupancy is not here yet: {e}"),
+    };
+    let Cells::I8(cells) = occupancy.cells else {
+        return tracing::warn!("the map server's occupancy is not i8 cells; the mapping stays");
+    };
+    if cells.len() as u64 != occupancy.meta.cell_count() {
+        return tracing::warn!("the map server's occupancy has the wrong cell count");
+    }
+    let static_map = Grid {
+        meta: occupancy.meta,
+        cells,
+    };
+    match state.spec.build(theirs.clone(), static_map) {
+        Ok(fresh) => {
+            let mut m = state.mapping();
+            tracing::info!(
+                world = %theirs,
+                was = %m.world,
+                "the map server holds another world: mapping it afresh on its {}x{} grid",
+                occupancy.meta.width,
+                occupancy.meta.height
+            );
+            let (epochs, now_s) = (m.epochs.clone(), m.now_s);
+            *m = Mapping {
+                epochs,
+                now_s,
+                ..fresh
+            };
+        }
+        Err(e) => tracing::error!("cannot map the map server's new world: {e}"),
+    }
 }
 
 /// Layers travel as f32 cells: the map server's float layer type, half the bytes.
@@ -446,35 +569,36 @@ fn f32_cells(cells: Vec<f64>) -> Vec<f32> {
 /// Sends the layers to the map server at most once per period.
 async fn publish_layers(state: Arc<MapperShared>, period: Duration, cancel: CancellationToken) {
     let requester = Requester::new(state.session.clone(), Duration::from_secs(5));
-    let meta = GridMeta {
-        width: state.meta.width,
-        height: state.meta.height,
-        resolution: state.meta.resolution,
-        origin: Origin {
-            x: state.meta.origin.x,
-            y: state.meta.origin.y,
-            yaw: 0.0,
-        },
-    };
     loop {
         tokio::select! {
             _ = cancel.cancelled() => return,
             _ = tokio::time::sleep(period) => {}
         }
-        let Some(layers) = layers_to_send(&state) else {
-            continue;
-        };
         let list: LayerList = match requester
             .request::<LayerList, LayerList>(&keys::map_index(&state.root), None)
             .await
         {
             Ok(l) => l,
             Err(e) => {
-                // Try again next period with fresher layers.
-                state.mapping().dirty = true;
                 tracing::debug!("no map server to send the layers to: {e}");
                 continue;
             }
+        };
+        follow_world(&state, &list, &requester).await;
+        let Some(LayersToSend {
+            world,
+            meta,
+            layers,
+        }) = layers_to_send(&state)
+        else {
+            continue;
+        };
+        let meta = GridMeta {
+            origin: Origin {
+                yaw: 0.0,
+                ..meta.origin
+            },
+            ..meta
         };
         let mut all_sent = true;
         for (name, cells) in layers {
@@ -486,7 +610,7 @@ async fn publish_layers(state: Arc<MapperShared>, period: Duration, cancel: Canc
             let update = LayerUpdate {
                 base_version,
                 change: LayerChange::Replace { meta, cells },
-                world: Some(state.world.clone()),
+                world: Some(world.clone()),
             };
             let sent = requester
                 .request::<LayerUpdate, UpdateAck>(
@@ -533,35 +657,24 @@ pub async fn run(
         checked.map_err(|e| MapperServiceError::Config(e.to_string()))?;
     }
     let (_, scenario) = load_or_builtin(config.scenario.as_deref())?;
-    let meta = scenario.occupancy.meta;
-    let news = NewsMap::new(meta, config.news.prior)
-        .map_err(|e| MapperServiceError::Config(e.to_string()))?;
     let reserve_radius_m = config
         .news
         .reserve
         .radius_m
         .unwrap_or(scenario.file.sensing.observation_radius_m)
         .max(0.0);
-    let observation_period_s = scenario.file.time.step_s;
-    let map = ChangeMap::new(
-        meta,
-        MapParams {
-            observation_period_s,
+    let spec = MappingSpec {
+        map: MapParams {
+            observation_period_s: scenario.file.time.step_s,
             ..config.map
         },
-    )
-    .map_err(|e| MapperServiceError::Config(e.to_string()))?;
-    let explorers = explore
-        .iter()
-        .map(|robot| {
-            // Seeded by the robot's name, not its place in the list: a robot explores
-            // the same way whichever other robots are explored beside it.
-            let seed = crate::seed::labelled(config.seed, &format!("explore/{robot}"));
-            Explorer::new(config.explorer, Mode::Curious, seed)
-                .map(|e| (robot.clone(), e))
-                .map_err(|e| MapperServiceError::Config(e.to_string()))
-        })
-        .collect::<Result<_, _>>()?;
+        news: config.news,
+        explorer: config.explorer,
+        seed: config.seed,
+        explore,
+    };
+    let world = roam_world::world_id::of_scenario(&scenario);
+    let mapping = spec.build(world.clone(), scenario.occupancy.clone())?;
     let mut service = Service::start(
         SERVICE_NAME,
         &config.root,
@@ -570,33 +683,15 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world = roam_world::world_id::of_scenario(&scenario);
-    let world_guard = world_check::guard(&service, world.clone());
+    let world_guard = world_check::guard(&service, world);
     let state = Arc::new(MapperShared {
-        world: world.clone(),
         root: config.root.clone(),
         session: service.session().clone(),
-        meta,
-        static_map: scenario.occupancy.clone(),
+        mapping: Mutex::new(mapping),
+        spec,
         belief: config.belief,
         reserve_radius_m,
         reserve_s_per_m: config.news.reserve.s_per_m,
-        mapping: Mutex::new(Mapping {
-            map,
-            news,
-            positions: BTreeMap::new(),
-            explorers,
-            published_goals: BTreeMap::new(),
-            observations: 0,
-            map_changes: 0,
-            features: (0.0, 0.0),
-            now_s: 0.0,
-            // Sent once at start too: the layers exist at the map's size before the
-            // first observation, so a planner on the change coupling has one to plan on.
-            dirty: true,
-            layers_sent: 0,
-            epochs: Epochs::default(),
-        }),
         warnings: WarnLimiter::new(),
     });
     service

@@ -192,6 +192,7 @@ impl LayerStore {
         self.check_budget(OCCUPANCY, &sizes)?;
         let mut pending = Pending::default();
         let info_cells = information.map(|g| roam_proto::cells::Cells::U8(g.cells));
+        let before = self.occupancy_meta();
         self.stage_source(
             &mut pending,
             OCCUPANCY,
@@ -199,7 +200,67 @@ impl LayerStore {
             roam_proto::cells::Cells::I8(occupancy_grid.cells),
             info_cells,
         )?;
-        Ok(names(&self.commit(pending)?))
+        let changed = names(&self.commit(pending)?);
+        self.follow_occupancy_grid(before)?;
+        Ok(changed)
+    }
+
+    fn occupancy_meta(&self) -> Option<GridMeta> {
+        self.layers.get(OCCUPANCY).map(|l| l.meta)
+    }
+
+    /// After occupancy moved to another grid (size, resolution or origin): it is another
+    /// world, so the world id becomes the new grid's (its name kept), and every free
+    /// layer still on the old grid is forgotten, as a delete does: a layer that covers
+    /// other cells than occupancy is nobody's map, and its writer sends it again on the
+    /// new grid, for the new world. Nothing happens when the grid is the same.
+    fn follow_occupancy_grid(&mut self, before: Option<GridMeta>) -> Result<(), StoreError> {
+        let Some(now) = self.get_shared(OCCUPANCY) else {
+            return Ok(());
+        };
+        if before.is_none_or(|b| b == now.meta) {
+            return Ok(());
+        }
+        let stale: Vec<(String, u64)> = self
+            .layers
+            .values()
+            .filter(|l| !BASE_LAYERS.contains(&l.name.as_str()) && l.meta != now.meta)
+            .map(|l| (l.name.clone(), l.version))
+            .collect();
+        for (name, version) in &stale {
+            self.forget(name, *version)?;
+        }
+        if let roam_proto::cells::Cells::I8(cells) = &now.cells {
+            let name = self.world.as_ref().map_or("map", |w| w.name.as_str());
+            let grid = Grid {
+                meta: now.meta,
+                cells: cells.clone(),
+            };
+            let world = roam_world::world_id::world_id(name, &grid);
+            tracing::info!(
+                world = %world,
+                forgotten = ?stale.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(),
+                "occupancy moved to a {}x{} grid of {} m: a new world",
+                now.meta.width,
+                now.meta.height,
+                now.meta.resolution
+            );
+            self.set_world(world)?;
+        }
+        Ok(())
+    }
+
+    /// Removes layer `name` (at `version`) and remembers its version, on disk too.
+    fn forget(&mut self, name: &str, version: u64) -> Result<(), StoreError> {
+        let mut tombstones = self.tombstones.clone();
+        remember(&mut tombstones, name, version);
+        if let Some(data) = &mut self.data {
+            data.delete(name, &tombstones)?;
+        }
+        self.tombstones = tombstones;
+        self.layers.remove(name);
+        self.derivations.remove(name);
+        Ok(())
     }
 
     /// Applies one update to layer `name`. Returns the acknowledgement and how each
@@ -230,6 +291,7 @@ impl LayerStore {
             "apply your change to it",
         )?;
         let mut pending = Pending::default();
+        let before = self.occupancy_meta();
         match &update.change {
             LayerChange::Replace { meta, cells } => {
                 check_meta(meta)?;
@@ -281,6 +343,9 @@ impl LayerStore {
         }
         let version = pending.version_of(name).unwrap_or(0);
         let changed = self.commit(pending)?;
+        if name == OCCUPANCY {
+            self.follow_occupancy_grid(before)?;
+        }
         let derived = changed
             .iter()
             .map(Publication::name)
@@ -327,14 +392,7 @@ impl LayerStore {
             "deletion",
             "delete it again if you still mean to",
         )?;
-        let mut tombstones = self.tombstones.clone();
-        remember(&mut tombstones, name, base_version);
-        if let Some(data) = &mut self.data {
-            data.delete(name, &tombstones)?;
-        }
-        self.tombstones = tombstones;
-        self.layers.remove(name);
-        self.derivations.remove(name);
+        self.forget(name, base_version)?;
         Ok(LayerDeleted {
             layer: name.to_owned(),
             version: base_version,
