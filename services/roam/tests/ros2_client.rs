@@ -304,3 +304,45 @@ async fn a_nav2_client_computes_paths_and_finds_the_robot_on_tf() {
     );
     let _ = session.close().await;
 }
+
+/// The router under a running `roam ros2` restarts: the node's session reconnects and
+/// declares its tokens again, and a ROS 2 client (the independent one, reading the graph
+/// as rmw_zenoh does) sees `/roam` and its action within 5 s of the new router.
+#[test]
+fn a_ros2_client_sees_the_node_again_after_the_router_restarts() {
+    if !python_has(
+        "zenoh, zenoh.ext, rosbags",
+        "a_ros2_client_sees_the_node_again_after_the_router_restarts",
+        "eclipse-zenoh==1.10.2 rosbags==0.11.9",
+    ) {
+        return;
+    }
+    let port = free_loopback_port().expect("port");
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let root = format!("ros2-restart-{}", std::process::id());
+    let router =
+        |root: &str| RoamProcess::start(&["router", "--listen", &endpoint], root, "router running");
+    let mut first = router(&root);
+    let _node = RoamProcess::start(
+        &["ros2", "--mode", "client", "--connect", &endpoint],
+        &root,
+        "node up on rmw_zenoh's keys",
+    );
+    let before = python(&["graph", "--connect", &endpoint, "--within", "10"]);
+    assert!(before.status.success(), "{before:?}");
+
+    let stopped = first.stop().expect("the router stops");
+    assert!(stopped.success(), "{stopped:?}");
+    let restarted_at = std::time::Instant::now();
+    let _second = router(&root);
+    let after = python(&["graph", "--connect", &endpoint, "--within", "5"]);
+    assert!(
+        after.status.success(),
+        "the node is not back within 5 s: {after:?}"
+    );
+    eprintln!(
+        "after the restart: {} (the client's view), {:.2} s from the new router's start to the client's exit",
+        after.stdout.trim(),
+        restarted_at.elapsed().as_secs_f64()
+    );
+}

@@ -5,6 +5,7 @@ message implementation: CDR, RIHS01 hashes, rosbag2 reading).
     python3 ros2_client.py live --connect tcp/127.0.0.1:7447 --robot r1 --waypoints '[[..]]'
     python3 ros2_client.py watch --connect tcp/127.0.0.1:7447 --robot robot
     python3 ros2_client.py nav2 --connect tcp/127.0.0.1:7447 --robot r1
+    python3 ros2_client.py graph --connect tcp/127.0.0.1:7447 --within 5
     python3 ros2_client.py bag DIR
 
 `live` finds roam's liveliness tokens, subscribes to /map and /<robot>/plan as
@@ -17,7 +18,8 @@ robot's /<robot>/plan and its /<robot>/pose with the CRB as covariance. `nav2` i
 client: it sends nav2_msgs/action/ComputePathToPose goals (good ones, and ones in a wall,
 off the map, in another frame, to an unknown planner, cancelled) with rcl_action's
 services on keys built from rosbags' hashes, checks Nav2's status and error codes, the
-latched status topic, and /tf against the robot's estimates. `bag` reads a
+latched status topic, and /tf against the robot's estimates. `graph` waits for roam's node
+and its action among the graph's tokens (after a router restart, say). `bag` reads a
 rosbag2 directory and prints its topics and counts.
 Exit code 0 when every check passed; 1 with the failed check on stderr otherwise.
 """
@@ -538,6 +540,27 @@ def nav2(args):
     print(json.dumps(out))
 
 
+def graph(args):
+    """Waits for roam's node and its action's send_goal service among the graph's tokens,
+    as rmw_zenoh's graph cache learns them (a liveliness get on the domain), and prints
+    how long that took; fails after --within seconds."""
+    started = time.time()
+    session = open_client(args.connect)
+    seen = None
+    while time.time() - started < args.within:
+        tokens = [str(r.ok.key_expr) for r in session.liveliness().get(f'@ros2_lv/{args.domain}/**')
+                  if r.ok is not None]
+        node = any(t.endswith('/NN/%/%/roam') for t in tokens)
+        action = any('/SS/' in t and '%compute_path_to_pose%_action%send_goal' in t for t in tokens)
+        if node and action:
+            seen = time.time() - started
+            break
+        time.sleep(0.1)
+    session.close()
+    check(seen is not None, f'roam\'s node and its action in the graph within {args.within} s')
+    print(json.dumps({'seen_after_s': round(seen, 2)}))
+
+
 def open_client(endpoint):
     conf = zenoh.Config()
     conf.insert_json5('mode', '"client"')
@@ -612,10 +635,14 @@ def main():
     p.add_argument('--domain', type=int, default=0)
     p.add_argument('--robot', default='r1')
     p.add_argument('--action', default='compute_path_to_pose')
+    p = sub.add_parser('graph')
+    p.add_argument('--connect', required=True)
+    p.add_argument('--domain', type=int, default=0)
+    p.add_argument('--within', type=float, default=5.0)
     p = sub.add_parser('bag')
     p.add_argument('dir')
     args = parser.parse_args()
-    {'live': live, 'watch': watch, 'nav2': nav2, 'bag': bag}[args.command](args)
+    {'live': live, 'watch': watch, 'nav2': nav2, 'graph': graph, 'bag': bag}[args.command](args)
 
 
 if __name__ == '__main__':
