@@ -368,6 +368,63 @@ pub struct ComputePathGetResultResponse {
     pub result: ComputePathResult,
 }
 
+/// rosgraph_msgs/msg/Clock: `/clock`, a simulation's time (`use_sim_time`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Clock {
+    pub clock: Time,
+}
+
+/// std_msgs/msg/Empty: its one generated member.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Empty {
+    pub structure_needs_at_least_one_member: u8,
+}
+
+/// nav2_msgs/action/FollowPath's goal.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct FollowPathGoal {
+    pub path: Path,
+    pub controller_id: String,
+    pub goal_checker_id: String,
+    pub progress_checker_id: String,
+}
+
+/// nav2_msgs/action/FollowPath's result: an error code (0: none) and why.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FollowPathResult {
+    pub result: Empty,
+    pub error_code: u16,
+    pub error_msg: String,
+}
+
+/// nav2_msgs/action/FollowPath's feedback.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct FollowPathFeedback {
+    pub distance_to_goal: f32,
+    pub speed: f32,
+}
+
+/// The FollowPath action's `_action/feedback` message.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct FollowPathFeedbackMessage {
+    pub goal_id: Uuid,
+    pub feedback: FollowPathFeedback,
+}
+
+/// The FollowPath action's `_action/send_goal` request.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct FollowPathSendGoalRequest {
+    pub goal_id: Uuid,
+    pub goal: FollowPathGoal,
+}
+
+/// The FollowPath action's `_action/get_result` response.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FollowPathGetResultResponse {
+    pub status: i8,
+    pub result: FollowPathResult,
+}
+
 /// geometry_msgs/msg/Vector3.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct Vector3 {

@@ -104,6 +104,15 @@ pub const COMPUTE_PATH_FEEDBACK_MESSAGE: &str =
     "nav2_msgs/action/ComputePathToPose_FeedbackMessage";
 pub const COMPUTE_PATH_SEND_GOAL: &str = "nav2_msgs/action/ComputePathToPose_SendGoal";
 pub const COMPUTE_PATH_GET_RESULT: &str = "nav2_msgs/action/ComputePathToPose_GetResult";
+pub const CLOCK: &str = "rosgraph_msgs/msg/Clock";
+pub const EMPTY: &str = "std_msgs/msg/Empty";
+/// Nav2's controller action (a robot's `follow_path`), and its generated parts.
+pub const FOLLOW_PATH_GOAL: &str = "nav2_msgs/action/FollowPath_Goal";
+pub const FOLLOW_PATH_RESULT: &str = "nav2_msgs/action/FollowPath_Result";
+pub const FOLLOW_PATH_FEEDBACK: &str = "nav2_msgs/action/FollowPath_Feedback";
+pub const FOLLOW_PATH_FEEDBACK_MESSAGE: &str = "nav2_msgs/action/FollowPath_FeedbackMessage";
+pub const FOLLOW_PATH_SEND_GOAL: &str = "nav2_msgs/action/FollowPath_SendGoal";
+pub const FOLLOW_PATH_GET_RESULT: &str = "nav2_msgs/action/FollowPath_GetResult";
 
 /// Every message definition, dependencies included.
 pub const MESSAGES: &[MsgDef] = &[
@@ -288,6 +297,62 @@ pub const MESSAGES: &[MsgDef] = &[
         fields: &[f("status", Int8), f("result", Nested(COMPUTE_PATH_RESULT))],
     },
     MsgDef {
+        name: CLOCK,
+        fields: &[f("clock", Nested(TIME))],
+    },
+    MsgDef {
+        name: EMPTY,
+        fields: &[f("structure_needs_at_least_one_member", Uint8)],
+    },
+    // nav2_msgs/action/FollowPath (Jazzy), less its error-code constants.
+    MsgDef {
+        name: FOLLOW_PATH_GOAL,
+        fields: &[
+            f("path", Nested(PATH)),
+            f("controller_id", Base::String),
+            f("goal_checker_id", Base::String),
+            f("progress_checker_id", Base::String),
+        ],
+    },
+    MsgDef {
+        name: FOLLOW_PATH_RESULT,
+        fields: &[
+            f("result", Nested(EMPTY)),
+            f("error_code", Uint16),
+            f("error_msg", Base::String),
+        ],
+    },
+    MsgDef {
+        name: FOLLOW_PATH_FEEDBACK,
+        fields: &[f("distance_to_goal", Float32), f("speed", Float32)],
+    },
+    MsgDef {
+        name: FOLLOW_PATH_FEEDBACK_MESSAGE,
+        fields: &[
+            f("goal_id", Nested(UUID)),
+            f("feedback", Nested(FOLLOW_PATH_FEEDBACK)),
+        ],
+    },
+    MsgDef {
+        name: "nav2_msgs/action/FollowPath_SendGoal_Request",
+        fields: &[
+            f("goal_id", Nested(UUID)),
+            f("goal", Nested(FOLLOW_PATH_GOAL)),
+        ],
+    },
+    MsgDef {
+        name: "nav2_msgs/action/FollowPath_SendGoal_Response",
+        fields: &[f("accepted", Bool), f("stamp", Nested(TIME))],
+    },
+    MsgDef {
+        name: "nav2_msgs/action/FollowPath_GetResult_Request",
+        fields: &[f("goal_id", Nested(UUID))],
+    },
+    MsgDef {
+        name: "nav2_msgs/action/FollowPath_GetResult_Response",
+        fields: &[f("status", Int8), f("result", Nested(FOLLOW_PATH_RESULT))],
+    },
+    MsgDef {
         name: SERVICE_EVENT_INFO,
         fields: &[
             f("event_type", Uint8),
@@ -342,6 +407,8 @@ pub const SERVICES: &[&str] = &[
     CANCEL_GOAL,
     COMPUTE_PATH_SEND_GOAL,
     COMPUTE_PATH_GET_RESULT,
+    FOLLOW_PATH_SEND_GOAL,
+    FOLLOW_PATH_GET_RESULT,
 ];
 
 /// The definition of message `name`, if roam knows it.

@@ -117,7 +117,7 @@ fn the_service_hashes_are_rosbags_s() {
     );
 }
 
-/// Nav2's planner action and tf2's message, hashed by rosbags (the action's services
+/// Nav2's planner and controller actions, tf2's message and the clock, hashed by rosbags (the action's services
 /// built as rosidl builds them, as for roam's own services above).
 /// `action_msgs/msg/GoalStatusArray`'s hash is also the one ROS 2 Jazzy publishes.
 #[test]
@@ -134,6 +134,14 @@ fn the_action_and_tf_hashes_are_rosbags_s() {
         (
             types::CANCEL_GOAL,
             "RIHS01_573d8b0a534451d7bc2ac8c5ffde8ac14b8593b7001175d0cd6516dcbeb8689a",
+        ),
+        (
+            types::FOLLOW_PATH_SEND_GOAL,
+            "RIHS01_5b662aee1159e1d7e7b5f8fef21f556b8bc67c818c730a68e18bb29b85f66946",
+        ),
+        (
+            types::FOLLOW_PATH_GET_RESULT,
+            "RIHS01_8ab4c588c878f0e997316ec559f172bb56fc210b484c2f6b280d391d3bd6890f",
         ),
     ] {
         assert_eq!(
@@ -154,6 +162,14 @@ fn the_action_and_tf_hashes_are_rosbags_s() {
         (
             types::TF_MESSAGE,
             "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087",
+        ),
+        (
+            types::FOLLOW_PATH_FEEDBACK_MESSAGE,
+            "RIHS01_3f4008700ba56ac4c82b01ef2b7fdd3fc18dc194399c48e5c43ebf8008b891d5",
+        ),
+        (
+            types::CLOCK,
+            "RIHS01_692f7a66e93a3c83e71765d033b60349ba68023a8c689a79e48078bcb5c58564",
         ),
     ] {
         assert_eq!(

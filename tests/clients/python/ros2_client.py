@@ -6,6 +6,7 @@ message implementation: CDR, RIHS01 hashes, rosbag2 reading).
     python3 ros2_client.py watch --connect tcp/127.0.0.1:7447 --robot robot
     python3 ros2_client.py nav2 --connect tcp/127.0.0.1:7447 --robot r1
     python3 ros2_client.py graph --connect tcp/127.0.0.1:7447 --within 5
+    python3 ros2_client.py fake-nav2-robot --connect tcp/127.0.0.1:7447 --speed 0.6 --rate 10
     python3 ros2_client.py bag DIR
 
 `live` finds roam's liveliness tokens, subscribes to /map and /<robot>/plan as
@@ -19,7 +20,9 @@ client: it sends nav2_msgs/action/ComputePathToPose goals (good ones, and ones i
 off the map, in another frame, to an unknown planner, cancelled) with rcl_action's
 services on keys built from rosbags' hashes, checks Nav2's status and error codes, the
 latched status topic, and /tf against the robot's estimates. `graph` waits for roam's node
-and its action among the graph's tokens (after a router restart, say). `bag` reads a
+and its action among the graph's tokens (after a router restart, say). `fake-nav2-robot`
+is a Nav2 robot (/clock, /amcl_pose, a FollowPath server driving the pose along each
+path) for roam's executive to drive through the node. `bag` reads a
 rosbag2 directory and prints its topics and counts.
 Exit code 0 when every check passed; 1 with the failed check on stderr otherwise.
 """
@@ -299,6 +302,7 @@ def live(args):
 
 
 NAV2 = 'nav2_msgs/action/ComputePathToPose'
+FOLLOW = 'nav2_msgs/action/FollowPath'
 STATUS = {'unknown': 0, 'accepted': 1, 'executing': 2, 'canceling': 3, 'succeeded': 4,
           'canceled': 5, 'aborted': 6}
 NAV2_ERRORS = {'NONE': 0, 'UNKNOWN': 200, 'INVALID_PLANNER': 201, 'TF_ERROR': 202,
@@ -319,7 +323,9 @@ def action_store():
         'geometry_msgs/msg/PoseStamped', 'nav_msgs/msg/Path', 'unique_identifier_msgs/msg/UUID',
         'action_msgs/msg/GoalInfo', 'action_msgs/msg/GoalStatus', 'action_msgs/msg/GoalStatusArray',
         'geometry_msgs/msg/Vector3', 'geometry_msgs/msg/Transform',
-        'geometry_msgs/msg/TransformStamped', 'tf2_msgs/msg/TFMessage']})
+        'geometry_msgs/msg/TransformStamped', 'tf2_msgs/msg/TFMessage', 'rosgraph_msgs/msg/Clock',
+        'std_msgs/msg/Empty', 'geometry_msgs/msg/PoseWithCovariance',
+        'geometry_msgs/msg/PoseWithCovarianceStamped']})
     types = {}
     types.update(get_types_from_msg(
         'uint8 event_type\nbuiltin_interfaces/Time stamp\nuint8[16] client_gid\nint64 sequence_number',
@@ -332,7 +338,17 @@ def action_store():
     types.update(get_types_from_msg('uint8 structure_needs_at_least_one_member', P + '_Feedback'))
     types.update(get_types_from_msg(f'unique_identifier_msgs/UUID goal_id\n{P}_Feedback feedback',
                                     P + '_FeedbackMessage'))
+    F = FOLLOW
+    types.update(get_types_from_msg('nav_msgs/Path path\nstring controller_id\nstring goal_checker_id\n'
+                                    'string progress_checker_id', F + '_Goal'))
+    types.update(get_types_from_msg('std_msgs/Empty result\nuint16 error_code\nstring error_msg', F + '_Result'))
+    types.update(get_types_from_msg('float32 distance_to_goal\nfloat32 speed', F + '_Feedback'))
+    types.update(get_types_from_msg(f'unique_identifier_msgs/UUID goal_id\n{F}_Feedback feedback',
+                                    F + '_FeedbackMessage'))
     for srv, req, resp in [
+            (F + '_SendGoal', f'unique_identifier_msgs/UUID goal_id\n{F}_Goal goal',
+             'bool accepted\nbuiltin_interfaces/Time stamp'),
+            (F + '_GetResult', 'unique_identifier_msgs/UUID goal_id', f'int8 status\n{F}_Result result'),
             (P + '_SendGoal', f'unique_identifier_msgs/UUID goal_id\n{P}_Goal goal',
              'bool accepted\nbuiltin_interfaces/Time stamp'),
             (P + '_GetResult', 'unique_identifier_msgs/UUID goal_id', f'int8 status\n{P}_Result result'),
@@ -540,6 +556,175 @@ def nav2(args):
     print(json.dumps(out))
 
 
+def fake_nav2_robot(args):
+    """A Nav2 robot as a ROS 2 system shows one to roam, on rmw_zenoh's wire: /clock
+    (simulated time at --rate times wall time), /amcl_pose (the robot's pose with a
+    covariance) and a /follow_path action server (nav2_msgs/action/FollowPath) that
+    drives the pose along each accepted path at --speed m/s of simulated time, with
+    feedback, from the pose's nearest path point on (searched forward, as Nav2's
+    controllers prune a plan); a new goal replaces the running one, a cancel stops it. --reject refuses
+    every goal, --silent never answers, --stop-pose-at S stops publishing poses from
+    simulated time S. Runs until simulated time --until-s, then prints what it did."""
+    import threading
+    A = action_store()
+    T = A.types
+    domain = args.domain
+    session = open_client(args.connect)
+    key_of = lambda name, ros_type: topic_key(domain, name, ros_type, A.hash_rihs01(ros_type))
+    gid = os.urandom(16)
+    lock = threading.Lock()
+    state = {'pos': list(args.start), 'path': [], 'goal': None, 'results': {}, 'waiting': {},
+             'goals': 0, 'cancels': 0, 'rejected': 0, 'driven_m': 0.0, 'succeeded': 0}
+    seq = {'n': 0}
+
+    def att():
+        seq['n'] += 1
+        return attachment(seq['n'], gid)
+
+    def reply(query, payload):
+        raw = query.attachment.to_bytes() if query.attachment is not None else None
+        check(raw is not None and len(raw) == 33, 'roam\'s call carries rmw_zenoh\'s attachment')
+        back = raw[0:8] + time.time_ns().to_bytes(8, 'little', signed=True) + raw[16:33]
+        query.reply(query.key_expr, bytes(payload), attachment=back)
+
+    def result_bytes(status):
+        R = T[FOLLOW + '_GetResult_Response'](status=status, result=T[FOLLOW + '_Result'](
+            result=T['std_msgs/msg/Empty'](structure_needs_at_least_one_member=0),
+            error_code=0 if status == STATUS['succeeded'] else 100, error_msg=''))
+        return A.serialize_cdr(R, FOLLOW + '_GetResult_Response')
+
+    def end(goal_id, status):
+        """Under the lock: goal_id ends with status; its waiting get_result calls are answered."""
+        state['results'][goal_id] = status
+        for q in state['waiting'].pop(goal_id, []):
+            reply(q, result_bytes(status))
+
+    def on_send_goal(query):
+        req = A.deserialize_cdr(query.payload.to_bytes(), FOLLOW + '_SendGoal_Request')
+        goal_id = bytes(req.goal_id.uuid)
+        if args.silent:
+            return
+        with lock:
+            state['goals'] += 1
+            accepted = not args.reject
+            if accepted:
+                if state['goal'] is not None:
+                    end(state['goal'], STATUS['canceled'])
+                state['goal'] = goal_id
+                path = [(p.pose.position.x, p.pose.position.y) for p in req.goal.path.poses]
+                # As Nav2's controllers prune the global plan: followed from the robot's
+                # nearest path point, searched forward from the start to the first local
+                # minimum of the distance (never a later pass of a loop), so never back
+                # to a start the robot has passed.
+                pos = state['pos']
+                dist = lambda i: math.hypot(path[i][0] - pos[0], path[i][1] - pos[1])
+                nearest = 0
+                while nearest + 1 < len(path) and dist(nearest + 1) <= dist(nearest):
+                    nearest += 1
+                state['path'] = path[nearest:]
+            else:
+                state['rejected'] += 1
+        resp = T[FOLLOW + '_SendGoal_Response'](accepted=accepted, stamp=T['builtin_interfaces/msg/Time'](sec=0, nanosec=0))
+        reply(query, A.serialize_cdr(resp, FOLLOW + '_SendGoal_Response'))
+
+    def on_get_result(query):
+        req = A.deserialize_cdr(query.payload.to_bytes(), FOLLOW + '_GetResult_Request')
+        goal_id = bytes(req.goal_id.uuid)
+        with lock:
+            if goal_id in state['results']:
+                reply(query, result_bytes(state['results'][goal_id]))
+            elif goal_id == state['goal']:
+                state['waiting'].setdefault(goal_id, []).append(query)
+            else:
+                reply(query, result_bytes(STATUS['unknown']))
+
+    def on_cancel(query):
+        req = A.deserialize_cdr(query.payload.to_bytes(), 'action_msgs/srv/CancelGoal_Request')
+        goal_id = bytes(req.goal_info.goal_id.uuid)
+        with lock:
+            canceling = []
+            if goal_id == state['goal']:
+                state['cancels'] += 1
+                canceling = [req.goal_info]
+                end(goal_id, STATUS['canceled'])
+                state['goal'], state['path'] = None, []
+            code = 0 if canceling else 2
+        resp = T['action_msgs/srv/CancelGoal_Response'](return_code=code, goals_canceling=canceling)
+        reply(query, A.serialize_cdr(resp, 'action_msgs/srv/CancelGoal_Response'))
+
+    base = f'/{args.action}/_action'
+    queryables = [
+        session.declare_queryable(key_of(base + '/send_goal', FOLLOW + '_SendGoal'), on_send_goal, complete=True),
+        session.declare_queryable(key_of(base + '/get_result', FOLLOW + '_GetResult'), on_get_result, complete=True),
+        session.declare_queryable(key_of(base + '/cancel_goal', 'action_msgs/srv/CancelGoal'), on_cancel, complete=True),
+    ]
+    clock_pub = session.declare_publisher(key_of('/clock', 'rosgraph_msgs/msg/Clock'))
+    pose_pub = session.declare_publisher(key_of('/amcl_pose', 'geometry_msgs/msg/PoseWithCovarianceStamped'))
+    feedback_pub = session.declare_publisher(key_of(base + '/feedback', FOLLOW + '_FeedbackMessage'))
+    Time = T['builtin_interfaces/msg/Time']
+
+    def stamp(sim):
+        return Time(sec=int(sim), nanosec=int((sim % 1) * 1e9))
+
+    period = 0.02
+    sim = 0.0
+    started = time.time()
+    cov = np.zeros(36)
+    cov[0] = cov[7] = 0.01
+    cov[35] = 0.05
+    while sim < args.until_s:
+        time.sleep(period)
+        before, sim = sim, (time.time() - started) * args.rate
+        step = args.speed * (sim - before)
+        with lock:
+            path, pos = state['path'], state['pos']
+            while step > 0 and path:
+                tx, ty = path[0]
+                d = math.hypot(tx - pos[0], ty - pos[1])
+                if d <= step:
+                    pos[0], pos[1] = tx, ty
+                    state['driven_m'] += d
+                    step -= d
+                    path.pop(0)
+                else:
+                    pos[0] += (tx - pos[0]) * step / d
+                    pos[1] += (ty - pos[1]) * step / d
+                    state['driven_m'] += step
+                    step = 0
+            goal = state['goal']
+            if goal is not None and not path:
+                end(goal, STATUS['succeeded'])
+                state['succeeded'] += 1
+                state['goal'] = None
+            elif goal is not None:
+                left = sum(math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip([tuple(pos)] + path, path))
+                fb = T[FOLLOW + '_FeedbackMessage'](
+                    goal_id=T['unique_identifier_msgs/msg/UUID'](uuid=np.frombuffer(goal, dtype=np.uint8).copy()),
+                    feedback=T[FOLLOW + '_Feedback'](distance_to_goal=np.float32(left), speed=np.float32(args.speed)))
+                feedback_pub.put(bytes(A.serialize_cdr(fb, FOLLOW + '_FeedbackMessage')), attachment=att())
+            x, y = pos
+        clock_pub.put(bytes(A.serialize_cdr(T['rosgraph_msgs/msg/Clock'](clock=stamp(sim)), 'rosgraph_msgs/msg/Clock')),
+                      attachment=att())
+        if args.stop_pose_at is None or sim < args.stop_pose_at:
+            msg = T['geometry_msgs/msg/PoseWithCovarianceStamped'](
+                header=T['std_msgs/msg/Header'](stamp=stamp(sim), frame_id='map'),
+                pose=T['geometry_msgs/msg/PoseWithCovariance'](
+                    pose=T['geometry_msgs/msg/Pose'](
+                        position=T['geometry_msgs/msg/Point'](x=x, y=y, z=0.0),
+                        orientation=T['geometry_msgs/msg/Quaternion'](x=0.0, y=0.0, z=0.0, w=1.0)),
+                    covariance=cov))
+            pose_pub.put(bytes(A.serialize_cdr(msg, 'geometry_msgs/msg/PoseWithCovarianceStamped')),
+                         attachment=att())
+    for q in queryables:
+        q.undeclare()
+    with lock:
+        out = {k: state[k] for k in ['goals', 'cancels', 'rejected', 'succeeded']}
+        out['driven_m'] = round(state['driven_m'], 2)
+        out['at'] = [round(v, 3) for v in state['pos']]
+    session.close()
+    print(json.dumps(out))
+
+
 def graph(args):
     """Waits for roam's node and its action's send_goal service among the graph's tokens,
     as rmw_zenoh's graph cache learns them (a liveliness get on the domain), and prints
@@ -639,10 +824,22 @@ def main():
     p.add_argument('--connect', required=True)
     p.add_argument('--domain', type=int, default=0)
     p.add_argument('--within', type=float, default=5.0)
+    p = sub.add_parser('fake-nav2-robot')
+    p.add_argument('--connect', required=True)
+    p.add_argument('--domain', type=int, default=0)
+    p.add_argument('--action', default='follow_path')
+    p.add_argument('--start', type=float, nargs=2, default=[-8.0, -8.0])
+    p.add_argument('--speed', type=float, default=0.6)
+    p.add_argument('--rate', type=float, default=10.0)
+    p.add_argument('--until-s', type=float, default=360.0)
+    p.add_argument('--reject', action='store_true')
+    p.add_argument('--silent', action='store_true')
+    p.add_argument('--stop-pose-at', type=float, default=None)
     p = sub.add_parser('bag')
     p.add_argument('dir')
     args = parser.parse_args()
-    {'live': live, 'watch': watch, 'nav2': nav2, 'graph': graph, 'bag': bag}[args.command](args)
+    {'live': live, 'watch': watch, 'nav2': nav2, 'graph': graph, 'fake-nav2-robot': fake_nav2_robot,
+     'bag': bag}[args.command](args)
 
 
 if __name__ == '__main__':

@@ -58,8 +58,9 @@ ROLES
                free-running or in lock-step. `roam sim render` draws a scenario.
   router       A Zenoh router: run one per site or fleet; services connect to it.
   ros2         roam in a ROS 2 system over rmw_zenoh (no bridge): /map and the layers,
-               each robot's plan, pose and driven path, the planner as ROS 2 services,
-               optionally the occupancy map from a ROS 2 topic and a rosbag2 recording.
+               each robot's plan, pose, driven path and /tf frame, the planner as ROS 2
+               services and Nav2's ComputePathToPose; optionally the occupancy map from
+               a ROS 2 topic, Nav2 robots driven through FollowPath, a rosbag2 record.
   stack        Every landed service in one process around an in-process router on
                loopback, multicast off. The embedded default world needs no files.
 

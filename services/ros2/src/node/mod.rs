@@ -9,12 +9,15 @@
 //! from either side is trusted: payloads are capped before they are read, names are
 //! checked, and each refusal is logged, rate-limited, naming the limit.
 
+mod action_client;
 mod compute_path;
 mod follow;
 mod map_input;
+mod nav2_robot;
 mod output;
 mod poses;
 mod services;
+mod sim_time;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -27,6 +30,7 @@ use crate::names::{self, NodeInfo};
 pub use compute_path::{
     DEFAULT_ACTION as COMPUTE_PATH_ACTION, MAX_GOALS, MAX_RUNNING_GOALS, PLANNER_IDS,
 };
+pub use nav2_robot::{Nav2Robot, MAX_NAV2_ROBOTS};
 pub use output::Output;
 /// What every call to the node's services is promised (see `services`).
 pub use services::{
@@ -60,6 +64,12 @@ pub struct Ros2Config {
     /// The robot whose latest estimate starts a ComputePathToPose goal without
     /// `use_start` (default: the only robot localized, if there is one).
     pub robot: Option<String>,
+    /// Robots on Nav2 that roam's executive drives: their poses become roam's
+    /// estimates, their missions FollowPath goals ([`Nav2Robot`]).
+    pub nav2_robots: Vec<Nav2Robot>,
+    /// Take roam's mission clock from this ROS 2 topic (rosgraph_msgs/msg/Clock: a
+    /// simulator's `/clock`); absent: wall time.
+    pub clock: Option<String>,
     /// The map server's `max_layer_cells`: a received map above it is refused.
     pub max_layer_cells: u64,
     /// Record every message published to this new rosbag2 directory.
@@ -80,6 +90,8 @@ impl Default for Ros2Config {
             map_input: None,
             compute_path_action: Some(compute_path::DEFAULT_ACTION.to_owned()),
             robot: None,
+            nav2_robots: Vec::new(),
+            clock: None,
             max_layer_cells: MAX_LAYER_CELLS,
             rosbag: None,
             zenoh: None,
@@ -103,6 +115,8 @@ pub enum Ros2Error {
     Domain(u32),
     #[error("roam ros2 has nothing to do: it neither offers topics to ROS 2 nor records")]
     NothingToDo,
+    #[error("{0} Nav2 robots; one node drives at most {MAX_NAV2_ROBOTS}")]
+    TooManyRobots(usize),
     #[error(transparent)]
     Bag(#[from] crate::bag::BagError),
     #[error("cannot declare {what} on '{key}': {reason}")]
@@ -127,6 +141,9 @@ pub async fn run(
     names::check_node_name(&config.node_name)?;
     if !config.offer && config.rosbag.is_none() {
         return Err(Ros2Error::NothingToDo);
+    }
+    if config.nav2_robots.len() > MAX_NAV2_ROBOTS {
+        return Err(Ros2Error::TooManyRobots(config.nav2_robots.len()));
     }
     let bag = config
         .rosbag
@@ -184,6 +201,20 @@ pub async fn run(
     }
     if let Some(topic) = &config.map_input {
         map_input::declare(&service, output.clone(), &config, topic).await?;
+    }
+    let mission_clock = match &config.clock {
+        Some(topic) => sim_time::declare(&service, output.clone(), &config.root, topic).await?,
+        None => sim_time::MissionClock::default(),
+    };
+    for robot in &config.nav2_robots {
+        nav2_robot::declare(
+            &service,
+            output.clone(),
+            &config.root,
+            robot.clone(),
+            mission_clock.clone(),
+        )
+        .await?;
     }
     let (root, out, stop) = (config.root.clone(), output.clone(), service.cancel_token());
     service.spawn(follow::run(

@@ -5,7 +5,8 @@ an implementation of ROS 2 messages independent of roam's:
 
 prints the CDR bytes of three messages and the RIHS01 hashes of roam's two services, of
 Nav2's ComputePathToPose action (its services, built as rosidl builds them, and its
-feedback message), action_msgs's CancelGoal and GoalStatusArray, and tf2's TFMessage.
+feedback message) and FollowPath, action_msgs's CancelGoal and GoalStatusArray, tf2's
+TFMessage and rosgraph_msgs's Clock.
 rosbags' own service_msgs/ServiceEventInfo reads `char[16]` as FIELD_TYPE_CHAR, which
 disagrees with the AddTwoInts hash rmw_zenoh publishes; rosidl reads it as uint8, so the
 services are hashed here in a type store that says uint8.
@@ -79,7 +80,14 @@ act.update(get_types_from_msg('geometry_msgs/PoseStamped goal\ngeometry_msgs/Pos
 act.update(get_types_from_msg('nav_msgs/Path path\nbuiltin_interfaces/Duration planning_time\nuint16 error_code\nstring error_msg', P + '_Result'))
 act.update(get_types_from_msg('uint8 structure_needs_at_least_one_member', P + '_Feedback'))
 act.update(get_types_from_msg(f'unique_identifier_msgs/UUID goal_id\n{P}_Feedback feedback', P + '_FeedbackMessage'))
+F = 'nav2_msgs/action/FollowPath'
+act.update(get_types_from_msg('nav_msgs/Path path\nstring controller_id\nstring goal_checker_id\nstring progress_checker_id', F + '_Goal'))
+act.update(get_types_from_msg('std_msgs/Empty result\nuint16 error_code\nstring error_msg', F + '_Result'))
+act.update(get_types_from_msg('float32 distance_to_goal\nfloat32 speed', F + '_Feedback'))
+act.update(get_types_from_msg(f'unique_identifier_msgs/UUID goal_id\n{F}_Feedback feedback', F + '_FeedbackMessage'))
 for s, req, resp in [
+        (F + '_SendGoal', f'unique_identifier_msgs/UUID goal_id\n{F}_Goal goal', 'bool accepted\nbuiltin_interfaces/Time stamp'),
+        (F + '_GetResult', 'unique_identifier_msgs/UUID goal_id', f'int8 status\n{F}_Result result'),
         (P + '_SendGoal', f'unique_identifier_msgs/UUID goal_id\n{P}_Goal goal', 'bool accepted\nbuiltin_interfaces/Time stamp'),
         (P + '_GetResult', 'unique_identifier_msgs/UUID goal_id', f'int8 status\n{P}_Result result'),
         ('action_msgs/srv/CancelGoal', 'action_msgs/GoalInfo goal_info', 'int8 return_code\naction_msgs/GoalInfo[] goals_canceling')]:
@@ -92,7 +100,7 @@ def fix_action(o):
     if isinstance(o, tuple): return tuple(fix_action(x) for x in o)
     if isinstance(o, list): return [fix_action(x) for x in o]
     return o
-ts.register({k: base.fielddefs[k] for k in ['builtin_interfaces/msg/Duration', 'unique_identifier_msgs/msg/UUID', 'action_msgs/msg/GoalInfo', 'action_msgs/msg/GoalStatus', 'action_msgs/msg/GoalStatusArray', 'geometry_msgs/msg/Vector3', 'geometry_msgs/msg/Transform', 'geometry_msgs/msg/TransformStamped', 'tf2_msgs/msg/TFMessage']})
+ts.register({k: base.fielddefs[k] for k in ['builtin_interfaces/msg/Duration', 'unique_identifier_msgs/msg/UUID', 'action_msgs/msg/GoalInfo', 'action_msgs/msg/GoalStatus', 'action_msgs/msg/GoalStatusArray', 'geometry_msgs/msg/Vector3', 'geometry_msgs/msg/Transform', 'geometry_msgs/msg/TransformStamped', 'tf2_msgs/msg/TFMessage', 'rosgraph_msgs/msg/Clock', 'std_msgs/msg/Empty']})
 ts.register({fix_action(k): fix_action(v) for k, v in act.items()})
-for s in [P + '_SendGoal', P + '_GetResult', P + '_FeedbackMessage', 'action_msgs/srv/CancelGoal', 'action_msgs/msg/GoalStatusArray', 'tf2_msgs/msg/TFMessage']:
+for s in [P + '_SendGoal', P + '_GetResult', P + '_FeedbackMessage', 'action_msgs/srv/CancelGoal', 'action_msgs/msg/GoalStatusArray', 'tf2_msgs/msg/TFMessage', F + '_SendGoal', F + '_GetResult', F + '_FeedbackMessage', 'rosgraph_msgs/msg/Clock']:
     print('HASH', s, ts.hash_rihs01(s))
