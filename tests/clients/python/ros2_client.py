@@ -6,6 +6,7 @@ message implementation: CDR, RIHS01 hashes, rosbag2 reading).
     python3 ros2_client.py watch --connect tcp/127.0.0.1:7447 --robot robot
     python3 ros2_client.py nav2 --connect tcp/127.0.0.1:7447 --robot r1
     python3 ros2_client.py graph --connect tcp/127.0.0.1:7447 --within 5
+    python3 ros2_client.py fleet --connect tcp/127.0.0.1:7447 --robots r1,r2,r3
     python3 ros2_client.py fake-nav2-robot --connect tcp/127.0.0.1:7447 --speed 0.6 --rate 10
     python3 ros2_client.py bag DIR
 
@@ -20,7 +21,8 @@ client: it sends nav2_msgs/action/ComputePathToPose goals (good ones, and ones i
 off the map, in another frame, to an unknown planner, cancelled) with rcl_action's
 services on keys built from rosbags' hashes, checks Nav2's status and error codes, the
 latched status topic, and /tf against the robot's estimates. `graph` waits for roam's node
-and its action among the graph's tokens (after a router restart, say). `fake-nav2-robot`
+and its action among the graph's tokens (after a router restart, say). `fleet` finds
+every robot of a fleet on /tf and its pose topic. `fake-nav2-robot`
 is a Nav2 robot (/clock, /amcl_pose, a FollowPath server driving the pose along each
 path) for roam's executive to drive through the node. `bag` reads a
 rosbag2 directory and prints its topics and counts.
@@ -725,6 +727,37 @@ def fake_nav2_robot(args):
     print(json.dumps(out))
 
 
+def fleet(args):
+    """Every robot of a fleet as a ROS 2 user sees it: its frame on /tf (map ->
+    <robot>/base_link) and its /<robot>/pose, for each robot named by --robots."""
+    A = action_store()
+    session = open_client(args.connect)
+    robots = args.robots.split(',')
+    frames, poses = set(), set()
+    tf_key = topic_key(args.domain, '/tf', 'tf2_msgs/msg/TFMessage', A.hash_rihs01('tf2_msgs/msg/TFMessage'))
+
+    def on_tf(sample):
+        for t in A.deserialize_cdr(sample.payload.to_bytes(), 'tf2_msgs/msg/TFMessage').transforms:
+            if t.header.frame_id == 'map':
+                frames.add(t.child_frame_id)
+
+    subs = [session.declare_subscriber(tf_key, on_tf)]
+    h_pose = STORE.hash_rihs01('geometry_msgs/msg/PoseWithCovarianceStamped')
+    for robot in robots:
+        key = topic_key(args.domain, f'/{robot}/pose', 'geometry_msgs/msg/PoseWithCovarianceStamped', h_pose)
+        subs.append(session.declare_subscriber(key, lambda s, r=robot: poses.add(r)))
+    want = {f'{r}/base_link' for r in robots}
+    deadline = time.time() + args.within
+    while time.time() < deadline and not (want <= frames and set(robots) <= poses):
+        time.sleep(0.1)
+    for sub in subs:
+        sub.undeclare()
+    session.close()
+    check(want <= frames, f'/tf has every robot\'s frame: missing {sorted(want - frames)}')
+    check(set(robots) <= poses, f'every robot\'s pose: missing {sorted(set(robots) - poses)}')
+    print(json.dumps({'frames': sorted(frames), 'poses': sorted(poses)}))
+
+
 def graph(args):
     """Waits for roam's node and its action's send_goal service among the graph's tokens,
     as rmw_zenoh's graph cache learns them (a liveliness get on the domain), and prints
@@ -824,6 +857,11 @@ def main():
     p.add_argument('--connect', required=True)
     p.add_argument('--domain', type=int, default=0)
     p.add_argument('--within', type=float, default=5.0)
+    p = sub.add_parser('fleet')
+    p.add_argument('--connect', required=True)
+    p.add_argument('--domain', type=int, default=0)
+    p.add_argument('--robots', required=True)
+    p.add_argument('--within', type=float, default=60.0)
     p = sub.add_parser('fake-nav2-robot')
     p.add_argument('--connect', required=True)
     p.add_argument('--domain', type=int, default=0)
@@ -838,7 +876,8 @@ def main():
     p = sub.add_parser('bag')
     p.add_argument('dir')
     args = parser.parse_args()
-    {'live': live, 'watch': watch, 'nav2': nav2, 'graph': graph, 'fake-nav2-robot': fake_nav2_robot,
+    {'live': live, 'watch': watch, 'nav2': nav2, 'graph': graph, 'fleet': fleet,
+     'fake-nav2-robot': fake_nav2_robot,
      'bag': bag}[args.command](args)
 
 
