@@ -341,31 +341,38 @@ pub enum Nav2Error {
     NoValidPath = 208,
 }
 
-/// The action's `_action/send_goal` request.
+/// An action's `_action/send_goal` request: the goal `G` and its id.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct ComputePathSendGoalRequest {
+pub struct SendGoalRequest<G> {
     pub goal_id: Uuid,
-    pub goal: ComputePathGoal,
+    pub goal: G,
 }
 
-/// The action's `_action/send_goal` response.
+/// An action's `_action/get_result` response: the goal's status and its result `R`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct GetResultResponse<R> {
+    pub status: i8,
+    pub result: R,
+}
+
+/// An action's `_action/feedback` message: the feedback `F` of goal `goal_id`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct FeedbackMessage<F> {
+    pub goal_id: Uuid,
+    pub feedback: F,
+}
+
+/// An action's `_action/send_goal` response.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct SendGoalResponse {
     pub accepted: bool,
     pub stamp: Time,
 }
 
-/// The action's `_action/get_result` request.
+/// An action's `_action/get_result` request.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct GetResultRequest {
     pub goal_id: Uuid,
-}
-
-/// The action's `_action/get_result` response.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct ComputePathGetResultResponse {
-    pub status: i8,
-    pub result: ComputePathResult,
 }
 
 /// rosgraph_msgs/msg/Clock: `/clock`, a simulation's time (`use_sim_time`).
@@ -402,27 +409,6 @@ pub struct FollowPathResult {
 pub struct FollowPathFeedback {
     pub distance_to_goal: f32,
     pub speed: f32,
-}
-
-/// The FollowPath action's `_action/feedback` message.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct FollowPathFeedbackMessage {
-    pub goal_id: Uuid,
-    pub feedback: FollowPathFeedback,
-}
-
-/// The FollowPath action's `_action/send_goal` request.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct FollowPathSendGoalRequest {
-    pub goal_id: Uuid,
-    pub goal: FollowPathGoal,
-}
-
-/// The FollowPath action's `_action/get_result` response.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub struct FollowPathGetResultResponse {
-    pub status: i8,
-    pub result: FollowPathResult,
 }
 
 /// geometry_msgs/msg/Vector3.

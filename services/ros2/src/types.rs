@@ -100,8 +100,7 @@ pub const COMPUTE_PATH_TO_POSE: &str = "nav2_msgs/action/ComputePathToPose";
 pub const COMPUTE_PATH_GOAL: &str = "nav2_msgs/action/ComputePathToPose_Goal";
 pub const COMPUTE_PATH_RESULT: &str = "nav2_msgs/action/ComputePathToPose_Result";
 pub const COMPUTE_PATH_FEEDBACK: &str = "nav2_msgs/action/ComputePathToPose_Feedback";
-pub const COMPUTE_PATH_FEEDBACK_MESSAGE: &str =
-    "nav2_msgs/action/ComputePathToPose_FeedbackMessage";
+pub const COMPUTE_PATH_FEEDBACK_MESSAGE: &str = COMPUTE_PATH_PARTS[0].name;
 pub const COMPUTE_PATH_SEND_GOAL: &str = "nav2_msgs/action/ComputePathToPose_SendGoal";
 pub const COMPUTE_PATH_GET_RESULT: &str = "nav2_msgs/action/ComputePathToPose_GetResult";
 pub const CLOCK: &str = "rosgraph_msgs/msg/Clock";
@@ -110,11 +109,63 @@ pub const EMPTY: &str = "std_msgs/msg/Empty";
 pub const FOLLOW_PATH_GOAL: &str = "nav2_msgs/action/FollowPath_Goal";
 pub const FOLLOW_PATH_RESULT: &str = "nav2_msgs/action/FollowPath_Result";
 pub const FOLLOW_PATH_FEEDBACK: &str = "nav2_msgs/action/FollowPath_Feedback";
-pub const FOLLOW_PATH_FEEDBACK_MESSAGE: &str = "nav2_msgs/action/FollowPath_FeedbackMessage";
+pub const FOLLOW_PATH_FEEDBACK_MESSAGE: &str = FOLLOW_PATH_PARTS[0].name;
 pub const FOLLOW_PATH_SEND_GOAL: &str = "nav2_msgs/action/FollowPath_SendGoal";
 pub const FOLLOW_PATH_GET_RESULT: &str = "nav2_msgs/action/FollowPath_GetResult";
 
-/// Every message definition, dependencies included.
+/// What rosidl generates for an action besides its goal, result and feedback: the
+/// feedback message with its goal id (first), and the request and response of the two
+/// services (`_SendGoal`, `_GetResult`) an action is made of on the wire.
+macro_rules! action_parts {
+    ($action:literal, $goal:expr, $result:expr, $feedback:expr) => {
+        [
+            MsgDef {
+                name: concat!($action, "_FeedbackMessage"),
+                fields: &[f("goal_id", Nested(UUID)), f("feedback", Nested($feedback))],
+            },
+            MsgDef {
+                name: concat!($action, "_SendGoal_Request"),
+                fields: &[f("goal_id", Nested(UUID)), f("goal", Nested($goal))],
+            },
+            MsgDef {
+                name: concat!($action, "_SendGoal_Response"),
+                fields: &[f("accepted", Bool), f("stamp", Nested(TIME))],
+            },
+            MsgDef {
+                name: concat!($action, "_GetResult_Request"),
+                fields: &[f("goal_id", Nested(UUID))],
+            },
+            MsgDef {
+                name: concat!($action, "_GetResult_Response"),
+                fields: &[f("status", Int8), f("result", Nested($result))],
+            },
+        ]
+    };
+}
+
+const COMPUTE_PATH_PARTS: [MsgDef; 5] = action_parts!(
+    "nav2_msgs/action/ComputePathToPose",
+    COMPUTE_PATH_GOAL,
+    COMPUTE_PATH_RESULT,
+    COMPUTE_PATH_FEEDBACK
+);
+const FOLLOW_PATH_PARTS: [MsgDef; 5] = action_parts!(
+    "nav2_msgs/action/FollowPath",
+    FOLLOW_PATH_GOAL,
+    FOLLOW_PATH_RESULT,
+    FOLLOW_PATH_FEEDBACK
+);
+
+/// Every message definition, dependencies included: [`MESSAGES`] and the actions' parts.
+pub fn all_messages() -> impl Iterator<Item = &'static MsgDef> {
+    MESSAGES
+        .iter()
+        .chain(COMPUTE_PATH_PARTS.iter())
+        .chain(FOLLOW_PATH_PARTS.iter())
+}
+
+/// The message definitions written out (the actions' generated parts are in
+/// [`all_messages`]).
 pub const MESSAGES: &[MsgDef] = &[
     MsgDef {
         name: TIME,
@@ -271,32 +322,6 @@ pub const MESSAGES: &[MsgDef] = &[
         fields: &[f("structure_needs_at_least_one_member", Uint8)],
     },
     MsgDef {
-        name: COMPUTE_PATH_FEEDBACK_MESSAGE,
-        fields: &[
-            f("goal_id", Nested(UUID)),
-            f("feedback", Nested(COMPUTE_PATH_FEEDBACK)),
-        ],
-    },
-    MsgDef {
-        name: "nav2_msgs/action/ComputePathToPose_SendGoal_Request",
-        fields: &[
-            f("goal_id", Nested(UUID)),
-            f("goal", Nested(COMPUTE_PATH_GOAL)),
-        ],
-    },
-    MsgDef {
-        name: "nav2_msgs/action/ComputePathToPose_SendGoal_Response",
-        fields: &[f("accepted", Bool), f("stamp", Nested(TIME))],
-    },
-    MsgDef {
-        name: "nav2_msgs/action/ComputePathToPose_GetResult_Request",
-        fields: &[f("goal_id", Nested(UUID))],
-    },
-    MsgDef {
-        name: "nav2_msgs/action/ComputePathToPose_GetResult_Response",
-        fields: &[f("status", Int8), f("result", Nested(COMPUTE_PATH_RESULT))],
-    },
-    MsgDef {
         name: CLOCK,
         fields: &[f("clock", Nested(TIME))],
     },
@@ -325,32 +350,6 @@ pub const MESSAGES: &[MsgDef] = &[
     MsgDef {
         name: FOLLOW_PATH_FEEDBACK,
         fields: &[f("distance_to_goal", Float32), f("speed", Float32)],
-    },
-    MsgDef {
-        name: FOLLOW_PATH_FEEDBACK_MESSAGE,
-        fields: &[
-            f("goal_id", Nested(UUID)),
-            f("feedback", Nested(FOLLOW_PATH_FEEDBACK)),
-        ],
-    },
-    MsgDef {
-        name: "nav2_msgs/action/FollowPath_SendGoal_Request",
-        fields: &[
-            f("goal_id", Nested(UUID)),
-            f("goal", Nested(FOLLOW_PATH_GOAL)),
-        ],
-    },
-    MsgDef {
-        name: "nav2_msgs/action/FollowPath_SendGoal_Response",
-        fields: &[f("accepted", Bool), f("stamp", Nested(TIME))],
-    },
-    MsgDef {
-        name: "nav2_msgs/action/FollowPath_GetResult_Request",
-        fields: &[f("goal_id", Nested(UUID))],
-    },
-    MsgDef {
-        name: "nav2_msgs/action/FollowPath_GetResult_Response",
-        fields: &[f("status", Int8), f("result", Nested(FOLLOW_PATH_RESULT))],
     },
     MsgDef {
         name: SERVICE_EVENT_INFO,
@@ -399,7 +398,7 @@ pub const MESSAGES: &[MsgDef] = &[
 ];
 
 /// The services: their full names; each has `<name>_Request` and `<name>_Response` in
-/// [`MESSAGES`], and rosidl's `<name>_Event` and the service's own description are
+/// [`all_messages`], and rosidl's `<name>_Event` and the service's own description are
 /// built from them ([`crate::hash::service_type_hash`]).
 pub const SERVICES: &[&str] = &[
     GET_PLAN,
@@ -413,7 +412,7 @@ pub const SERVICES: &[&str] = &[
 
 /// The definition of message `name`, if roam knows it.
 pub fn message(name: &str) -> Option<&'static MsgDef> {
-    MESSAGES.iter().find(|m| m.name == name)
+    all_messages().find(|m| m.name == name)
 }
 
 /// `pkg/msg/Name` as DDS names it, which is what rmw_zenoh puts in its keys:
@@ -513,7 +512,7 @@ mod tests {
 
     #[test]
     fn every_nested_type_is_defined() {
-        for def in MESSAGES {
+        for def in all_messages() {
             for field in def.fields {
                 if let Nested(name) = field.base {
                     assert!(message(name).is_some(), "{} needs {name}", def.name);

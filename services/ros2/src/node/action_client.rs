@@ -37,13 +37,13 @@ impl ServiceClient {
         name: String,
         ros_type: &'static str,
     ) -> Result<ServiceClient, Ros2Error> {
-        let endpoint = out
-            .endpoint(EntityKind::Client, &name, ros_type, Qos::SERVICE)
-            .map_err(|e| Ros2Error::Declare {
-                what: "action client",
-                key: name.clone(),
-                reason: e.to_string(),
-            })?;
+        let endpoint = out.declared_endpoint(
+            "action client",
+            EntityKind::Client,
+            &name,
+            ros_type,
+            Qos::SERVICE,
+        )?;
         let token = out.token(&endpoint.token).await?;
         Ok(ServiceClient {
             endpoint,

@@ -47,14 +47,14 @@ use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
 
 use super::poses::RobotPoses;
-use super::services::{self, now, payload, reply, request_attachment};
+use super::services::{self, answer_call, now};
 use super::{Output, Ros2Error};
 use crate::action::GoalTable;
 use crate::convert;
 use crate::msg::{
-    CancelGoalRequest, CancelGoalResponse, ComputePathGetResultResponse, ComputePathGoal,
-    ComputePathResult, ComputePathSendGoalRequest, GetResultRequest, GoalState, Nav2Error,
-    SendGoalResponse, Time, Uuid, CANCEL_REJECTED,
+    CancelGoalRequest, CancelGoalResponse, ComputePathGoal, ComputePathResult, GetResultRequest,
+    GetResultResponse, GoalState, Nav2Error, SendGoalRequest, SendGoalResponse, Time, Uuid,
+    CANCEL_REJECTED,
 };
 use crate::names::{EntityKind, Qos};
 use crate::types;
@@ -132,13 +132,13 @@ pub(super) async fn declare(
         ("cancel_goal", types::CANCEL_GOAL),
     ] {
         let name = format!("{action}/_action/{part}");
-        let endpoint = out
-            .endpoint(EntityKind::Service, &name, ros_type, Qos::SERVICE)
-            .map_err(|e| Ros2Error::Declare {
-                what: "action service",
-                key: name.clone(),
-                reason: e.to_string(),
-            })?;
+        let endpoint = out.declared_endpoint(
+            "action service",
+            EntityKind::Service,
+            &name,
+            ros_type,
+            Qos::SERVICE,
+        )?;
         let queryable = service.declare_queryable(&endpoint.key).await?;
         tokens.push(out.token(&endpoint.token).await?);
         let key = endpoint.key.clone();
@@ -374,94 +374,80 @@ impl Failure {
 
 async fn send_goal(server: Arc<Server>, query: Query, key: String) {
     let out = &server.out;
-    let Some(att) = request_attachment(out, &query, &key).await else {
-        return;
-    };
-    let request = crate::cdr::decode::<ComputePathSendGoalRequest>(
-        &payload(&query),
-        "ComputePathToPose goal",
-        services::MAX_REQUEST_BYTES,
-    );
-    let cancel = CancellationToken::new();
-    let admitted = match request {
-        Err(e) => Err(e.to_string()),
-        Ok(request) => server
-            .admit(request.goal_id, cancel.clone())
-            .map(|stamp| (request, stamp)),
-    };
-    let response = match admitted {
-        Ok((request, stamp)) => {
-            tokio::spawn(
+    let answer = |request: Result<SendGoalRequest<ComputePathGoal>, _>| async {
+        let cancel = CancellationToken::new();
+        let admitted = request
+            .map_err(|e: crate::cdr::CdrError| e.to_string())
+            .and_then(|request| {
                 server
+                    .admit(request.goal_id, cancel.clone())
+                    .map(|stamp| (request, stamp))
+            });
+        match admitted {
+            Ok((request, stamp)) => {
+                let execute = server
                     .clone()
-                    .execute(request.goal_id, request.goal, cancel),
-            );
-            server.publish_status().await;
-            SendGoalResponse {
-                accepted: true,
-                stamp,
+                    .execute(request.goal_id, request.goal, cancel);
+                tokio::spawn(execute);
+                server.publish_status().await;
+                SendGoalResponse {
+                    accepted: true,
+                    stamp,
+                }
             }
-        }
-        Err(why) => {
-            out.refuse(&key, &format!("goal not accepted: {why}"));
-            SendGoalResponse {
-                accepted: false,
-                stamp: now(),
+            Err(why) => {
+                out.refuse(&key, &format!("goal not accepted: {why}"));
+                SendGoalResponse {
+                    accepted: false,
+                    stamp: now(),
+                }
             }
         }
     };
-    reply(out, &query, &key, &att, &response).await;
+    answer_call(out, query, &key, "ComputePathToPose goal", answer).await;
 }
 
 async fn get_result(server: Arc<Server>, query: Query, key: String) {
-    let out = &server.out;
-    let Some(att) = request_attachment(out, &query, &key).await else {
-        return;
-    };
-    let response = match crate::cdr::decode::<GetResultRequest>(
-        &payload(&query),
-        "ComputePathToPose result request",
-        services::MAX_REQUEST_BYTES,
-    ) {
-        Err(e) => {
-            out.refuse(&key, &e.to_string());
-            ComputePathGetResultResponse::default()
-        }
-        Ok(request) => {
-            let within = Duration::from_secs_f64(GOAL_ANSWER_S) + Duration::from_secs(5);
-            let (state, result) = server.result_of(&request.goal_id, within).await;
-            ComputePathGetResultResponse {
-                status: state as i8,
-                result,
+    let server = &server;
+    let answer = |request: Result<GetResultRequest, _>| async move {
+        match request {
+            Err(_) => GetResultResponse::<ComputePathResult>::default(),
+            Ok(request) => {
+                let within = Duration::from_secs_f64(GOAL_ANSWER_S) + Duration::from_secs(5);
+                let (state, result) = server.result_of(&request.goal_id, within).await;
+                GetResultResponse {
+                    status: state as i8,
+                    result,
+                }
             }
         }
     };
-    reply(out, &query, &key, &att, &response).await;
+    answer_call(
+        &server.out,
+        query,
+        &key,
+        "ComputePathToPose result request",
+        answer,
+    )
+    .await;
 }
 
 async fn cancel_goal(server: Arc<Server>, query: Query, key: String) {
-    let out = &server.out;
-    let Some(att) = request_attachment(out, &query, &key).await else {
-        return;
-    };
-    let response = match crate::cdr::decode::<CancelGoalRequest>(
-        &payload(&query),
-        "CancelGoal request",
-        services::MAX_REQUEST_BYTES,
-    ) {
-        Err(e) => {
-            out.refuse(&key, &e.to_string());
-            CancelGoalResponse {
+    let server = &server;
+    let answer = |request: Result<CancelGoalRequest, _>| async move {
+        let response = match request {
+            Err(_) => CancelGoalResponse {
                 return_code: CANCEL_REJECTED,
                 goals_canceling: Vec::new(),
-            }
+            },
+            Ok(request) => server.cancel(&request),
+        };
+        if !response.goals_canceling.is_empty() {
+            server.publish_status().await;
         }
-        Ok(request) => server.cancel(&request),
+        response
     };
-    if !response.goals_canceling.is_empty() {
-        server.publish_status().await;
-    }
-    reply(out, &query, &key, &att, &response).await;
+    answer_call(&server.out, query, &key, "CancelGoal request", answer).await;
 }
 
 #[cfg(test)]

@@ -40,10 +40,10 @@ use super::action_client::ActionClient;
 use super::{Output, Ros2Error};
 use crate::convert;
 use crate::msg::{
-    FollowPathFeedbackMessage, FollowPathGetResultResponse, FollowPathGoal,
-    FollowPathSendGoalRequest, GoalState, PoseWithCovarianceStamped, Uuid,
+    FeedbackMessage, FollowPathFeedback, FollowPathGoal, FollowPathResult, GetResultResponse,
+    GoalState, PoseWithCovarianceStamped, SendGoalRequest, Uuid,
 };
-use crate::names::{EntityKind, Qos};
+use crate::names::Qos;
 use crate::types;
 
 /// A robot on Nav2 that roam drives (`roam ros2`'s `nav2_robots`).
@@ -136,53 +136,33 @@ pub(super) async fn declare(
         key: config.robot.clone(),
         reason,
     })?;
-    let session = out.session().clone();
-    let declare_error = |what: &'static str, key: &str, e: zenoh::Error| Ros2Error::Declare {
-        what,
-        key: key.to_owned(),
-        reason: e.to_string(),
-    };
-    let pose = out
-        .endpoint(
-            EntityKind::Subscription,
+    let (pose, poses, pose_token) = out
+        .subscribe(
+            "pose subscription",
             &config.pose_topic,
             types::POSE_WITH_COVARIANCE_STAMPED,
             Qos::STREAM,
         )
-        .map_err(|e| Ros2Error::Declare {
-            what: "pose subscription",
-            key: config.pose_topic.clone(),
-            reason: e.to_string(),
-        })?;
-    let feedback = out
-        .endpoint(
-            EntityKind::Subscription,
+        .await?;
+    let (_, feedbacks, feedback_token) = out
+        .subscribe(
+            "feedback subscription",
             &format!("{}/_action/feedback", config.follow_path),
             types::FOLLOW_PATH_FEEDBACK_MESSAGE,
             Qos::STREAM,
         )
-        .map_err(|e| Ros2Error::Declare {
-            what: "feedback subscription",
-            key: config.follow_path.clone(),
-            reason: e.to_string(),
-        })?;
-    let poses = session
-        .declare_subscriber(pose.key.clone())
-        .await
-        .map_err(|e| declare_error("pose subscriber", &pose.key, e))?;
-    let feedbacks = session
-        .declare_subscriber(feedback.key.clone())
-        .await
-        .map_err(|e| declare_error("feedback subscriber", &feedback.key, e))?;
+        .await?;
     let mission_key = keys::robot_mission(root, &config.robot);
-    let missions = session
+    let missions = out
+        .session()
         .declare_subscriber(mission_key.clone())
         .await
-        .map_err(|e| declare_error("mission subscriber", &mission_key, e))?;
-    let tokens = vec![
-        out.token(&pose.token).await?,
-        out.token(&feedback.token).await?,
-    ];
+        .map_err(|e| Ros2Error::Declare {
+            what: "mission subscriber",
+            key: mission_key.clone(),
+            reason: e.to_string(),
+        })?;
+    let tokens = vec![pose_token, feedback_token];
     let follow_path = ActionClient::declare(
         &out,
         &config.follow_path,
@@ -318,7 +298,7 @@ impl Robot {
         // the robot themselves (the robot's projection onto it), as roam's controller
         // follows it from its projection.
         let waypoints = &mission.waypoints;
-        let request = FollowPathSendGoalRequest {
+        let request = SendGoalRequest {
             goal_id,
             goal: FollowPathGoal {
                 path: convert::path(waypoints, super::services::now()),
@@ -355,7 +335,7 @@ impl Robot {
                 })
                 .await;
             let event = match client
-                .get_result::<FollowPathGetResultResponse>(goal_id, RESULT_WITHIN)
+                .get_result::<GetResultResponse<FollowPathResult>>(goal_id, RESULT_WITHIN)
                 .await
             {
                 Ok(r) if r.status == GoalState::Succeeded as i8 => {
@@ -463,7 +443,7 @@ impl Robot {
     }
 
     fn on_feedback(&mut self, sample: &Sample) {
-        let Ok(feedback) = crate::cdr::decode::<FollowPathFeedbackMessage>(
+        let Ok(feedback) = crate::cdr::decode::<FeedbackMessage<FollowPathFeedback>>(
             &sample.payload().to_bytes(),
             "feedback",
             MAX_FEEDBACK_BYTES,

@@ -7,8 +7,11 @@ use std::sync::Mutex;
 use std::time::Duration;
 
 use serde::Serialize;
+use zenoh::handlers::FifoChannelHandler;
 use zenoh::liveliness::LivelinessToken;
+use zenoh::pubsub::Subscriber;
 use zenoh::qos::{CongestionControl, Reliability as ZReliability};
+use zenoh::sample::Sample;
 use zenoh::Session;
 use zenoh_ext::{AdvancedPublisher, AdvancedPublisherBuilderExt, CacheConfig, MissDetectionConfig};
 
@@ -106,6 +109,54 @@ impl Output {
     ) -> Result<Endpoint, wire::EndpointError> {
         let id = self.next_id.fetch_add(1, Ordering::Relaxed);
         wire::endpoint(&self.node, id, kind, name, ros_type, qos)
+    }
+
+    /// [`Output::endpoint`], a failure named as declaring `what` on `name`.
+    pub(crate) fn declared_endpoint(
+        &self,
+        what: &'static str,
+        kind: EntityKind,
+        name: &str,
+        ros_type: &'static str,
+        qos: Qos,
+    ) -> Result<Endpoint, Ros2Error> {
+        self.endpoint(kind, name, ros_type, qos)
+            .map_err(|e| Ros2Error::Declare {
+                what,
+                key: name.to_owned(),
+                reason: e.to_string(),
+            })
+    }
+
+    /// A plain subscription to topic `name` with its `MS` token (kept alive by the
+    /// caller): what the node reads from ROS 2 as a stream.
+    pub(crate) async fn subscribe(
+        &self,
+        what: &'static str,
+        name: &str,
+        ros_type: &'static str,
+        qos: Qos,
+    ) -> Result<
+        (
+            Endpoint,
+            Subscriber<FifoChannelHandler<Sample>>,
+            LivelinessToken,
+        ),
+        Ros2Error,
+    > {
+        let endpoint =
+            self.declared_endpoint(what, EntityKind::Subscription, name, ros_type, qos)?;
+        let subscriber = self
+            .session
+            .declare_subscriber(endpoint.key.clone())
+            .await
+            .map_err(|e| Ros2Error::Declare {
+                what,
+                key: endpoint.key.clone(),
+                reason: e.to_string(),
+            })?;
+        let token = self.token(&endpoint.token).await?;
+        Ok((endpoint, subscriber, token))
     }
 
     /// Declares a liveliness token, naming the key when it fails.

@@ -93,13 +93,8 @@ pub(super) async fn declare(
         (PLAN_DOWNTIME, types::PLAN_DOWNTIME),
         (GET_PLAN, types::GET_PLAN),
     ] {
-        let endpoint = out
-            .endpoint(EntityKind::Service, name, ros_type, Qos::SERVICE)
-            .map_err(|e| Ros2Error::Declare {
-                what: "service",
-                key: name.to_owned(),
-                reason: e.to_string(),
-            })?;
+        let endpoint =
+            out.declared_endpoint("service", EntityKind::Service, name, ros_type, Qos::SERVICE)?;
         let queryable = service.declare_queryable(&endpoint.key).await?;
         tokens.push(out.token(&endpoint.token).await?);
         let key = endpoint.key.clone();
@@ -143,6 +138,32 @@ pub(super) async fn request_attachment(
             None
         }
     }
+}
+
+/// Answers one ROS 2 call the rmw_zenoh way: a query without the attachment gets a Zenoh
+/// error reply; otherwise the request is decoded (up to [`MAX_REQUEST_BYTES`]; a request
+/// that is not valid CDR is logged and given to `answer` as the error), `answer` makes
+/// the response, and the reply echoes the request's sequence number and GID.
+pub(super) async fn answer_call<Req, Resp, Fut>(
+    out: &Output,
+    query: Query,
+    key: &str,
+    what: &'static str,
+    answer: impl FnOnce(Result<Req, crate::cdr::CdrError>) -> Fut,
+) where
+    Req: serde::de::DeserializeOwned,
+    Resp: Serialize,
+    Fut: std::future::Future<Output = Resp>,
+{
+    let Some(att) = request_attachment(out, &query, key).await else {
+        return;
+    };
+    let request = crate::cdr::decode::<Req>(&payload(&query), what, MAX_REQUEST_BYTES);
+    if let Err(e) = &request {
+        out.refuse(key, &e.to_string());
+    }
+    let response = answer(request).await;
+    reply(out, &query, key, &att, &response).await;
 }
 
 /// Replies with `response` on the service's key, the request's sequence number and GID.

@@ -12,7 +12,7 @@ use roam_runtime::{Delivery, Service};
 
 use super::{Output, Ros2Error};
 use crate::msg::Clock;
-use crate::names::{EntityKind, Qos};
+use crate::names::Qos;
 use crate::types;
 
 /// The latest simulated time heard, seconds; `None` without a clock topic or before
@@ -33,23 +33,9 @@ pub(super) async fn declare(
     root: &str,
     topic: &str,
 ) -> Result<MissionClock, Ros2Error> {
-    let endpoint = out
-        .endpoint(EntityKind::Subscription, topic, types::CLOCK, Qos::STREAM)
-        .map_err(|e| Ros2Error::Declare {
-            what: "clock subscription",
-            key: topic.to_owned(),
-            reason: e.to_string(),
-        })?;
-    let clocks = out
-        .session()
-        .declare_subscriber(endpoint.key.clone())
-        .await
-        .map_err(|e| Ros2Error::Declare {
-            what: "clock subscriber",
-            key: endpoint.key.clone(),
-            reason: e.to_string(),
-        })?;
-    let token = out.token(&endpoint.token).await?;
+    let (endpoint, clocks, token) = out
+        .subscribe("clock subscription", topic, types::CLOCK, Qos::STREAM)
+        .await?;
     let clock = MissionClock::default();
     let (shared, key, cancel) = (clock.clone(), keys::sim_clock(root), service.cancel_token());
     service.spawn(async move {
