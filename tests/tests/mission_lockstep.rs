@@ -53,7 +53,9 @@ async fn the_live_executive_and_the_batch_make_the_same_day() {
         plan_wall_s: 0.0,
         ..DaysOptions::default()
     };
-    let (_, _, batch, _) = drive(&world, &config, false, sim_seed(seed), &options).expect("batch");
+    let batch = drive(&world, &config, false, sim_seed(seed), &options)
+        .expect("batch")
+        .reports;
     assert_eq!(batch.len(), 4, "{batch:?}");
 
     // Live.

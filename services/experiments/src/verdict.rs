@@ -1,16 +1,22 @@
 //! One rule for judging a paper's claim against our figures, shared by every
 //! `roam reproduce …` runner: no verdict is written by hand, so a row reads "does not
-//! hold" whenever our figures contradict the paper's.
+//! hold" whenever our figures contradict the paper's, and a row always shows the
+//! paper's published figure beside ours.
 //!
 //! The rule, by the kind of figure the paper reports:
-//! - a relative change or a quantity with a range (`Range`): **holds** when each of ours
-//!   (one per goal, mission, …) lies in the paper's range, **same direction** when each
-//!   has the sign of the paper's range but some lie outside it, **does not hold**
-//!   otherwise (any of ours with the other sign, or zero where the paper reports a
-//!   change). A single published value v is the range v ± |v|/4 ([`PaperFigure::about`]):
-//!   a quarter either way, so a figure read off a plot or rounded in the text can hold;
-//! - a count (`Count`): **holds** when ours equals the paper's, **same direction** when
-//!   both are zero or both are not, **does not hold** otherwise;
+//! - a single published value v (`Value`: an RMSE, a distance, a step count, a relative
+//!   change): **holds** when each of ours lies within [`TOLERANCE`] of v (ours ÷ v in
+//!   1 ± 0.15), **near** when each lies within [`NEAR_FACTOR`] of it (ours ÷ v in
+//!   ½ ..= 2: the same sign and the same size), **does not hold** otherwise. The rule is
+//!   on the ratio, not the sign, so it judges an always-positive figure (an RMSE ten times
+//!   the paper's does not hold) and a signed change alike (−44.6% against the paper's
+//!   −4.4% does not hold, though both are improvements);
+//! - a range lo ..= hi (`Range`: the paper's spread over its goals): **holds** when each
+//!   of ours lies in it, **near** when each has its sign and lies within [`NEAR_FACTOR`]
+//!   of its ends (|ours| in |lo|/2 ..= 2·|hi| for 0 < lo ≤ hi, mirrored below zero),
+//!   **does not hold** otherwise (a range across zero has no "near");
+//! - a count (`Count`): **holds** when ours equals the paper's, **near** when both are
+//!   positive and within [`NEAR_FACTOR`] of each other, **does not hold** otherwise;
 //! - a yes/no property (`Yes`: "plain APF fails ES1", "the learner beats recency"): ours
 //!   is 1 where the property is true of our figures and 0 where it is false; **holds**
 //!   when every one of ours agrees with the paper, **does not hold** otherwise;
@@ -19,12 +25,27 @@
 
 use serde::Serialize;
 
+/// How far (relative) a figure of ours may lie from a single published value and still
+/// hold: 15%. What it covers is the rebuilt scenario, not the paper's rounding (every
+/// single value we compare with is printed in the paper's text, to 2–4 digits): paper
+/// 002's anchors, corridor and obstacles are placed from its figure, so a path's length,
+/// its step count and its RMSE move with where we put them. The widest "holds" today
+/// needs 13.4% (ES3: cutoff's distance +6.9% against the paper's +7.97%; fixed's ES1
+/// steps 693–696 against 799 need 13.3%); 15% is that, rounded up, and no wider.
+pub const TOLERANCE: f64 = 0.15;
+
+/// Beyond this factor of the paper's figure, either way, ours does not hold: a figure
+/// more than twice or less than half the paper's measures a different effect, whatever
+/// its sign ([`Verdict::Near`] is only for figures of the paper's size).
+pub const NEAR_FACTOR: f64 = 2.0;
+
 /// How our figures relate to the paper's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
     Holds,
-    SameDirection,
+    /// Outside the paper's range or tolerance, within [`NEAR_FACTOR`] of its figure.
+    Near,
     DoesNotHold,
     NoData,
 }
@@ -33,7 +54,7 @@ impl Verdict {
     pub fn as_str(self) -> &'static str {
         match self {
             Verdict::Holds => "holds",
-            Verdict::SameDirection => "same direction, outside the paper's range",
+            Verdict::Near => "near: within 2x of the paper's, outside its range",
             Verdict::DoesNotHold => "does not hold",
             Verdict::NoData => "no data",
         }
@@ -43,7 +64,9 @@ impl Verdict {
 /// What the paper reports for one claim, as a figure ours can be judged against.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum PaperFigure {
-    /// A value (often a relative change in percent) in `lo ..= hi`.
+    /// A single published value (module doc: within [`TOLERANCE`] of it).
+    Value(f64),
+    /// A published range `lo ..= hi` (the paper's spread over its goals).
     Range { lo: f64, hi: f64 },
     /// A count of `of` things (configurations, runs).
     Count { paper: usize, of: usize },
@@ -51,13 +74,17 @@ pub enum PaperFigure {
     Yes(bool),
 }
 
+/// Whether `ours` is within `factor` of `paper` (the same sign, ratio in 1/factor ..=
+/// factor).
+fn within_factor(ours: f64, paper: f64, factor: f64) -> bool {
+    let ratio = ours / paper;
+    paper != 0.0 && (1.0 / factor..=factor).contains(&ratio)
+}
+
 impl PaperFigure {
-    /// A single published value `v`, judged as the range v ± |v|/4 (module doc).
+    /// A single published value `v` (module doc).
     pub fn about(v: f64) -> PaperFigure {
-        PaperFigure::Range {
-            lo: v - v.abs() / 4.0,
-            hi: v + v.abs() / 4.0,
-        }
+        PaperFigure::Value(v)
     }
 
     /// The verdict for `ours`, one figure per goal (`expected` of them), by the module
@@ -66,31 +93,50 @@ impl PaperFigure {
         if ours.len() < expected || ours.is_empty() || ours.iter().any(|v| !v.is_finite()) {
             return Verdict::NoData;
         }
+        let all = |f: &dyn Fn(f64) -> bool| ours.iter().all(|&v| f(v));
         match *self {
-            PaperFigure::Range { lo, hi } => {
-                if ours.iter().all(|v| (lo..=hi).contains(v)) {
+            PaperFigure::Value(paper) => {
+                if all(&|v| (v - paper).abs() <= TOLERANCE * paper.abs()) {
                     Verdict::Holds
-                } else if lo.signum() == hi.signum()
-                    && lo != 0.0
-                    && ours.iter().all(|v| *v != 0.0 && v.signum() == lo.signum())
-                {
-                    Verdict::SameDirection
+                } else if all(&|v| within_factor(v, paper, NEAR_FACTOR)) {
+                    Verdict::Near
+                } else {
+                    Verdict::DoesNotHold
+                }
+            }
+            PaperFigure::Range { lo, hi } => {
+                let (small, large) = if lo.abs() <= hi.abs() {
+                    (lo, hi)
+                } else {
+                    (hi, lo)
+                };
+                let near = |v: f64| {
+                    lo.signum() == hi.signum()
+                        && small != 0.0
+                        && v.signum() == small.signum()
+                        && (small.abs() / NEAR_FACTOR..=large.abs() * NEAR_FACTOR)
+                            .contains(&v.abs())
+                };
+                if all(&|v| (lo..=hi).contains(&v)) {
+                    Verdict::Holds
+                } else if all(&near) {
+                    Verdict::Near
                 } else {
                     Verdict::DoesNotHold
                 }
             }
             PaperFigure::Count { paper, .. } => {
                 let paper = paper as f64;
-                if ours.iter().all(|v| *v == paper) {
+                if all(&|v| v == paper) {
                     Verdict::Holds
-                } else if ours.iter().all(|v| (*v > 0.0) == (paper > 0.0)) {
-                    Verdict::SameDirection
+                } else if all(&|v| within_factor(v, paper, NEAR_FACTOR)) {
+                    Verdict::Near
                 } else {
                     Verdict::DoesNotHold
                 }
             }
             PaperFigure::Yes(paper) => {
-                if ours.iter().all(|v| (*v > 0.5) == paper) {
+                if all(&|v| (v > 0.5) == paper) {
                     Verdict::Holds
                 } else {
                     Verdict::DoesNotHold
@@ -99,9 +145,19 @@ impl PaperFigure {
         }
     }
 
-    /// The paper's figure as text.
+    /// Ours as multiples of a single published value (empty for the other figures, or
+    /// a published zero).
+    pub fn ratios(&self, ours: &[f64]) -> Vec<f64> {
+        match *self {
+            PaperFigure::Value(paper) if paper != 0.0 => ours.iter().map(|v| v / paper).collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The paper's figure as published.
     pub fn describe(&self) -> String {
         match *self {
+            PaperFigure::Value(v) => format!("{v}"),
             PaperFigure::Range { lo, hi } if lo == hi => format!("{lo:+.2}"),
             PaperFigure::Range { lo, hi } => format!("{lo:+.2} to {hi:+.2}"),
             PaperFigure::Count { paper, of } => format!("{paper} of {of}"),
@@ -115,8 +171,12 @@ impl PaperFigure {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Comparison {
     pub claim: String,
+    /// The paper's figure as published, and where it comes from.
     pub paper: String,
     pub ours: String,
+    /// Ours ÷ the paper's, for a single published value (empty otherwise).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub ratios: Vec<f64>,
     pub verdict: Verdict,
 }
 
@@ -140,6 +200,7 @@ impl Comparison {
             claim: claim.into(),
             paper: paper_text,
             ours: ours_text,
+            ratios: paper.ratios(ours),
             verdict: paper.judge(ours, expected),
         }
     }
@@ -174,8 +235,14 @@ pub fn percent_change(a: f64, b: f64) -> f64 {
 pub fn lines(comparisons: &[Comparison]) -> String {
     let mut out = String::new();
     for c in comparisons {
+        let ratios = if c.ratios.is_empty() {
+            String::new()
+        } else {
+            let each: Vec<String> = c.ratios.iter().map(|r| format!("{r:.2}x")).collect();
+            format!(" ({} the paper's)", each.join(", "))
+        };
         out.push_str(&format!(
-            "  {}: paper {}, ours {}: {}\n",
+            "  {}: paper {}, ours {}{ratios}: {}\n",
             c.claim,
             c.paper,
             c.ours,
@@ -200,7 +267,65 @@ mod tests {
         assert_eq!(RANGE.judge(&[-20.0, 43.0], 2), Verdict::DoesNotHold);
         assert_eq!(RANGE.judge(&[-20.0, 0.0], 2), Verdict::DoesNotHold);
         assert_eq!(RANGE.judge(&[-20.0, -25.0], 2), Verdict::Holds);
-        assert_eq!(RANGE.judge(&[-20.0, -40.0], 2), Verdict::SameDirection);
+        assert_eq!(RANGE.judge(&[-20.0, -40.0], 2), Verdict::Near);
+    }
+
+    #[test]
+    fn a_figure_of_the_right_sign_far_outside_the_range_does_not_hold() {
+        // Issue 29: ES2's −44.6% against the paper's −4.4%, Model I's +102% against
+        // Table II's +10.29..+33.61%.
+        assert_eq!(
+            PaperFigure::about(-4.4).judge(&[-44.6], 1),
+            Verdict::DoesNotHold
+        );
+        let table_ii = PaperFigure::Range {
+            lo: 10.29,
+            hi: 33.61,
+        };
+        assert_eq!(table_ii.judge(&[102.0, 46.19], 2), Verdict::DoesNotHold);
+        assert_eq!(table_ii.judge(&[67.0, 46.19], 2), Verdict::Near);
+        assert_eq!(table_ii.judge(&[5.2], 1), Verdict::Near);
+        assert_eq!(table_ii.judge(&[5.2, 5.1], 2), Verdict::DoesNotHold);
+        assert_eq!(RANGE.judge(&[-60.0], 1), Verdict::DoesNotHold);
+        assert_eq!(RANGE.judge(&[-9.0], 1), Verdict::DoesNotHold);
+        let across_zero = PaperFigure::Range { lo: -1.0, hi: 1.0 };
+        assert_eq!(across_zero.judge(&[1.5], 1), Verdict::DoesNotHold);
+    }
+
+    #[test]
+    fn an_always_positive_figure_is_judged_by_its_ratio() {
+        // An RMSE of 0.21 m: ten times it (issue 29's 14 m is 67 times) does not hold,
+        // and neither does a tenth; a third more is near, 0.226 m holds.
+        let rmse = PaperFigure::about(0.21);
+        assert_eq!(rmse.judge(&[2.1], 1), Verdict::DoesNotHold);
+        assert_eq!(rmse.judge(&[14.0], 1), Verdict::DoesNotHold);
+        assert_eq!(rmse.judge(&[0.021], 1), Verdict::DoesNotHold);
+        assert_eq!(rmse.judge(&[0.28], 1), Verdict::Near);
+        assert_eq!(rmse.judge(&[0.226], 1), Verdict::Holds);
+        assert_eq!(rmse.ratios(&[0.42]), vec![2.0]);
+        assert_eq!(rmse.describe(), "0.21");
+        // Steps: 696 against the paper's 799 holds (13% fewer), 1,700 does not.
+        let steps = PaperFigure::about(799.0);
+        assert_eq!(steps.judge(&[696.0], 1), Verdict::Holds);
+        assert_eq!(steps.judge(&[1700.0], 1), Verdict::DoesNotHold);
+    }
+
+    #[test]
+    fn a_row_shows_the_published_figure_and_our_ratio() {
+        let c = Comparison::judged(
+            "steps",
+            PaperFigure::about(296.0),
+            "",
+            &[322.0],
+            "322".into(),
+            1,
+        );
+        assert_eq!(c.paper, "296");
+        let line = lines(&[c]);
+        assert!(
+            line.contains("paper 296, ours 322 (1.09x the paper's): holds"),
+            "{line}"
+        );
     }
 
     #[test]
@@ -221,17 +346,21 @@ mod tests {
         assert_eq!(count(3).judge(&[0.0], 1), Verdict::DoesNotHold);
         assert_eq!(count(0).judge(&[0.0], 1), Verdict::Holds);
         assert_eq!(count(0).judge(&[2.0], 1), Verdict::DoesNotHold);
-        assert_eq!(count(3).judge(&[5.0], 1), Verdict::SameDirection);
+        assert_eq!(count(3).judge(&[5.0], 1), Verdict::Near);
+        assert_eq!(count(3).judge(&[7.0], 1), Verdict::DoesNotHold);
         assert_eq!(count(3).describe(), "3 of 6");
     }
 
     #[test]
-    fn a_single_value_holds_within_a_quarter_of_it() {
+    fn a_single_value_holds_within_the_tolerance() {
         let v = PaperFigure::about(-3.13);
         assert_eq!(v.judge(&[-3.5], 1), Verdict::Holds);
-        assert_eq!(v.judge(&[-2.4], 1), Verdict::Holds);
-        assert_eq!(v.judge(&[-2.3], 1), Verdict::SameDirection);
-        assert_eq!(v.judge(&[-9.0], 1), Verdict::SameDirection);
+        assert_eq!(v.judge(&[-2.7], 1), Verdict::Holds);
+        assert_eq!(v.judge(&[-2.6], 1), Verdict::Near);
+        assert_eq!(v.judge(&[-6.2], 1), Verdict::Near);
+        assert_eq!(v.judge(&[-9.0], 1), Verdict::DoesNotHold);
+        // ES3: sinusoidal's −1.1% against the paper's −3.13% is a third of it.
+        assert_eq!(v.judge(&[-1.1], 1), Verdict::DoesNotHold);
         assert_eq!(v.judge(&[1.0], 1), Verdict::DoesNotHold);
     }
 

@@ -43,9 +43,13 @@ proptest! {
         let mut s = spec(model, [sx, sy], [gx, gy], 1.0, seed, 30);
         // Find the shortest ETA by asking with a huge budget first.
         s.t_exec_s = 86_400.0;
+        // A blocked start or goal is rejected, not passed: proptest draws another case,
+        // so 24 cases plan for real (and it fails after too many rejections).
         let needed = match plan(&world, &PlanSpec { model: PlannerModel::Shortest, ..s.clone() }, &AtomicBool::new(false), |_, _| {}) {
             Ok(outcome) => outcome.t_eta_s,
-            Err(PlanError::Blocked { .. }) | Err(PlanError::NoPath) => return Ok(()),
+            Err(PlanError::Blocked { .. }) | Err(PlanError::NoPath) => {
+                return Err(TestCaseError::reject("start or goal blocked"))
+            }
             Err(e) => panic!("{e}"),
         };
         s.t_exec_s = (needed * slack).max(1.0);

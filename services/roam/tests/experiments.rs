@@ -78,7 +78,7 @@ fn reproduce_planner_prints_every_row_and_draws_each_model() {
         for c in comparisons {
             let verdict = c["verdict"].as_str().expect("verdict");
             assert!(
-                ["holds", "same_direction", "does_not_hold", "no_data"].contains(&verdict),
+                ["holds", "near", "does_not_hold", "no_data"].contains(&verdict),
                 "{c}"
             );
         }
@@ -259,9 +259,18 @@ fn reproduce_apf_prints_every_scheme_and_draws_the_figures() {
         }
         let verdict = c["verdict"].as_str().expect("a verdict");
         assert!(
-            ["holds", "same_direction", "does_not_hold", "no_data"].contains(&verdict),
+            ["holds", "near", "does_not_hold", "no_data"].contains(&verdict),
             "{c}"
         );
+    }
+    // A single published value is printed as the paper has it, with ours as a multiple.
+    let rmse = claims
+        .iter()
+        .find(|c| c["claim"] == "ES1 (guard on): fixed's mission RMSE, m")
+        .expect("fixed's RMSE claim");
+    assert_eq!(rmse["paper"], "0.21", "{rmse}");
+    if rmse["verdict"] != "no_data" {
+        assert!(rmse["ratios"][0].as_f64().is_some(), "{rmse}");
     }
     let plain_rate = value["es1"][0]["success_rate"].as_f64().expect("a share");
     let plain = claims

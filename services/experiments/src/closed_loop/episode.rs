@@ -180,6 +180,9 @@ pub struct Episode {
     pub source: PositionSource,
     /// Sim steps taken.
     pub sim_steps: u64,
+    /// Scans localization refused (an error, not a missing fix), counted so that none
+    /// hides behind a step without an estimate.
+    pub localization_errors: u64,
     /// One entry per mission, in the missions' order.
     pub robots: Vec<RobotTrack>,
 }
@@ -274,6 +277,7 @@ pub fn run_episode_with(
         seed,
         source,
         sim_steps: stepper.sim().steps(),
+        localization_errors: stepper.localization_errors,
         robots: robots.into_iter().map(|(_, t)| t).collect(),
     })
 }

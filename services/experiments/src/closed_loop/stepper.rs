@@ -66,6 +66,11 @@ pub struct Stepper {
     controllers: BTreeMap<String, Controller>,
     /// The commands the next step applies: the last step's decisions.
     commands: Vec<Command>,
+    /// Scans localization refused (not a missing fix: an error, such as a range that is
+    /// not finite), and the first refusal's message: the step goes on without an
+    /// estimate, as the live service's does, and the reports show the count.
+    pub localization_errors: u64,
+    pub first_localization_error: Option<String>,
 }
 
 impl Stepper {
@@ -89,6 +94,8 @@ impl Stepper {
             tracker: Tracker::new(setup.scenario.file.sensing, FimOptions::default()),
             controllers: BTreeMap::new(),
             commands: Vec::new(),
+            localization_errors: 0,
+            first_localization_error: None,
         })
     }
 
@@ -158,7 +165,15 @@ impl Stepper {
         let mut robots = Vec::with_capacity(report.robots.len());
         for r in &report.robots {
             let messages = robot_messages(&self.sim, report.step, report.time_s, r);
-            let estimate = self.tracker.on_scan(&messages.ranges).ok();
+            let estimate = match self.tracker.on_scan(&messages.ranges) {
+                Ok(estimate) => Some(estimate),
+                Err(e) => {
+                    self.localization_errors += 1;
+                    self.first_localization_error
+                        .get_or_insert_with(|| format!("{}: {e}", r.name));
+                    None
+                }
+            };
             let decision = match (&estimate, self.controllers.get_mut(r.name.as_str())) {
                 (Some(e), Some(controller)) => {
                     let truth = r.readings.truth;
@@ -311,6 +326,7 @@ mod tests {
             seed,
             source,
             sim_steps,
+            localization_errors: 0,
             robots: robots.into_iter().map(|(_, t)| t).collect(),
         })
     }

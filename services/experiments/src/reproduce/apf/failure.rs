@@ -69,6 +69,9 @@ pub struct FailureCauses {
     pub estimate_diverged: usize,
     /// Ended in coverage on a good estimate.
     pub other: usize,
+    /// Not a cause of failure: scans localization refused over all the runs (successful
+    /// ones too), 0 on a healthy run.
+    pub localization_errors: u64,
 }
 
 impl FailureCauses {
@@ -99,6 +102,7 @@ impl FailureCauses {
             out_of_coverage: self.out_of_coverage + other.out_of_coverage,
             estimate_diverged: self.estimate_diverged + other.estimate_diverged,
             other: self.other + other.other,
+            localization_errors: self.localization_errors + other.localization_errors,
         }
     }
 

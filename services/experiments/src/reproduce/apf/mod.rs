@@ -163,6 +163,8 @@ pub struct RunSummary {
     pub squared_error: Vec<f64>,
     /// Why the run failed ([`failure`]); `None` when it succeeded.
     pub failure: Option<FailureCause>,
+    /// Scans localization refused ([`Episode::localization_errors`]).
+    pub localization_errors: u64,
 }
 
 impl RunSummary {
@@ -191,6 +193,7 @@ impl RunSummary {
             distance_m: episode.robots.iter().map(|r| r.distance_m).sum(),
             squared_error,
             failure: failure::cause(episode, setup),
+            localization_errors: episode.localization_errors,
         }
     }
 }
@@ -259,7 +262,10 @@ pub fn summarize(runs: &[RunSummary]) -> Summary {
         failures: runs.len() - ok.len(),
         steps_all: mean(runs.iter().map(|r| r.steps as f64).collect()),
         distance_all_m: mean(runs.iter().map(|r| r.distance_m).collect()),
-        causes: FailureCauses::count(runs.iter().filter_map(|r| r.failure)),
+        causes: FailureCauses {
+            localization_errors: runs.iter().map(|r| r.localization_errors).sum(),
+            ..FailureCauses::count(runs.iter().filter_map(|r| r.failure))
+        },
     }
 }
 
@@ -436,6 +442,7 @@ mod tests {
             distance_m,
             squared_error: errors.iter().map(|e| e * e).collect(),
             failure: (!success).then_some(FailureCause::Other),
+            localization_errors: 0,
         }
     }
 

@@ -100,6 +100,10 @@ pub struct WindowLog {
     pub first_sent_at_s: Option<f64>,
     pub first_curious: Option<bool>,
     pub ga_plans: u32,
+    /// Plans the planner refused (an error, not a plan the budget cut): the window
+    /// machine then goes on as the live executive does on a refusal, and the reports
+    /// count them.
+    pub refused_plans: u32,
 }
 
 /// A window that ended with an outcome.
@@ -376,6 +380,7 @@ impl<'a> InProcessExecutive<'a> {
                         log.ga_plans += u32::from(ask.curious);
                         let request = plan_request(self.config, &ask, self.time_model());
                         let answer = io.answer(&request, now);
+                        log.refused_plans += u32::from(answer.is_none());
                         let cost_s = if ask.curious {
                             self.plan_wall_s.min(ask.deadline_s) * self.rate
                         } else {

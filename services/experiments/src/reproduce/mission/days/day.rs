@@ -34,6 +34,9 @@ pub struct DayResult {
     pub day: usize,
     pub variant: Variant,
     pub windows: Vec<WindowResult>,
+    /// Scans localization refused through the day (an error, not a missing fix: the
+    /// step goes on without an estimate), counted so that none hides.
+    pub localization_errors: u64,
     /// The ranges of the day's first scan: the same in every variant of a day (the
     /// sim's noise depends on the day, not on the variant).
     pub first_ranges: Vec<f64>,
@@ -85,7 +88,7 @@ pub fn run_day(
 ) -> Result<DayResult, DaysError> {
     let seed = day_seed(options.seed, day);
     let config = day_config(world, variant, options, seed);
-    let (windows, first_ranges, reports, truth) = drive(
+    let driven = drive(
         world,
         &config,
         variant.change_coupling(),
@@ -95,21 +98,28 @@ pub fn run_day(
     Ok(DayResult {
         day,
         variant,
-        windows,
-        first_ranges,
-        reports,
-        truth,
+        windows: driven.windows,
+        localization_errors: driven.localization_errors,
+        first_ranges: driven.first_ranges,
+        reports: driven.reports,
+        truth: driven.truth,
     })
 }
 
-/// What [`drive`] returns: the windows' measures, the first scan's ranges, the
-/// executive's window reports and the robot's true path.
-pub type Driven = (
-    Vec<WindowResult>,
-    Vec<f64>,
-    Vec<WindowReport>,
-    Vec<[f64; 2]>,
-);
+/// What [`drive`] returns.
+#[derive(Debug)]
+pub struct Driven {
+    /// The windows' measures.
+    pub windows: Vec<WindowResult>,
+    /// The ranges of the day's first scan.
+    pub first_ranges: Vec<f64>,
+    /// The executive's window reports.
+    pub reports: Vec<WindowReport>,
+    /// The robot's true path.
+    pub truth: Vec<[f64; 2]>,
+    /// Scans localization refused.
+    pub localization_errors: u64,
+}
 
 /// The executive configured by `config` through its day, the planner coupling the
 /// change layer when `change`, the sim seeded `sim_seed`, with the controller the demo
@@ -125,9 +135,13 @@ pub fn drive(
     let robot = Robot::new(world, &ApfParams::indoor(), sim_seed)?;
     let mut day_run = DayRun::new(world, config, planner, robot, options)?;
     let windows = day_run.drive_day()?;
-    let first_ranges = day_run.robot.first_ranges().to_vec();
-    let reports = std::mem::take(&mut day_run.executive.reports);
-    Ok((windows, first_ranges, reports, day_run.truth))
+    Ok(Driven {
+        windows,
+        first_ranges: day_run.robot.first_ranges().to_vec(),
+        reports: std::mem::take(&mut day_run.executive.reports),
+        localization_errors: day_run.robot.localization_errors(),
+        truth: day_run.truth,
+    })
 }
 
 /// The executive through one variant's day, and the robot it drives.
@@ -262,6 +276,7 @@ impl<'a> DayRun<'a> {
             curious: log.first_curious.unwrap_or(false),
             first_plan_cells: outcome.plans.first().map_or(0, Vec::len),
             ga_plans: log.ga_plans,
+            refused_plans: log.refused_plans,
             driven_information,
             planned_information,
             shortest_information: report.shortest_information,

@@ -43,6 +43,9 @@ pub struct WindowResult {
     pub first_plan_cells: usize,
     /// Curious plans the window asked for (its GA runs).
     pub ga_plans: u32,
+    /// Plans the planner refused (errors; the window machine went on as on a live
+    /// refusal).
+    pub refused_plans: u32,
     /// Paper 000's measure on the static map (distinct cells seen in the perception
     /// window): along the true driven path, along what the plans laid out (each
     /// replaced plan up to where the robot left it, the last one whole), and along the

@@ -69,6 +69,11 @@ impl Robot {
         &self.change
     }
 
+    /// Scans localization refused so far (the stepper's count).
+    pub fn localization_errors(&self) -> u64 {
+        self.stepper.localization_errors
+    }
+
     pub fn first_ranges(&self) -> &[f64] {
         &self.first_ranges
     }

@@ -34,6 +34,10 @@ pub struct VariantSummary {
     pub replans_per_day: Option<f64>,
     pub replans_by_reason: BTreeMap<&'static str, usize>,
     pub ga_plans_per_day: Option<f64>,
+    /// Plans the planner refused and scans localization refused, over every day: 0 on
+    /// a healthy run, counted so that an error cannot hide as a fallback.
+    pub refused_plans: u64,
+    pub localization_errors: u64,
     /// Windows whose first plan was curious.
     pub curious_windows: usize,
     /// The median over arrived windows of the time model's relative error.
@@ -164,6 +168,12 @@ pub fn variant_summary(results: &[DayResult], variant: Variant) -> Option<Varian
         replans_per_day: mean(per_day(&days, |w| w.replans.len() as f64)),
         replans_by_reason: by_reason,
         ga_plans_per_day: mean(per_day(&days, |w| f64::from(w.ga_plans))),
+        refused_plans: days
+            .iter()
+            .flat_map(|d| &d.windows)
+            .map(|w| u64::from(w.refused_plans))
+            .sum(),
+        localization_errors: days.iter().map(|d| d.localization_errors).sum(),
         curious_windows: all.iter().filter(|w| w.curious).count(),
         model_error_median: median(all.iter().filter_map(|w| w.time_model.map(|m| m.error))),
         by_window,

@@ -20,7 +20,7 @@ fn pct(x: Option<f64>) -> String {
 fn variants(out: &mut String, r: &DaysReport) {
     let _ = writeln!(
         out,
-        "{:<14} {:>6} {:>9} {:>8} {:>9} {:>9} {:>8} {:>7} {:>7} {:>8} {:>8} {:>9}",
+        "{:<14} {:>6} {:>9} {:>8} {:>9} {:>9} {:>8} {:>7} {:>7} {:>8} {:>8} {:>9} {:>9}",
         "variant",
         "share",
         "late",
@@ -32,12 +32,13 @@ fn variants(out: &mut String, r: &DaysReport) {
         "halt/d",
         "repl/day",
         "GA/day",
-        "model err"
+        "model err",
+        "refused"
     );
     for v in &r.variants {
         let _ = writeln!(
             out,
-            "{:<14} {:>6} {:>9} {:>8} {:>9} {:>9} {:>8} {:>7} {:>7} {:>8} {:>8} {:>9}",
+            "{:<14} {:>6} {:>9} {:>8} {:>9} {:>9} {:>8} {:>7} {:>7} {:>8} {:>8} {:>9} {:>9}",
             v.variant.name(),
             num(v.share_median, 2),
             format!("{}/{}", v.late, v.windows),
@@ -50,6 +51,8 @@ fn variants(out: &mut String, r: &DaysReport) {
             num(v.replans_per_day, 1),
             num(v.ga_plans_per_day, 1),
             pct(v.model_error_median),
+            // Plans the planner refused / scans localization refused: 0 / 0 when healthy.
+            format!("{}/{}", v.refused_plans, v.localization_errors),
         );
     }
 }
