@@ -39,6 +39,10 @@ pub(crate) struct FleetArgs {
     /// The PEB (metres) the PEB cost forgives: a cell costs W_loc · max(0, PEB − this).
     #[arg(long, default_value_t = FleetOptions::default().peb_free_m)]
     peb_free_m: f64,
+    /// Plan on the static map only: no plan goes around what the fleet has seen (a
+    /// pallet left in an aisle), as `roam demo --fleet --static-map`.
+    #[arg(long)]
+    static_map: bool,
     /// Write the week's pictures into this directory: detection.svg (the share of the
     /// changes seen within t minutes, per variant) and warehouse-<variant>.svg (paths,
     /// changes, zones, anchors).
@@ -73,6 +77,7 @@ pub(crate) async fn run(args: FleetArgs, quiet: bool) -> anyhow::Result<()> {
         generations: args.generations,
         w_loc: args.w_loc,
         peb_free_m: args.peb_free_m,
+        avoid_seen: !args.static_map,
         model: curious_model(&args.model).ok_or_else(|| {
             anyhow::anyhow!(
                 "no planner model {:?}; give greedy, model0, model1 or model2",

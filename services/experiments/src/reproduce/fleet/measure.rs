@@ -29,6 +29,9 @@ pub struct WindowRecord {
     /// Paper 000's measure on the static map along the true driven path.
     pub driven_information: f64,
     pub ga_plans: u32,
+    /// Plans the planner refused in the window (`None`: a live window, whose report
+    /// does not say).
+    pub refused_plans: Option<u32>,
 }
 
 impl WindowRecord {
@@ -51,6 +54,7 @@ impl WindowRecord {
             },
             driven_information: track.information(&world.planning, &world.params),
             ga_plans: w.log.ga_plans,
+            refused_plans: Some(w.log.refused_plans),
         }
     }
 }
@@ -82,6 +86,7 @@ impl WindowRecord {
             },
             driven_information: gathered(&world.planning, &world.params, truth),
             ga_plans: report.asks.iter().filter(|a| a.curious).count() as u32,
+            refused_plans: None,
         }
     }
 }
@@ -135,6 +140,10 @@ pub struct WeekRecord {
     pub plan_latencies_s: Vec<f64>,
     /// Steps a robot's controller held it for its PEB, per robot.
     pub halted_steps: Vec<u64>,
+    /// Scans localization refused (the batch stepper's count; `None` live, where the
+    /// localization service logs them) and the first one's message.
+    pub localization_errors: Option<u64>,
+    pub first_localization_error: Option<String>,
     /// Each robot's true path through the first shift, every [`PATH_EVERY_STEPS`]th
     /// step: for the picture, not the report (at most a shift's steps per robot).
     #[serde(skip)]
@@ -154,6 +163,8 @@ impl WeekRecord {
             events: Vec::new(),
             plan_latencies_s: Vec::new(),
             halted_steps: vec![0; robots],
+            localization_errors: None,
+            first_localization_error: None,
             paths: vec![Vec::new(); robots],
             end_s: 0.0,
             wall_s: 0.0,

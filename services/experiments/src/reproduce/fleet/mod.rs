@@ -21,6 +21,7 @@ pub mod mapper;
 pub mod measure;
 pub mod patrol;
 pub mod picture;
+pub mod seen;
 pub mod summary;
 pub mod variant;
 pub mod week;
@@ -61,6 +62,10 @@ pub struct FleetOptions {
     /// sends the news into the anchor gaps, where the controller holds the robots, and
     /// 35–42 windows of 114 end late.
     pub peb_free_m: f64,
+    /// Every plan (tasks, patrol and curious alike) goes around what the fleet believes
+    /// occupied where the static map is free ([`seen`]), as `roam demo --fleet`'s
+    /// planners do; `false`: on the static map only (`--static-map`).
+    pub avoid_seen: bool,
     /// What a curious plan costs, wall seconds, before its deadline cuts it.
     pub plan_wall_s: f64,
     /// The clock's rate the executives assume, mission seconds per wall second.
@@ -78,6 +83,7 @@ impl Default for FleetOptions {
             generations: 200,
             w_loc: 2000.0,
             peb_free_m: 0.0,
+            avoid_seen: true,
             plan_wall_s: 0.2,
             // A fleet runs on the wall clock: a plan's computing time is its cost.
             rate: 1.0,
@@ -244,16 +250,16 @@ impl FleetReport {
         );
         let _ = writeln!(
             out,
-            "| variant | late | share | changes | seen ≤10 min | seen ≤1 h | detection median s (by day) | Brier (by day) | Brier zones / others | information / robot-hour (by day) | halted / robot-day | plans | p50 / p99 ms | wall s |"
+            "| variant | late | share | changes | seen ≤10 min | seen ≤1 h | detection median s (by day) | Brier (by day) | Brier zones / others | information / robot-hour (by day) | halted / robot-day | plans | refused plans / scans | p50 / p99 ms | wall s |"
         );
         let _ = writeln!(
             out,
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
         );
         for s in &self.variants {
             let _ = writeln!(
                 out,
-                "| {} | {}/{} | {} | {} | {} | {} | {}{} | {}{} | {} / {} | {}{} | {:.1} | {} | {} / {} | {:.0} |",
+                "| {} | {}/{} | {} | {} | {} | {} | {}{} | {}{} | {} / {} | {}{} | {:.1} | {} | {} / {} | {} / {} | {:.0} |",
                 s.variant,
                 s.late,
                 s.windows,
@@ -271,6 +277,10 @@ impl FleetReport {
                 spread(s.information_per_robot_hour_by_day, 0),
                 s.halted_steps_per_robot_day,
                 s.curious_plans,
+                s.refused_plans
+                    .map_or_else(|| "-".to_owned(), |n| n.to_string()),
+                s.localization_errors
+                    .map_or_else(|| "-".to_owned(), |n| n.to_string()),
                 num(s.plan_p50_ms, 0),
                 num(s.plan_p99_ms, 0),
                 s.wall_s,

@@ -55,6 +55,12 @@ pub struct FleetSummary {
     pub information_per_robot_hour_by_day: Option<Spread>,
     pub halted_steps_per_robot_day: f64,
     pub curious_plans: usize,
+    /// Plans the planner refused (errors, not budget cuts), over the windows that say;
+    /// scans localization refused (`None`: not counted, live). Both 0 on a healthy run:
+    /// they are counted so that a planner or localization error cannot hide as a
+    /// fallback.
+    pub refused_plans: Option<u64>,
+    pub localization_errors: Option<u64>,
     /// Curious plans per second of the planner's computing, and their latency.
     pub plans_per_s: Option<f64>,
     pub plan_p50_ms: Option<f64>,
@@ -146,6 +152,13 @@ pub fn summarize(week: &WeekRecord, shift_s: f64, days: usize) -> FleetSummary {
         halted_steps_per_robot_day: week.halted_steps.iter().sum::<u64>() as f64
             / (week.robots.max(1) * days.max(1)) as f64,
         curious_plans: lat.len(),
+        refused_plans: week
+            .windows
+            .iter()
+            .filter_map(|w| w.refused_plans)
+            .map(u64::from)
+            .reduce(|a, b| a + b),
+        localization_errors: week.localization_errors,
         plans_per_s: (plan_s > 0.0).then(|| lat.len() as f64 / plan_s),
         plan_p50_ms: quantile(&lat, 0.5).map(|s| s * 1e3),
         plan_p99_ms: quantile(&lat, 0.99).map(|s| s * 1e3),

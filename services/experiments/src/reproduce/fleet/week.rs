@@ -12,6 +12,7 @@ use roam_mission::config::ExecutiveConfig;
 use roam_mission::information::InformationScale;
 use roam_planner::coupling::news_product;
 use roam_planner::params::GaParams;
+use roam_planner::world::World;
 use roam_proto::controller::Mission;
 use roam_proto::planner::{Plan, PlanRequest, PlannerModel};
 use roam_sim::semi_static::landed_truth;
@@ -24,6 +25,7 @@ use crate::reproduce::executive::{InProcessExecutive, Io, Step};
 use super::events::ChangeLog;
 use super::mapper::FleetMapper;
 use super::measure::{MapSample, WeekRecord, WindowRecord, PATH_EVERY_STEPS};
+use super::seen::SeenWorld;
 use super::variant::{FleetVariant, Planning};
 use super::world::FleetWorld;
 use super::{FleetError, FleetOptions};
@@ -64,6 +66,8 @@ pub fn robot_config(
 /// The planner, the patrol and the mapper as one robot's executive asks them.
 struct FleetIo<'r, 'w> {
     world: &'w FleetWorld,
+    /// The grid plans are made on: the static one, or around what the fleet has seen.
+    planning_world: &'r World,
     planning: Planning,
     stepper: &'r mut Stepper,
     mapper: &'r mut FleetMapper,
@@ -116,7 +120,7 @@ impl Io for FleetIo<'_, '_> {
 
 impl FleetIo<'_, '_> {
     fn plan(&mut self, request: &PlanRequest, now_s: f64) -> Option<Plan> {
-        let world = &self.world.planning;
+        let world = self.planning_world;
         if request.model == PlannerModel::Shortest {
             return roam_planner::answer::answer(world, request, 1).ok();
         }
@@ -141,7 +145,7 @@ impl FleetIo<'_, '_> {
     /// The patrol's route as the plan's answer: the planner's own answer for the
     /// shortest path (its fallback and its comparison), with the patrol as its route.
     fn patrol(&mut self, request: &PlanRequest) -> Option<Plan> {
-        let world = &self.world.planning;
+        let world = self.planning_world;
         let shortest = PlanRequest {
             model: PlannerModel::Shortest,
             ..request.clone()
@@ -230,6 +234,7 @@ pub fn run_week(
     let mut changes = ChangeLog::default();
     let end_s = options.days as f64 * shift.length_s;
     let mut next_sample_s = MAP_SAMPLE_S;
+    let mut seen = SeenWorld::default();
     let radius_m = world.sim_params.sensing.observation_radius_m;
     let started = Instant::now();
     while executives.iter().any(|e| !e.done()) && stepper.sim().time_s() < end_s {
@@ -237,6 +242,9 @@ pub fn run_week(
         let t = out.time_s;
         let landed = landed_truth(stepper.sim().world().objects());
         changes.update(&landed, t);
+        if options.avoid_seen && seen.due(t) {
+            seen.refresh(world, &mapper.belief(world, t)?, t)?;
+        }
         for r in &out.robots {
             let Some(i) = names.iter().position(|n| *n == r.robot) else {
                 continue;
@@ -259,6 +267,7 @@ pub fn run_week(
             let s_per_m = exec.time_model().v_lin;
             let mut io = FleetIo {
                 world,
+                planning_world: seen.world(world),
                 planning,
                 stepper: &mut stepper,
                 mapper: &mut mapper,
@@ -286,6 +295,8 @@ pub fn run_week(
                 .push(MapSample::score(world, t, &belief, &truth)?);
         }
     }
+    record.localization_errors = Some(stepper.localization_errors);
+    record.first_localization_error = stepper.first_localization_error.clone();
     record.finish(
         changes,
         stepper.sim().time_s(),

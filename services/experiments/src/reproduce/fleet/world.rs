@@ -43,6 +43,12 @@ pub struct FleetWorld {
     /// The planner's grid at [`PLANNING_RESOLUTION_M`]: the inflated map, the static
     /// information and the PEB field, as the planner service holds them.
     pub planning: World,
+    /// The map's inflated occupancy and static information at its own resolution, and
+    /// localization's PEB field on it: what the planning world is rebuilt from around
+    /// what the fleet has seen ([`super::seen`]).
+    pub inflated: Grid<i8>,
+    pub information: Grid<u8>,
+    pub peb: Vec<f32>,
     pub params: GaParams,
     /// The mapper's grid: the planning grid's cells.
     pub coarse: GridMeta,
@@ -146,6 +152,9 @@ impl FleetWorld {
             sim_params,
             shift,
             planning,
+            inflated,
+            information: scenario.information,
+            peb: field.peb,
             params: GaParams::default(),
             coarse,
             factor,
