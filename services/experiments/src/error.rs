@@ -1,6 +1,4 @@
-//! What an experiment or a benchmark can fail with.
-
-use std::time::Duration;
+//! What an experiment can fail with.
 
 use crate::reproduce::apf::render::RenderError;
 use crate::reproduce::apf::ApfError;
@@ -9,7 +7,7 @@ use crate::reproduce::mapper::truth::TruthError;
 use crate::reproduce::mission::days::DaysError;
 use crate::reproduce::mission::missions::MissionExperimentError;
 
-/// An experiment or benchmark that could not run to its end. Each says what was being
+/// An experiment that could not run to its end. Each says what was being
 /// set up or asked, so the fix is in the message; each experiment's own error says
 /// which of its options or inputs was refused.
 #[derive(Debug, thiserror::Error)]
@@ -17,12 +15,6 @@ pub enum ExperimentError {
     /// The world, a scenario, a service or an output directory could not be made ready.
     #[error("{0}")]
     Setup(String),
-    /// A request to a running service failed.
-    #[error("the benchmark's request failed: {0}")]
-    Client(#[from] roam_runtime::ClientError),
-    /// A publication the benchmark waited for never came.
-    #[error("no publication arrived within {0:?}")]
-    Lost(Duration),
     /// A closed-loop run could not be set up or stepped.
     #[error(transparent)]
     Episode(#[from] crate::closed_loop::EpisodeError),

@@ -1,7 +1,9 @@
-//! roam's experiments and benchmarks, in one home: each paper's evaluation reproduced
-//! next to its published figures, the papers joined, and the benchmarks `roam bench`
-//! runs. The services' crates hold the algorithms; this crate holds what is run *with*
-//! them, so no service depends on another only for an experiment.
+//! roam's experiments, in one home: each paper's evaluation reproduced next to its
+//! published figures, and the papers joined. The services' crates hold the algorithms;
+//! this crate holds what is run *with* them, so no service depends on another only for
+//! an experiment. It builds without the network stack (no Zenoh, no tokio: CI checks
+//! with `cargo tree`): a batch is the algorithms in process. The benchmarks, most of
+//! which measure the services through Zenoh, are `roam-bench`.
 //!
 //! - [`reproduce`]: `roam reproduce planner | apf | mapper | mission`: paper 000 §III,
 //!   paper 002 §4 (ES1–ES3), paper 004 §5, and the papers joined (the executive's day
@@ -9,12 +11,10 @@
 //! - [`closed_loop`]: the sim, localization and the APF controller in one loop without
 //!   a network, one run at a time ([`closed_loop::episode`]) or a step at a time with
 //!   missions changed between steps ([`closed_loop::stepper`]).
-//! - [`bench`]: `roam bench …`, each printing JSON.
 //! - [`parallel`]: runs spread over threads, put back in order before anything is summed.
 //! - [`progress`]: how a long run reports how far it is (the binary draws it).
-//! - [`error`]: [`ExperimentError`], what a run or a benchmark can fail with.
+//! - [`error`]: [`ExperimentError`], what a run can fail with.
 
-pub mod bench;
 pub mod closed_loop;
 pub mod error;
 pub mod parallel;

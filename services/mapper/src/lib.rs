@@ -7,7 +7,7 @@
 //! tile-coded learner, goal sampling, §2's wavefront controller) and answers each
 //! update with the robot's next unit command. The batch experiment
 //! (`roam_experiments::reproduce::mapper`, `roam reproduce mapper`), the bench
-//! (`roam_experiments::bench::mapper`, `roam bench mapper`) and the network service
+//! (`roam_bench::mapper`, `roam bench mapper`) and the network service
 //! all call the same code.
 //!
 //! # Modules

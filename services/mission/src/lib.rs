@@ -34,7 +34,10 @@
 //!   performs its actions; `inputs`: what it hears (clock, estimates, controller
 //!   status, the world).
 //! - [`service`]: `roam mission`, the executive as a service that publishes its reports.
+//! - [`baseline`]: the demo's baseline, one plan per window and no replans, replayed in
+//!   process beside the shipped executive's windows.
 
+pub mod baseline;
 pub mod calibration;
 pub mod config;
 pub mod day_check;

@@ -27,7 +27,7 @@ use roam_world::legend::framed;
 use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
-use roam_experiments::reproduce::mission::todays_plans::{todays_plans, TodaysPlan};
+use roam_mission::baseline::{one_plan_per_window, BaselinePlan};
 use roam_stack::stack::{Stack, StackOptions};
 
 use crate::demo_picture::{self, Day};
@@ -100,10 +100,10 @@ pub struct DemoReport {
     pub information_shortest_path: f64,
     /// The same along the planned curious paths.
     pub information_planned: f64,
-    /// What today's executive (static map, Table I, one plan per window, paper 000's
-    /// initialization) would have planned per window ([`roam_experiments::reproduce::mission::todays_plans`]), and the
+    /// What the one-plan baseline (static map, Table I, one plan per window, paper 000's
+    /// initialization) would have planned per window ([`roam_mission::baseline`]), and the
     /// information those plans promised, summed.
-    pub todays_plans: Vec<Option<TodaysPlan>>,
+    pub todays_plans: Vec<Option<BaselinePlan>>,
     pub information_todays_plans: f64,
     /// The mean PEB of the estimates along the way, metres.
     pub peb_mean_m: Option<f64>,
@@ -369,7 +369,7 @@ async fn drive(
         let seed = config.seed;
         let information = information.clone();
         tokio::task::spawn_blocking(move || {
-            todays_plans(&inflated, &information, &outcomes, generations, seed)
+            one_plan_per_window(&inflated, &information, &outcomes, generations, seed)
         })
         .await
         .map_err(|e| DemoError::Zenoh(format!("today's plans: {e}")))?

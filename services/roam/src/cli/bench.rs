@@ -2,7 +2,7 @@
 
 use anyhow::bail;
 use clap::{Args, Subcommand};
-use roam_experiments::bench as benches;
+use roam_bench as benches;
 
 use super::print_json;
 use super::progress::Progress;
@@ -132,7 +132,7 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 bail!("--estimates must be at least 1");
             }
             let result = tokio::task::spawn_blocking(move || {
-                roam_experiments::bench::localization::localization(estimates)
+                roam_bench::localization::localization(estimates)
             })
             .await??;
             print_json(&result, json)
@@ -146,8 +146,7 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
             check_robots_run(robots, rate_hz, seconds)?;
             let progress = Progress::new("bench sim", quiet);
             let shown = progress.callback();
-            let result =
-                roam_experiments::bench::sim::sim(robots, rate_hz, seconds, &shown).await?;
+            let result = roam_bench::sim::sim(robots, rate_hz, seconds, &shown).await?;
             print_json(&result, json)
         }
         BenchCommand::Load {
@@ -155,16 +154,13 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
             requests,
             deadline_s,
         } => {
-            if requests == 0 || requests > roam_experiments::bench::load::MAX_REQUESTS {
-                bail!(
-                    "--requests must be 1..={}",
-                    roam_experiments::bench::load::MAX_REQUESTS
-                );
+            if requests == 0 || requests > roam_bench::load::MAX_REQUESTS {
+                bail!("--requests must be 1..={}", roam_bench::load::MAX_REQUESTS);
             }
             if !(deadline_s.is_finite() && deadline_s > 0.0 && deadline_s <= 600.0) {
                 bail!("--deadline-s must be in (0, 600] seconds");
             }
-            let result = roam_experiments::bench::load::load(requests, deadline_s).await?;
+            let result = roam_bench::load::load(requests, deadline_s).await?;
             print_json(&result, json)
         }
         BenchCommand::Fleet {
@@ -176,8 +172,7 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
             check_robots_run(robots, rate_hz, seconds)?;
             let progress = Progress::new("bench fleet", quiet);
             let shown = progress.callback();
-            let result =
-                roam_experiments::bench::fleet::fleet(robots, rate_hz, seconds, &shown).await?;
+            let result = roam_bench::fleet::fleet(robots, rate_hz, seconds, &shown).await?;
             print_json(&result, json)
         }
         BenchCommand::Mapper {
@@ -188,15 +183,13 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
             if updates == 0 || !(128..=2048).contains(&side) {
                 bail!("--updates must be at least 1 and --side 128..=2048 cells");
             }
-            let options = roam_experiments::bench::mapper::BenchOptions {
+            let options = roam_bench::mapper::BenchOptions {
                 map_cells: side,
                 updates,
-                ..roam_experiments::bench::mapper::BenchOptions::default()
+                ..roam_bench::mapper::BenchOptions::default()
             };
-            let result = tokio::task::spawn_blocking(move || {
-                roam_experiments::bench::mapper::bench(&options)
-            })
-            .await??;
+            let result =
+                tokio::task::spawn_blocking(move || roam_bench::mapper::bench(&options)).await??;
             print_json(&result, json)
         }
         BenchCommand::Planner {
@@ -213,7 +206,7 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 let result = tokio::task::spawn_blocking(move || {
                     let progress = Progress::new("bench planner --scaling", quiet);
                     let shown = progress.callback();
-                    roam_experiments::bench::scaling::scaling(runs, &shown)
+                    roam_bench::scaling::scaling(runs, &shown)
                 })
                 .await??;
                 return print_json(&result, json);
@@ -222,15 +215,14 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 let result = tokio::task::spawn_blocking(move || {
                     let progress = Progress::new("bench planner --peer", quiet);
                     let shown = progress.callback();
-                    roam_experiments::bench::peer::peer(runs, &shown)
+                    roam_bench::peer::peer(runs, &shown)
                 })
                 .await??;
                 return print_json(&result, json);
             }
             let progress = Progress::new("bench planner", quiet);
             let shown = progress.callback();
-            let result =
-                roam_experiments::bench::planner::planner(runs, paper_init, &shown).await?;
+            let result = roam_bench::planner::planner(runs, paper_init, &shown).await?;
             print_json(&result, json)
         }
     }

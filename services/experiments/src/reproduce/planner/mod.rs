@@ -34,9 +34,24 @@ use roam_world::render::{draw_marker, draw_path, render_map, INFORMATION, MARKER
 use roam_world::DEFAULT_MAX_CELLS;
 use serde::Serialize;
 
-use crate::bench::planner::builtin_world;
 use crate::progress::{Done, Progress};
 use crate::ExperimentError;
+
+/// The built-in world as the planner sees it (the planner service's inflation and
+/// Table I's heuristic compression).
+pub fn builtin_world() -> Result<World, ExperimentError> {
+    let content = roam_map_server::map_file::builtin(DEFAULT_MAX_CELLS)
+        .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+    let inflated = roam_world::layers::inflate(
+        &content.occupancy,
+        content.robot_radius_m.unwrap_or(0.2),
+        65,
+    );
+    let information = content.information.ok_or_else(|| {
+        ExperimentError::Setup("the built-in world has no information map".into())
+    })?;
+    World::new(&inflated, &information, 0.25).map_err(|e| ExperimentError::Setup(e.to_string()))
+}
 
 mod claims;
 mod seeding;

@@ -17,9 +17,9 @@ use roam_runtime::ClientError;
 use serde::Serialize;
 use tokio::task::JoinSet;
 
-use crate::bench::ms;
-use crate::bench::process::peak_rss_mib;
-use crate::ExperimentError;
+use crate::ms;
+use crate::process::peak_rss_mib;
+use crate::{setup, BenchError};
 use roam_stack::stack::{Stack, StackOptions};
 
 /// The most concurrent requests one run sends.
@@ -69,7 +69,7 @@ fn percentile(samples: &mut [f64], q: f64) -> f64 {
     samples[i.min(samples.len() - 1)]
 }
 
-pub async fn load(requests: usize, deadline_s: f64) -> Result<LoadBench, ExperimentError> {
+pub async fn load(requests: usize, deadline_s: f64) -> Result<LoadBench, BenchError> {
     let planners = 2;
     let stack = Stack::start(
         StackOptions {
@@ -80,7 +80,7 @@ pub async fn load(requests: usize, deadline_s: f64) -> Result<LoadBench, Experim
         Duration::from_secs(30),
     )
     .await
-    .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+    .map_err(setup)?;
     let deadline = Duration::from_secs_f64(deadline_s);
     let patience = deadline + Duration::from_secs(5);
     let client = PlannerClient::new(stack.router.session.clone(), &stack.root);
@@ -92,7 +92,7 @@ pub async fn load(requests: usize, deadline_s: f64) -> Result<LoadBench, Experim
     })
     .await;
     if seen.is_err() {
-        return Err(ExperimentError::Setup(format!(
+        return Err(BenchError::Setup(format!(
             "fewer than {planners} planner instances announced themselves"
         )));
     }
@@ -170,9 +170,6 @@ pub async fn load(requests: usize, deadline_s: f64) -> Result<LoadBench, Experim
         wall_s,
         peak_rss_mib: peak_rss_mib(),
     };
-    stack
-        .shutdown()
-        .await
-        .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+    stack.shutdown().await.map_err(setup)?;
     Ok(result)
 }

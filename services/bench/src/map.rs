@@ -20,10 +20,10 @@ use roam_world::grid::{occupancy, Grid};
 use roam_world::ros_map::{self, SaveParams};
 use serde::Serialize;
 
-use crate::ExperimentError;
+use crate::{setup, BenchError};
 use zenoh::qos::CongestionControl;
 
-use crate::bench::ms;
+use crate::ms;
 use roam_stack::stack::{Stack, StackOptions};
 
 /// What `roam bench map --json` prints.
@@ -74,12 +74,8 @@ fn max(samples: &[f64]) -> f64 {
 }
 
 /// Runs the map benchmark with a `side × side` map.
-pub async fn map(
-    side: u32,
-    iterations: usize,
-    work_dir: &Path,
-) -> Result<MapBench, ExperimentError> {
-    let setup = |e: String| ExperimentError::Setup(e);
+pub async fn map(side: u32, iterations: usize, work_dir: &Path) -> Result<MapBench, BenchError> {
+    let setup = |e: String| BenchError::Setup(e);
     let grid = warehouse_grid(side, side);
     let yaml = work_dir.join("warehouse.yaml");
     ros_map::save(&grid, &yaml, SaveParams::default()).map_err(|e| setup(e.to_string()))?;
@@ -103,16 +99,12 @@ async fn measure(
     stack: &Stack,
     grid: &Grid<i8>,
     iterations: usize,
-) -> Result<MapBench, ExperimentError> {
+) -> Result<MapBench, BenchError> {
     let open = |endpoint: &str| {
         let args = SessionArgs::client_of(endpoint);
         async move {
-            let config = args
-                .zenoh_config(None)
-                .map_err(|e| ExperimentError::Setup(e.to_string()))?;
-            roam_runtime::session::open(config)
-                .await
-                .map_err(|e| ExperimentError::Setup(e.to_string()))
+            let config = args.zenoh_config(None).map_err(setup)?;
+            roam_runtime::session::open(config).await.map_err(setup)
         }
     };
     let client = open(&stack.router.endpoint).await?;
@@ -124,7 +116,7 @@ async fn measure(
         let layer: Layer = requester.request::<Layer, Layer>(&layer_key, None).await?;
         gets.push(ms(started.elapsed()));
         if layer.cells.len() != grid.cells.len() {
-            return Err(ExperimentError::Setup(format!(
+            return Err(BenchError::Setup(format!(
                 "got {} cells, expected {}",
                 layer.cells.len(),
                 grid.cells.len()
@@ -147,7 +139,7 @@ async fn measure(
         bytes = encode(&layer);
         encodes.push(ms(started.elapsed()));
         let started = Instant::now();
-        let back: Layer = decode(&bytes).map_err(|e| ExperimentError::Setup(e.to_string()))?;
+        let back: Layer = decode(&bytes).map_err(setup)?;
         decodes.push(ms(started.elapsed()));
         std::hint::black_box(back);
     }
@@ -157,12 +149,12 @@ async fn measure(
     let subscriber = listener
         .declare_subscriber(&publish_key)
         .await
-        .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+        .map_err(setup)?;
     let publisher = client
         .declare_publisher(&publish_key)
         .congestion_control(CongestionControl::Block)
         .await
-        .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+        .map_err(setup)?;
     // Declarations propagate asynchronously: wait until the publisher sees the subscriber.
     let matched = tokio::time::timeout(Duration::from_secs(10), async {
         while !publisher
@@ -176,7 +168,7 @@ async fn measure(
     })
     .await;
     if matched.is_err() {
-        return Err(ExperimentError::Setup(
+        return Err(BenchError::Setup(
             "the subscriber never matched the publisher".into(),
         ));
     }
@@ -184,16 +176,12 @@ async fn measure(
     let wait = Duration::from_secs(10);
     for _ in 0..iterations {
         let started = Instant::now();
-        publisher
-            .put(bytes.clone())
-            .await
-            .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+        publisher.put(bytes.clone()).await.map_err(setup)?;
         let sample = tokio::time::timeout(wait, subscriber.recv_async())
             .await
-            .map_err(|_| ExperimentError::Lost(wait))?
-            .map_err(|e| ExperimentError::Setup(e.to_string()))?;
-        let received: Layer = decode(&sample.payload().to_bytes())
-            .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+            .map_err(|_| BenchError::Lost(wait))?
+            .map_err(setup)?;
+        let received: Layer = decode(&sample.payload().to_bytes()).map_err(setup)?;
         publishes.push(ms(started.elapsed()));
         std::hint::black_box(received);
     }

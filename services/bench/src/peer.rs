@@ -19,10 +19,11 @@ use roam_proto::planner::PlannerModel;
 use roam_world::grid::Grid;
 use serde::Serialize;
 
-use crate::bench::planner::{builtin_world, GOAL, START};
-use crate::bench::scaling::{warehouse, WAREHOUSE_GOAL, WAREHOUSE_START};
-use crate::progress::{Done, Progress};
-use crate::ExperimentError as BenchError;
+use crate::{setup, BenchError};
+
+use crate::planner::{builtin_world, GOAL, START};
+use crate::scaling::{warehouse, WAREHOUSE_GOAL, WAREHOUSE_START};
+use roam_experiments::progress::{Done, Progress};
 
 #[derive(Debug, Clone, Serialize)]
 pub struct PlannerRun {
@@ -56,10 +57,6 @@ pub struct PeerTrip {
 pub struct PeerBench {
     pub trips: Vec<PeerTrip>,
     pub runs: usize,
-}
-
-fn setup<E: std::fmt::Display>(e: E) -> BenchError {
-    BenchError::Setup(e.to_string())
 }
 
 fn median_run(mut runs: Vec<PlannerRun>) -> PlannerRun {

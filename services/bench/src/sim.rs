@@ -20,9 +20,9 @@ use roam_world::scenario::load_or_builtin;
 use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
-use crate::bench::process::process_cpu_seconds;
-use crate::progress::{Done, Progress};
-use crate::ExperimentError;
+use crate::process::process_cpu_seconds;
+use crate::{setup, BenchError};
+use roam_experiments::progress::{Done, Progress};
 use roam_stack::router::Router;
 use roam_stack::stack::wait_until_live;
 
@@ -39,17 +39,13 @@ pub struct SimBench {
     pub ranges_expected: u64,
 }
 
-fn setup<E: std::fmt::Display>(e: E) -> ExperimentError {
-    ExperimentError::Setup(e.to_string())
-}
-
 /// Runs the bench; `progress` each second of the timed run (stage `running`).
 pub async fn sim(
     robots: usize,
     rate_hz: f64,
     seconds: f64,
     progress: Progress<'_>,
-) -> Result<SimBench, ExperimentError> {
+) -> Result<SimBench, BenchError> {
     let router = Router::on_loopback().await.map_err(setup)?;
     let root = "roam-bench-sim".to_owned();
     let cancel = CancellationToken::new();
@@ -94,7 +90,7 @@ pub async fn sim(
             .map(|(i, _)| i)
             .collect();
         if free.len() < robots {
-            return Err(ExperimentError::Setup(format!(
+            return Err(BenchError::Setup(format!(
                 "the built-in world has only {} free cells",
                 free.len()
             )));

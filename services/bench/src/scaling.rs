@@ -30,10 +30,11 @@ use roam_world::grid::{cell_center, world_to_cell, Grid};
 use roam_world::layers::inflate;
 use serde::Serialize;
 
-use crate::bench::planner::{builtin_world, GOAL, START};
-use crate::bench::process::{peak_rss_mib, process_cpu_seconds, rss_mib};
-use crate::progress::{Done, Progress};
-use crate::ExperimentError as BenchError;
+use crate::{setup, BenchError};
+
+use crate::planner::{builtin_world, GOAL, START};
+use crate::process::{peak_rss_mib, process_cpu_seconds, rss_mib};
+use roam_experiments::progress::{Done, Progress};
 
 /// The map resolutions of the built-in world the bench plans on.
 pub const RESOLUTIONS: [f64; 4] = [0.2, 0.1, 0.05, 0.03];
@@ -98,7 +99,7 @@ pub struct ScalingBench {
 pub fn builtin_at(resolution: f64) -> Result<(Grid<i8>, Grid<u8>), BenchError> {
     let content =
         roam_map_server::map_file::builtin(roam_map_server::store::DEFAULT_LIMITS.max_layer_cells)
-            .map_err(|e| BenchError::Setup(e.to_string()))?;
+            .map_err(setup)?;
     let information = content
         .information
         .ok_or_else(|| BenchError::Setup("the built-in world has no information map".into()))?;
@@ -178,10 +179,6 @@ pub const WAREHOUSE_GOAL: [f64; 2] = [22.0, 15.0];
 fn median(values: &mut [f64]) -> f64 {
     values.sort_by(f64::total_cmp);
     values.get(values.len() / 2).copied().unwrap_or(f64::NAN)
-}
-
-fn setup<E: std::fmt::Display>(e: E) -> BenchError {
-    BenchError::Setup(e.to_string())
 }
 
 /// The distinct information of a driven path on the reference world's cells.

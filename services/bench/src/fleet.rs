@@ -35,12 +35,13 @@ use roam_sim::service::SimConfig;
 use roam_world::grid::cell_center;
 use roam_world::scenario::load_or_builtin;
 use serde::Serialize;
+
+use crate::{setup, BenchError};
 use tokio_util::sync::CancellationToken;
 
-use crate::bench::process::{peak_rss_mib, rss_mib};
-use crate::bench::sim::{run_sim_for, TimedRun};
-use crate::progress::Progress;
-use crate::ExperimentError as BenchError;
+use crate::process::{peak_rss_mib, rss_mib};
+use crate::sim::{run_sim_for, TimedRun};
+use roam_experiments::progress::Progress;
 use roam_stack::router::Router;
 use roam_stack::stack::wait_until_live;
 
@@ -66,10 +67,6 @@ pub struct FleetBench {
     pub rss_per_robot_mib: f64,
     pub rss_mib: Option<f64>,
     pub peak_rss_mib: Option<f64>,
-}
-
-fn setup<E: std::fmt::Display>(e: E) -> BenchError {
-    BenchError::Setup(e.to_string())
 }
 
 /// What the subscribers saw.

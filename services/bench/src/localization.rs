@@ -9,7 +9,7 @@ use roam_localization::field::{peb_field, GridRegion};
 use roam_localization::{estimate, FimOptions, Range, RangingModel, WlsOptions};
 use serde::Serialize;
 
-use crate::ExperimentError;
+use crate::BenchError;
 
 #[derive(Debug, Clone, Serialize)]
 pub struct LocalizationBench {
@@ -20,8 +20,8 @@ pub struct LocalizationBench {
     pub field_500_ms: f64,
 }
 
-pub fn localization(estimates: usize) -> Result<LocalizationBench, ExperimentError> {
-    let setup = |e: String| ExperimentError::Setup(e);
+pub fn localization(estimates: usize) -> Result<LocalizationBench, BenchError> {
+    let setup = |e: String| BenchError::Setup(e);
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenarios/es3.yaml");
     let (_, scenario) =

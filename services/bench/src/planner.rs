@@ -11,19 +11,17 @@ use std::collections::BTreeMap;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-use roam_map_server::map_file;
 use roam_planner::client::PlannerClient;
 use roam_planner::plan::{plan, PlanSpec};
 use roam_planner::world::World;
 use roam_proto::planner::{GaOverrides, PlanRequest, PlannerModel, ShortestPathUse};
 use roam_runtime::SessionArgs;
-use roam_world::layers::inflate;
-use roam_world::DEFAULT_MAX_CELLS;
 use serde::Serialize;
 
-use crate::bench::ms;
-use crate::progress::{Done, Progress};
-use crate::ExperimentError;
+use crate::ms;
+use crate::{setup, BenchError};
+use roam_experiments::progress::{Done, Progress};
+pub use roam_experiments::reproduce::planner::builtin_world;
 use roam_stack::stack::{Stack, StackOptions};
 
 #[derive(Debug, Clone, Serialize)]
@@ -52,21 +50,6 @@ pub struct PlannerBench {
 pub const START: [f64; 2] = [-8.0, -8.0];
 pub const GOAL: [f64; 2] = [6.0, -7.0];
 
-/// The built-in world as the planner sees it.
-pub fn builtin_world() -> Result<World, ExperimentError> {
-    let content =
-        map_file::builtin(DEFAULT_MAX_CELLS).map_err(|e| ExperimentError::Setup(e.to_string()))?;
-    let inflated = inflate(
-        &content.occupancy,
-        content.robot_radius_m.unwrap_or(0.2),
-        65,
-    );
-    let information = content.information.ok_or_else(|| {
-        ExperimentError::Setup("the built-in world has no information map".into())
-    })?;
-    World::new(&inflated, &information, 0.25).map_err(|e| ExperimentError::Setup(e.to_string()))
-}
-
 fn median(values: &mut [f64]) -> f64 {
     values.sort_by(f64::total_cmp);
     values.get(values.len() / 2).copied().unwrap_or(f64::NAN)
@@ -83,7 +66,7 @@ pub async fn planner(
     runs: usize,
     paper_initialization: bool,
     progress: Progress<'_>,
-) -> Result<PlannerBench, ExperimentError> {
+) -> Result<PlannerBench, BenchError> {
     let world = builtin_world()?;
     let never = AtomicBool::new(false);
     let shortest = plan(
@@ -92,7 +75,7 @@ pub async fn planner(
         &never,
         |_, _| {},
     )
-    .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+    .map_err(setup)?;
     let budget = 2.0 * shortest.t_eta_s;
     let mut models = BTreeMap::new();
     let all = [
@@ -114,8 +97,7 @@ pub async fn planner(
                 s.params = s.params.with_paper_initialization();
             }
             let started = Instant::now();
-            let outcome = plan(&world, &s, &never, |_, _| {})
-                .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+            let outcome = plan(&world, &s, &never, |_, _| {}).map_err(setup)?;
             let elapsed = started.elapsed().as_secs_f64();
             seconds.push(elapsed);
             rates.push(outcome.evaluations as f64 / elapsed);
@@ -160,7 +142,7 @@ async fn zenoh_overhead(
     budget: f64,
     runs: usize,
     progress: Progress<'_>,
-) -> Result<f64, ExperimentError> {
+) -> Result<f64, BenchError> {
     let stack = Stack::start(
         StackOptions {
             root: Some("roam-bench-planner".into()),
@@ -170,14 +152,12 @@ async fn zenoh_overhead(
         Duration::from_secs(30),
     )
     .await
-    .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+    .map_err(setup)?;
     let result = async {
         let config = SessionArgs::client_of(&stack.router.endpoint)
             .zenoh_config(None)
-            .map_err(|e| ExperimentError::Setup(e.to_string()))?;
-        let session = roam_runtime::session::open(config)
-            .await
-            .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+            .map_err(setup)?;
+        let session = roam_runtime::session::open(config).await.map_err(setup)?;
         let client = PlannerClient::new(session.clone(), &stack.root);
         let request = PlanRequest {
             request_id: None,
@@ -205,7 +185,7 @@ async fn zenoh_overhead(
                 &never,
                 |_, _| {},
             )
-            .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+            .map_err(setup)?;
             local.push(ms(started.elapsed()));
             let started = Instant::now();
             client.plan(&request).await?;
@@ -213,12 +193,9 @@ async fn zenoh_overhead(
             progress(Done::of("round trips", "round trips", run + 1, runs));
         }
         let _ = session.close().await;
-        Ok::<f64, ExperimentError>(median(&mut remote) - median(&mut local))
+        Ok::<f64, BenchError>(median(&mut remote) - median(&mut local))
     }
     .await;
-    stack
-        .shutdown()
-        .await
-        .map_err(|e| ExperimentError::Setup(e.to_string()))?;
+    stack.shutdown().await.map_err(setup)?;
     result
 }
