@@ -16,7 +16,6 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 
-use crate::error::{ErrorCode, ErrorReply};
 use crate::excerpt::{excerpt, parser_reason};
 
 /// The protocol version every roam message carries.
@@ -59,18 +58,6 @@ pub enum DecodeError {
     },
     #[error("the '{kind}' message body is invalid: {reason}")]
     Body { kind: &'static str, reason: String },
-}
-
-impl DecodeError {
-    /// The error reply a service sends for this decode failure.
-    pub fn to_reply(&self) -> ErrorReply {
-        let code = match self {
-            DecodeError::Envelope(_) | DecodeError::Body { .. } => ErrorCode::Malformed,
-            DecodeError::UnsupportedVersion { .. } => ErrorCode::UnsupportedVersion,
-            DecodeError::WrongKind { .. } => ErrorCode::WrongMessage,
-        };
-        ErrorReply::new(code, self.to_string())
-    }
 }
 
 /// Encodes a message with the protocol envelope.

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::codec::Message;
+use crate::codec::{DecodeError, Message};
 
 /// What kind of failure a request met. Stable strings on the wire (`snake_case`), so a
 /// client in any language can branch on them.
@@ -176,4 +176,17 @@ impl std::error::Error for ErrorReply {}
 
 impl Message for ErrorReply {
     const KIND: &'static str = "error";
+}
+
+/// Beside the error codes rather than in the codec: the codec knows nothing of replies.
+impl DecodeError {
+    /// The error reply a service sends for this decode failure.
+    pub fn to_reply(&self) -> ErrorReply {
+        let code = match self {
+            DecodeError::Envelope(_) | DecodeError::Body { .. } => ErrorCode::Malformed,
+            DecodeError::UnsupportedVersion { .. } => ErrorCode::UnsupportedVersion,
+            DecodeError::WrongKind { .. } => ErrorCode::WrongMessage,
+        };
+        ErrorReply::new(code, self.to_string())
+    }
 }

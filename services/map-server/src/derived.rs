@@ -10,12 +10,24 @@
 use std::collections::BTreeMap;
 
 use roam_proto::cells::Cells;
-use roam_proto::map::GridMeta;
+use roam_proto::map::{
+    GridMeta, HEURISTIC_LAYER, INFLATED_LAYER, INFORMATION_LAYER, OCCUPANCY_LAYER,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::edits::CellEdits;
 use roam_world::grid::Grid;
 use roam_world::layers;
+
+/// The source of a derived layer: `inflated` is derived from `occupancy`, `heuristic`
+/// from `information`; `None` for a layer that is not derived.
+pub fn derived_source(name: &str) -> Option<&'static str> {
+    match name {
+        INFLATED_LAYER => Some(OCCUPANCY_LAYER),
+        HEURISTIC_LAYER => Some(INFORMATION_LAYER),
+        _ => None,
+    }
+}
 
 /// How a derived layer is computed from its source.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -49,8 +49,8 @@ pub enum EditError {
 /// The values a cell of layer `name` with cells of type `dtype` may take.
 pub fn value_range(name: &str, dtype: Dtype) -> (f64, f64) {
     match (name, dtype) {
-        (crate::store::OCCUPANCY, _) => (f64::from(occupancy::UNKNOWN), 100.0),
-        (crate::store::INFORMATION, _) => (0.0, 100.0),
+        (roam_proto::map::OCCUPANCY_LAYER, _) => (f64::from(occupancy::UNKNOWN), 100.0),
+        (roam_proto::map::INFORMATION_LAYER, _) => (0.0, 100.0),
         (_, Dtype::I8) => (-128.0, 127.0),
         (_, Dtype::U8) => (0.0, 255.0),
         (_, Dtype::F32) => (f64::from(f32::MIN), f64::from(f32::MAX)),

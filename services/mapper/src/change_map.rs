@@ -17,18 +17,15 @@
 //! robots' windows of one instant merge by observing each in turn).
 
 use roam_proto::map::GridMeta;
-use roam_sim::Observation;
 use roam_world::grid::{occupancy, world_to_cell, Grid};
+use roam_world::observation::Observation;
+
+pub use crate::limits::MAX_MAP_CELLS;
 use serde::{Deserialize, Serialize};
 
 use crate::error::MapperError;
 use crate::features::{Features, TileCache};
 use crate::poisson::{CellProcess, Watch};
-
-/// The most cells a change map holds (limit `max_map_cells`): 2048 × 2048. Each cell
-/// costs about 49 bytes (its processes and its obstacle value), so the largest map
-/// takes about 205 MB; a full-size warehouse map (1.7 M cells) about 84 MB.
-pub const MAX_MAP_CELLS: u64 = 1 << 22;
 
 /// A seen value at or above this is occupied, below it free.
 pub const OCCUPIED_FROM: i8 = 50;

@@ -1,8 +1,7 @@
 //! Why the mapper refused something. Every limit an error names is a constant of this
 //! crate, so a caller can tell the user what to change.
 
-use crate::change_map::MAX_MAP_CELLS;
-use crate::news::{MAX_RESERVED_CELLS, MAX_RESERVING_ROBOTS};
+use crate::limits::{MAX_MAP_CELLS, MAX_RESERVED_CELLS, MAX_RESERVING_ROBOTS};
 
 /// Why the change map or the explorer refused an input. Nothing changes when a call is
 /// refused.

@@ -32,7 +32,8 @@
 //!   with localization.
 //! - [`explorer`]: the per-robot loop: episodes, navigation, local exploration, reward.
 //! - [`seed`]: the seeded ChaCha8 streams every random choice draws from.
-//! - [`error`]: [`MapperError`], naming the limit when a size is refused.
+//! - [`error`]: [`MapperError`], naming the limit when a size is refused; [`limits`]:
+//!   the limits it names.
 //!
 //! # Where paper 004 is ambiguous, and roam's choices
 //!
@@ -134,6 +135,7 @@ pub mod explorer;
 pub mod features;
 pub mod goals;
 pub mod learner;
+pub mod limits;
 pub mod news;
 pub mod poisson;
 pub mod prior;

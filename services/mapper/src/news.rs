@@ -33,8 +33,9 @@ use roam_proto::map::GridMeta;
 use roam_world::grid::Grid;
 use serde::{Deserialize, Serialize};
 
-use crate::change_map::{scores, ChangeMap, MAX_MAP_CELLS};
+use crate::change_map::{scores, ChangeMap};
 use crate::error::MapperError;
+pub use crate::limits::{MAX_MAP_CELLS, MAX_RESERVED_CELLS, MAX_RESERVING_ROBOTS};
 use crate::poisson::CellProcess;
 use crate::prior::RatePrior;
 use crate::reserve::{ReserveParams, TimedCell};
@@ -80,13 +81,6 @@ impl NewsParams {
         self.reserve.check()
     }
 }
-
-/// The most robots holding a reservation at once (limit `max_reserving_robots`).
-pub const MAX_RESERVING_ROBOTS: usize = 32;
-
-/// The most cells one reservation holds (limit `max_reserved_cells`): 16 bytes each, so
-/// 8 MB a robot.
-pub const MAX_RESERVED_CELLS: usize = 1 << 19;
 
 /// P_news of one cell (module doc): 1 − exp(−λ̂ · (t_now − t_seen)), 1 when `seen_s` is
 /// `None` (never seen), 0 when the cell counts as seen at or after `now_s`.

@@ -40,7 +40,7 @@ use crate::calibration::{path_measure, store, Calibration, CalibrationConfig, Ti
 use crate::information::InformationScale;
 use crate::inputs::{listen, wait_for_world, Inputs};
 use crate::request::plan_request;
-use crate::tasks::{Task, TaskError};
+use crate::tasks::Task;
 pub use crate::window::WindowOutcome;
 use crate::window::{
     DowntimeWindow, DrivenMission, Handover, Now, PlanAsk, WindowAction, WindowEvent, WindowRules,
@@ -49,25 +49,7 @@ use crate::window::{
 
 pub use crate::config::ExecutiveConfig;
 
-#[derive(Debug, thiserror::Error)]
-pub enum ExecutiveError {
-    #[error(transparent)]
-    Tasks(#[from] TaskError),
-    #[error("invalid config: {0}")]
-    Config(String),
-    #[error(transparent)]
-    Settings(#[from] crate::config::ConfigError),
-    #[error(transparent)]
-    Client(#[from] ClientError),
-    #[error("the map server's {0} layer is not usable: {1}")]
-    Layer(&'static str, String),
-    #[error("no estimate of robot {robot:?} within {waited:?}: is localization running and the robot in range of the anchors?")]
-    NoEstimate { robot: String, waited: Duration },
-    #[error("zenoh: {0}")]
-    Zenoh(String),
-    #[error("stopped")]
-    Cancelled,
-}
+pub use crate::error::ExecutiveError;
 
 /// What the executive is doing, for a progress display.
 #[derive(Debug, Clone, PartialEq)]

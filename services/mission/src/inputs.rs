@@ -23,7 +23,7 @@ use roam_world::grid::Grid;
 use tokio_util::sync::CancellationToken;
 use zenoh::sample::Sample;
 
-use crate::executive::ExecutiveError;
+use crate::error::ExecutiveError;
 
 /// The mission clock: the sim's when it publishes one, wall time otherwise.
 #[derive(Debug)]

@@ -29,7 +29,7 @@
 //! - `roam_experiments::reproduce::mission`: `roam reproduce mission`, the couplings
 //!   compared in batch, and with `--days N` the executive's whole day in batch: the
 //!   same window machine driven in process, once per configuration compared.
-//! - [`executive`]: the executive on Zenoh (a client of the planner, the controller,
+//! - [`executive`] (its [`error`]): the executive on Zenoh (a client of the planner, the controller,
 //!   localization and the sim clock), a thin loop that feeds the window's machine and
 //!   performs its actions; `inputs`: what it hears (clock, estimates, controller
 //!   status, the world).
@@ -41,6 +41,8 @@ pub mod baseline;
 pub mod calibration;
 pub mod config;
 pub mod day_check;
+#[cfg(feature = "zenoh")]
+pub mod error;
 #[cfg(feature = "zenoh")]
 pub mod executive;
 pub mod information;

@@ -3,6 +3,7 @@
 //! A robot with downtime asks for a path from where it stands to its next task that
 //! gathers the most information and still arrives within the time it has. The
 //! algorithm side is plain Rust over plain types:
+//! - [`cell`]: a planning cell's index and the eight moves;
 //! - [`world`]: the planning grid (traversable cells, information, heuristic blocks);
 //! - [`params`]: the GA parameters, Table I's values as defaults;
 //! - [`eta`]: the travel-time estimate t_ETA (Eq. 2);
@@ -17,7 +18,8 @@
 //! - [`search`]: the fastest path (Eq. 2 over cell and heading: the baseline and the
 //!   budget floor), the distance-shortest path and the distance field;
 //! - [`resolution`]: the planning grid at a resolution apart from the map's, and the
-//!   path the robot drives on the map's cells;
+//!   path the robot drives on the map's cells; [`fine`]: the map it is derived from,
+//!   and the limits of a planning resolution;
 //! - [`limits`]: what one plan may cost (path length from Eq. 2, memory, work);
 //! - [`plan`]: one request end to end, with the checks that refuse bad requests.
 //!
@@ -32,6 +34,7 @@ pub mod answer;
 pub mod best;
 #[cfg(feature = "zenoh")]
 pub mod budget;
+pub mod cell;
 #[cfg(feature = "zenoh")]
 pub mod client;
 #[cfg(feature = "zenoh")]
@@ -39,6 +42,7 @@ pub mod config;
 pub mod coupling;
 pub mod curiosity;
 pub mod eta;
+pub mod fine;
 pub mod ga;
 pub mod greedy;
 #[cfg(feature = "zenoh")]

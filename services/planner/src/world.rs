@@ -2,7 +2,7 @@
 //! legal, their information scores, and the heuristic blocks of Model II.
 //!
 //! A world is at the map's resolution ([`World::new`]) or at a coarser planning
-//! resolution derived from it ([`World::at_resolution`], [`crate::resolution`]): then
+//! resolution derived from it ([`World::at_resolution`], `resolution`): then
 //! it also holds the fine map it came from, on which the reply's path is driven.
 
 use std::sync::Arc;
@@ -11,20 +11,9 @@ use roam_proto::map::GridMeta;
 use roam_world::grid::{cell_center, world_to_cell, Grid};
 use roam_world::layers::block_size;
 
-/// A cell index, `y * width + x`.
-pub type Cell = u32;
+use crate::fine::{FineMap, ResolutionError};
 
-/// The eight moves, counter-clockwise from east; the index is the heading in units of 45°.
-pub const MOVES: [(i32, i32); 8] = [
-    (1, 0),
-    (1, 1),
-    (0, 1),
-    (-1, 1),
-    (-1, 0),
-    (-1, -1),
-    (0, -1),
-    (1, -1),
-];
+pub use crate::cell::{Cell, MOVES};
 
 /// The grid the planner works on.
 #[derive(Debug, Clone)]
@@ -34,13 +23,13 @@ pub struct World {
     height: usize,
     /// A cell is traversable when the inflated occupancy is free (0). Unknown cells
     /// are not: a plan never counts on space nobody has seen. (At a coarser planning
-    /// resolution: when the robot can stand in it, [`crate::resolution`].)
+    /// resolution: when the robot can stand in it, `resolution`.)
     traversable: Vec<bool>,
     /// The legal moves out of each cell, bit `d` for [`MOVES`]`[d]`: onto a traversable
     /// cell on the map, and for a diagonal without cutting a corner (both orthogonal
     /// neighbours traversable). At a coarser planning resolution: where the fine map
     /// has a legal step from one cell's free space into the other's
-    /// ([`crate::resolution`]). Symmetric: a legal move a → b implies b → a.
+    /// (`resolution`). Symmetric: a legal move a → b implies b → a.
     moves: Vec<u8>,
     /// Information scores I_xy, 0..=[`MAX_INFORMATION_SCORE`]: higher scores of the
     /// layer were clamped (see [`World::clamped`]).
@@ -62,7 +51,7 @@ pub struct World {
     move_offsets: [i64; 8],
     /// The map this grid was derived from, when it plans at a coarser resolution than
     /// the map's ([`World::at_resolution`]); `None` when it plans on the map's own cells.
-    pub fine: Option<Arc<crate::resolution::FineMap>>,
+    pub fine: Option<Arc<FineMap>>,
 }
 
 /// The highest information score I_xy (paper 000's scores, the map server's
@@ -130,7 +119,7 @@ pub enum WorldError {
     #[error("the map has no cells")]
     Empty,
     #[error(transparent)]
-    Resolution(#[from] crate::resolution::ResolutionError),
+    Resolution(#[from] ResolutionError),
 }
 
 impl World {
@@ -165,38 +154,7 @@ impl World {
         )
     }
 
-    /// The planning grid of `inflated` and `information` at `planning_resolution_m`
-    /// ([`crate::resolution`]): the map's own cells when that is the map's resolution
-    /// (to rounding, [`crate::resolution::cell_factor`]), else cells of a whole number
-    /// of map cells, holding the fine map to drive on. A planning resolution finer than
-    /// the map's or coarser than [`crate::resolution::MAX_PLANNING_RESOLUTION_M`] is
-    /// refused naming the limit.
-    pub fn at_resolution(
-        inflated: &Grid<i8>,
-        information: &Grid<u8>,
-        heuristic_compression: f64,
-        planning_resolution_m: f64,
-    ) -> Result<World, WorldError> {
-        let factor =
-            crate::resolution::cell_factor(inflated.meta.resolution, planning_resolution_m)?;
-        if factor == 1 {
-            return World::new(inflated, information, heuristic_compression);
-        }
-        if (information.width(), information.height()) != (inflated.width(), inflated.height()) {
-            return Err(WorldError::SizeMismatch(
-                inflated.meta.width,
-                inflated.meta.height,
-                information.meta.width,
-                information.meta.height,
-            ));
-        }
-        if inflated.width() == 0 || inflated.height() == 0 {
-            return Err(WorldError::Empty);
-        }
-        crate::resolution::coarse_world(inflated, information, heuristic_compression, factor)
-    }
-
-    /// A world from its parts: what [`World::new`] and [`crate::resolution`] build.
+    /// A world from its parts: what [`World::new`] and `resolution` build.
     /// Scores above [`MAX_INFORMATION_SCORE`] are clamped and reported in `clamped`.
     pub(crate) fn from_parts(
         meta: GridMeta,
@@ -204,7 +162,7 @@ impl World {
         moves: Vec<u8>,
         information: &Grid<u8>,
         heuristic_compression: f64,
-        fine: Option<Arc<crate::resolution::FineMap>>,
+        fine: Option<Arc<FineMap>>,
     ) -> Result<World, WorldError> {
         let (w, h) = (meta.width as usize, meta.height as usize);
         if w == 0 || h == 0 {

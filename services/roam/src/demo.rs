@@ -123,7 +123,7 @@ pub enum DemoError {
     #[error(transparent)]
     Stack(#[from] roam_stack::stack::StackError),
     #[error(transparent)]
-    Executive(#[from] roam_mission::executive::ExecutiveError),
+    Executive(#[from] roam_mission::error::ExecutiveError),
     #[error(transparent)]
     Client(#[from] roam_runtime::ClientError),
     #[error("zenoh: {0}")]

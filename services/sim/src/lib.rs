@@ -14,7 +14,8 @@
 //! - [`robot`]: a robot and paper 002's motion model (Eq. 1) with a top speed and
 //!   collisions; [`unicycle`]: roam's robot with a heading, which turns (at most
 //!   w_max·dt per step) before it drives, so turning costs time as paper 000's Eq. 2
-//!   assumes (`motion.model: { unicycle: ... }`).
+//!   assumes (`motion.model: { unicycle: ... }`); [`translate`]: one move against the
+//!   world, where both end.
 //! - [`sensors`]: TOA ranges to the anchors in range; [`los`]: the local grid observation
 //!   with line of sight; [`raster`]: the cells a segment crosses.
 //! - [`sim`]: [`Sim`], its step, reset, robots, reports and errors; [`event`]: what
@@ -29,6 +30,7 @@
 //! top speed and the sim time per step (`motion`, `time`).
 
 pub mod event;
+pub mod footprint;
 pub mod los;
 pub mod messages;
 pub mod raster;
@@ -40,6 +42,7 @@ pub mod sensors;
 pub mod service;
 pub mod sim;
 pub mod snapshot;
+pub mod translate;
 pub mod unicycle;
 pub mod world;
 

@@ -20,8 +20,8 @@ use roam_world::noise;
 use roam_world::scenario::changes::ChangeZoneSpec;
 use serde::Serialize;
 
+use crate::footprint::Footprint;
 use crate::raster::CellXy;
-use crate::world::Footprint;
 
 /// Candidate places a zone draws for a new object; the first whose footprint covers no
 /// wall and no other object is taken, and none when all are taken.

@@ -4,9 +4,9 @@ use rand::RngCore;
 use roam_world::scenario::{RangeGate, SensingSpec};
 use serde::Serialize;
 
-use crate::los::Observation;
 use crate::world::Anchor;
 use roam_world::noise::ToaNoise;
+use roam_world::observation::Observation;
 
 /// One TOA range: `d̂ = d + n` to one anchor.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

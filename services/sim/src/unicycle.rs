@@ -37,7 +37,7 @@ use std::f64::consts::{PI, TAU};
 use roam_world::scenario::{MotionSpec, TimeSpec, UnicycleSpec};
 
 use crate::event::Event;
-use crate::robot::{translate, Moved};
+use crate::translate::{translate, Moved};
 use crate::world::World;
 
 /// An angle in [-π, π).

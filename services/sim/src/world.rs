@@ -18,31 +18,7 @@ pub struct Anchor {
     pub at: [f64; 2],
 }
 
-/// How many cells an obstacle covers, centred on the cell its position falls in; for an
-/// even size the extra column (row) is on the +x (+y) side.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub struct Footprint {
-    pub width_cells: u32,
-    pub height_cells: u32,
-}
-
-impl Footprint {
-    /// Metres rounded to whole cells, at least one.
-    pub fn from_metres(meta: &GridMeta, [w, h]: [f64; 2]) -> Footprint {
-        let cells = |m: f64| ((m / meta.resolution).round() as u32).max(1);
-        Footprint {
-            width_cells: cells(w),
-            height_cells: cells(h),
-        }
-    }
-
-    /// The cells covered when centred on `centre`, possibly partly off the map.
-    pub fn cells(&self, centre: CellXy) -> impl Iterator<Item = CellXy> {
-        let (w, h) = (i64::from(self.width_cells), i64::from(self.height_cells));
-        let (x0, y0) = (centre.0 - (w - 1) / 2, centre.1 - (h - 1) / 2);
-        (y0..y0 + h).flat_map(move |y| (x0..x0 + w).map(move |x| (x, y)))
-    }
-}
+pub use crate::footprint::Footprint;
 
 /// A scripted block: it holds each position of its path for `period_steps` steps and
 /// cycles through the path (paper 004 §5, Fig. 3).
@@ -299,7 +275,7 @@ impl World {
         let free =
             |(x, y): CellXy| x >= 0 && y >= 0 && x < w && y < h && !statics[(y * w + x) as usize];
         let reach = self.clearance_cells;
-        let robot_on = |f: crate::world::Footprint, centre: CellXy| {
+        let robot_on = |f: Footprint, centre: CellXy| {
             let (hw, hh) = (
                 i64::from(f.width_cells) / 2 + reach + 1,
                 i64::from(f.height_cells) / 2 + reach + 1,

@@ -52,8 +52,7 @@ pub const MAX_LAYER_BYTES_SHOWN: usize = 1 << 30;
 /// 1.7-million-cell warehouse map's f32 layers are 6.8 MB); a delta of a larger layer
 /// fetches it whole, so the largest layers are not held twice.
 pub const MAX_LAYER_BYTES_KEPT: usize = 16 << 20;
-/// The most robots whose missions are kept, and the most whose driven paths are.
-pub const MAX_ROBOTS: usize = 256;
+pub use crate::roster::MAX_ROBOTS;
 /// The most points kept per driven path, and the least distance between two of them.
 pub const DRIVEN_POINTS: usize = 4096;
 pub const DRIVEN_STEP_M: f64 = 0.05;

@@ -24,7 +24,7 @@ use foxglove::messages::SceneUpdate;
 use foxglove::websocket::{ChannelView, Client, ServerListener};
 use foxglove::{ChannelId, Context, Encode, McapWriterHandle, RawChannel, WebSocketServerHandle};
 
-use crate::follow::MAX_ROBOTS;
+use crate::roster::MAX_ROBOTS;
 use crate::wire::{clipped, shown, Throttle, WireError};
 use crate::ViewError;
 

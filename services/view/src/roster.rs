@@ -9,6 +9,9 @@
 
 use std::collections::BTreeMap;
 
+/// The most robots whose missions are kept, and the most whose driven paths are.
+pub const MAX_ROBOTS: usize = 256;
+
 /// State of type `T` for at most `capacity` robots.
 #[derive(Debug)]
 pub(crate) struct Roster<T> {

@@ -10,6 +10,7 @@
 //!   world's sections), its checks and loader, and the built-in world;
 //!   [`ros_map`]: ROS `map_server` maps as Nav2 reads and writes them;
 //!   [`load_dirs`]: which directories a load request from the wire may read.
+//! - [`observation`]: what a robot sees of the grid (the sim's output, the mapper's input).
 //! - [`world_id`]: which world a map is (one stack runs one world); [`epoch`]: message
 //!   times checked against the sim clock, resets as new epochs.
 //! - [`seed`]: the seeded random streams behind every random choice; [`noise`]: the
@@ -23,6 +24,7 @@ pub mod layers;
 pub mod legend;
 pub mod load_dirs;
 pub mod noise;
+pub mod observation;
 pub mod render;
 pub mod ros_map;
 pub mod scenario;

@@ -5,11 +5,11 @@
 //! The structure is kept literally like the services' (sim → ranges → localization →
 //! controller → commands → sim):
 //!
-//! 1. `Sim::with_params(scenario, seed)`, a [`Tracker`] with the scenario's sensing model
-//!    and default [`FimOptions`], one [`Controller`] per robot with its mission.
+//! 1. `Sim::with_params(scenario, seed)`, a `Tracker` with the scenario's sensing model
+//!    and default `FimOptions`, one `Controller` per robot with its mission.
 //! 2. `sim.step(&[])`: the first step, without commands.
-//! 3. For each robot's report: its messages ([`robot_messages`]), the estimate from its
-//!    range scan ([`Tracker::on_scan`], exactly what the localization service publishes),
+//! 3. For each robot's report: its messages (`robot_messages`), the estimate from its
+//!    range scan (`Tracker::on_scan`, exactly what the localization service publishes),
 //!    then the controller's update from the estimate and its PEB
 //!    ([`PositionSource::Estimate`]) or from the true position and the PEB there
 //!    ([`PositionSource::Truth`], paper 002 ES2's "nominal conditions").
@@ -26,94 +26,21 @@
 
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::sync::Arc;
 
-use roam_localization::fim::FimOptions;
-use roam_localization::model::RangingModel;
-use roam_localization::LocalizationError;
-use roam_sim::{SimError, SimParams};
+use roam_controller::controller::{Decision, MissionStatus};
+use roam_controller::params::ApfParams;
+use roam_sim::SimParams;
 use roam_world::scenario::Scenario;
 use serde::Serialize;
 
-use roam_controller::controller::{Decision, MissionStatus};
-
+pub use crate::closed_loop::setup::{EpisodeError, PositionSource, Setup};
 use crate::closed_loop::stepper::Stepper;
-use roam_controller::information::InformationField;
-use roam_controller::obstacle_field::ObstacleField;
-use roam_controller::params::{ApfParams, ParamError};
-
-/// Where the controller's position comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PositionSource {
-    /// The localization estimate and its PEB (paper 002 ES1, ES3).
-    Estimate,
-    /// The true position and the PEB there (paper 002 ES2: "nominal conditions").
-    Truth,
-}
 
 /// The waypoints one robot is to visit, in order.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RobotMission {
     pub robot: String,
     pub waypoints: Vec<[f64; 2]>,
-}
-
-/// What an episode cannot start with.
-#[derive(Debug, thiserror::Error)]
-pub enum EpisodeError {
-    #[error("the sim refused the scenario: {0}")]
-    Sim(#[from] SimError),
-    #[error("the scenario's sensing model is unusable: {0}")]
-    Model(#[from] LocalizationError),
-    #[error(transparent)]
-    Params(#[from] ParamError),
-    #[error("a mission names robot '{0}', which the scenario does not have")]
-    UnknownRobot(String),
-    #[error("robot '{0}' has two missions")]
-    DuplicateMission(String),
-    #[error(transparent)]
-    Scenario(#[from] roam_world::scenario::ScenarioError),
-    #[error("scenario {0} has no robot")]
-    NoRobot(String),
-}
-
-/// A scenario made ready for many episodes: the sim's parameters and the two fields,
-/// built once.
-#[derive(Debug, Clone)]
-pub struct Setup {
-    pub scenario: Scenario,
-    pub sim_params: SimParams,
-    pub obstacles: Arc<ObstacleField>,
-    pub information: Arc<InformationField>,
-}
-
-impl Setup {
-    /// The scenario's sim parameters without the observation (module doc), its obstacle
-    /// field, and its anchors' information field with default [`FimOptions`].
-    pub fn new(scenario: &Scenario) -> Result<Setup, EpisodeError> {
-        let mut sim_params = SimParams::from_file(&scenario.file);
-        sim_params.sensing.observation_radius_m = 0.0;
-        sim_params.check(scenario.occupancy.meta.resolution)?;
-        let anchors: Vec<[f64; 2]> = scenario.file.anchors.iter().map(|a| a.at).collect();
-        let model = RangingModel::from_spec(&anchors, &scenario.file.sensing)?;
-        Ok(Setup {
-            scenario: scenario.clone(),
-            sim_params,
-            obstacles: Arc::new(ObstacleField::new(&scenario.occupancy)),
-            information: Arc::new(InformationField::new(model, FimOptions::default())),
-        })
-    }
-
-    /// The scenario's start of robot `name`.
-    pub fn start_of(&self, name: &str) -> Option<[f64; 2]> {
-        self.scenario
-            .file
-            .robots
-            .iter()
-            .find(|r| r.name == name)
-            .map(|r| r.at)
-    }
 }
 
 /// What one robot did in an episode. The per-step vectors hold one entry per update

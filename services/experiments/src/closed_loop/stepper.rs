@@ -29,7 +29,7 @@ use roam_proto::localization::PositionEstimate;
 use roam_sim::messages::{robot_messages, RobotMessages};
 use roam_sim::{Command, Sim, SimParams};
 
-use crate::closed_loop::episode::{EpisodeError, PositionSource, Setup};
+use crate::closed_loop::setup::{EpisodeError, PositionSource, Setup};
 use roam_controller::controller::{Controller, Decision, MissionStatus};
 use roam_controller::params::ApfParams;
 

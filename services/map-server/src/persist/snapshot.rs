@@ -225,7 +225,7 @@ fn check_header_names(header: &Header, name: &str) -> Result<(), String> {
     if header.name != name {
         return Err(format!("its header names another layer, not '{name}'"));
     }
-    let source = crate::store::derived_source(name);
+    let source = crate::derived::derived_source(name);
     if header.derived_from.as_deref() != source {
         return Err(match source {
             Some(source) => format!("its header does not say it is derived from '{source}'"),

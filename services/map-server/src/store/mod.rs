@@ -38,6 +38,7 @@ pub use error::StoreError;
 pub use limits::{DerivedParams, Limits, DEFAULT_LIMITS, DEFAULT_MAX_TOTAL_CELL_BYTES};
 pub use publication::{Publication, DELTA_MAX_SHARE};
 
+pub use crate::derived::derived_source;
 use crate::derived::Derivation;
 use crate::edits::CellEdits;
 use crate::persist::{DataDir, Tombstone, MAX_TOMBSTONES};
@@ -447,15 +448,6 @@ fn remember(tombstones: &mut Vec<Tombstone>, name: &str, version: u64) {
     });
     let excess = tombstones.len().saturating_sub(MAX_TOMBSTONES);
     tombstones.drain(..excess);
-}
-
-/// The source of a derived layer.
-pub fn derived_source(name: &str) -> Option<&'static str> {
-    match name {
-        INFLATED => Some(OCCUPANCY),
-        HEURISTIC => Some(INFORMATION),
-        _ => None,
-    }
 }
 
 pub fn info(layer: &Layer) -> LayerInfo {

@@ -45,8 +45,7 @@ pub const DRIVEN_STEP_M: f64 = 0.05;
 /// tf2's topic, relative to the node's namespace as tf2_ros resolves it (`/tf` in the
 /// root namespace).
 pub const TF_TOPIC: &str = "tf";
-/// The most robots published.
-pub const MAX_ROBOTS: usize = 256;
+pub use super::poses::MAX_ROBOTS;
 /// The largest layer read: the map server's largest (16,777,216 f32 cells in base64)
 /// and its envelope.
 pub const MAX_LAYER_BYTES: usize = roam_runtime::service::DEFAULT_MAX_SAMPLE_BYTES;

@@ -5,7 +5,8 @@
 use std::collections::BTreeMap;
 use std::sync::Mutex;
 
-use super::follow::MAX_ROBOTS;
+/// The most robots published (poses, `/tf`, driven paths).
+pub const MAX_ROBOTS: usize = 256;
 
 #[derive(Debug, Default)]
 pub struct RobotPoses {

@@ -16,7 +16,7 @@ use roam_world::font::{draw_text, text_height, text_width};
 use roam_world::legend::{framed, Entry, Frame};
 use roam_world::scenario::is_blocked;
 
-use crate::closed_loop::episode::Setup;
+use crate::closed_loop::setup::Setup;
 use crate::reproduce::apf::{Es2Row, Reproduction, Trajectory};
 use roam_controller::weights::Scheme;
 

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::closed_loop::episode::Setup;
+use crate::closed_loop::setup::Setup;
 use crate::reproduce::apf::{paper, reproduce, ReproduceOptions, Reproduction};
 use roam_world::scenario::{self, Scenario};
 use roam_world::DEFAULT_MAX_CELLS;

@@ -44,7 +44,7 @@ use roam_proto::localization::PositionEstimate;
 use roam_proto::mission::WindowReport;
 use roam_proto::planner::{Plan, PlanRequest};
 
-use crate::closed_loop::episode::EpisodeError;
+use crate::closed_loop::setup::EpisodeError;
 use track::{Leg, Track};
 
 /// The steps an executive waits for its robot's first fix.

@@ -19,7 +19,7 @@ use super::robot::Robot;
 use super::variant::Variant;
 use super::world::DayWorld;
 use super::{DaysError, DaysOptions};
-use crate::closed_loop::episode::EpisodeError;
+use crate::closed_loop::setup::EpisodeError;
 use crate::reproduce::executive::track::planned_path;
 use crate::reproduce::executive::{FinishedWindow, InProcessExecutive, Io};
 

@@ -2,7 +2,7 @@
 //! controller one step at a time ([`Stepper`]), and the mapper's [`ChangeMap`] fed the
 //! robot's observation every step. Mission time is sim time.
 
-use crate::closed_loop::episode::EpisodeError;
+use crate::closed_loop::setup::EpisodeError;
 use crate::closed_loop::stepper::Stepper;
 use crate::closed_loop::PositionSource;
 use crate::reproduce::executive::Step;

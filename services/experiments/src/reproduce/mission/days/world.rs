@@ -2,7 +2,7 @@
 //! (the demo's day, [`roam_mission::tasks::DAY_SCENARIO`], or a user's map and day file,
 //! [`roam_mission::site`]) as each service sees it.
 
-use crate::closed_loop::episode::Setup;
+use crate::closed_loop::setup::Setup;
 use crate::closed_loop::stepper::Stepper;
 use crate::closed_loop::PositionSource;
 use roam_controller::params::ApfParams;
