@@ -244,6 +244,13 @@ impl Watch {
         self.resends
     }
 
+    /// The controller spoke on the current mission at wall time `wall_s`, whatever it
+    /// said: held for the PEB or driving a recovery, it is not silent, and a
+    /// "controller silent" replan would only resend a mission it is answering.
+    pub fn heard(&mut self, wall_s: f64) {
+        self.heard_at_wall_s = wall_s;
+    }
+
     /// The time passes: give up, or resend a lost mission.
     pub fn on_tick(&mut self, now_s: f64, wall_s: f64) -> Decision {
         if now_s > self.task_start_s + self.params.give_up_after_s {

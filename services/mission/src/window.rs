@@ -527,6 +527,7 @@ impl<'a> DowntimeWindow<'a> {
         if s.mission.as_deref() != Some(drive.mission.as_str()) {
             return Vec::new();
         }
+        drive.watch.heard(now.wall_s);
         let status = match s.state {
             MissionState::Completed => Status::Completed,
             MissionState::Stuck | MissionState::StepLimit => Status::Stuck,

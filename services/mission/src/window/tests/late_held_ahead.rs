@@ -238,3 +238,40 @@ fn a_robot_held_across_windows_is_driven_back_along_the_previous_track() {
         .expect("the window's outcome");
     assert_eq!(outcome.driven.first().copied(), Some(FROM));
 }
+
+#[test]
+fn a_held_robot_whose_controller_reports_is_not_called_silent() {
+    // The controller reports HaltedPeb on every update; the window waits out its
+    // patience and recovers, but never replans for a silent controller (3 s here), which
+    // would resend a mission the controller is answering, every 3 s, for as long as the
+    // robot is held.
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    let mut actions = Vec::new();
+    for k in 0..20 {
+        let t = 10.0 + 0.2 * f64::from(k);
+        actions.extend(w.handle(status(&first.id, MissionState::HaltedPeb, 2.0), at(t, t)));
+        actions.extend(w.handle(WindowEvent::Tick, at(t + 0.1, t + 0.1)));
+    }
+    // A silent-controller replan asks the planner first (a curious window): no ask, no
+    // replan.
+    assert!(
+        !actions.iter().any(|a| matches!(
+            a,
+            WindowAction::RequestPlan(_) | WindowAction::Replanned { .. }
+        )),
+        "{actions:?}"
+    );
+    // Held for 3.8 s of the 4 s patience: no recovery yet either.
+    assert!(!actions
+        .iter()
+        .any(|a| matches!(a, WindowAction::Recovering { .. })));
+    // A controller that says nothing at all is still called silent: the replan's ask.
+    let quiet = w.handle(WindowEvent::Tick, at(20.0, 20.0));
+    assert!(
+        quiet
+            .iter()
+            .any(|a| matches!(a, WindowAction::RequestPlan(_))),
+        "{quiet:?}"
+    );
+}
