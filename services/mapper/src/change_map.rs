@@ -111,6 +111,24 @@ impl<'a> From<&'a Observation> for ObservationWindow<'a> {
     }
 }
 
+impl<'a> ObservationWindow<'a> {
+    /// The window of a sim observation from the wire (`sim/observation`), or `None`
+    /// when its cells are not i8 occupancy values. (Its fit to the map is the
+    /// mapper's check; [`ChangeMap::observe`] refuses a window that does not fit.)
+    pub fn from_wire(o: &'a roam_proto::sim::LocalObservation) -> Option<Self> {
+        let roam_proto::cells::Cells::I8(cells) = &o.cells else {
+            return None;
+        };
+        Some(ObservationWindow {
+            x0: o.x0,
+            y0: o.y0,
+            width: o.meta.width,
+            height: o.meta.height,
+            cells,
+        })
+    }
+}
+
 /// What one observation did to the map.
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct Update {
@@ -517,6 +535,26 @@ mod tests {
             resolution: 1.0,
             origin: Origin::default(),
         }
+    }
+
+    #[test]
+    fn a_wire_observation_is_its_window_and_other_cells_are_none() {
+        let mut o = roam_proto::sim::LocalObservation {
+            robot: "r1".into(),
+            step: 3,
+            time_s: 1.2,
+            at: [2.5, 1.5],
+            x0: 1,
+            y0: 0,
+            meta: meta(2, 3),
+            cells: roam_proto::cells::Cells::I8(vec![0, 100, -1, 0, 0, 100]),
+        };
+        assert_eq!(
+            ObservationWindow::from_wire(&o),
+            Some(window(1, 0, 2, 3, &[0, 100, -1, 0, 0, 100]))
+        );
+        o.cells = roam_proto::cells::Cells::U8(vec![0; 6]);
+        assert_eq!(ObservationWindow::from_wire(&o), None);
     }
 
     fn window(x0: u32, y0: u32, width: u32, height: u32, cells: &[i8]) -> ObservationWindow<'_> {

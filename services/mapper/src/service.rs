@@ -295,15 +295,8 @@ fn on_observation(state: &MapperShared, key: &str, o: LocalObservation) {
     if let Err(e) = check_observation(&meta, &o) {
         return limited_warn!(state.warnings, robot, %robot, step = o.step, "ignoring an observation: {e}");
     }
-    let Cells::I8(cells) = &o.cells else {
+    let Some(window) = ObservationWindow::from_wire(&o) else {
         return;
-    };
-    let window = ObservationWindow {
-        x0: o.x0,
-        y0: o.y0,
-        width: o.meta.width,
-        height: o.meta.height,
-        cells,
     };
     let out = {
         let mut guard = state.mapping();

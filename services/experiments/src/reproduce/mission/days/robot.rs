@@ -8,7 +8,6 @@ use crate::closed_loop::PositionSource;
 use crate::reproduce::executive::Step;
 use roam_controller::params::ApfParams;
 use roam_mapper::change_map::{ChangeMap, MapParams, ObservationWindow};
-use roam_proto::cells::Cells;
 
 use super::world::DayWorld;
 use super::DaysError;
@@ -106,14 +105,7 @@ impl Robot {
             self.first_ranges = r.messages.ranges.ranges.iter().map(|a| a.range_m).collect();
         }
         if let Some(o) = &r.messages.observation {
-            if let Cells::I8(cells) = &o.cells {
-                let window = ObservationWindow {
-                    x0: o.x0,
-                    y0: o.y0,
-                    width: o.meta.width,
-                    height: o.meta.height,
-                    cells,
-                };
+            if let Some(window) = ObservationWindow::from_wire(o) {
                 self.change
                     .observe(&window, out.time_s)
                     .map_err(|e| DaysError::Mapper(e.to_string()))?;
