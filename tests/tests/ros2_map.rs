@@ -6,7 +6,7 @@
 //! naming `max_layer_cells`) and change nothing; a good map after them is still taken.
 
 use std::io::Write;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Duration;
 
 use roam_proto::cells::Cells;
@@ -35,6 +35,24 @@ impl Capture {
     fn text(&self) -> String {
         String::from_utf8_lossy(&self.0.lock().expect("log")).into_owned()
     }
+}
+
+/// The log of this test binary, captured: its global subscriber is installed once, by
+/// whichever test comes first, before any harness installs its own (which then finds
+/// one set and leaves it). Every test here calls it first, so the capture never loses
+/// the race for the global default to the harness of a test running beside it.
+fn captured_log() -> Capture {
+    static LOG: OnceLock<Capture> = OnceLock::new();
+    LOG.get_or_init(|| {
+        let log = Capture::default();
+        let writer = log.clone();
+        tracing_subscriber::fmt()
+            .with_writer(move || writer.clone())
+            .with_ansi(false)
+            .init();
+        log
+    })
+    .clone()
 }
 
 fn grid(width: u32, height: u32, data: Vec<i8>) -> OccupancyGrid {
@@ -67,12 +85,7 @@ async fn occupancy_version(client: &roam_runtime::Requester, root: &str) -> u64 
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_ros2_map_becomes_occupancy_and_bad_maps_are_refused() {
-    let log = Capture::default();
-    let writer = log.clone();
-    tracing_subscriber::fmt()
-        .with_writer(move || writer.clone())
-        .with_ansi(false)
-        .init();
+    let log = captured_log();
     let h = Harness::start().await;
     let _map_server = h.start_role(h.map_server_config()).await;
     let config = Ros2Config {
@@ -177,6 +190,7 @@ async fn a_ros2_map_becomes_occupancy_and_bad_maps_are_refused() {
 /// Zenoh as any client reads it).
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_ros2_map_of_another_size_reaches_every_service() {
+    let _log = captured_log();
     let h = Harness::start().await;
     let _map_server = h.start_role(h.map_server_config()).await;
     let _mapper = h.start_role(h.mapper_config()).await;
