@@ -363,7 +363,7 @@ async fn drive(
         .save(&picture)
         .map_err(|e| write_error(&picture, e))?;
 
-    progress("replaying today's executive's plans for comparison");
+    progress("replaying the one-plan-per-window baseline for comparison");
     let today = {
         let (outcomes, generations) = (outcomes.clone(), config.max_generations.unwrap_or(1000));
         let seed = config.seed;
@@ -372,7 +372,7 @@ async fn drive(
             one_plan_per_window(&inflated, &information, &outcomes, generations, seed)
         })
         .await
-        .map_err(|e| DemoError::Zenoh(format!("today's plans: {e}")))?
+        .map_err(|e| DemoError::Zenoh(format!("the one-plan baseline: {e}")))?
     };
     let windows: Vec<WindowReport> = outcomes.iter().map(|o| o.report.clone()).collect();
     let pebs: Vec<f64> = windows.iter().filter_map(|w| w.peb_mean_m).collect();
@@ -436,7 +436,7 @@ fn markdown(r: &DemoReport) -> String {
         r.seed,
         r.wall_s
     ));
-    out.push_str("| window | task | task starts s | arrived s | on time | budget s | share driven | information driven | planned | driven / planned | shortest path | today's plan | v_lin s/m | v_ang s/rad | mean PEB m | replans |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| window | task | task starts s | arrived s | on time | budget s | share driven | information driven | planned | driven / planned | shortest path | one-plan baseline | v_lin s/m | v_ang s/rad | mean PEB m | replans |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for w in &r.windows {
         let today = r
             .todays_plans
@@ -488,7 +488,7 @@ fn markdown(r: &DemoReport) -> String {
         "-".to_owned()
     };
     out.push_str(&format!(
-        "\nOn time at every task: **{}**. Information gathered: **{:.0}** against {:.0} on the shortest paths ({gain}) and {:.0} that today's executive would have planned ({against_today}; static map, Table I's time model, one plan per window; what it planned, of which it drove 84-89%). Mean PEB {}.\n\n",
+        "\nOn time at every task: **{}**. Information gathered: **{:.0}** against {:.0} on the shortest paths ({gain}) and {:.0} that one plan per window would have planned ({against_today}; the baseline: static map, Table I's time model, no replans; what it planned, of which a robot drove 84-89%). Mean PEB {}.\n\n",
         if r.on_time { "yes" } else { "no" },
         r.information,
         r.information_shortest_path,

@@ -417,7 +417,7 @@ fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
     }
     let markdown = std::fs::read_to_string(out.path().join("report.md")).expect("md");
     assert!(markdown.contains("| 1 | goal1 |") && markdown.contains("world.png"));
-    assert!(markdown.contains("today's plan"), "{markdown}");
+    assert!(markdown.contains("one-plan baseline"), "{markdown}");
 
     // The built-in world: 100 x 100 cells of 0.2 m from (-10, -10), 8 px per cell,
     // framed with a title, a legend and a scale bar where the layout puts them.

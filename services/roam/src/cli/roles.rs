@@ -440,7 +440,7 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
         driven_shares.join(" ")
     );
     println!(
-        "information: {:.0} (shortest paths: {:.0}; today's executive planned: {:.0})   mean PEB: {}",
+        "information: {:.0} (shortest paths: {:.0}; one plan per window planned: {:.0})   mean PEB: {}",
         report.information,
         report.information_shortest_path,
         report.information_todays_plans,
