@@ -1,16 +1,18 @@
 //! No two files of a crate import each other, directly or round a loop: each crate's
-//! files stand in floors, every import pointing down (issue 29: the planner's
-//! `world ↔ resolution`, the map server's `store ↔ persist`, the sim's
-//! `robot ↔ unicycle` and the others were cut, and this keeps them cut).
+//! files stand in floors, every import pointing down.
 //!
-//! A file's imports are the `crate::…` and `super::…` paths in its code (comments and
-//! doc comments are not code: a doc link is not an import), each resolved to the file
-//! of the longest module path it names. Test code (`#[cfg(test)]` items and the files
-//! of `#[cfg(test)] mod x;`) is left out: a test may use what it tests from anywhere;
-//! the floors are the shipped code's.
+//! Each file is parsed with `syn` (the parser Rust's own derive macros use), so what
+//! counts is code, never a comment, a doc link or a string. A file's imports are the
+//! `crate::…`, `super::…` and `self::…` paths in its items, its `use` trees (groups
+//! nested to any depth) and the tokens of its macro calls (`tracing::warn!(…
+//! crate::x::LIMIT)`), each resolved to the file of the longest module path it names.
+//! Test code (`#[cfg(test)]` items and the files of `#[cfg(test)] mod x;`) is left out:
+//! a test may use what it tests from anywhere; the floors are the shipped code's.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+
+use syn::visit::{self, Visit};
 
 /// Every crate with a `src/` in the workspace.
 fn crate_sources(root: &Path) -> Vec<PathBuf> {
@@ -56,222 +58,148 @@ fn module_path(src: &Path, file: &Path) -> Vec<String> {
     parts
 }
 
-/// The code of a file without comments (line comments, doc comments, block comments)
-/// and without string literals' contents, so neither a doc link nor a message naming a
-/// path counts as an import.
-fn code_only(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    let chars: Vec<char> = text.chars().collect();
-    let (mut i, mut block_depth, mut in_string) = (0, 0usize, false);
-    while i < chars.len() {
-        let (c, next) = (chars[i], chars.get(i + 1).copied());
-        if block_depth > 0 {
-            if c == '*' && next == Some('/') {
-                block_depth -= 1;
-                i += 2;
-            } else if c == '/' && next == Some('*') {
-                block_depth += 1;
-                i += 2;
-            } else {
-                i += 1;
-            }
-            continue;
-        }
-        if in_string {
-            if c == '\\' {
-                i += 2;
-                continue;
-            }
-            if c == '"' {
-                in_string = false;
-                out.push('"');
-            }
-            i += 1;
-            continue;
-        }
-        // A char literal of a quote ('"') opens no string.
-        if c == '\'' && next == Some('"') && chars.get(i + 2) == Some(&'\'') {
-            i += 3;
-            continue;
-        }
-        // A raw string (r"…", r#"…"#, br##"…"##) ends only at its own closing quote.
-        let after_ident = i > 0 && (chars[i - 1].is_alphanumeric() || chars[i - 1] == '_');
-        if c == 'r' && !after_ident || (c == 'b' && next == Some('r') && !after_ident) {
-            let mut j = i + if c == 'b' { 2 } else { 1 };
-            let mut hashes = 0;
-            while chars.get(j) == Some(&'#') {
-                hashes += 1;
-                j += 1;
-            }
-            if chars.get(j) == Some(&'"') {
-                let close: Vec<char> = std::iter::once('"')
-                    .chain(std::iter::repeat_n('#', hashes))
-                    .collect();
-                j += 1;
-                while j < chars.len() && !chars[j..].starts_with(&close) {
-                    j += 1;
-                }
-                out.push_str("\"\"");
-                i = j + close.len();
-                continue;
+fn is_test(attrs: &[syn::Attribute]) -> bool {
+    attrs.iter().any(|a| {
+        a.path().is_ident("cfg")
+            && a.parse_args::<syn::Ident>()
+                .is_ok_and(|ident| ident == "test")
+    })
+}
+
+/// What one file's shipped code names: module paths from the crate's root, and the
+/// modules it declares test-only in files of their own.
+struct Named<'m> {
+    module: &'m [String],
+    paths: Vec<Vec<String>>,
+    test_modules: Vec<String>,
+}
+
+impl Named<'_> {
+    /// `segments` as a path from the crate's root, when it starts at `crate`, `super`
+    /// or `self` (any other path is another crate's or a local name).
+    fn push(&mut self, segments: &[String]) {
+        let mut base = match segments.first().map(String::as_str) {
+            Some("crate") => Vec::new(),
+            Some("super" | "self") => self.module.to_vec(),
+            _ => return,
+        };
+        let mut rest = &segments[1..];
+        if segments[0] == "super" {
+            base.pop();
+            while rest.first().is_some_and(|s| s == "super") {
+                base.pop();
+                rest = &rest[1..];
             }
         }
-        match (c, next) {
-            ('/', Some('/')) => {
-                while i < chars.len() && chars[i] != '\n' {
-                    i += 1;
+        base.extend(rest.iter().cloned());
+        self.paths.push(base);
+    }
+
+    fn use_tree(&mut self, tree: &syn::UseTree, prefix: &mut Vec<String>) {
+        match tree {
+            syn::UseTree::Path(p) => {
+                prefix.push(p.ident.to_string());
+                self.use_tree(&p.tree, prefix);
+                prefix.pop();
+            }
+            syn::UseTree::Name(n) => self.push_with(prefix, &n.ident),
+            syn::UseTree::Rename(r) => self.push_with(prefix, &r.ident),
+            syn::UseTree::Glob(_) => self.push(&prefix.clone()),
+            syn::UseTree::Group(g) => {
+                for item in &g.items {
+                    self.use_tree(item, prefix);
                 }
             }
-            ('/', Some('*')) => {
-                block_depth = 1;
-                i += 2;
+        }
+    }
+
+    fn push_with(&mut self, prefix: &[String], last: &syn::Ident) {
+        let mut path = prefix.to_vec();
+        path.push(last.to_string());
+        self.push(&path);
+    }
+
+    /// Paths in a macro call's tokens: `crate`, `super` or `self`, then `:: ident`…
+    fn macro_tokens(&mut self, tokens: proc_macro2::TokenStream) {
+        let flat = flatten(tokens);
+        for (i, tree) in flat.iter().enumerate() {
+            let proc_macro2::TokenTree::Ident(start) = tree else {
+                continue;
+            };
+            if !["crate", "super", "self"].contains(&start.to_string().as_str()) {
+                continue;
             }
-            ('"', _) => {
-                in_string = true;
-                out.push('"');
-                i += 1;
+            let mut path = vec![start.to_string()];
+            let mut k = i + 1;
+            while let (
+                Some(proc_macro2::TokenTree::Punct(a)),
+                Some(proc_macro2::TokenTree::Punct(b)),
+                Some(proc_macro2::TokenTree::Ident(next)),
+            ) = (flat.get(k), flat.get(k + 1), flat.get(k + 2))
+            {
+                if a.as_char() != ':' || b.as_char() != ':' {
+                    break;
+                }
+                path.push(next.to_string());
+                k += 3;
             }
-            _ => {
-                out.push(c);
-                i += 1;
+            if path.len() > 1 {
+                self.push(&path);
             }
+        }
+    }
+}
+
+/// A token stream with its groups opened, in order.
+fn flatten(tokens: proc_macro2::TokenStream) -> Vec<proc_macro2::TokenTree> {
+    let mut out = Vec::new();
+    for tree in tokens {
+        match tree {
+            proc_macro2::TokenTree::Group(g) => out.extend(flatten(g.stream())),
+            other => out.push(other),
         }
     }
     out
 }
 
-/// `code` without its `#[cfg(test)]` items (an inline module or function, to its
-/// closing brace), and the names of the modules it declares test-only in files of their
-/// own (`#[cfg(test)] mod tests;`).
-fn without_tests(code: &str) -> (String, Vec<String>) {
-    const MARK: &str = "#[cfg(test)]";
-    let (mut out, mut test_files, mut rest) = (String::new(), Vec::new(), code);
-    while let Some(at) = rest.find(MARK) {
-        out.push_str(&rest[..at]);
-        let after = &rest[at + MARK.len()..];
-        let (brace, semi) = (after.find('{'), after.find(';'));
-        match (brace, semi) {
-            (_, Some(semi)) if brace.is_none_or(|b| semi < b) => {
-                let item = after[..semi].trim();
-                if let Some(name) = item.strip_prefix("mod ").or(item.strip_prefix("pub mod ")) {
-                    test_files.push(name.trim().to_owned());
-                }
-                rest = &after[semi + 1..];
+impl<'ast> Visit<'ast> for Named<'_> {
+    fn visit_item_mod(&mut self, m: &'ast syn::ItemMod) {
+        if is_test(&m.attrs) {
+            if m.content.is_none() {
+                self.test_modules.push(m.ident.to_string());
             }
-            (Some(open), _) => {
-                let mut depth = 0usize;
-                let mut end = after.len();
-                for (k, ch) in after[open..].char_indices() {
-                    match ch {
-                        '{' => depth += 1,
-                        '}' => {
-                            depth -= 1;
-                            if depth == 0 {
-                                end = open + k + 1;
-                                break;
-                            }
-                        }
-                        _ => {}
-                    }
-                }
-                rest = &after[end..];
-            }
-            _ => rest = "",
+            return;
+        }
+        visit::visit_item_mod(self, m);
+    }
+
+    fn visit_item_fn(&mut self, f: &'ast syn::ItemFn) {
+        if !is_test(&f.attrs) {
+            visit::visit_item_fn(self, f);
         }
     }
-    out.push_str(rest);
-    (out, test_files)
-}
 
-/// The module paths a file's code names: `crate::a::b::C` → `[a, b, C]`,
-/// `super::x` from module `[p, q]` → `[p, x]`, and `use crate::{a::X, b}` → both.
-fn named_paths(code: &str, module: &[String]) -> Vec<Vec<String>> {
-    let mut paths = Vec::new();
-    let bytes: Vec<char> = code.chars().collect();
-    let is_ident = |c: char| c.is_alphanumeric() || c == '_';
-    let mut i = 0;
-    while i < bytes.len() {
-        let starts_word = i == 0 || !is_ident(bytes[i - 1]);
-        let rest: String = bytes[i..bytes.len().min(i + 7)].iter().collect();
-        let (prefix, base): (usize, Vec<String>) = if starts_word && rest.starts_with("crate::") {
-            (7, Vec::new())
-        } else if starts_word && rest.starts_with("super::") {
-            // In `a/b.rs` and in `a/b/mod.rs` (both module [a, b]) super is [a], and
-            // each further `super::` one level up. (In an inline `mod tests`, super is
-            // the file's own module: read as its parent, at worst an edge to a file
-            // the module sits in, which imports it anyway.)
-            let mut parent = module.to_vec();
-            parent.pop();
-            let mut skip = 7;
-            while bytes[i + skip..].starts_with(&['s', 'u', 'p', 'e', 'r', ':', ':']) {
-                parent.pop();
-                skip += 7;
-            }
-            (skip, parent)
-        } else {
-            i += 1;
-            continue;
-        };
-        i += prefix;
-        for tail in path_tails(&bytes, &mut i) {
-            let mut full = base.clone();
-            full.extend(tail);
-            paths.push(full);
+    fn visit_item_impl(&mut self, i: &'ast syn::ItemImpl) {
+        if !is_test(&i.attrs) {
+            visit::visit_item_impl(self, i);
         }
     }
-    paths
-}
 
-/// Reads `a::b::C`, or `a::{b::C, d}` (one level of braces, nested ones flattened),
-/// from `chars[*i..]`, advancing `*i`.
-fn path_tails(chars: &[char], i: &mut usize) -> Vec<Vec<String>> {
-    let is_ident = |c: char| c.is_alphanumeric() || c == '_';
-    let mut head = Vec::new();
-    loop {
-        let start = *i;
-        while *i < chars.len() && is_ident(chars[*i]) {
-            *i += 1;
+    fn visit_item_use(&mut self, u: &'ast syn::ItemUse) {
+        if !is_test(&u.attrs) {
+            self.use_tree(&u.tree, &mut Vec::new());
         }
-        if *i > start {
-            head.push(chars[start..*i].iter().collect::<String>());
-        }
-        if chars.get(*i) == Some(&':') && chars.get(*i + 1) == Some(&':') {
-            *i += 2;
-            if chars.get(*i) == Some(&'{') {
-                // A group: each comma-separated item is a tail of `head`.
-                let mut depth = 0;
-                let start = *i;
-                while *i < chars.len() {
-                    match chars[*i] {
-                        '{' => depth += 1,
-                        '}' => {
-                            depth -= 1;
-                            if depth == 0 {
-                                *i += 1;
-                                break;
-                            }
-                        }
-                        _ => {}
-                    }
-                    *i += 1;
-                }
-                let inner: String = chars[start + 1..(*i).saturating_sub(1)].iter().collect();
-                return inner
-                    .split([',', '{', '}'])
-                    .map(|item| {
-                        let mut path = head.clone();
-                        path.extend(
-                            item.split("::")
-                                .map(|s| s.trim().to_owned())
-                                .filter(|s| !s.is_empty() && s.chars().all(is_ident)),
-                        );
-                        path
-                    })
-                    .collect();
-            }
-            continue;
-        }
-        return vec![head];
+    }
+
+    fn visit_path(&mut self, p: &'ast syn::Path) {
+        let segments: Vec<String> = p.segments.iter().map(|s| s.ident.to_string()).collect();
+        self.push(&segments);
+        visit::visit_path(self, p);
+    }
+
+    fn visit_macro(&mut self, m: &'ast syn::Macro) {
+        self.macro_tokens(m.tokens.clone());
+        visit::visit_macro(self, m);
     }
 }
 
@@ -283,37 +211,39 @@ fn import_graph(src: &Path) -> BTreeMap<PathBuf, BTreeSet<PathBuf>> {
         .iter()
         .map(|f| (module_path(src, f), f.clone()))
         .collect();
-    let mut code = BTreeMap::new();
+    let mut named = BTreeMap::new();
     let mut test_only = BTreeSet::new();
     for file in &files {
         let text = std::fs::read_to_string(file).expect("a source file");
+        let parsed = syn::parse_file(&text).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
         let module = module_path(src, file);
-        let (shipped, test_files) = without_tests(&code_only(&text));
-        for name in test_files {
+        let mut visitor = Named {
+            module: &module,
+            paths: Vec::new(),
+            test_modules: Vec::new(),
+        };
+        visitor.visit_file(&parsed);
+        for name in visitor.test_modules {
             let mut test_module = module.clone();
             test_module.push(name);
             if let Some(f) = modules.get(&test_module) {
                 test_only.insert(f.clone());
             }
         }
-        code.insert(file.clone(), (module, shipped));
+        named.insert(file.clone(), visitor.paths);
     }
     let mut graph = BTreeMap::new();
-    for (file, (module, shipped)) in &code {
-        if test_only.contains(file) {
+    for (file, paths) in named {
+        if test_only.contains(&file) {
             continue;
         }
-        let mut imports = BTreeSet::new();
-        for path in named_paths(shipped, module) {
-            // The longest prefix that is a file's module.
-            let target = (1..=path.len()).rev().find_map(|n| modules.get(&path[..n]));
-            if let Some(target) = target {
-                if target != file && !test_only.contains(target) {
-                    imports.insert(target.clone());
-                }
-            }
-        }
-        graph.insert(file.clone(), imports);
+        let imports: BTreeSet<PathBuf> = paths
+            .iter()
+            .filter_map(|path| (1..=path.len()).rev().find_map(|n| modules.get(&path[..n])))
+            .filter(|target| **target != file && !test_only.contains(*target))
+            .cloned()
+            .collect();
+        graph.insert(file, imports);
     }
     graph
 }
@@ -393,12 +323,15 @@ fn no_crate_has_files_that_import_each_other() {
 }
 
 #[test]
-fn the_check_sees_a_circle_and_ignores_comments_and_strings() {
-    let dir = std::env::temp_dir().join(format!("roam-import-circles-{}", std::process::id()));
-    let src = dir.join("src");
-    std::fs::create_dir_all(src.join("store")).expect("a temporary crate");
+fn the_check_sees_a_circle_and_ignores_comments_strings_and_tests() {
+    let dir = tempfile::tempdir().expect("a temporary crate");
+    let src = dir.path().join("src");
+    std::fs::create_dir_all(src.join("store")).expect("src/store");
     let write = |path: &str, text: &str| std::fs::write(src.join(path), text).expect("write");
-    write("lib.rs", "pub mod edits;\npub mod store;\npub mod quiet;\n");
+    write(
+        "lib.rs",
+        "pub mod edits;\npub mod store;\npub mod quiet;\npub mod loud;\n",
+    );
     write(
         "store/mod.rs",
         "use crate::edits::CellEdits;\npub mod stage;\n",
@@ -408,15 +341,20 @@ fn the_check_sees_a_circle_and_ignores_comments_and_strings() {
         "use super::super::quiet as _;\nconst J: &str = r#\"a \"crate::store\" b\"#;\n",
     );
     write("edits.rs", "fn f() { let _ = crate::store::OCCUPANCY; }\n");
-    // Names the store only in a doc link, a comment and a string: no import.
+    // Names the store only in a doc link, a comment, a string and test code: no import.
     write(
         "quiet.rs",
         "//! See [`crate::store`].\n/* crate::store */\nconst S: &str = \"crate::store\";\n\
          #[cfg(test)]\nmod tests {\n    use crate::store::stage;\n}\n",
     );
+    // A nested use group and a path inside a macro call.
+    write(
+        "loud.rs",
+        "use crate::{quiet as _, store::{stage::{self as _}}};\n\
+         fn f() { println!(\"{}\", crate::edits::X); }\n",
+    );
     let graph = import_graph(&src);
     let found = circles(&graph);
-    let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(found.len(), 1, "{found:?}");
     let names: BTreeSet<String> = found[0]
         .iter()
@@ -441,5 +379,8 @@ fn the_check_sees_a_circle_and_ignores_comments_and_strings() {
     );
     // `super::super::quiet` from store/stage.rs is quiet.rs; the raw string is no path.
     let stage = graph.get(&src.join("store/stage.rs"));
-    assert_eq!(stage, Some(&BTreeSet::from([quiet])), "{graph:?}");
+    assert_eq!(stage, Some(&BTreeSet::from([quiet.clone()])), "{graph:?}");
+    let loud = graph.get(&src.join("loud.rs"));
+    let expected = BTreeSet::from([quiet, src.join("store/stage.rs"), src.join("edits.rs")]);
+    assert_eq!(loud, Some(&expected), "{graph:?}");
 }
