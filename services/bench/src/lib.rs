@@ -10,9 +10,9 @@
 //! - [`load`]: a burst of concurrent plan requests against two planners;
 //! - [`sim`]: many robots publishing their sensors at a fixed rate;
 //! - [`mapper`]: change-map observation updates per second;
-//! - [`scaling`]: the planner's cost as the map gets finer, and its memory (issue 16);
-//! - [`peer`]: the greedy planner against Model I at equal wall time (issue 16);
-//! - [`fleet`]: robots in closed loop through Zenoh (issue 16).
+//! - [`scaling`]: the planner's cost as the map gets finer, and its memory;
+//! - [`peer`]: the greedy planner against Model I at equal wall time;
+//! - [`fleet`]: robots in closed loop through Zenoh.
 
 pub mod fleet;
 pub mod load;

@@ -2,7 +2,7 @@
 //! thread count change a figure.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Mutex, PoisonError};
+use std::sync::Mutex;
 
 /// Runs `job` on every element of `jobs` over up to `threads` scoped threads and returns
 /// the results in the order of `jobs`, whatever order they finished in: anything summed
@@ -30,11 +30,7 @@ pub fn run_in_order<J: Sync, R: Send>(
                 };
                 let result = job(j);
                 let stopping = stop(&result);
-                if let Some(slot) = slots
-                    .lock()
-                    .unwrap_or_else(PoisonError::into_inner)
-                    .get_mut(i)
-                {
+                if let Some(slot) = roam_world::lock::lock(&slots).get_mut(i) {
                     *slot = Some(result);
                 }
                 progress(done.fetch_add(1, Ordering::Relaxed) + 1, j);

@@ -272,8 +272,8 @@ mod tests {
 
     #[test]
     fn a_figure_of_the_right_sign_far_outside_the_range_does_not_hold() {
-        // Issue 29: ES2's −44.6% against the paper's −4.4%, Model I's +102% against
-        // Table II's +10.29..+33.61%.
+        // Right sign, far off: ES2's −44.6% against the paper's −4.4%, Model I's +102%
+        // against Table II's +10.29..+33.61%.
         assert_eq!(
             PaperFigure::about(-4.4).judge(&[-44.6], 1),
             Verdict::DoesNotHold
@@ -294,7 +294,7 @@ mod tests {
 
     #[test]
     fn an_always_positive_figure_is_judged_by_its_ratio() {
-        // An RMSE of 0.21 m: ten times it (issue 29's 14 m is 67 times) does not hold,
+        // An RMSE of 0.21 m: ten times it does not hold,
         // and neither does a tenth; a third more is near, 0.226 m holds.
         let rmse = PaperFigure::about(0.21);
         assert_eq!(rmse.judge(&[2.1], 1), Verdict::DoesNotHold);

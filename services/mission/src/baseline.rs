@@ -8,8 +8,8 @@
 //! goal, no via-point seeds), and never replans. This replays exactly that plan in
 //! process ([`roam_planner::plan::plan`], seeded as the executive's) for each window of
 //! the run. What it reports is the information that plan *promised*; a robot driving it
-//! drove 84–89% of it (measured when it was roam's executive), so the comparison is in
-//! the baseline's favour.
+//! drives 84–89% of it (measured in the demo's windows), so the comparison is in the
+//! baseline's favour.
 
 use std::sync::atomic::AtomicBool;
 

@@ -13,7 +13,8 @@
 //! - [`publish`]: put with the congestion control named at each call, failures logged;
 //! - [`subscribe`]: a subscriber that keeps the newest samples (a ring, never blocking
 //!   the session);
-//! - [`lock`]: shared state under a mutex, usable after a panicked holder;
+//! - [`lock`]: shared state under a mutex, usable after a panicked holder (from
+//!   `roam-world`, so network-free code locks the same way);
 //! - [`liveliness`]: waiting until a service's token is seen;
 //! - [`world_check`]: a service's check that its world is the map server's;
 //! - [`zenoh_threads`]: Zenoh's process-wide thread pools, sized for many sessions.
@@ -21,7 +22,6 @@
 pub mod client;
 pub mod config_file;
 pub mod liveliness;
-pub mod lock;
 pub mod publish;
 pub mod reply;
 pub mod routing;
@@ -36,8 +36,8 @@ pub mod zenoh_threads;
 
 pub use client::{ClientError, Requester};
 pub use liveliness::{wait_for_liveliness, LivelinessWait};
-pub use lock::lock;
 pub use publish::{publish, publish_bytes, publish_wait, Delivery};
+pub use roam_world::lock::lock;
 pub use service::{PayloadBudget, Service, ServiceError};
 pub use session::{SessionArgs, SessionError};
 pub use subscribe::{subscribe_latest, FleetStreams, LatestSamples};

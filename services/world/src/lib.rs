@@ -13,6 +13,7 @@
 //! - [`observation`]: what a robot sees of the grid (the sim's output, the mapper's input).
 //! - [`world_id`]: which world a map is (one stack runs one world); [`epoch`]: message
 //!   times checked against the sim clock, resets as new epochs.
+//! - [`lock`]: a mutex's state even after a holder panicked.
 //! - [`seed`]: the seeded random streams behind every random choice; [`noise`]: the
 //!   Gaussian sampler and paper 002's TOA and transition noise drawn from them.
 
@@ -23,6 +24,7 @@ pub mod grid;
 pub mod layers;
 pub mod legend;
 pub mod load_dirs;
+pub mod lock;
 pub mod noise;
 pub mod observation;
 pub mod render;

@@ -1,4 +1,4 @@
-//! Locking shared service state.
+//! Locking shared state: a service's, or the slots of runs spread over threads.
 
 use std::sync::{Mutex, MutexGuard};
 
