@@ -1,7 +1,7 @@
 //! A robot the controller's PEB guard holds (paper 002's uncertainty, roam's guard): the
 //! window counts the hold and, after `hold_patience_s`, drives the robot back along its
 //! own track past its last fix with a recovery mission (which the guard lets through),
-//! then goes straight to the task from there ([`super::DowntimeWindow::on_status`]).
+//! then goes straight to the task from there (`heard.rs`).
 
 use super::{straight, DowntimeWindow, Now, Phase, WindowAction};
 use crate::path::mission_waypoints;

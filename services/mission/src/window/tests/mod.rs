@@ -5,6 +5,7 @@ use super::*;
 use crate::calibration::path_measure;
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
+use roam_proto::controller::{ControllerStatus, MissionState};
 use roam_proto::map::{GridMeta, Origin};
 use roam_proto::mission::WindowReport;
 use roam_proto::planner::{FitnessTerms, MapVersion, Plan, PlannerModel, ShortestPath, StopReason};
