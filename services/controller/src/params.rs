@@ -156,22 +156,8 @@ impl Default for ApfParams {
     }
 }
 
-/// A parameter outside its allowed range.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("parameter {name} = {value} is out of range: use {range}")]
-pub struct ParamError {
-    pub name: &'static str,
-    pub value: f64,
-    pub range: &'static str,
-}
-
-fn check(name: &'static str, value: f64, ok: bool, range: &'static str) -> Result<(), ParamError> {
-    if ok && value.is_finite() {
-        Ok(())
-    } else {
-        Err(ParamError { name, value, range })
-    }
-}
+use roam_world::param::check_param as check;
+pub use roam_world::param::ParamError;
 
 impl ApfParams {
     /// Parameters for buildings like the built-in world. Paper 002's η_thres = 3 m and
@@ -410,7 +396,7 @@ mod tests {
         .map(|e| e.to_string());
         assert_eq!(
             e.as_deref(),
-            Some("parameter cutoff_keep = 2 is out of range: use 0 to 1")
+            Some("parameter cutoff_keep = 2 is out of range; use 0 to 1")
         );
     }
 

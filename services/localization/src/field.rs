@@ -220,6 +220,7 @@ struct Kernel {
     k2: f64,
     k_is_2: bool,
     derivative: bool,
+    fix_anchors: usize,
 }
 
 impl Kernel {
@@ -234,6 +235,7 @@ impl Kernel {
             k2: n.k * n.k,
             k_is_2: n.k == 2.0,
             derivative: options.variance_derivative,
+            fix_anchors: model.fix_anchors(),
         }
     }
 
@@ -267,6 +269,6 @@ impl Kernel {
             c += s * dy * dy;
             used += 1;
         }
-        bound_from_fim(Matrix2::new(a, b, b, c), used, options)
+        bound_from_fim(Matrix2::new(a, b, b, c), used, self.fix_anchors, options)
     }
 }

@@ -20,14 +20,16 @@ use crate::model::{RangingModel, MIN_DISTANCE_M};
 /// The default reciprocal condition number below which a FIM counts as singular.
 pub const DEFAULT_MIN_RCOND: f64 = 1e-9;
 
-/// The fewest anchors in range the estimator fixes a position from (WLS, `crate::wls`):
-/// two range circles meet in two points, so two anchors leave the position ambiguous.
-/// The bound follows the estimator (issue 18: one rule): with fewer anchors the PEB is
-/// +∞ and the bound degraded, although the FIM of two non-collinear anchors is
-/// invertible. Paper 002 §2.2 does not say; with its bound finite on two-anchor ground,
-/// the IS field, the `peb` layer and the planner's W_loc cost called localizable a
-/// place where the robot had no fix, and the controller's guard held it there.
-pub const MIN_FIX_ANCHORS: usize = 3;
+/// The fewest anchors in range the estimator fixes a position from, unless the scenario
+/// says otherwise (`sensing.fix_anchors`, [`RangingModel::fix_anchors`]): two range
+/// circles meet in two points, so two anchors leave the position ambiguous without a
+/// prior. The bound follows the estimator (one rule): with fewer anchors than the model's
+/// minimum the PEB is +∞ and the bound degraded, although the FIM of two non-collinear
+/// anchors is invertible. Paper 002 §2.2 does not say; with the bound finite where the
+/// estimator has no fix, the IS field, the `peb` layer and the planner's W_loc cost
+/// would call localizable a place where the robot had no fix, and the controller's
+/// guard would hold it there.
+pub const MIN_FIX_ANCHORS: usize = roam_world::scenario::DEFAULT_FIX_ANCHORS;
 
 /// How the FIM is formed and when it counts as singular.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -117,9 +119,15 @@ pub fn fim_from(
 }
 
 /// The CRB and PEB of a FIM (paper 002 §2.2: CRB = F⁻¹, PEB = √tr(F⁻¹)), degraded when
-/// fewer than [`MIN_FIX_ANCHORS`] anchors contributed, when F is singular or ill-conditioned (λ_min/λ_max ≤ `min_rcond`, computed in closed form
+/// fewer than `fix_anchors` anchors contributed ([`RangingModel::fix_anchors`]), when F
+/// is singular or ill-conditioned (λ_min/λ_max ≤ `min_rcond`, computed in closed form
 /// for the symmetric 2 × 2 matrix) or anything is not finite.
-pub fn bound_from_fim(f: Matrix2<f64>, anchors_used: usize, options: &FimOptions) -> Bound {
+pub fn bound_from_fim(
+    f: Matrix2<f64>,
+    anchors_used: usize,
+    fix_anchors: usize,
+    options: &FimOptions,
+) -> Bound {
     let degraded = Bound {
         fim: f,
         crb: Matrix2::new(f64::INFINITY, 0.0, 0.0, f64::INFINITY),
@@ -127,7 +135,7 @@ pub fn bound_from_fim(f: Matrix2<f64>, anchors_used: usize, options: &FimOptions
         anchors_used,
         degraded: true,
     };
-    if anchors_used < MIN_FIX_ANCHORS {
+    if anchors_used < fix_anchors {
         return degraded;
     }
     let (a, b, c) = (f[(0, 0)], 0.5 * (f[(0, 1)] + f[(1, 0)]), f[(1, 1)]);
@@ -159,5 +167,5 @@ pub fn bound_from_fim(f: Matrix2<f64>, anchors_used: usize, options: &FimOptions
 /// §2.2). Never panics, never NaN: a singular FIM gives PEB = +∞ and `degraded`.
 pub fn bound(model: &RangingModel, p: [f64; 2], options: &FimOptions) -> Bound {
     let (f, used) = fim(model, p, options);
-    bound_from_fim(f, used, options)
+    bound_from_fim(f, used, model.fix_anchors(), options)
 }

@@ -8,7 +8,7 @@
 
 use nalgebra::Vector2;
 use roam_world::noise::ToaNoise;
-use roam_world::scenario::SensingSpec;
+use roam_world::scenario::{SensingSpec, FEWEST_FIX_ANCHORS, MOST_FIX_ANCHORS};
 
 use crate::error::LocalizationError;
 
@@ -26,6 +26,7 @@ pub struct RangingModel {
     anchors: Vec<Vector2<f64>>,
     sensing_range_m: f64,
     noise: ToaNoise,
+    fix_anchors: usize,
 }
 
 impl RangingModel {
@@ -73,6 +74,7 @@ impl RangingModel {
             anchors: anchors.iter().map(|a| Vector2::new(a[0], a[1])).collect(),
             sensing_range_m,
             noise,
+            fix_anchors: crate::fim::MIN_FIX_ANCHORS,
         })
     }
 
@@ -81,7 +83,31 @@ impl RangingModel {
         anchors: &[[f64; 2]],
         spec: &SensingSpec,
     ) -> Result<RangingModel, LocalizationError> {
-        RangingModel::new(anchors, spec.range_m, ToaNoise::from_spec(spec))
+        RangingModel::new(anchors, spec.range_m, ToaNoise::from_spec(spec))?
+            .with_fix_anchors(spec.fix_anchors)
+    }
+
+    /// The same model fixing positions from `fix_anchors` anchors in range (at least
+    /// [`FEWEST_FIX_ANCHORS`], at most [`MOST_FIX_ANCHORS`]): `sensing.fix_anchors`.
+    pub fn with_fix_anchors(
+        mut self,
+        fix_anchors: usize,
+    ) -> Result<RangingModel, LocalizationError> {
+        if !(FEWEST_FIX_ANCHORS..=MOST_FIX_ANCHORS).contains(&fix_anchors) {
+            return Err(LocalizationError::BadParameter {
+                name: "fix_anchors",
+                value: fix_anchors as f64,
+                expected: "2 to 8 anchors",
+            });
+        }
+        self.fix_anchors = fix_anchors;
+        Ok(self)
+    }
+
+    /// The fewest anchors in range a position is fixed from (3 unless the scenario's
+    /// `sensing.fix_anchors` says 2: see [`crate::wls`] for how two anchors fix).
+    pub fn fix_anchors(&self) -> usize {
+        self.fix_anchors
     }
 
     /// The anchor positions.

@@ -16,15 +16,30 @@
 //! long, a bias), and at convergence the normal matrix is the FIM without the
 //! variance-derivative term, so the estimate attains the CRB at high SNR. The closed-form
 //! start, having no iterate, is unweighted.
+//!
+//! **Two anchors, or anchors in one line** (a site's `sensing.fix_anchors: 2`; the default
+//! is 3 and the papers' worlds keep it): the ranges fix the position up to its mirror
+//! image in the anchors' line. With a prior (the robot's last fix) Gauss–Newton started
+//! there settles on the nearer of the two, and the estimate is a fix when the mirror
+//! image is clearly farther from the prior: at least [`MIRROR_MARGIN`] times as far.
+//! Near the line the two points merge, the margin fails and the estimate is degraded
+//! (the FIM, nearly singular there, would give a large PEB anyway). Without a prior
+//! nothing tells the two apart: degraded.
 
 use nalgebra::{Matrix2, Vector2};
 
 use crate::error::LocalizationError;
-use crate::fim::{bound_from_fim, fim_from, FimOptions, MIN_FIX_ANCHORS};
+use crate::fim::{bound_from_fim, fim_from, FimOptions};
 use crate::model::{RangingModel, MIN_DISTANCE_M};
 
 /// The most ranges one estimate takes.
 pub const MAX_RANGES: usize = 4096;
+
+/// A fix from anchors in one line (module doc) holds when the mirror image of the
+/// solution in that line is at least this many times as far from the prior as the
+/// solution: with the prior e metres off, the robot at h metres from the line, about
+/// e < 2h/3.
+pub const MIRROR_MARGIN: f64 = 2.0;
 
 /// One measured range d̂ to an anchor of the model (paper 002 §2.1).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -72,8 +87,13 @@ pub enum Degraded {
     /// Fewer than three distinct anchors gave a usable range (a 2-D fix from fewer is
     /// ambiguous: two circles meet in two points).
     TooFewAnchors { usable: usize },
-    /// The usable anchors lie on one line (the fix is ambiguous by reflection in it).
+    /// The usable anchors lie on one line (the fix is ambiguous by reflection in it), and
+    /// the model wants three anchors or there is no prior to tell the two points apart.
     CollinearAnchors,
+    /// Two anchors (or anchors in one line) and a prior, but the solution's mirror image
+    /// is not clearly farther from the prior ([`MIRROR_MARGIN`]): the robot is near the
+    /// anchors' line, or its prior is old.
+    Ambiguous,
     /// Gauss–Newton did not settle within the iteration limit, or left finite numbers.
     NotConverged,
     /// The normal matrix or the FIM at the estimate is singular or ill-conditioned.
@@ -173,16 +193,23 @@ pub fn estimate(
         }
     };
 
-    if used.len() < MIN_FIX_ANCHORS {
+    if used.len() < model.fix_anchors() {
         return Ok(fail(
             Degraded::TooFewAnchors { usable: used.len() },
             0,
             used,
         ));
     }
-    if spread(usable.iter().map(|u| u.0)) <= options.min_anchor_spread {
-        return Ok(fail(Degraded::CollinearAnchors, 0, used));
-    }
+    // Anchors in one line: a fix only from a prior, checked against the mirror image.
+    let in_line = spread(usable.iter().map(|u| u.0)) <= options.min_anchor_spread;
+    let mirror_line = match (in_line, prior) {
+        (false, _) => None,
+        (true, Some(_)) if model.fix_anchors() <= 2 => match line_of(&usable) {
+            Some(line) => Some(line),
+            None => return Ok(fail(Degraded::CollinearAnchors, 0, used)),
+        },
+        (true, _) => return Ok(fail(Degraded::CollinearAnchors, 0, used)),
+    };
     let start = match prior {
         Some(p) => Vector2::new(p[0], p[1]),
         None => match linearised_start(&usable) {
@@ -195,8 +222,16 @@ pub fn estimate(
         Ok(done) => done,
         Err((reason, iterations)) => return Ok(fail(reason, iterations, used)),
     };
+    if let (Some((point, direction)), Some(p)) = (mirror_line, prior) {
+        let p = Vector2::new(p[0], p[1]);
+        let offset = x - point;
+        let mirror = point + direction * (2.0 * offset.dot(&direction)) - offset;
+        if (mirror - p).norm() < MIRROR_MARGIN * (x - p).norm() {
+            return Ok(fail(Degraded::Ambiguous, iterations, used));
+        }
+    }
     let (f, n) = fim_from(model, usable.iter().map(|u| u.0), x, &options.fim);
-    let b = bound_from_fim(f, n, &options.fim);
+    let b = bound_from_fim(f, n, model.fix_anchors(), &options.fim);
     if b.degraded {
         return Ok(fail(Degraded::SingularFim, iterations, used));
     }
@@ -308,6 +343,27 @@ fn linearised_start(usable: &[(Vector2<f64>, f64)]) -> Option<Vector2<f64>> {
     let q = Matrix2::new(d, -b, -b, a) * rhs / det;
     let p = q + c;
     (p[0].is_finite() && p[1].is_finite()).then_some(p)
+}
+
+/// The best-fit line of the anchors: a point on it (their centroid) and its unit
+/// direction (the scatter's principal axis); `None` when they are all one point.
+fn line_of(usable: &[(Vector2<f64>, f64)]) -> Option<(Vector2<f64>, Vector2<f64>)> {
+    let c = centroid(usable.iter().map(|u| u.0))?;
+    let c = Vector2::new(c[0], c[1]);
+    let s: Matrix2<f64> = usable.iter().fold(Matrix2::zeros(), |s, &(a, _)| {
+        let q = a - c;
+        s + q * q.transpose()
+    });
+    let (a, b, d) = (s[(0, 0)], s[(0, 1)], s[(1, 1)]);
+    let lambda_max = 0.5 * (a + d) + (0.5 * (a - d)).hypot(b);
+    // An eigenvector of the largest eigenvalue: (b, λ − a) or (λ − d, b), the longer.
+    let (u, v) = (
+        Vector2::new(b, lambda_max - a),
+        Vector2::new(lambda_max - d, b),
+    );
+    let direction = if u.norm() >= v.norm() { u } else { v };
+    let norm = direction.norm();
+    (norm.is_finite() && norm > 0.0).then(|| (c, direction / norm))
 }
 
 /// The mean of the points, or `None` for none.

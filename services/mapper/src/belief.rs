@@ -26,7 +26,7 @@
 use roam_world::grid::Grid;
 use serde::{Deserialize, Serialize};
 
-use crate::change_map::ChangeMap;
+use crate::change_map::{percent, ChangeMap};
 use crate::error::MapperError;
 use crate::poisson::{CellProcess, CellState};
 use crate::prior::RatePrior;
@@ -153,14 +153,12 @@ pub fn occupied_now(
     })
 }
 
-/// Probabilities as ROS occupancy: round(100 · p), p clamped to 0..=1 (NaN as 1/2).
+/// Probabilities as ROS occupancy: [`percent`] of each, NaN as 1/2 (50, as unsure as a
+/// cell can be).
 pub fn ros_occupancy(probabilities: &[f64]) -> Vec<i8> {
     probabilities
         .iter()
-        .map(|&p| {
-            let p = if p.is_nan() { 0.5 } else { p.clamp(0.0, 1.0) };
-            (p * 100.0).round() as i8
-        })
+        .map(|&p| percent(if p.is_nan() { 0.5 } else { p }) as i8)
         .collect()
 }
 

@@ -128,22 +128,8 @@ pub const MAX_GENERATIONS: u32 = 100_000;
 /// The widest perception diameter, in cells.
 pub const MAX_PERCEPTION_DIAMETER: u32 = 15;
 
-/// A parameter outside its range.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("parameter {name} = {} is out of range; use {range}", roam_proto::number(*.value))]
-pub struct ParamError {
-    pub name: &'static str,
-    pub value: f64,
-    pub range: &'static str,
-}
-
-fn check(name: &'static str, value: f64, ok: bool, range: &'static str) -> Result<(), ParamError> {
-    if ok && value.is_finite() {
-        Ok(())
-    } else {
-        Err(ParamError { name, value, range })
-    }
-}
+use roam_world::param::check_param as check;
+pub use roam_world::param::ParamError;
 
 impl GaParams {
     /// Table I's values with the request's overrides applied, then checked.

@@ -37,6 +37,7 @@ use crate::resolution::{self, Anchor, FineCell};
 use crate::search::{distance_field, fastest_path, shortest_path};
 use crate::seeds::{self, SeedProblem, ViaSeeds};
 use crate::world::{Cell, World, MOVES};
+use roam_world::param::check_param;
 
 /// The longest planning deadline a request may set.
 pub const MAX_DEADLINE_S: f64 = 600.0;
@@ -172,12 +173,6 @@ pub enum PlanError {
         needed_s: f64,
         short_by_s: f64,
     },
-    #[error("{name} = {} is out of range; use {range}", number(*.value))]
-    OutOfRange {
-        name: &'static str,
-        value: f64,
-        range: &'static str,
-    },
     #[error(transparent)]
     Param(#[from] ParamError),
     #[error(transparent)]
@@ -205,7 +200,7 @@ impl PlanError {
                 let (max, actual) = limit.max_actual();
                 ErrorReply::limit(limit.name(), max, actual, message)
             }
-            PlanError::OutOfRange { name, value, .. }
+            PlanError::Param(ParamError { name, value, .. })
                 if *name == "deadline_s" || *name == "t_exec_s" =>
             {
                 let max = if *name == "deadline_s" {
@@ -301,11 +296,7 @@ fn locate(
 /// Checks a request's numbers before any work.
 pub fn check_spec(spec: &PlanSpec) -> Result<(), PlanError> {
     let range = |name, value: f64, max: f64, range| {
-        if value.is_finite() && value > 0.0 && value <= max {
-            Ok(())
-        } else {
-            Err(PlanError::OutOfRange { name, value, range })
-        }
+        check_param(name, value, value > 0.0 && value <= max, range)
     };
     range(
         "t_exec_s",
@@ -320,13 +311,7 @@ pub fn check_spec(spec: &PlanSpec) -> Result<(), PlanError> {
         "(0, 600] seconds",
     )?;
     for v in spec.start.iter().chain(&spec.goal) {
-        if !v.is_finite() {
-            return Err(PlanError::OutOfRange {
-                name: "start/goal",
-                value: *v,
-                range: "finite world coordinates in metres",
-            });
-        }
+        check_param("start/goal", *v, true, "finite world coordinates in metres")?;
     }
     spec.params.validate()?;
     Ok(())

@@ -8,6 +8,7 @@ use std::sync::atomic::AtomicBool;
 use common::check_geometry;
 use proptest::prelude::*;
 use roam_planner::best::PlanSource;
+use roam_planner::params::ParamError;
 use roam_planner::plan::{plan, PlanError, PlanOutcome, PlanSpec, START_SNAP_M};
 use roam_planner::world::World;
 use roam_proto::planner::{PlannerModel, ShortestPathUse, StopReason};
@@ -240,10 +241,10 @@ fn refusals_say_what_to_change() {
     );
     assert!(matches!(
         deadline,
-        Err(PlanError::OutOfRange {
+        Err(PlanError::Param(ParamError {
             name: "deadline_s",
             ..
-        })
+        }))
     ));
 }
 

@@ -27,6 +27,7 @@ pub mod load_dirs;
 pub mod lock;
 pub mod noise;
 pub mod observation;
+pub mod param;
 pub mod render;
 pub mod ros_map;
 pub mod scenario;

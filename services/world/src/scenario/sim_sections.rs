@@ -16,6 +16,14 @@ pub const DEFAULT_SIGMA_TOA_M: f64 = 0.10;
 pub const DEFAULT_D0_M: f64 = 15.0;
 /// Paper 002 §4's K: 2.
 pub const DEFAULT_K: f64 = 2.0;
+/// The fewest anchors a position is fixed from by default: three, as two range circles
+/// meet in two points (roam's rule; paper 002 does not say).
+pub const DEFAULT_FIX_ANCHORS: usize = 3;
+/// The fewest anchors a site may fix from: two, where the robot's last fix tells the
+/// two points apart (`sensing.fix_anchors`).
+pub const FEWEST_FIX_ANCHORS: usize = 2;
+/// The most a site may ask for: beyond this no UWB layout roam has seen would fix at all.
+pub const MOST_FIX_ANCHORS: usize = 8;
 /// roam's choice (no paper gives one for a laser-like grid observation): 5 m, about what
 /// covers one of the 6 × 6 m rooms of paper 004's Stage world from inside it.
 pub const DEFAULT_OBSERVATION_RADIUS_M: f64 = 5.0;
@@ -64,6 +72,13 @@ pub struct SensingSpec {
     pub range_gate: RangeGate,
     /// Radius of the local grid observation with line of sight, metres; 0 turns it off.
     pub observation_radius_m: f64,
+    /// The fewest anchors in range that fix a position (default 3). 2 lets localization
+    /// track through places where only two anchors are heard, from the robot's last fix:
+    /// the two circles meet in two points and the one near the last fix is taken when
+    /// the other is clearly farther (`roam_localization::wls`). The PEB field follows
+    /// the same rule, so the planner and the controller's guard see the fix the
+    /// estimator has. A site whose anchors leave gaps sets 2; the papers' worlds keep 3.
+    pub fix_anchors: usize,
 }
 
 impl Default for SensingSpec {
@@ -75,6 +90,7 @@ impl Default for SensingSpec {
             k: DEFAULT_K,
             range_gate: RangeGate::default(),
             observation_radius_m: DEFAULT_OBSERVATION_RADIUS_M,
+            fix_anchors: DEFAULT_FIX_ANCHORS,
         }
     }
 }
@@ -371,6 +387,15 @@ impl SensingSpec {
         positive("d0_m", self.d0_m, "metres")?;
         non_negative("k", self.k, "(a unitless exponent)")?;
         non_negative("observation_radius_m", self.observation_radius_m, "metres")?;
+        if !(FEWEST_FIX_ANCHORS..=MOST_FIX_ANCHORS).contains(&self.fix_anchors) {
+            return Err(FieldIssue::new(
+                "sensing.fix_anchors",
+                format!(
+                    "must be {FEWEST_FIX_ANCHORS} to {MOST_FIX_ANCHORS} anchors, got {}",
+                    self.fix_anchors
+                ),
+            ));
+        }
         let cells = self.observation_radius_m / resolution;
         if cells > MAX_OBSERVATION_RADIUS_CELLS {
             return Err(FieldIssue::new(
