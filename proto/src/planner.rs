@@ -186,8 +186,11 @@ pub enum StopReason {
     Cancelled,
     /// The planner's CPU budget granted less wall time than `deadline_s` (its
     /// `max_plan_seconds`, or what its plan-seconds bucket held) and the plan used it
-    /// all: the path is the best found in [`Plan::budget_s`] seconds.
-    Budget,
+    /// all: the path is the best found in [`Plan::cpu_grant_s`] seconds. On the wire
+    /// `cpu_grant` (`budget` is read too: "budget" alone is the driving budget,
+    /// `t_exec_s`, everywhere else).
+    #[serde(alias = "budget")]
+    CpuGrant,
     /// Baselines that are not iterative.
     Complete,
 }
@@ -226,9 +229,10 @@ pub struct Plan {
     /// map's where that is coarser. `cells` are map cells whatever this is.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub planning_resolution_m: Option<f64>,
-    /// With `stop_reason: budget`: the wall seconds the CPU budget granted.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub budget_s: Option<f64>,
+    /// With `stop_reason: cpu_grant`: the wall seconds the planner's CPU budget granted
+    /// (`budget_s` is read too).
+    #[serde(default, alias = "budget_s", skip_serializing_if = "Option::is_none")]
+    pub cpu_grant_s: Option<f64>,
     pub seed: u64,
     pub map_version: MapVersion,
     /// The planner instance that answered.

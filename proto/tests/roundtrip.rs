@@ -366,7 +366,7 @@ mod planner_messages {
                 Just(StopReason::MaxGenerations),
                 Just(StopReason::Deadline),
                 Just(StopReason::Cancelled),
-                Just(StopReason::Budget),
+                Just(StopReason::CpuGrant),
                 Just(StopReason::Complete)
             ],
             (any::<u64>(), version(), name(), prop::option::of(finite())),
@@ -381,7 +381,7 @@ mod planner_messages {
                     f,
                     (u_ges, density, distinct_information, generations, planning_ms),
                     stop_reason,
-                    (seed, map_version, instance, budget_s),
+                    (seed, map_version, instance, cpu_grant_s),
                     shortest,
                 )| {
                     let points = cells
@@ -411,8 +411,8 @@ mod planner_messages {
                         generations,
                         planning_ms,
                         stop_reason,
-                        planning_resolution_m: budget_s.map(f64::abs),
-                        budget_s,
+                        planning_resolution_m: cpu_grant_s.map(f64::abs),
+                        cpu_grant_s,
                         seed,
                         map_version,
                         instance,
@@ -425,6 +425,22 @@ mod planner_messages {
     proptest! {
         #[test]
         fn plan_request_round_trips(m in request()) { round_trips(&m); }
+
+        /// A plan written with the CPU grant's old names (`stop_reason: budget`,
+        /// `budget_s`) reads as the same plan.
+        #[test]
+        fn a_plan_under_the_cpu_grants_old_names_reads_the_same(m in plan()) {
+            let mut value = serde_json::to_value(&m).expect("json");
+            let object = value.as_object_mut().expect("an object");
+            if let Some(grant) = object.remove("cpu_grant_s") {
+                object.insert("budget_s".into(), grant);
+            }
+            if object.get("stop_reason") == Some(&serde_json::json!("cpu_grant")) {
+                object.insert("stop_reason".into(), serde_json::json!("budget"));
+            }
+            let read: Plan = serde_json::from_value(value).expect("read");
+            prop_assert_eq!(read, m);
+        }
 
         #[test]
         fn plan_round_trips(m in plan()) {

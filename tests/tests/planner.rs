@@ -668,10 +668,10 @@ async fn maximal_requests_are_cut_at_the_cpu_budget_or_refused() {
     let mut granted: Vec<f64> = cut
         .iter()
         .map(|plan| {
-            assert_eq!(plan.stop_reason, StopReason::Budget, "{plan:?}");
+            assert_eq!(plan.stop_reason, StopReason::CpuGrant, "{plan:?}");
             // Cut, not refused: it ran generations before the grant ended it.
             assert!((1..9000).contains(&plan.generations), "{plan:?}");
-            plan.budget_s.expect("the grant is in the reply")
+            plan.cpu_grant_s.expect("the grant is in the reply")
         })
         .collect();
     granted.sort_by(f64::total_cmp);

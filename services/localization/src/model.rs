@@ -8,7 +8,9 @@
 
 use nalgebra::Vector2;
 use roam_world::noise::ToaNoise;
-use roam_world::scenario::{SensingSpec, FEWEST_FIX_ANCHORS, MOST_FIX_ANCHORS};
+use roam_world::scenario::{
+    SensingSpec, DEFAULT_FIX_ANCHORS, FEWEST_FIX_ANCHORS, MOST_FIX_ANCHORS,
+};
 
 use crate::error::LocalizationError;
 
@@ -74,7 +76,7 @@ impl RangingModel {
             anchors: anchors.iter().map(|a| Vector2::new(a[0], a[1])).collect(),
             sensing_range_m,
             noise,
-            fix_anchors: crate::fim::MIN_FIX_ANCHORS,
+            fix_anchors: DEFAULT_FIX_ANCHORS,
         })
     }
 

@@ -84,7 +84,7 @@ pub fn to_message(
         generations: outcome.generations,
         planning_ms: outcome.planning.as_secs_f64() * 1000.0,
         stop_reason: outcome.stop_reason,
-        budget_s: None,
+        cpu_grant_s: None,
         seed: request.seed,
         map_version,
         instance: instance.to_owned(),

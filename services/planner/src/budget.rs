@@ -17,7 +17,7 @@
 //! A grant only moves the plan's wall deadline. A plan that ends by its generation
 //! count before its grant runs out is the same bit for bit whatever the bucket held;
 //! one that runs into a grant shorter than its own deadline says so in its reply
-//! (`stop_reason: budget`, with the seconds granted), since a GA is anytime and returns
+//! (`stop_reason: cpu_grant`, with the seconds granted in `cpu_grant_s`), since a GA is anytime and returns
 //! its best path so far.
 
 use std::sync::Mutex;

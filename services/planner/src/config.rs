@@ -77,7 +77,7 @@ pub struct PlannerConfig {
     /// Refused `limit_exceeded` above it.
     pub max_plan_cost: u64,
     /// One plan's wall time at most, seconds: a longer `deadline_s` is cut to it and a
-    /// plan that runs into it replies `stop_reason: budget` ([`crate::budget`]).
+    /// plan that runs into it replies `stop_reason: cpu_grant` ([`crate::budget`]).
     pub max_plan_seconds: f64,
     /// Plan-seconds the instance's CPU budget refills per wall second.
     pub plan_seconds_per_second: f64,

@@ -830,8 +830,8 @@ fn plan_now(
     grant.finish(Instant::now());
     publish(&mut batch, true);
     // The grant ended the plan only if it was shorter than the request's deadline.
-    let budget_s = (cut && outcome.stop_reason == StopReason::Deadline).then(|| {
-        outcome.stop_reason = StopReason::Budget;
+    let cpu_grant_s = (cut && outcome.stop_reason == StopReason::Deadline).then(|| {
+        outcome.stop_reason = StopReason::CpuGrant;
         granted_s
     });
     let share = if sized_generations == 0 || outcome.generations == 0 {
@@ -847,7 +847,7 @@ fn plan_now(
         &state.instance,
         outcome,
     );
-    plan.budget_s = budget_s;
+    plan.cpu_grant_s = cpu_grant_s;
     Ok((plan, share))
 }
 

@@ -103,8 +103,8 @@ pub struct DemoReport {
     /// What the one-plan baseline (static map, Table I, one plan per window, paper 000's
     /// initialization) would have planned per window ([`roam_mission::baseline`]), and the
     /// information those plans promised, summed.
-    pub todays_plans: Vec<Option<BaselinePlan>>,
-    pub information_todays_plans: f64,
+    pub baseline_plans: Vec<Option<BaselinePlan>>,
+    pub information_baseline_plans: f64,
     /// The mean PEB of the estimates along the way, metres.
     pub peb_mean_m: Option<f64>,
     pub windows: Vec<WindowReport>,
@@ -364,7 +364,7 @@ async fn drive(
         .map_err(|e| write_error(&picture, e))?;
 
     progress("replaying the one-plan-per-window baseline for comparison");
-    let today = {
+    let baseline = {
         let (outcomes, generations) = (outcomes.clone(), config.max_generations.unwrap_or(1000));
         let seed = config.seed;
         let information = information.clone();
@@ -381,8 +381,12 @@ async fn drive(
         information: windows.iter().map(|w| w.driven_information).sum(),
         information_shortest_path: windows.iter().map(|w| w.shortest_information).sum(),
         information_planned: windows.iter().map(|w| w.planned_information).sum(),
-        information_todays_plans: today.iter().flatten().map(|t| t.planned_information).sum(),
-        todays_plans: today,
+        information_baseline_plans: baseline
+            .iter()
+            .flatten()
+            .map(|t| t.planned_information)
+            .sum(),
+        baseline_plans: baseline,
         peb_mean_m: (!pebs.is_empty()).then(|| pebs.iter().sum::<f64>() / pebs.len() as f64),
         windows,
         site: options.site.name.clone(),
@@ -438,8 +442,8 @@ fn markdown(r: &DemoReport) -> String {
     ));
     out.push_str("| window | task | task starts s | arrived s | on time | budget s | share driven | information driven | planned | driven / planned | shortest path | one-plan baseline | v_lin s/m | v_ang s/rad | mean PEB m | replans |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for w in &r.windows {
-        let today = r
-            .todays_plans
+        let baseline = r
+            .baseline_plans
             .iter()
             .flatten()
             .find(|t| t.window == w.window)
@@ -454,7 +458,7 @@ fn markdown(r: &DemoReport) -> String {
         };
         let model = w.time_model;
         out.push_str(&format!(
-            "| {} | {} | {:.1} | {} | {} | {:.1} | {} | {:.0} | {:.0} | {ratio} | {:.0} | {today} | {} | {} | {} | {} |\n",
+            "| {} | {} | {:.1} | {} | {} | {:.1} | {} | {:.0} | {:.0} | {ratio} | {:.0} | {baseline} | {} | {} | {} | {} |\n",
             w.window + 1,
             w.task,
             w.task_start_s,
@@ -479,20 +483,20 @@ fn markdown(r: &DemoReport) -> String {
     } else {
         "-".to_owned()
     };
-    let against_today = if r.information_todays_plans > 0.0 {
+    let against_baseline = if r.information_baseline_plans > 0.0 {
         format!(
             "{:+.0}%",
-            (r.information / r.information_todays_plans - 1.0) * 100.0
+            (r.information / r.information_baseline_plans - 1.0) * 100.0
         )
     } else {
         "-".to_owned()
     };
     out.push_str(&format!(
-        "\nOn time at every task: **{}**. Information gathered: **{:.0}** against {:.0} on the shortest paths ({gain}) and {:.0} that one plan per window would have planned ({against_today}; the baseline: static map, Table I's time model, no replans; what it planned, of which a robot drove 84-89%). Mean PEB {}.\n\n",
+        "\nOn time at every task: **{}**. Information gathered: **{:.0}** against {:.0} on the shortest paths ({gain}) and {:.0} that one plan per window would have planned ({against_baseline}; the baseline: static map, Table I's time model, no replans; what it planned, of which a robot drove 84-89%). Mean PEB {}.\n\n",
         if r.on_time { "yes" } else { "no" },
         r.information,
         r.information_shortest_path,
-        r.information_todays_plans,
+        r.information_baseline_plans,
         r.peb_mean_m.map_or("-".to_owned(), |p| format!("{p:.3} m")),
     ));
     out.push_str("![the day world with its zones of interest (orange), the curious plans (blue), shortest (magenta) and driven (red) paths, anchors (purple), start and task places (green), each window's number where it began, a legend and a scale bar](world.png)\n");

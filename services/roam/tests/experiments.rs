@@ -362,24 +362,24 @@ fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
         "on_time",
         "information",
         "information_shortest_path",
-        "information_todays_plans",
+        "information_baseline_plans",
         "peb_mean_m",
     ] {
         assert!(!report[field].is_null(), "{field} missing: {report}");
     }
-    // Today's executive's plan replayed for each window, within its window.
-    let today = report["todays_plans"].as_array().expect("today's plans");
-    assert_eq!(today.len(), 4, "{report}");
+    // One plan per window (the baseline) replayed for each window, within its window.
+    let baseline = report["baseline_plans"].as_array().expect("baseline plans");
+    assert_eq!(baseline.len(), 4, "{report}");
     for (w, t) in report["windows"]
         .as_array()
         .expect("windows")
         .iter()
-        .zip(today)
+        .zip(baseline)
     {
         let window =
             w["task_start_s"].as_f64().expect("start") - w["began_s"].as_f64().expect("began");
         // A window the robot began late can be shorter than the shortest path on
-        // today's slower time model: then today's planner refuses, naming the floor.
+        // the baseline's slower time model: then the baseline's planner refuses, naming the floor.
         match t["refused"].as_str() {
             Some(reason) => {
                 assert!(reason.contains("give at least"), "{t}");
@@ -389,16 +389,16 @@ fn roam_demo_writes_the_report_with_the_driven_path_in_the_picture() {
                 );
             }
             None => {
-                let eta = t["t_eta_s"].as_f64().expect("today's plan");
+                let eta = t["t_eta_s"].as_f64().expect("baseline plan");
                 assert!(
                     eta <= window + 1e-6,
-                    "today's plan {t} does not fit window {w}"
+                    "the baseline plan {t} does not fit window {w}"
                 );
             }
         }
     }
-    // The first window begins at the start of the day, never late: today plans it.
-    assert!(today[0]["refused"].is_null(), "{}", today[0]);
+    // The first window begins at the start of the day, never late: the baseline plans it.
+    assert!(baseline[0]["refused"].is_null(), "{}", baseline[0]);
     // The day: four windows, one a round trip, each with the time model it planned with
     // and the share of the window the robot drove.
     let windows = report["windows"].as_array().expect("windows");

@@ -443,7 +443,7 @@ pub(crate) async fn demo(args: DemoArgs) -> anyhow::Result<()> {
         "information: {:.0} (shortest paths: {:.0}; one plan per window planned: {:.0})   mean PEB: {}",
         report.information,
         report.information_shortest_path,
-        report.information_todays_plans,
+        report.information_baseline_plans,
         report
             .peb_mean_m
             .map_or("-".to_owned(), |p| format!("{p:.3} m"))

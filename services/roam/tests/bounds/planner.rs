@@ -66,7 +66,7 @@ pub(crate) async fn maximal_plans(session: &zenoh::Session, root: &str) -> Durat
         match result {
             Ok(plan) => assert_eq!(
                 plan.stop_reason,
-                StopReason::Budget,
+                StopReason::CpuGrant,
                 "{:?}",
                 plan.stop_reason
             ),

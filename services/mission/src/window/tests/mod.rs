@@ -222,7 +222,7 @@ fn plan(model: PlannerModel, points: Vec<[f64; 2]>, t_eta_s: f64) -> Plan {
         planning_ms: 1.0,
         stop_reason: StopReason::MaxGenerations,
         planning_resolution_m: None,
-        budget_s: None,
+        cpu_grant_s: None,
         seed: 0,
         map_version: MapVersion {
             inflated: 1,
