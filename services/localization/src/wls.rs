@@ -348,14 +348,9 @@ fn linearised_start(usable: &[(Vector2<f64>, f64)]) -> Option<Vector2<f64>> {
 /// The best-fit line of the anchors: a point on it (their centroid) and its unit
 /// direction (the scatter's principal axis); `None` when they are all one point.
 fn line_of(usable: &[(Vector2<f64>, f64)]) -> Option<(Vector2<f64>, Vector2<f64>)> {
-    let c = centroid(usable.iter().map(|u| u.0))?;
-    let c = Vector2::new(c[0], c[1]);
-    let s: Matrix2<f64> = usable.iter().fold(Matrix2::zeros(), |s, &(a, _)| {
-        let q = a - c;
-        s + q * q.transpose()
-    });
+    let (c, s) = scatter(usable.iter().map(|u| u.0))?;
     let (a, b, d) = (s[(0, 0)], s[(0, 1)], s[(1, 1)]);
-    let lambda_max = 0.5 * (a + d) + (0.5 * (a - d)).hypot(b);
+    let lambda_max = largest_eigenvalue(&s);
     // An eigenvector of the largest eigenvalue: (b, λ − a) or (λ − d, b), the longer.
     let (u, v) = (
         Vector2::new(b, lambda_max - a),
@@ -364,6 +359,25 @@ fn line_of(usable: &[(Vector2<f64>, f64)]) -> Option<(Vector2<f64>, Vector2<f64>
     let direction = if u.norm() >= v.norm() { u } else { v };
     let norm = direction.norm();
     (norm.is_finite() && norm > 0.0).then(|| (c, direction / norm))
+}
+
+/// The points' centroid and scatter matrix Σ (p − c)(p − c)ᵀ; `None` for no points.
+fn scatter(
+    points: impl Iterator<Item = Vector2<f64>> + Clone,
+) -> Option<(Vector2<f64>, Matrix2<f64>)> {
+    let c = centroid(points.clone())?;
+    let c = Vector2::new(c[0], c[1]);
+    let s = points.fold(Matrix2::zeros(), |s, p| {
+        let q = p - c;
+        s + q * q.transpose()
+    });
+    Some((c, s))
+}
+
+/// The larger eigenvalue of a symmetric 2 × 2 matrix, in closed form.
+fn largest_eigenvalue(s: &Matrix2<f64>) -> f64 {
+    let (a, b, d) = (s[(0, 0)], s[(0, 1)], s[(1, 1)]);
+    0.5 * (a + d) + (0.5 * (a - d)).hypot(b)
 }
 
 /// The mean of the points, or `None` for none.
@@ -378,19 +392,13 @@ fn centroid(points: impl Iterator<Item = Vector2<f64>>) -> Option<[f64; 2]> {
 /// √(λ_min/λ_max) of the points' scatter matrix: 0 for points on one line, 1 for points
 /// spread alike in every direction; 0 for fewer than two distinct points.
 fn spread(points: impl Iterator<Item = Vector2<f64>> + Clone) -> f64 {
-    let Some(c) = centroid(points.clone()) else {
+    let Some((_, s)) = scatter(points) else {
         return 0.0;
     };
-    let c = Vector2::new(c[0], c[1]);
-    let s: Matrix2<f64> = points.fold(Matrix2::zeros(), |s, p| {
-        let q = p - c;
-        s + q * q.transpose()
-    });
-    let (a, b, d) = (s[(0, 0)], s[(0, 1)], s[(1, 1)]);
-    let lambda_max = 0.5 * (a + d) + (0.5 * (a - d)).hypot(b);
+    let lambda_max = largest_eigenvalue(&s);
     if lambda_max.is_nan() || lambda_max <= 0.0 {
         return 0.0;
     }
-    let lambda_min = (a * d - b * b) / lambda_max;
+    let lambda_min = (s[(0, 0)] * s[(1, 1)] - s[(0, 1)] * s[(0, 1)]) / lambda_max;
     (lambda_min.max(0.0) / lambda_max).sqrt()
 }
