@@ -95,13 +95,66 @@ pub struct Evaluator<'a> {
     step_times: [[f64; 8]; 9],
     stamp: Vec<u32>,
     current: u32,
+    // Model II: block sums as this path has changed them.
+    block_sums: Vec<f64>,
+}
+
+/// The walk's running state after a gene: all that scoring the rest of a path needs
+/// besides which cells are already perceived.
+#[derive(Debug, Clone, Copy)]
+pub struct WalkState {
+    t: f64,
+    /// The direction of the last move (8: none yet).
+    prev_dir: usize,
+    cx: usize,
+    cy: usize,
+    information: f64,
+    localizability: f64,
     // Model I: per score value, experiences so far, time of the last, gene of the last.
     experiences: [u32; SCORES],
     last_time: [f64; SCORES],
     last_gene: [u32; SCORES],
     factor: [f64; SCORES],
-    // Model II: block sums as this path has changed them.
-    block_sums: Vec<f64>,
+}
+
+impl WalkState {
+    fn at(world: &World, first: Option<&Cell>) -> Self {
+        let (cx, cy) = first.map_or((0, 0), |&c| world.xy(c));
+        WalkState {
+            t: 0.0,
+            prev_dir: 8,
+            cx,
+            cy,
+            information: 0.0,
+            localizability: 0.0,
+            experiences: [0; SCORES],
+            last_time: [f64::NEG_INFINITY; SCORES],
+            last_gene: [u32::MAX; SCORES],
+            factor: [0.0; SCORES],
+        }
+    }
+}
+
+/// A path scored once, kept so that paths sharing its start can be scored from one of
+/// its marked genes onward ([`Evaluator::evaluate_after`]): the gene at which it first
+/// perceived each cell, and the walk's state after each mark. The greedy planner tries
+/// hundreds of routes a round that differ from the current one only after one stop;
+/// scoring them from that stop gives the same [`Evaluation`], bit for bit, as scoring
+/// them whole.
+#[derive(Debug, Clone, Default)]
+pub struct Prefix {
+    path: Vec<Cell>,
+    /// Per cell, the first gene that perceived it (`u32::MAX`: none).
+    first_seen: Vec<u32>,
+    /// (gene, the state after it), in the order of the marks.
+    marks: Vec<(u32, WalkState)>,
+}
+
+impl Prefix {
+    /// The path scored.
+    pub fn path(&self) -> &[Cell] {
+        &self.path
+    }
 }
 
 impl<'a> Evaluator<'a> {
@@ -125,63 +178,136 @@ impl<'a> Evaluator<'a> {
             }),
             stamp: vec![0; world.cell_count()],
             current: 0,
-            experiences: [0; SCORES],
-            last_time: [f64::NEG_INFINITY; SCORES],
-            last_gene: [u32::MAX; SCORES],
-            factor: [0.0; SCORES],
             block_sums: Vec::new(),
         }
     }
 
-    fn next_stamp(&mut self) {
+    /// A new stamp (no cell perceived yet) and Model II's block sums as the world has them.
+    fn start_path(&mut self) {
         self.current = self.current.wrapping_add(1);
         if self.current == 0 {
             self.stamp.fill(0);
             self.current = 1;
         }
+        if self.model == Model::Heterogeneity {
+            self.block_sums.clear();
+            self.block_sums.extend_from_slice(&self.world.block_sums);
+        }
     }
 
     /// The fitness of `path` (Eqs. 1–7).
     pub fn evaluate(&mut self, path: &[Cell]) -> Evaluation {
-        self.next_stamp();
-        match self.model {
-            Model::Novelty => {
-                self.experiences = [0; SCORES];
-                self.last_time = [f64::NEG_INFINITY; SCORES];
-                self.last_gene = [u32::MAX; SCORES];
-            }
-            Model::Heterogeneity => {
-                self.block_sums.clear();
-                self.block_sums.extend_from_slice(&self.world.block_sums);
-            }
-            Model::Coverage => {}
+        self.start_path();
+        let mut state = WalkState::at(self.world, path.first());
+        self.walk(&mut state, None, path, 0, |_| false, |_, _| {}, |_, _| {});
+        self.finish(&state, path.last())
+    }
+
+    /// Scores `path` as [`Evaluator::evaluate`] does and keeps it in `prefix`, with the
+    /// walk's state after each gene of `marks` (ascending).
+    pub fn evaluate_prefix(
+        &mut self,
+        prefix: &mut Prefix,
+        path: &[Cell],
+        marks: &[usize],
+    ) -> Evaluation {
+        self.start_path();
+        prefix.path.clear();
+        prefix.path.extend_from_slice(path);
+        prefix.first_seen.clear();
+        prefix.first_seen.resize(self.world.cell_count(), u32::MAX);
+        prefix.marks.clear();
+        let mut state = WalkState::at(self.world, path.first());
+        let (first_seen, kept) = (&mut prefix.first_seen, &mut prefix.marks);
+        let mut next = 0;
+        self.walk(
+            &mut state,
+            None,
+            path,
+            0,
+            |_| false,
+            |idx, gene| first_seen[idx] = gene,
+            |gene, s| {
+                while marks.get(next).is_some_and(|&m| m as u32 == gene) {
+                    kept.push((gene, *s));
+                    next += 1;
+                }
+            },
+        );
+        self.finish(&state, path.last())
+    }
+
+    /// The fitness of `prefix`'s path up to its `mark`-th marked gene followed by
+    /// `tail`: equal to [`Evaluator::evaluate`] of that whole path, at the cost of the
+    /// tail alone. `None` if there is no such mark.
+    pub fn evaluate_after(
+        &mut self,
+        prefix: &Prefix,
+        mark: usize,
+        tail: &[Cell],
+    ) -> Option<Evaluation> {
+        let &(gene, state) = prefix.marks.get(mark)?;
+        let cut = prefix.path.get(..=gene as usize)?;
+        if self.model == Model::Heterogeneity {
+            // Model II's block sums are not kept per mark: score the whole path.
+            let whole: Vec<Cell> = cut.iter().chain(tail).copied().collect();
+            return Some(self.evaluate(&whole));
         }
+        self.start_path();
+        let mut state = state;
+        let first_seen = &prefix.first_seen;
+        self.walk(
+            &mut state,
+            cut.last().copied(),
+            tail,
+            gene + 1,
+            |idx| first_seen[idx] <= gene,
+            |_, _| {},
+            |_, _| {},
+        );
+        Some(self.finish(&state, tail.last().or(cut.last())))
+    }
+
+    /// Walks `cells` (genes `first_gene`…, after the cell `prev` if any), perceiving the
+    /// window around each (Eq. 3). A cell counts if neither `seen_before` nor this walk
+    /// has perceived it; `on_new` hears of each such cell, `on_gene` of the state after
+    /// each gene.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn walk(
+        &mut self,
+        state: &mut WalkState,
+        mut prev: Option<Cell>,
+        cells: &[Cell],
+        first_gene: u32,
+        seen_before: impl Fn(usize) -> bool,
+        mut on_new: impl FnMut(usize, u32),
+        mut on_gene: impl FnMut(u32, &WalkState),
+    ) {
         let (w, h) = (self.world.width() as i32, self.world.height() as i32);
-        let mut t = 0.0;
-        let mut prev_dir = 8;
-        let mut information = 0.0;
-        let mut localizability = 0.0;
         let costed = self.params.w_loc > 0.0 && !self.world.localizability.is_empty();
-        // The position is tracked move by move: no division per gene.
-        let (mut cx, mut cy) = path.first().map_or((0, 0), |&c| self.world.xy(c));
-        for (gene, &cell) in path.iter().enumerate() {
+        for (j, &cell) in cells.iter().enumerate() {
+            let gene = first_gene + j as u32;
             let mut moved = None;
-            if gene > 0 {
-                match self.world.move_between(path[gene - 1], cell, cx, cy) {
+            // The position is tracked move by move: no division per gene.
+            if let Some(p) = prev {
+                match self.world.move_between(p, cell, state.cx, state.cy) {
                     Some(dir) => {
-                        t += self.step_times[prev_dir][dir];
-                        prev_dir = dir;
+                        state.t += self.step_times[state.prev_dir][dir];
+                        state.prev_dir = dir;
                         moved = Some(dir);
-                        cx = (cx as i64 + i64::from(MOVES[dir].0)) as usize;
-                        cy = (cy as i64 + i64::from(MOVES[dir].1)) as usize;
+                        state.cx = (state.cx as i64 + i64::from(MOVES[dir].0)) as usize;
+                        state.cy = (state.cy as i64 + i64::from(MOVES[dir].1)) as usize;
                     }
-                    None => (cx, cy) = self.world.xy(cell),
+                    None => (state.cx, state.cy) = self.world.xy(cell),
                 }
             }
-            let (x, y) = (cx as i32, cy as i32);
+            prev = Some(cell);
+            let (x, y) = (state.cx as i32, state.cy as i32);
             if costed {
-                let peb = f64::from(self.world.localizability[cy * self.world.width() + cx]);
-                localizability += (peb - self.params.peb_free_m).max(0.0);
+                let peb =
+                    f64::from(self.world.localizability[state.cy * self.world.width() + state.cx]);
+                state.localizability += (peb - self.params.peb_free_m).max(0.0);
             }
             let count = moved.map_or(self.window.len(), |dir| self.entering[dir].len());
             for k in 0..count {
@@ -194,14 +320,22 @@ impl<'a> Evaluator<'a> {
                     continue;
                 }
                 let idx = (ny * w + nx) as usize;
-                if self.stamp[idx] == self.current {
+                if self.stamp[idx] == self.current || seen_before(idx) {
                     continue;
                 }
                 self.stamp[idx] = self.current;
-                information += self.gain(idx, gene as u32, t);
+                on_new(idx, gene);
+                let t = state.t;
+                state.information += self.gain(state, idx, gene, t);
             }
+            on_gene(gene, state);
         }
-        let reaches_goal = path.last() == Some(&self.goal);
+    }
+
+    /// The fitness terms of a walked path ending at `last` (Eqs. 1, 4–7).
+    fn finish(&self, state: &WalkState, last: Option<&Cell>) -> Evaluation {
+        let (t, information) = (state.t, state.information);
+        let reaches_goal = last == Some(&self.goal);
         let p = self.params;
         let f1 = p.w1 * information;
         let f2 = if t < self.t_exec { p.w2 } else { 0.0 };
@@ -209,7 +343,7 @@ impl<'a> Evaluator<'a> {
         let f4 = -p.w4 * (t - self.t_exec).max(0.0);
         let f5 = -p.w5 * (self.t_exec - t).max(0.0);
         // roam's localizability cost (GaParams::w_loc, peb_free_m), not paper 000's.
-        let f6 = -p.w_loc * localizability;
+        let f6 = -p.w_loc * state.localizability;
         Evaluation {
             fitness: FitnessTerms {
                 f1_information: f1,
@@ -228,7 +362,7 @@ impl<'a> Evaluator<'a> {
 
     /// M_xy of a newly perceived cell (Eqs. 8–10).
     #[inline]
-    fn gain(&mut self, idx: usize, gene: u32, t: f64) -> f64 {
+    fn gain(&mut self, state: &mut WalkState, idx: usize, gene: u32, t: f64) -> f64 {
         match self.model {
             Model::Coverage => self.params.coverage_gain,
             Model::Novelty => {
@@ -237,21 +371,21 @@ impl<'a> Evaluator<'a> {
                 if score == 0 {
                     return 0.0;
                 }
-                if self.last_gene[score] != gene {
+                if state.last_gene[score] != gene {
                     // A new experience of stimulus `score` at this gene (Eq. 9).
-                    self.experiences[score] += 1;
-                    let t_s = t - self.last_time[score];
-                    let n = f64::from(self.experiences[score]);
+                    state.experiences[score] += 1;
+                    let t_s = t - state.last_time[score];
+                    let n = f64::from(state.experiences[score]);
                     let time_term = if t_s.is_finite() {
                         self.params.w_t / (t_s + 1.0)
                     } else {
                         0.0
                     };
-                    self.factor[score] = (1.0 - time_term - self.params.w_n * (n - 1.0)).max(0.0);
-                    self.last_time[score] = t;
-                    self.last_gene[score] = gene;
+                    state.factor[score] = (1.0 - time_term - self.params.w_n * (n - 1.0)).max(0.0);
+                    state.last_time[score] = t;
+                    state.last_gene[score] = gene;
                 }
-                score as f64 * self.factor[score]
+                score as f64 * state.factor[score]
             }
             Model::Heterogeneity => {
                 let score = f64::from(self.world.information[idx]);
@@ -333,6 +467,50 @@ mod tests {
                 if dir % 2 == 0 { 4 } else { 7 },
                 "direction {dir}"
             );
+        }
+    }
+
+    /// A walk of `steps` legal moves from `start`, each direction drawn from `moves`,
+    /// staying on the grid.
+    fn walk_from(world: &World, start: Cell, moves: &[u8]) -> Vec<Cell> {
+        let mut path = vec![start];
+        for &m in moves {
+            let last = *path.last().expect("a start");
+            if let Some(next) = world.step(last, usize::from(m % 8)) {
+                path.push(next);
+            }
+        }
+        path
+    }
+
+    proptest::proptest! {
+        /// Scoring from a mark gives what scoring the whole path gives, bit for bit,
+        /// for every model, with and without the localizability cost.
+        #[test]
+        fn scoring_after_a_mark_equals_scoring_the_whole_path(
+            scores in proptest::collection::vec(0u8..=100, 24 * 16),
+            base_moves in proptest::collection::vec(0u8..8, 1..60),
+            tail_moves in proptest::collection::vec(0u8..8, 0..60),
+            cut in 0usize..60,
+            w_loc in proptest::prop_oneof![proptest::strategy::Just(0.0), 0.1f64..5.0],
+        ) {
+            let mut world = world_with_scores(&scores, 24);
+            world.localizability = scores.iter().map(|&s| f32::from(s) / 50.0).collect();
+            let params = GaParams { w_loc, ..GaParams::default() };
+            let base = walk_from(&world, world.cell(12, 8), &base_moves);
+            let cut = cut % base.len();
+            let tail = walk_from(&world, base[cut], &tail_moves);
+            let whole: Vec<Cell> = base[..=cut].iter().chain(&tail[1..]).copied().collect();
+            let goal = *whole.last().expect("cells");
+            for model in [Model::Coverage, Model::Novelty, Model::Heterogeneity] {
+                let mut evaluator = Evaluator::new(&world, &params, model, goal, 30.0);
+                let mut prefix = Prefix::default();
+                let scored = evaluator.evaluate_prefix(&mut prefix, &base, &[0, cut]);
+                proptest::prop_assert_eq!(scored, evaluator.evaluate(&base));
+                let resumed = evaluator.evaluate_after(&prefix, 1, &tail[1..]);
+                proptest::prop_assert_eq!(resumed, Some(evaluator.evaluate(&whole)), "{:?}", model);
+                proptest::prop_assert_eq!(evaluator.evaluate_after(&prefix, 2, &tail), None);
+            }
         }
     }
 }

@@ -30,7 +30,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use crate::curiosity::{Evaluation, Evaluator, Model};
+use crate::curiosity::{Evaluation, Evaluator, Model, Prefix};
 use crate::params::GaParams;
 use crate::search::{descend_to_goal, distance_field, STRAIGHT};
 use crate::seeds::MAX_FIELD_ENTRIES;
@@ -78,48 +78,132 @@ struct Route<'a> {
     stops: Vec<Cell>,
     /// The distance field of each stop (the cost to it from every cell).
     fields: Vec<std::rc::Rc<Vec<u32>>>,
+    /// `legs[k]`: the cells after `stops[k]` up to and including `stops[k + 1]`, the
+    /// descent along the next stop's field. A change re-descends only its own legs.
+    legs: Vec<Vec<Cell>>,
+}
+
+/// A change to the route that step 2 or 3 tries.
+#[derive(Debug, Clone, Copy)]
+enum Change {
+    /// `v` inserted before stop `at` (1 ≤ at < stops).
+    Insert { at: usize, v: Cell },
+    /// Via-point `i` removed and `v`, if any, put in its place.
+    Replace { i: usize, v: Option<Cell> },
+}
+
+/// The cells after `from` up to and including the field's own stop: the descent
+/// along `field`.
+fn leg_to(world: &World, from: Cell, field: &[u32]) -> Option<Vec<Cell>> {
+    let mut path = vec![from];
+    descend_to_goal(world, field, &mut path).then(|| path.split_off(1))
+}
+
+/// The cells after the field's own stop up to and including `to`: the descent from
+/// `to` along `field`, reversed (`to` has no field yet).
+fn leg_from(world: &World, field: &[u32], to: Cell) -> Option<Vec<Cell>> {
+    let mut back = vec![to];
+    if !descend_to_goal(world, field, &mut back) {
+        return None;
+    }
+    back.pop();
+    back.reverse();
+    Some(back)
 }
 
 impl Route<'_> {
-    /// The path through `stops` (with `extra` inserted before index `at`, if any).
-    fn path(&self, extra: Option<(usize, Cell)>, skip: Option<usize>) -> Option<Vec<Cell>> {
-        let mut stops: Vec<(Cell, Option<&[u32]>)> = self
-            .stops
-            .iter()
-            .zip(&self.fields)
-            .enumerate()
-            .filter(|(i, _)| Some(*i) != skip)
-            .map(|(_, (&c, f))| (c, Some(f.as_slice())))
-            .collect();
-        if let Some((at, cell)) = extra {
-            let at = if skip.is_some_and(|s| s < at) {
-                at - 1
-            } else {
-                at
-            };
-            stops.insert(at, (cell, None));
+    fn new<'w>(
+        world: &'w World,
+        stops: Vec<Cell>,
+        fields: Vec<std::rc::Rc<Vec<u32>>>,
+    ) -> Option<Route<'w>> {
+        let legs = stops
+            .windows(2)
+            .zip(&fields[1..])
+            .map(|(pair, field)| leg_to(world, pair[0], field))
+            .collect::<Option<Vec<_>>>()?;
+        Some(Route {
+            world,
+            stops,
+            fields,
+            legs,
+        })
+    }
+
+    /// The path through the stops.
+    fn path(&self) -> Vec<Cell> {
+        let mut path = Vec::with_capacity(1 + self.legs.iter().map(Vec::len).sum::<usize>());
+        path.push(self.stops[0]);
+        for leg in &self.legs {
+            path.extend_from_slice(leg);
         }
-        let mut path = vec![stops[0].0];
-        for pair in stops.windows(2) {
-            let ((_, fa), (b, fb)) = (pair[0], pair[1]);
-            match fb {
-                Some(f) => {
-                    if !descend_to_goal(self.world, f, &mut path) {
-                        return None;
-                    }
+        path
+    }
+
+    /// The gene (index in [`Route::path`]) of each stop.
+    fn stop_genes(&self) -> Vec<usize> {
+        std::iter::once(0)
+            .chain(self.legs.iter().scan(0, |gene, leg| {
+                *gene += leg.len();
+                Some(*gene)
+            }))
+            .collect()
+    }
+
+    /// The legs `change` puts in place of its stretch, and the stop the route is
+    /// unchanged up to.
+    fn new_legs(&self, change: Change) -> Option<(usize, Vec<Vec<Cell>>)> {
+        let world = self.world;
+        match change {
+            Change::Insert { at, v } => Some((
+                at - 1,
+                vec![
+                    leg_from(world, &self.fields[at - 1], v)?,
+                    leg_to(world, v, &self.fields[at])?,
+                ],
+            )),
+            Change::Replace { i, v: Some(v) } => Some((
+                i - 1,
+                vec![
+                    leg_from(world, &self.fields[i - 1], v)?,
+                    leg_to(world, v, &self.fields[i + 1])?,
+                ],
+            )),
+            Change::Replace { i, v: None } => Some((
+                i - 1,
+                vec![leg_to(world, self.stops[i - 1], &self.fields[i + 1])?],
+            )),
+        }
+    }
+
+    /// The legs after `change`'s stretch that it leaves as they are.
+    fn kept_legs(&self, change: Change) -> &[Vec<Cell>] {
+        match change {
+            Change::Insert { at, .. } => &self.legs[at..],
+            Change::Replace { i, .. } => &self.legs[i + 1..],
+        }
+    }
+
+    /// Makes `change` with its `new` legs.
+    fn apply(&mut self, change: Change, new: Vec<Vec<Cell>>) {
+        let world = self.world;
+        let field = |v: Cell| std::rc::Rc::new(distance_field(world, v));
+        match change {
+            Change::Insert { at, v } => {
+                self.stops.insert(at, v);
+                self.fields.insert(at, field(v));
+                self.legs.splice(at - 1..at, new);
+            }
+            Change::Replace { i, v } => {
+                self.stops.remove(i);
+                self.fields.remove(i);
+                if let Some(v) = v {
+                    self.stops.insert(i, v);
+                    self.fields.insert(i, field(v));
                 }
-                None => {
-                    // b has no field yet: descend from b to a on a's field, reversed.
-                    let f = fa?;
-                    let mut back = vec![b];
-                    if !descend_to_goal(self.world, f, &mut back) {
-                        return None;
-                    }
-                    path.extend(back.iter().rev().skip(1));
-                }
+                self.legs.splice(i - 1..i + 1, new);
             }
         }
-        Some(path)
     }
 
     /// Where inserting `v` adds the least distance (cost units), and how much.
@@ -135,6 +219,54 @@ impl Route<'_> {
                 })
             })
             .min_by_key(|&(i, added)| (added, i))
+    }
+}
+
+/// The current route scored, and the scoring of changes to it from the stop each
+/// leaves unchanged ([`Evaluator::evaluate_after`]).
+struct Scorer<'w> {
+    evaluator: Evaluator<'w>,
+    prefix: Prefix,
+    tail: Vec<Cell>,
+    evaluations: u64,
+    genes: u64,
+}
+
+impl<'w> Scorer<'w> {
+    /// Scores `path` whole.
+    fn evaluate(&mut self, path: &[Cell]) -> Evaluation {
+        self.evaluations += 1;
+        self.genes += path.len() as u64;
+        self.evaluator.evaluate(path)
+    }
+
+    /// Scores the route as it now is and keeps it as the prefix of the changes tried next.
+    fn settle(&mut self, route: &Route<'_>) -> Evaluation {
+        let path = route.path();
+        self.evaluations += 1;
+        self.genes += path.len() as u64;
+        self.evaluator
+            .evaluate_prefix(&mut self.prefix, &path, &route.stop_genes())
+    }
+
+    /// The route after `change` scored (the same [`Evaluation`] as scoring its path
+    /// whole), with the new legs; `None` if a leg cannot be descended.
+    fn try_change(
+        &mut self,
+        route: &Route<'_>,
+        change: Change,
+    ) -> Option<(Evaluation, Vec<Vec<Cell>>)> {
+        let (kept_to, new) = route.new_legs(change)?;
+        self.tail.clear();
+        for leg in new.iter().chain(route.kept_legs(change)) {
+            self.tail.extend_from_slice(leg);
+        }
+        self.evaluations += 1;
+        self.genes += (self.prefix.path().len() + self.tail.len()) as u64;
+        let e = self
+            .evaluator
+            .evaluate_after(&self.prefix, kept_to, &self.tail)?;
+        Some((e, new))
     }
 }
 
@@ -182,46 +314,43 @@ fn candidates(problem: &GreedyProblem<'_>, start_field: &[u32]) -> Vec<Cell> {
 /// Plans (see the module doc) until nothing improves, `deadline`, or `cancel`.
 pub fn run(problem: &GreedyProblem<'_>, deadline: Instant, cancel: &AtomicBool) -> GreedyResult {
     let world = problem.world;
-    let mut evaluator = Evaluator::new(
-        world,
-        problem.params,
-        Model::Novelty,
-        problem.goal,
-        problem.t_exec,
-    );
-    let mut evaluations = 0u64;
-    let mut genes = 0u64;
-    let mut evaluate = |path: &[Cell], evaluator: &mut Evaluator<'_>| {
-        evaluations += 1;
-        genes += path.len() as u64;
-        evaluator.evaluate(path)
+    let mut scorer = Scorer {
+        evaluator: Evaluator::new(
+            world,
+            problem.params,
+            Model::Novelty,
+            problem.goal,
+            problem.t_exec,
+        ),
+        prefix: Prefix::default(),
+        tail: Vec::new(),
+        evaluations: 0,
+        genes: 0,
     };
     let floor = problem.floor.to_vec();
-    let mut best_eval = evaluate(&floor, &mut evaluator);
+    let mut best_eval = scorer.evaluate(&floor);
     let mut best_path = floor;
     let stop = || cancel.load(Ordering::Relaxed) || Instant::now() >= deadline;
     let start_field = std::rc::Rc::new(distance_field(world, problem.start));
     let goal_field = std::rc::Rc::new(problem.goal_field.to_vec());
     let pool = candidates(problem, &start_field);
     let max_vias = MAX_VIAS.min((MAX_FIELD_ENTRIES / world.cell_count().max(1)).saturating_sub(2));
-    let mut route = Route {
-        world,
-        stops: vec![problem.start, problem.goal],
-        fields: vec![start_field, goal_field],
-    };
     // The route as routed (its legs are shortest paths, not the floor path itself).
-    let Some(routed) = route.path(None, None) else {
+    let Some(mut route) = Route::new(
+        world,
+        vec![problem.start, problem.goal],
+        vec![start_field, goal_field],
+    ) else {
         return GreedyResult {
             path: best_path,
             evaluation: best_eval,
             rounds: 0,
-            evaluations,
-            evaluated_genes: genes,
+            evaluations: scorer.evaluations,
+            evaluated_genes: scorer.genes,
             interrupted: false,
         };
     };
-    let mut current = evaluate(&routed, &mut evaluator);
-    let mut current_path = routed;
+    let mut current = scorer.settle(&route);
     let mut used = vec![false; pool.len()];
     let mut rounds = 0u32;
     let mut interrupted = false;
@@ -233,7 +362,7 @@ pub fn run(problem: &GreedyProblem<'_>, deadline: Instant, cancel: &AtomicBool) 
             break;
         }
         rounds += 1;
-        let mut pick: Option<(f64, usize, usize, Vec<Cell>, Evaluation)> = None;
+        let mut pick: Option<(f64, usize, Change, Vec<Vec<Cell>>)> = None;
         for (k, &v) in pool.iter().enumerate() {
             if used[k] || route.stops.contains(&v) {
                 continue;
@@ -241,10 +370,10 @@ pub fn run(problem: &GreedyProblem<'_>, deadline: Instant, cancel: &AtomicBool) 
             let Some((at, _)) = route.cheapest_place(v) else {
                 continue;
             };
-            let Some(path) = route.path(Some((at, v)), None) else {
+            let change = Change::Insert { at, v };
+            let Some((e, legs)) = scorer.try_change(&route, change) else {
                 continue;
             };
-            let e = evaluate(&path, &mut evaluator);
             let gained = e.model_information - current.model_information;
             if !fits(&e) || gained <= 0.0 {
                 continue;
@@ -252,19 +381,15 @@ pub fn run(problem: &GreedyProblem<'_>, deadline: Instant, cancel: &AtomicBool) 
             let seconds = (e.t_eta - current.t_eta).max(1e-6);
             let rate = gained / seconds;
             if pick.as_ref().is_none_or(|p| rate > p.0) {
-                pick = Some((rate, k, at, path, e));
+                pick = Some((rate, k, change, legs));
             }
         }
-        let Some((_, k, at, path, e)) = pick else {
+        let Some((_, k, change, legs)) = pick else {
             break;
         };
         used[k] = true;
-        route.stops.insert(at, pool[k]);
-        route
-            .fields
-            .insert(at, std::rc::Rc::new(distance_field(world, pool[k])));
-        current = e;
-        current_path = path;
+        route.apply(change, legs);
+        current = scorer.settle(&route);
     }
     // Step 3: remove each via-point and put back the fittest replacement, or none.
     let mut improved = true;
@@ -277,42 +402,40 @@ pub fn run(problem: &GreedyProblem<'_>, deadline: Instant, cancel: &AtomicBool) 
                 break;
             }
             rounds += 1;
-            let mut best: Option<(f64, Option<usize>, Vec<Cell>, Evaluation)> = None;
-            if let Some(path) = route.path(None, Some(i)) {
-                let e = evaluate(&path, &mut evaluator);
+            let mut best: Option<(f64, Option<usize>, Vec<Vec<Cell>>)> = None;
+            let removal = Change::Replace { i, v: None };
+            if let Some((e, legs)) = scorer.try_change(&route, removal) {
                 if fits(&e) {
-                    best = Some((e.fitness.total, None, path, e));
+                    best = Some((e.fitness.total, None, legs));
                 }
             }
             for (k, &v) in pool.iter().enumerate() {
                 if used[k] || route.stops.contains(&v) {
                     continue;
                 }
-                let Some(path) = route.path(Some((i, v)), Some(i)) else {
+                let change = Change::Replace { i, v: Some(v) };
+                let Some((e, legs)) = scorer.try_change(&route, change) else {
                     continue;
                 };
-                let e = evaluate(&path, &mut evaluator);
                 if fits(&e) && best.as_ref().is_none_or(|b| e.fitness.total > b.0) {
-                    best = Some((e.fitness.total, Some(k), path, e));
+                    best = Some((e.fitness.total, Some(k), legs));
                 }
             }
             match best {
-                Some((total, replacement, path, e)) if total > current.fitness.total => {
-                    let removed = route.stops.remove(i);
-                    route.fields.remove(i);
+                Some((total, replacement, legs)) if total > current.fitness.total => {
+                    let removed = route.stops[i];
                     if let Some(k) = pool.iter().position(|&c| c == removed) {
                         used[k] = false;
                     }
                     if let Some(k) = replacement {
                         used[k] = true;
-                        route.stops.insert(i, pool[k]);
-                        route
-                            .fields
-                            .insert(i, std::rc::Rc::new(distance_field(world, pool[k])));
+                    }
+                    let v = replacement.map(|k| pool[k]);
+                    route.apply(Change::Replace { i, v }, legs);
+                    if v.is_some() {
                         i += 1;
                     }
-                    current = e;
-                    current_path = path;
+                    current = scorer.settle(&route);
                     improved = true;
                 }
                 _ => i += 1,
@@ -321,14 +444,14 @@ pub fn run(problem: &GreedyProblem<'_>, deadline: Instant, cancel: &AtomicBool) 
     }
     if fits(&current) && current.fitness.total > best_eval.fitness.total {
         best_eval = current;
-        best_path = current_path;
+        best_path = scorer.prefix.path().to_vec();
     }
     GreedyResult {
         path: best_path,
         evaluation: best_eval,
         rounds,
-        evaluations,
-        evaluated_genes: genes,
+        evaluations: scorer.evaluations,
+        evaluated_genes: scorer.genes,
         interrupted,
     }
 }
