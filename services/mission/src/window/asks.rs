@@ -5,9 +5,9 @@
 use roam_planner::plan::MAX_T_EXEC_S;
 use roam_proto::mission::{AskReport, MAX_REPORTED_ASKS};
 
-use super::{
-    AheadAsk, DowntimeWindow, DriveAsk, Now, PlanAsk, WindowAction, LEAST_T_EXEC_S, MIN_DEADLINE_S,
-};
+use super::events::{Now, PlanAsk, WindowAction};
+use super::setup::{LEAST_T_EXEC_S, MIN_DEADLINE_S};
+use super::state::{AheadAsk, DowntimeWindow, DriveAsk};
 use crate::watch::Reason;
 
 impl DowntimeWindow<'_> {

@@ -5,10 +5,10 @@
 
 use roam_proto::mission::{TimeModelReport, WindowReport, MAX_REPORTED_ASKS};
 
-use super::{
-    DowntimeWindow, Drive, DrivenMission, Handover, Now, Phase, WindowAction, WindowEnd,
-    WindowOutcome, NO_PLAN_REASON,
-};
+use super::events::{DrivenMission, Now, WindowAction};
+use super::handover::{Handover, WindowEnd, WindowOutcome};
+use super::setup::NO_PLAN_REASON;
+use super::state::{DowntimeWindow, Drive, Phase};
 use crate::calibration::path_measure;
 
 impl DowntimeWindow<'_> {

@@ -3,7 +3,7 @@
 use roam_proto::controller::{ControllerStatus, Mission};
 use roam_proto::planner::Plan;
 
-use super::WindowEnd;
+use super::handover::WindowEnd;
 use crate::watch::Reason;
 
 /// When an event happens.

@@ -2,7 +2,7 @@
 
 use roam_proto::mission::WindowReport;
 
-use super::PlannedAhead;
+use super::routes::PlannedAhead;
 use crate::margin::ArrivalMargin;
 
 /// A window's outcome with the paths, for pictures.

@@ -6,7 +6,8 @@
 
 use roam_proto::controller::{ControllerStatus, MissionState};
 
-use super::{DowntimeWindow, Now, Phase, WindowAction};
+use super::events::{Now, WindowAction};
+use super::state::{DowntimeWindow, Phase};
 use crate::watch::{Reason, Status};
 
 impl DowntimeWindow<'_> {

@@ -3,7 +3,10 @@
 //! own track past its last fix with a recovery mission (which the guard lets through),
 //! then goes straight to the task from there (`heard.rs`).
 
-use super::{straight, DowntimeWindow, Now, Phase, WindowAction};
+use super::events::{Now, WindowAction};
+use super::setup::{MAX_RECOVERIES, RECOVERY_BACK_M};
+use super::state::{DowntimeWindow, Phase};
+use super::straight;
 use crate::path::mission_waypoints;
 use crate::watch::Replanned;
 
@@ -20,11 +23,11 @@ impl DowntimeWindow<'_> {
             now.mission_s
         });
         let held_s = now.mission_s - since;
-        let spent = drive.recoveries >= super::MAX_RECOVERIES;
+        let spent = drive.recoveries >= MAX_RECOVERIES;
         if !rules.recover || drive.recovering || spent || held_s < rules.hold_patience_s {
             return Vec::new();
         }
-        let back = straight::back_along(&self.driven, self.last_fix, super::RECOVERY_BACK_M);
+        let back = straight::back_along(&self.driven, self.last_fix, RECOVERY_BACK_M);
         let waypoints = mission_waypoints(&back, spacing);
         let mut actions = self.forget_drive_ask();
         let Phase::Driving(drive) = &mut self.phase else {

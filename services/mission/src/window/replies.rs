@@ -4,10 +4,10 @@
 
 use roam_proto::planner::Plan;
 
-use super::{
-    routes, AheadAsk, DowntimeWindow, DriveAsk, Follows, Now, Phase, PlanAsk, PlannedAhead, Route,
-    WindowAction, FALLBACK_AFTER_FAILURES, PLAN_RETRY_S,
-};
+use super::events::{Now, PlanAsk, WindowAction};
+use super::routes::{routes, PlannedAhead, Route};
+use super::setup::{FALLBACK_AFTER_FAILURES, PLAN_RETRY_S};
+use super::state::{AheadAsk, DowntimeWindow, DriveAsk, Follows, Phase};
 use crate::watch::{Reason, Replanned};
 
 impl DowntimeWindow<'_> {

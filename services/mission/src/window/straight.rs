@@ -5,7 +5,7 @@
 use roam_planner::params::GaParams;
 use roam_planner::search::fastest_path;
 
-use super::Route;
+use super::routes::Route;
 use crate::calibration::TimeModel;
 use crate::information::InformationScale;
 use crate::path::distance;

@@ -2,10 +2,14 @@
 //! 3 m east of the robot at 100 s, the next one 3 m north of the robot at 200 s.
 
 use super::*;
-use crate::calibration::path_measure;
+use crate::calibration::{path_measure, TimeModel};
+use crate::information::InformationScale;
+use crate::margin::ArrivalMargin;
+use crate::tasks::Task;
+use crate::watch::WatchParams;
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
-use roam_proto::controller::{ControllerStatus, MissionState};
+use roam_proto::controller::{ControllerStatus, Mission, MissionState};
 use roam_proto::map::{GridMeta, Origin};
 use roam_proto::mission::WindowReport;
 use roam_proto::planner::{FitnessTerms, MapVersion, Plan, PlannerModel, ShortestPath, StopReason};
