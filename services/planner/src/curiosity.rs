@@ -273,7 +273,7 @@ impl<'a> Evaluator<'a> {
     /// has perceived it; `on_new` hears of each such cell, `on_gene` of the state after
     /// each gene.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     fn walk(
         &mut self,
         state: &mut WalkState,
@@ -361,7 +361,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// M_xy of a newly perceived cell (Eqs. 8–10).
-    #[inline]
+    #[inline(always)]
     fn gain(&mut self, state: &mut WalkState, idx: usize, gene: u32, t: f64) -> f64 {
         match self.model {
             Model::Coverage => self.params.coverage_gain,
