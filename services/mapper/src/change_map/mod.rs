@@ -16,194 +16,24 @@
 //! **Time.** Observations must come in time order (the same time again is fine: several
 //! robots' windows of one instant merge by observing each in turn).
 
+mod params;
+mod scores;
+mod update;
+mod window;
+
 use roam_proto::map::GridMeta;
 use roam_world::grid::{occupancy, world_to_cell, Grid};
-use roam_world::observation::Observation;
 
 pub use crate::limits::MAX_MAP_CELLS;
-use serde::{Deserialize, Serialize};
 
 use crate::error::MapperError;
 use crate::features::{Features, TileCache};
-use crate::poisson::{CellProcess, Watch};
+use crate::poisson::CellProcess;
 
-/// A seen value at or above this is occupied, below it free.
-pub const OCCUPIED_FROM: i8 = 50;
-
-/// The change map's parameters.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MapParams {
-    /// The sensor period, seconds: sightings of a cell at most this far apart mean it
-    /// was watched the whole time in between (see [`crate::poisson`]). 1 s in the grid
-    /// world (one observation per sim step). Give a little more than the nominal
-    /// period when the sensor jitters.
-    pub observation_period_s: f64,
-    /// Whether a change found after a gap longer than the period is a Poisson event
-    /// (see [`crate::poisson`]; default false: only watched changes are events).
-    #[serde(default)]
-    pub events_across_gaps: bool,
-    /// Whether the learner's feature r = max_c r^c (paper 004 Eq. 4) runs over the cells
-    /// seen at least once only. The paper defines r^c = t_now − t_last^c through the
-    /// timestamp "each cell c that is observed" gets, and leaves a cell never observed
-    /// open. Default false: a cell never seen counts as the stalest
-    /// ([`ChangeMap::unseen_recency`]), as it does for recency goals; on grid004 four
-    /// wall corners are never seen, so r is then the run's clock, t − t_first + 1 s.
-    /// Leaving them out changed no result there (the crate doc's reproduction).
-    #[serde(default)]
-    pub r_over_seen_cells: bool,
-}
-
-impl Default for MapParams {
-    fn default() -> Self {
-        MapParams {
-            observation_period_s: 1.0,
-            events_across_gaps: false,
-            r_over_seen_cells: false,
-        }
-    }
-}
-
-impl MapParams {
-    /// The per-cell rule these parameters give.
-    pub fn watch(&self) -> Watch {
-        Watch {
-            period_s: self.observation_period_s,
-            events_across_gaps: self.events_across_gaps,
-        }
-    }
-}
-
-impl MapParams {
-    pub fn check(&self) -> Result<(), MapperError> {
-        let p = self.observation_period_s;
-        if !(p.is_finite() && p > 0.0) {
-            return Err(MapperError::Param {
-                field: "observation_period_s",
-                reason: format!("must be a positive number of seconds, got {p}"),
-            });
-        }
-        Ok(())
-    }
-}
-
-/// A sensor window: a rectangle of the map and what was seen in it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ObservationWindow<'a> {
-    /// The map cell at the window's lower-left corner.
-    pub x0: u32,
-    pub y0: u32,
-    pub width: u32,
-    pub height: u32,
-    /// Row-major from (x0, y0): -1 not seen, 0..=100 seen (see the module doc).
-    pub cells: &'a [i8],
-}
-
-impl<'a> From<&'a Observation> for ObservationWindow<'a> {
-    fn from(o: &'a Observation) -> Self {
-        ObservationWindow {
-            x0: o.x0,
-            y0: o.y0,
-            width: o.width,
-            height: o.height,
-            cells: &o.cells,
-        }
-    }
-}
-
-impl<'a> ObservationWindow<'a> {
-    /// The window of a sim observation from the wire (`sim/observation`), or `None`
-    /// when its cells are not i8 occupancy values. (Its fit to the map is the
-    /// mapper's check; [`ChangeMap::observe`] refuses a window that does not fit.)
-    pub fn from_wire(o: &'a roam_proto::sim::LocalObservation) -> Option<Self> {
-        let roam_proto::cells::Cells::I8(cells) = &o.cells else {
-            return None;
-        };
-        Some(ObservationWindow {
-            x0: o.x0,
-            y0: o.y0,
-            width: o.meta.width,
-            height: o.meta.height,
-            cells,
-        })
-    }
-}
-
-/// What one observation did to the map.
-#[derive(Debug, Clone, PartialEq, Default, Serialize)]
-pub struct Update {
-    /// The observation's time, seconds.
-    pub t: f64,
-    /// Cells seen in the window.
-    pub observed: u32,
-    /// Cells seen free where the map had them occupied, or the reverse.
-    pub flipped: Vec<(u32, u32)>,
-    /// Cells seen for the first time.
-    pub discovered: Vec<(u32, u32)>,
-    /// Poisson events recorded (flips that count as events, see [`crate::poisson`]).
-    pub events: u32,
-}
-
-impl Update {
-    /// The number of map changes: flips, and discoveries too if `count_discoveries`.
-    pub fn map_changes(&self, count_discoveries: bool) -> usize {
-        self.flipped.len()
-            + if count_discoveries {
-                self.discovered.len()
-            } else {
-                0
-            }
-    }
-
-    /// The changed cells: flips, then discoveries if `count_discoveries`.
-    pub fn changed(&self, count_discoveries: bool) -> impl Iterator<Item = (u32, u32)> + '_ {
-        let discovered: &[(u32, u32)] = if count_discoveries {
-            &self.discovered
-        } else {
-            &[]
-        };
-        self.flipped.iter().chain(discovered).copied()
-    }
-
-    /// The centroid of the changed cells, rounded to a cell (§2's local exploration
-    /// goal); `None` when nothing changed.
-    pub fn centroid(&self, count_discoveries: bool) -> Option<(u32, u32)> {
-        let (mut n, mut sx, mut sy) = (0u64, 0u64, 0u64);
-        for (x, y) in self.changed(count_discoveries) {
-            n += 1;
-            sx += u64::from(x);
-            sy += u64::from(y);
-        }
-        if n == 0 {
-            return None;
-        }
-        let round = |s: u64| ((s as f64 / n as f64).round() as u64).min(u64::from(u32::MAX)) as u32;
-        Some((round(sx), round(sy)))
-    }
-
-    /// Folds another update of the same map into this one (several robots' windows of
-    /// one instant); the time is the later one's.
-    pub fn merge(&mut self, other: Update) {
-        self.t = self.t.max(other.t);
-        self.observed = self.observed.saturating_add(other.observed);
-        self.flipped.extend(other.flipped);
-        self.discovered.extend(other.discovered);
-        self.events = self.events.saturating_add(other.events);
-    }
-}
-
-/// Counts over the whole map.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
-pub struct MapStats {
-    /// Cells seen at least once.
-    pub seen_cells: u64,
-    /// Cells with at least one event (a rate above zero).
-    pub active_cells: u64,
-    /// Poisson events recorded since the start.
-    pub events: u64,
-    /// Observations taken.
-    pub observations: u64,
-}
+pub use params::MapParams;
+pub use scores::{percent, scores};
+pub use update::{MapStats, Update};
+pub use window::{ObservationWindow, OCCUPIED_FROM};
 
 /// The obstacle map, the Poisson processes and the feature caches of one map.
 #[derive(Debug, Clone)]
@@ -512,21 +342,6 @@ impl ChangeMap {
         } else {
             0.0
         }
-    }
-}
-
-/// Probabilities as paper 000's information scores: [`percent`] of each (NaN as 0).
-pub fn scores(probabilities: &[f64]) -> Vec<u8> {
-    probabilities.iter().map(|&p| percent(p)).collect()
-}
-
-/// A probability as a whole percentage, round(100 · p) with p clamped to 0..=1, NaN as 0:
-/// the one conversion behind the information scores and the map now's occupancy.
-pub fn percent(p: f64) -> u8 {
-    if p.is_nan() {
-        0
-    } else {
-        (p.clamp(0.0, 1.0) * 100.0).round() as u8
     }
 }
 
