@@ -1,0 +1,233 @@
+//! The executive on one robot: its Zenoh ends, what it keeps from window to window, and
+//! what it does for the window machine (plans asked, missions and statuses published,
+//! the clock and the first estimate waited for, the calibration fed).
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use roam_planner::client::PlannerClient;
+use roam_proto::controller::Mission;
+use roam_proto::keys;
+use roam_proto::mission::ExecutiveStatus;
+use roam_proto::planner::{Plan, PlannerModel};
+use roam_runtime::{lock, ClientError, Delivery};
+use tokio::task::JoinSet;
+use tokio_util::sync::CancellationToken;
+
+use crate::calibration::{path_measure, store, Calibration, TimeModel};
+use crate::config::ExecutiveConfig;
+use crate::error::ExecutiveError;
+use crate::inputs::Inputs;
+use crate::request::plan_request;
+use crate::window::{DrivenMission, Handover, Now, PlanAsk};
+
+/// A curious plan is expected to take this times the slowest recent one, plus
+/// [`PLAN_WALL_SLACK_S`].
+const PLAN_WALL_MARGIN: f64 = 1.5;
+const PLAN_WALL_SLACK_S: f64 = 0.05;
+
+/// How long the executive waits for the sim's clock at its start.
+const CLOCK_WAIT: Duration = Duration::from_secs(2);
+
+/// The executive on one robot while it runs its tasks: its Zenoh ends, and what it
+/// keeps from window to window.
+pub(super) struct Executive<'a> {
+    pub(super) session: &'a zenoh::Session,
+    pub(super) root: &'a str,
+    pub(super) config: &'a ExecutiveConfig,
+    pub(super) planner: Arc<PlannerClient>,
+    pub(super) inputs: Inputs,
+    /// The robot's last good estimate.
+    pub(super) position: Option<[f64; 2]>,
+    /// The robot's time calibration, fitted as it drives.
+    pub(super) calibration: Calibration,
+    /// Wall seconds the recent curious plans took (request to reply), the slowest.
+    pub(super) plan_wall_s: Option<f64>,
+    /// What the last window handed the next (the arrival margin, the mission and ask
+    /// counts, the next window's plan).
+    pub(super) handover: Handover,
+    /// This executive's own tag in its mission ids (from its Zenoh session id), so a
+    /// restarted executive never reuses an id its predecessor sent: the controller's
+    /// statuses on an old mission are not taken for a new one's.
+    pub(super) tag: String,
+    /// What it heard last, for its status.
+    pub(super) heard: Heard,
+}
+
+/// The sim steps of the last estimate and controller status the loop handled.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Heard {
+    pub(super) estimate_step: Option<u64>,
+    pub(super) status_step: Option<u64>,
+}
+
+/// A plan request's answer as the loop gets it back: the ask's id, whether it was
+/// curious, the wall seconds it took, and the reply.
+pub(super) type Answered = (u64, bool, f64, Result<Plan, ClientError>);
+
+impl Executive<'_> {
+    pub(super) fn now(&self) -> f64 {
+        lock(&self.inputs.clock).now_s()
+    }
+
+    /// The model plans are made with: the fit, or Table I when not calibrating.
+    pub(super) fn time_model(&self) -> TimeModel {
+        if self.config.calibrate {
+            self.calibration.model()
+        } else {
+            TimeModel::table_i()
+        }
+    }
+
+    /// What a curious plan costs on the mission clock: the config's fixed figure when
+    /// it sets one, else the wall time the last ones took (with a margin; the deadline
+    /// until one was measured) at the clock's rate. Charging the whole deadline would
+    /// waste it whenever the GA ends sooner (its generations, on a small map).
+    fn planning_cost_s(&self) -> f64 {
+        if let Some(cost) = self.config.planning_cost_s {
+            return cost;
+        }
+        let wall = self.plan_wall_s.map_or(self.config.plan_deadline_s, |w| {
+            (w * PLAN_WALL_MARGIN + PLAN_WALL_SLACK_S).min(self.config.plan_deadline_s)
+        });
+        wall * lock(&self.inputs.clock).rate()
+    }
+
+    /// The machine's time: the mission clock, wall seconds since `began`, what a plan
+    /// costs now, and the clock's rate.
+    pub(super) fn moment(&self, began: Instant) -> Now {
+        Now {
+            mission_s: self.now(),
+            wall_s: began.elapsed().as_secs_f64(),
+            planning_cost_s: self.planning_cost_s(),
+            clock_rate: lock(&self.inputs.clock).rate(),
+        }
+    }
+
+    /// Sends the request `ask` describes ([`plan_request`]) without waiting: its answer
+    /// joins `in_flight`.
+    pub(super) fn ask(&self, ask: &PlanAsk, in_flight: &mut JoinSet<Answered>) {
+        let request = plan_request(self.config, ask, self.time_model());
+        let planner = self.planner.clone();
+        let (id, curious) = (ask.id, ask.curious);
+        in_flight.spawn(async move {
+            let asked = Instant::now();
+            let reply = planner.plan(&request).await;
+            (id, curious, asked.elapsed().as_secs_f64(), reply)
+        });
+    }
+
+    /// Learns what a curious plan costs from one that came back.
+    pub(super) fn took(&mut self, plan: &Plan, took_s: f64) {
+        // Only what the GA took says what a curious plan costs (a fallback to the
+        // shortest path is answered at once).
+        if plan.model != PlannerModel::Shortest {
+            // The slowest of the recent plans, forgetting slowly.
+            self.plan_wall_s = Some(self.plan_wall_s.map_or(took_s, |w| took_s.max(0.8 * w)));
+        }
+    }
+
+    /// Sends `mission`, decided on the last estimate heard: the controller starts it
+    /// after answering that estimate ([`Mission::after_step`]), as the batch does.
+    pub(super) fn publish(&self, mission: &Mission) {
+        let key = keys::robot_mission(self.root, &self.config.robot);
+        let mission = Mission {
+            after_step: self.heard.estimate_step,
+            ..mission.clone()
+        };
+        roam_runtime::publish_wait(self.session, &key, &mission, Delivery::Reliable);
+    }
+
+    /// What the executive is doing, for operators and for lock-step drivers: the sim
+    /// steps of the last estimate and controller status it handled, and the plans in
+    /// flight.
+    pub(super) fn publish_status(&self, window: usize, asks: usize) {
+        let heard = self.heard;
+        let key = keys::robot_executive(self.root, &self.config.robot);
+        let status = ExecutiveStatus {
+            robot: self.config.robot.clone(),
+            window,
+            estimate_step: heard.estimate_step,
+            status_step: heard.status_step,
+            plans_in_flight: asks as u32,
+        };
+        roam_runtime::publish_wait(self.session, &key, &status, Delivery::Latest);
+    }
+
+    /// Waits briefly for the sim's clock, so that an executive restarted mid-mission
+    /// sees the mission time and skips the tasks that ended while it was down. Without
+    /// a sim (a real fleet on wall time) it goes on after the wait.
+    pub(super) async fn hear_the_clock(
+        &self,
+        cancel: &CancellationToken,
+    ) -> Result<(), ExecutiveError> {
+        let waited = Instant::now();
+        while !lock(&self.inputs.clock).heard() && waited.elapsed() < CLOCK_WAIT {
+            tokio::select! {
+                _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
+                _ = tokio::time::sleep(Duration::from_millis(20)) => {}
+            }
+        }
+        Ok(())
+    }
+
+    pub(super) async fn first_position(
+        &mut self,
+        cancel: &CancellationToken,
+    ) -> Result<[f64; 2], ExecutiveError> {
+        if let Some(p) = self.position {
+            return Ok(p);
+        }
+        let waited = Duration::from_secs(30);
+        let deadline = tokio::time::sleep(waited);
+        tokio::pin!(deadline);
+        loop {
+            tokio::select! {
+                _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
+                _ = &mut deadline => {
+                    return Err(ExecutiveError::NoEstimate { robot: self.config.robot.clone(), waited });
+                }
+                sample = self.inputs.estimates.recv_async() => {
+                    let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };
+                    if let Some(e) = self.inputs.estimate(&sample) {
+                        self.heard.estimate_step = Some(e.step);
+                        if !e.degraded {
+                            self.position = Some(e.position);
+                            // A sim that stepped for this estimate published its clock
+                            // too: the window begins on the sim's time, not on wall time.
+                            self.hear_the_clock(cancel).await?;
+                            lock(&self.inputs.clock).heard_at(e.time_s);
+                            return Ok(e.position);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The calibration learns from the mission that arrived (its Σd and Σθ as Eq. 2
+    /// counts them on the cells, and how long driving it took) and keeps the fit in the
+    /// calibration file.
+    pub(super) fn calibrate(&mut self, window: usize, drive: &DrivenMission) {
+        if !self.config.calibrate {
+            return;
+        }
+        let (d, theta) = path_measure(&drive.path);
+        if !self.calibration.add_planned(d, theta, drive.took_s) {
+            return;
+        }
+        if let Some(path) = &self.config.calibration_file {
+            if let Err(e) = store::save(path, &self.config.robot, &self.calibration) {
+                tracing::warn!("{e}");
+            }
+        }
+        let fitted = self.calibration.model();
+        tracing::info!(
+            window,
+            v_lin = fitted.v_lin,
+            v_ang = fitted.v_ang,
+            took_s = drive.took_s,
+            "time model updated from the window's driving"
+        );
+    }
+}
