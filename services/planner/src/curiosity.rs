@@ -419,8 +419,8 @@ mod tests {
         World::new(&Grid::filled(meta, 0i8), &information, 0.25).expect("world")
     }
 
-    /// Issue 18: any u8 layer can be the information map, and a score above 100 indexed
-    /// past Model I's tables. A world clamps it to 100, so a 255 cell counts as a 100
+    /// Any u8 layer can be the information map, and a score above 100 would index past
+    /// Model I's tables. A world clamps it to 100, so a 255 cell counts as a 100
     /// cell, and the clamping is reported.
     #[test]
     fn a_score_of_255_is_clamped_to_100_and_model_one_does_not_panic() {

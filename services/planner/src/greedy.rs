@@ -1,4 +1,4 @@
-//! A peer for the GA (issue 16): greedy insertion of informative via-points by
+//! A peer for the GA: greedy insertion of informative via-points by
 //! information per second, with local improvement, within the budget. Model `greedy`.
 //!
 //! Paper 000 compares its GA only with a coverage GA (Model 0) and the shortest path. A

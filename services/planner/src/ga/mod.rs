@@ -16,7 +16,7 @@
 //!   plan just because no random walk happened to fit. These three choices (budget cap,
 //!   finish at G, shortest path) force "on time at the goal";
 //!   [`GaParams::random_walks_only`] turns all three off, for the reproduction.
-//! - Round trips (roam, issue 14; [`GaParams::walk_end_share`], default 0.5): a walk
+//! - Round trips (roam's; [`GaParams::walk_end_share`], default 0.5): a walk
 //!   ends only once its t_ETA (Eq. 2, summed as it walks) has reached
 //!   `walk_end_share · t_exec`. Before that, arriving at G does not end it (it walks on
 //!   through G) and neither does its drawn length; after that, the first of the two
@@ -27,7 +27,7 @@
 //!   heading back. Far goals change little: a walk that reaches G late, or is drawn
 //!   long (random walks turn at almost every step, so they cost several times the
 //!   budget's cells), has used the share anyway. `walk_end_share = 0` is the paper's rule.
-//! - Via-point seeds (roam, issue 14; [`GaParams::via_share`], default 0.25): that share
+//! - Via-point seeds (roam's; [`GaParams::via_share`], default 0.25): that share
 //!   of the first population is built by [`crate::seeds`] (paths through cells drawn ∝
 //!   information, joined by shortest paths, within the budget) and handed in with the
 //!   shortest path as [`Problem::seed_paths`]; the rest are random walks.

@@ -294,7 +294,7 @@ mod tests {
         }
     }
 
-    /// Issue 14: with S = G the round-trip rule makes every walk a loop that used at
+    /// With S = G the round-trip rule makes every walk a loop that used at
     /// least `walk_end_share` of the budget before heading back (the paper's rule makes
     /// every walk the one cell S), and crossover and mutation keep every chromosome a
     /// legal path from S back to S.

@@ -168,8 +168,8 @@ pub(super) struct Checked {
     pub(super) fastest_t_eta_s: f64,
     pub(super) budget_fits: bool,
     /// The path the GA's first population holds and [`best_of`] never falls below: the
-    /// distance-shortest path when it fits the budget (as before issue 16, so plans
-    /// whose budget admits it are unchanged bit for bit), else the fastest path.
+    /// distance-shortest path when it fits the budget (the paper's floor, which the
+    /// reproductions pin bit for bit), else the fastest path.
     pub(super) shortest: Vec<Cell>,
     /// The GA's size; `None` for the baseline.
     pub(super) size: Option<PlanSize>,

@@ -6,12 +6,11 @@
 //! when any of its 5 cm cells is seen occupied now, seen free when none is and none of
 //! its others is still believed occupied from an earlier sighting, and not seen
 //! otherwise (it keeps its state, and its belief fades with its rates, as a 5 cm cell
-//! nobody looks at). Laying each window onto the coarse cells alone (occupied when any
-//! seen map cell is, free otherwise) was the old rule, and it let a robot looking along
-//! a pallet's face, which sees few of the face's cells (the grid's line of sight runs
-//! centre to centre), write the face's coarse cells free over the view of the robot
-//! standing at the pallet: the fleet planned through the pallet for a minute and the
-//! robot was late.
+//! nobody looks at). Why not lay each window onto the coarse cells alone (occupied when
+//! any seen map cell is, free otherwise): a robot looking along a pallet's face sees few
+//! of the face's cells (the grid's line of sight runs centre to centre), so its view
+//! would write the face's coarse cells free over the view of the robot standing at the
+//! pallet, and the fleet would plan through the pallet.
 
 use roam_mapper::belief::{belief_layer, BeliefParams};
 use roam_mapper::change_map::{ChangeMap, MapParams, ObservationWindow};

@@ -11,8 +11,8 @@
 //! **Seeds and common random numbers.** Repetition r's seed is
 //! `seed::derive(options.seed, [r])` ([`run_seed`]) for *every* mode: the mode is left
 //! out on purpose, so the modes are compared on the same random numbers rather than on
-//! different ones (issue 18: with the mode in the seed, a difference between two modes
-//! mixed their effect with their luck, and 5 repetitions are few to average luck out).
+//! different ones (with the mode in the seed, a difference between two modes would mix
+//! their effect with their luck, and 5 repetitions are few to average luck out).
 //! The sim and the explorer take their own labelled streams of that seed (the sim's
 //! `"world"` and `"robot/<name>"`, the explorer's `"tiles"` and `"explorer/…"`, see
 //! [`roam_world::seed`] and [`roam_mapper::explorer`]), so no consumer's draws depend on another's:
