@@ -15,7 +15,7 @@ use roam_experiments::reproduce::fleet::{self, FleetOptions, FleetReport, FleetV
 use roam_mapper::news::DEFAULT_NEWS_PRIOR;
 use roam_mission::calibration::TimeModel;
 use roam_mission::shift::WAREHOUSE_SCENARIO;
-use roam_planner::coupling::news_product;
+use roam_planner::coupling::{Coupling, DEFAULT_NEWS_FLOOR};
 use roam_proto::planner::{Plan, PlanRequest, PlannerModel};
 
 const SHIFT: &str = "
@@ -114,7 +114,8 @@ fn plan_on_news(world: &FleetWorld, mapper: &FleetMapper, robot: usize, name: &s
         .news_scores(robot, name, 0.0, true)
         .expect("news scores");
     let mut coupled = world.planning.clone();
-    coupled.information = news_product(&world.planning.information, &news);
+    coupled.information =
+        Coupling::News.apply(&world.planning.information, &news, DEFAULT_NEWS_FLOOR);
     coupled.set_heuristic_compression(coupled.heuristic_compression);
     let request = PlanRequest {
         request_id: None,

@@ -9,6 +9,7 @@
 //! information_layer: information  # or change_information: plan on the mapper's P(E>0)
 //! change_layer: change_information # optional: plan on max(information, change) (crate::coupling)
 //! coupling: max                # or news: interest × the probability of news (crate::coupling::news_product), with change_layer: news
+//! news_floor: 0.25             # 0..=1: the share of interest a just-seen cell keeps under coupling: news
 //! obstacles_layer: occupied_now # optional: plan around what the fleet saw occupied (crate::seen)
 //! obstacle_inflation_m: 0.3    # how far around each such cell, metres (0..=5)
 //! planning_resolution_m: 0.2   # optional; default 0.2 (paper 000), or the map's if coarser (crate::resolution)
@@ -57,6 +58,10 @@ pub struct PlannerConfig {
     /// best interest ([`crate::coupling::news_product`]), with the mapper's `news` layer
     /// as `change_layer` (required).
     pub coupling: Coupling,
+    /// The news product's floor ε, 0 to 1 ([`crate::coupling`]: why a floor): the share
+    /// of its interest a cell keeps however recently a robot saw it. Used by `coupling:
+    /// news` only.
+    pub news_floor: f64,
     /// An i8 layer of the world now (the mapper's `occupied_now`): cells it believes
     /// occupied where the static map is free are planned around ([`crate::seen`]). Off
     /// by default.
@@ -99,6 +104,7 @@ impl Default for PlannerConfig {
             information_layer: crate::maps::INFORMATION.to_owned(),
             change_layer: None,
             coupling: Coupling::Max,
+            news_floor: crate::coupling::DEFAULT_NEWS_FLOOR,
             obstacles_layer: None,
             obstacle_inflation_m: 0.3,
             planning_resolution_m: None,
@@ -153,6 +159,10 @@ mod tests {
         let news: PlannerConfig =
             serde_json::from_str(r#"{"change_layer": "news", "coupling": "news"}"#).expect("news");
         assert_eq!(news.coupling, Coupling::News);
+        assert_eq!(news.news_floor, crate::coupling::DEFAULT_NEWS_FLOOR);
+        let floorless: PlannerConfig =
+            serde_json::from_str(r#"{"coupling": "news", "news_floor": 0}"#).expect("floor 0");
+        assert_eq!(floorless.news_floor, 0.0);
         assert!(serde_json::from_str::<PlannerConfig>(r#"{"coupling": "sum"}"#).is_err());
     }
 }

@@ -25,19 +25,31 @@
 //! on
 //!
 //! ```text
-//! I'_xy = round(I_xy · N_xy · max(I) / max(I · N))      (N_xy = round(100 · P_news))
+//! w_xy  = ε + (1 − ε) · N_xy / 100                      (N_xy = round(100 · P_news))
+//! I'_xy = round(I_xy · w_xy · max(I) / max(I · w))
 //! ```
 //!
 //! interest × the probability that there is news: what a look at the cell is expected to
 //! find that the fleet does not know, scaled so that the best news on the map is worth
-//! the best interest. A cell just seen, or on another robot's plan, is worth nothing
-//! however interesting; where nothing was seen, I' = I; a cell of no interest stays at 0
-//! however much it changes (what is worth a look is the operator's information map; the
-//! news only weighs it). The product cannot leave paper 000's 0–100 scale (I' ≤ max I),
-//! and it needs no "early in the day" escape as the maximum does: the news value's prior
+//! the best interest. ε is the **news floor** (`news_floor`, default
+//! [`DEFAULT_NEWS_FLOOR`]): the share of its interest a cell keeps however recently it
+//! was seen. Where nothing was seen, I' = I; a cell of no interest stays at 0 however
+//! much it changes (what is worth a look is the operator's information map; the news
+//! only weighs it). The product cannot leave paper 000's 0–100 scale (I' ≤ max I), and
+//! it needs no "early in the day" escape as the maximum does: the news value's prior
 //! makes every cell news as time passes unseen, so the map never goes dark. Pair it with
 //! the `news` layer, not with `change_information`, which is 0 wherever no event was
 //! seen.
+//!
+//! **Why a floor** (roam's choice; measured in `roam reproduce fleet`, seed 0, one
+//! shift). With ε = 0 a cell just seen, or on another robot's plan, is worth nothing:
+//! the planner then threads its route between the fleet's recent looks, drives a median
+//! 0.29 of each window and detected changes in a median 489 s, worse than ten robots
+//! planning on the static map alone (`independent`, 0.70 of each window). With ε = 0.25
+//! a look at a just-seen cell still counts for a quarter of its interest, so the news
+//! decides where a robot goes first without making the rest of the map a wall of zeros:
+//! the fleet drove 0.64 of each window, detected in a median 144 s, and its belief's
+//! Brier score fell from 0.0140 to 0.0084, with no window late.
 //!
 //! **Why scaled** (the parameter of the rule: the scale is the map's own best news; the
 //! choice is roam's). Unscaled, I · N / 100 shrinks as the fleet keeps looking: an hour
@@ -60,16 +72,29 @@ pub enum Coupling {
     /// I' = max(I, C) (default).
     #[default]
     Max,
-    /// I' = round(I · N · max(I) / max(I · N)), N the news scores ([`news_product`]).
+    /// I' = round(I · w · max(I) / max(I · w)), w = ε + (1 − ε) · N / 100, N the news
+    /// scores and ε the news floor ([`news_product`]).
     News,
 }
 
+/// The news floor ε by default (module doc: why a floor).
+pub const DEFAULT_NEWS_FLOOR: f64 = 0.25;
+
+/// The config key of the news floor, named in its errors.
+pub const NEWS_FLOOR_NAME: &str = "news_floor";
+
+/// Whether `floor` is a news floor the coupling takes: a share, 0 to 1.
+pub fn is_news_floor(floor: f64) -> bool {
+    floor.is_finite() && (0.0..=1.0).contains(&floor)
+}
+
 impl Coupling {
-    /// The coupled information map; `change` as long as `information`.
-    pub fn apply(self, information: &[u8], change: &[u8]) -> Vec<u8> {
+    /// The coupled information map; `change` as long as `information`; `news_floor`
+    /// the news product's ε (unused by `max`).
+    pub fn apply(self, information: &[u8], change: &[u8], news_floor: f64) -> Vec<u8> {
         match self {
             Coupling::Max => couple(information, change),
-            Coupling::News => news_product(information, change),
+            Coupling::News => news_product(information, change, news_floor),
         }
     }
 
@@ -99,20 +124,35 @@ pub fn couple(information: &[u8], change: &[u8]) -> Vec<u8> {
         .collect()
 }
 
-/// I'_xy = round(I_xy · N_xy · max(I) / max(I · N)) cell by cell (module doc): the
-/// news product scaled so that the best news on the map is worth the best interest; N
-/// above 100 taken as 100; `news` as long as `information`. All 0 when there is no news.
-pub fn news_product(information: &[u8], news: &[u8]) -> Vec<u8> {
-    let products: Vec<u32> = information
+/// I'_xy = round(I_xy · w_xy · max(I) / max(I · w)), w_xy = ε + (1 − ε) · N_xy / 100,
+/// cell by cell (module doc): the news product with the news floor ε = `floor`, scaled
+/// so that the best news on the map is worth the best interest; N above 100 taken as
+/// 100; `news` as long as `information`. All 0 when there is no news (ε = 0 and N = 0
+/// everywhere).
+///
+/// Exact in integers: ε is taken in thousandths (f = round(1000 · ε), clamped to
+/// 0..=1000, so 0.25 is exactly 250), w in units of 1/100,000, and the scaling rounds
+/// halves up, so the same maps give the same scores on every machine.
+pub fn news_product(information: &[u8], news: &[u8], floor: f64) -> Vec<u8> {
+    let floor_thousandths = if floor.is_finite() {
+        (floor.clamp(0.0, 1.0) * 1000.0).round() as u32
+    } else {
+        0
+    };
+    let products: Vec<u64> = information
         .iter()
         .zip(news)
-        .map(|(&i, &n)| u32::from(i) * u32::from(n.min(100)))
+        .map(|(&i, &n)| {
+            let weight =
+                floor_thousandths * 100 + (1000 - floor_thousandths) * u32::from(n.min(100));
+            u64::from(i) * u64::from(weight)
+        })
         .collect();
     let top_product = products.iter().copied().max().unwrap_or(0);
     let top_interest = information
         .iter()
         .take(products.len())
-        .map(|&i| u32::from(i))
+        .map(|&i| u64::from(i))
         .max()
         .unwrap_or(0);
     if top_product == 0 {
@@ -121,9 +161,9 @@ pub fn news_product(information: &[u8], news: &[u8]) -> Vec<u8> {
     products
         .iter()
         .map(|&p| {
-            // Exact in integers, halves rounded up; at most top_interest, so within u8.
-            let scaled = (u64::from(p) * u64::from(top_interest) * 2 + u64::from(top_product))
-                / (2 * u64::from(top_product));
+            // Halves rounded up; at most top_interest, so within u8. p ≤ 255 · 100,000,
+            // so the product with top_interest stays far inside u64.
+            let scaled = (p * top_interest * 2 + top_product) / (2 * top_product);
             u8::try_from(scaled).unwrap_or(u8::MAX)
         })
         .collect()
@@ -143,40 +183,78 @@ mod tests {
     }
 
     #[test]
-    fn the_news_product_is_interest_times_the_probability_of_news_scaled_to_the_best() {
+    fn without_a_floor_the_news_product_is_interest_times_the_probability_of_news_scaled_to_the_best(
+    ) {
         // All news: the interest itself.
         assert_eq!(
-            news_product(&[80, 40, 0, 10], &[100; 4]),
+            news_product(&[80, 40, 0, 10], &[100; 4], 0.0),
             vec![80, 40, 0, 10]
         );
         // Interest 80 at N 0, 50, 100; 0 stays 0; 55 × 50 → 27.5 rounds up; N above
         // 100 counts as 100.
         assert_eq!(
-            news_product(&[80, 80, 80, 0, 55, 40], &[0, 50, 100, 100, 50, 255]),
+            news_product(&[80, 80, 80, 0, 55, 40], &[0, 50, 100, 100, 50, 255], 0.0),
             vec![0, 40, 80, 0, 28, 40]
         );
         // Little news anywhere (the fleet looked everywhere lately): the best of it is
         // worth the best interest, the rest in proportion, so the planner's trade-offs
         // (the PEB cost, the idle term) meet the same scale as on the static map.
         assert_eq!(
-            news_product(&[80, 40, 40, 10], &[2, 4, 1, 0]),
+            news_product(&[80, 40, 40, 10], &[2, 4, 1, 0], 0.0),
             vec![80, 80, 20, 0]
         );
-        assert_eq!(news_product(&[80, 40], &[0, 0]), vec![0, 0]);
-        assert_eq!(Coupling::News.apply(&[80, 30], &[25, 100]), vec![53, 80]);
-        assert_eq!(Coupling::Max.apply(&[80, 30], &[25, 100]), vec![80, 100]);
+        assert_eq!(news_product(&[80, 40], &[0, 0], 0.0), vec![0, 0]);
+        assert_eq!(
+            Coupling::News.apply(&[80, 30], &[25, 100], 0.0),
+            vec![53, 80]
+        );
+        assert_eq!(
+            Coupling::Max.apply(&[80, 30], &[25, 100], 0.5),
+            vec![80, 100]
+        );
         assert_eq!(Coupling::default(), Coupling::Max);
-        // Exhaustively on two cells: never above the best interest, the best product at
-        // it, and in the order of I · N.
-        for i in (0..=200u8).step_by(5) {
-            for n in 0..=100u8 {
-                let got = news_product(&[i, 200], &[n, 1]);
-                let (a, b) = (u32::from(i) * u32::from(n), 200);
-                let top = a.max(b);
-                let want = |p: u32| (f64::from(p) * 200.0 / f64::from(top)).round();
-                assert_eq!(f64::from(got[0]), want(a), "I {i}, N {n}");
-                assert_eq!(f64::from(got[1]), want(b), "I {i}, N {n}");
-                assert!(got[0].max(got[1]) == 200);
+    }
+
+    #[test]
+    fn the_news_floor_keeps_a_share_of_a_just_seen_cells_interest() {
+        // ε = 0.25: N 0, 50, 100 weigh 0.25, 0.625, 1.
+        assert_eq!(
+            news_product(&[80, 80, 80, 0], &[0, 50, 100, 100], 0.25),
+            vec![20, 50, 80, 0]
+        );
+        // No news anywhere: the interest scaled by the floor alone, so the map keeps
+        // its shape.
+        assert_eq!(news_product(&[80, 40], &[0, 0], 0.25), vec![80, 40]);
+        // ε = 1: the news is ignored; out-of-range floors are taken at the nearest end.
+        assert_eq!(news_product(&[80, 40], &[0, 100], 1.0), vec![80, 40]);
+        assert_eq!(news_product(&[80, 40], &[0, 100], 7.0), vec![80, 40]);
+        // Below 0 (or not a number) is no floor: the only news, worth 40 · 100, is worth
+        // the best interest.
+        assert_eq!(news_product(&[80, 40], &[0, 100], -1.0), vec![0, 80]);
+        assert_eq!(news_product(&[80, 40], &[0, 100], f64::NAN), vec![0, 80]);
+        assert!(is_news_floor(DEFAULT_NEWS_FLOOR));
+        assert!(!is_news_floor(1.5) && !is_news_floor(f64::NAN) && !is_news_floor(-0.1));
+    }
+
+    #[test]
+    fn the_news_product_never_passes_the_best_interest_and_keeps_the_order_of_interest_times_weight(
+    ) {
+        // Exhaustively on two cells, at three floors: the best product at the best
+        // interest, every cell at its exact ratio rounded half up.
+        for floor_thousandths in [0u32, 250, 600] {
+            let floor = f64::from(floor_thousandths) / 1000.0;
+            for i in (0..=200u8).step_by(5) {
+                for n in 0..=100u8 {
+                    let got = news_product(&[i, 200], &[n, 1], floor);
+                    let weight =
+                        |n: u8| floor_thousandths * 100 + (1000 - floor_thousandths) * u32::from(n);
+                    let (a, b) = (u32::from(i) * weight(n), 200 * weight(1));
+                    let top = a.max(b);
+                    let want = |p: u32| (f64::from(p) * 200.0 / f64::from(top)).round();
+                    assert_eq!(f64::from(got[0]), want(a), "ε {floor}, I {i}, N {n}");
+                    assert_eq!(f64::from(got[1]), want(b), "ε {floor}, I {i}, N {n}");
+                    assert!(got[0].max(got[1]) == 200);
+                }
             }
         }
     }

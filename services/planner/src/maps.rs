@@ -52,8 +52,9 @@ pub struct MapCache {
     /// The change layer coupled into the information map, if any, and its latest.
     change_layer: Option<String>,
     change: Option<Layer>,
-    /// How it is coupled ([`crate::coupling`]).
+    /// How it is coupled ([`crate::coupling`]), and the news product's floor ε.
     coupling: Coupling,
+    news_floor: f64,
     /// The layer of what the fleet has seen, planned around ([`crate::seen`]), if any,
     /// its latest, and how far its obstacles are inflated, metres.
     obstacles_layer: Option<String>,
@@ -87,9 +88,11 @@ impl MapCache {
         self
     }
 
-    /// This cache coupling its change layer by `rule` (default [`Coupling::Max`]).
-    pub fn coupled_by(mut self, rule: Coupling) -> Self {
+    /// This cache coupling its change layer by `rule` (default [`Coupling::Max`]), the
+    /// news product with the floor `news_floor` ([`crate::coupling::news_product`]).
+    pub fn coupled_by(mut self, rule: Coupling, news_floor: f64) -> Self {
         self.coupling = rule;
+        self.news_floor = news_floor;
         self
     }
 
@@ -221,7 +224,7 @@ impl MapCache {
         let info = Grid {
             meta: information.meta,
             cells: match change.map(|c| &c.cells) {
-                Some(Cells::U8(scores)) => self.coupling.apply(info, scores),
+                Some(Cells::U8(scores)) => self.coupling.apply(info, scores, self.news_floor),
                 _ => info.clone(),
             },
         };
@@ -351,7 +354,7 @@ pub(crate) mod tests {
     fn a_cache_coupled_by_the_news_product_plans_on_interest_times_news() {
         let mut cache = MapCache::new(4)
             .coupling_change(Some("news"))
-            .coupled_by(Coupling::News);
+            .coupled_by(Coupling::News, crate::coupling::DEFAULT_NEWS_FLOOR);
         cache.update(layer(INFLATED, 1, Cells::I8(vec![0; 4])));
         cache.update(layer(INFORMATION, 1, Cells::U8(vec![10, 20, 30, 40])));
         let coupled = cache
@@ -359,8 +362,9 @@ pub(crate) mod tests {
             .expect("a new world for the news layer");
         assert_eq!(coupled.change, Some(2));
         let (_, world) = cache.world(None).expect("world");
-        // I · N = 1000, 0, 1500, 1000, the best (1500) worth the best interest (40).
-        assert_eq!(world.information, vec![27, 0, 40, 27]);
+        // The weights ε + (1 − ε) · N / 100 at ε = 0.25 are 1, 0.25, 0.625, 0.4375, so
+        // I · w = 10, 5, 18.75, 17.5, the best (18.75) worth the best interest (40).
+        assert_eq!(world.information, vec![21, 11, 40, 37]);
     }
 
     #[test]

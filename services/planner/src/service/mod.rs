@@ -73,7 +73,7 @@ pub async fn run(
         maps: Mutex::new(
             MapCache::with_information(config.map_history, &config.information_layer)
                 .coupling_change(config.change_layer.as_deref())
-                .coupled_by(config.coupling)
+                .coupled_by(config.coupling, config.news_floor)
                 .avoiding_seen(
                     config.obstacles_layer.as_deref(),
                     config.obstacle_inflation_m,

@@ -75,6 +75,17 @@ pub fn check_config(config: &PlannerConfig) -> Result<(), PlannerError> {
             config.coupling.as_str()
         )));
     }
+    if !crate::coupling::is_news_floor(config.news_floor) {
+        return Err(SettingError {
+            name: crate::coupling::NEWS_FLOOR_NAME,
+            value: config.news_floor.to_string(),
+            allowed: format!(
+                "a share from 0 to 1 (default {})",
+                crate::coupling::DEFAULT_NEWS_FLOOR
+            ),
+        }
+        .into());
+    }
     if let Some(obstacles) = &config.obstacles_layer {
         keys::check_name("obstacles_layer", obstacles)
             .map_err(|e| PlannerError::Config(e.to_string()))?;
@@ -125,5 +136,24 @@ mod tests {
             ..alone
         };
         assert!(check_config(&paired).is_ok());
+    }
+
+    #[test]
+    fn a_news_floor_outside_zero_to_one_is_refused_by_name() {
+        for floor in [-0.1, 1.5, f64::NAN, f64::INFINITY] {
+            let config = PlannerConfig {
+                news_floor: floor,
+                ..PlannerConfig::default()
+            };
+            let e = check_config(&config).expect_err("refused").to_string();
+            assert!(e.contains("news_floor") && e.contains("0 to 1"), "{e}");
+        }
+        for floor in [0.0, 0.25, 1.0] {
+            let config = PlannerConfig {
+                news_floor: floor,
+                ..PlannerConfig::default()
+            };
+            assert!(check_config(&config).is_ok(), "{floor}");
+        }
     }
 }
