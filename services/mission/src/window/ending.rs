@@ -46,6 +46,7 @@ impl DowntimeWindow<'_> {
             outcome: Box::new(outcome),
             leave_at_s,
             retry_at_wall_s: None,
+            failures: 0,
         };
         let mut actions = vec![arrived];
         let ask_now = self.setup.next.is_some()

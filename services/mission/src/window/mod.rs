@@ -14,7 +14,9 @@
 //!    the robot will be when it comes (the window's time is not spent waiting for the
 //!    planner); if that plan fails the robot drives on and the slack rule may bring
 //!    curiosity back. Without it (or with no fastest path), a plan is asked for, and
-//!    asked again every [`PLAN_RETRY_S`] (wall) after a failure. After
+//!    asked again [`PLAN_RETRY_S`] (wall) after a failure, the wait doubling with each
+//!    failure in a row up to [`MAX_PLAN_RETRY_S`] (the next window's plan, asked while
+//!    the robot is at its task, backs off the same way). After
 //!    [`FALLBACK_AFTER_FAILURES`] failures the robot drives the fastest path the window
 //!    computes itself (no planner: degrade, don't stop) and curiosity comes back
 //!    through the slack rule.
@@ -74,8 +76,9 @@ pub use events::{DrivenMission, Now, PlanAsk, WindowAction, WindowEvent};
 pub use handover::{Handover, WindowEnd, WindowOutcome};
 pub use routes::{routes, PlannedAhead, Route};
 pub use setup::{
-    WindowRules, WindowSetup, FALLBACK_AFTER_FAILURES, MAX_RECOVERIES, MIN_DEADLINE_S,
-    NO_PLAN_REASON, PLAN_RETRY_S, PREPLAN_FROM_M, PREPLAN_LATE_S, RECOVERY_BACK_M, SAFE_CHECK_S,
+    plan_retry_after_s, WindowRules, WindowSetup, FALLBACK_AFTER_FAILURES, MAX_PLAN_RETRY_S,
+    MAX_RECOVERIES, MIN_DEADLINE_S, NO_PLAN_REASON, PLAN_RETRY_S, PREPLAN_FROM_M, PREPLAN_LATE_S,
+    RECOVERY_BACK_M, SAFE_CHECK_S,
 };
 pub use state::DowntimeWindow;
 

@@ -6,7 +6,7 @@ use roam_proto::planner::Plan;
 
 use super::events::{Now, PlanAsk, WindowAction};
 use super::routes::{routes, PlannedAhead, Route};
-use super::setup::{FALLBACK_AFTER_FAILURES, PLAN_RETRY_S};
+use super::setup::{plan_retry_after_s, FALLBACK_AFTER_FAILURES};
 use super::state::{AheadAsk, DowntimeWindow, DriveAsk, Follows, Phase};
 use crate::watch::{Reason, Replanned};
 
@@ -99,7 +99,7 @@ impl DowntimeWindow<'_> {
                     }
                 }
                 self.phase = Phase::FirstPlan {
-                    retry_at_wall_s: Some(now.wall_s + PLAN_RETRY_S),
+                    retry_at_wall_s: Some(now.wall_s + plan_retry_after_s(failures)),
                     failures,
                 };
                 Vec::new()
@@ -177,6 +177,7 @@ impl DowntimeWindow<'_> {
         let Phase::AtTask {
             leave_at_s,
             retry_at_wall_s,
+            failures,
             ..
         } = &mut self.phase
         else {
@@ -189,7 +190,8 @@ impl DowntimeWindow<'_> {
             .as_ref()
             .is_none_or(|n| now.mission_s > n.start_s + self.setup.give_up_after_s);
         if now.mission_s < *leave_at_s && !next_given_up {
-            *retry_at_wall_s = Some(now.wall_s + PLAN_RETRY_S);
+            *failures += 1;
+            *retry_at_wall_s = Some(now.wall_s + plan_retry_after_s(*failures));
             return Vec::new();
         }
         self.finish_at_task_end(now)

@@ -16,8 +16,24 @@ pub const PREPLAN_FROM_M: f64 = 0.5;
 pub const PREPLAN_LATE_S: f64 = 1.0;
 
 /// Wall seconds between two requests for a window's first plan (or the next window's)
-/// when none came: an outage costs downtime, not the mission.
+/// after the first failure: an outage costs downtime, not the mission.
 pub const PLAN_RETRY_S: f64 = 1.0;
+
+/// The longest wait between two such requests, wall seconds: the wait doubles with each
+/// failure in a row ([`plan_retry_after_s`]) up to this.
+pub const MAX_PLAN_RETRY_S: f64 = 8.0;
+
+/// Wall seconds to wait before asking again after `failures` failed requests in a row:
+/// [`PLAN_RETRY_S`] doubled for each failure after the first, at most
+/// [`MAX_PLAN_RETRY_S`]. Why back off: a refusal that retrying cannot cure soon (the
+/// next task's place inside what the fleet saw occupied, a budget too short for the
+/// path) was asked again every second until the window's end, 409 times in one
+/// warehouse window; an outage or a busy planner still gets its first retries within
+/// seconds.
+pub fn plan_retry_after_s(failures: u32) -> f64 {
+    let doublings = failures.saturating_sub(1).min(16);
+    (PLAN_RETRY_S * f64::from(1u32 << doublings)).min(MAX_PLAN_RETRY_S)
+}
 
 /// Failed first-plan requests after which the robot drives the window's own fastest
 /// path rather than wait on.

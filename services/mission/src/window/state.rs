@@ -109,11 +109,13 @@ pub(super) enum Phase {
         failures: u32,
     },
     Driving(Box<Drive>),
-    /// Arrived; at the task until `leave_at_s`.
+    /// Arrived; at the task until `leave_at_s`; the next window's plan asked again at
+    /// `retry_at_wall_s` after `failures` failures in a row.
     AtTask {
         outcome: Box<WindowOutcome>,
         leave_at_s: f64,
         retry_at_wall_s: Option<f64>,
+        failures: u32,
     },
     Done,
 }

@@ -763,6 +763,54 @@ fn learnt_margin() -> ArrivalMargin {
     m
 }
 
+/// A next-window plan refused again and again (say its place is inside what the fleet
+/// saw occupied) is asked again after 1, 2, 4, 8 and then every 8 wall seconds, not
+/// every second until the task ends.
+#[test]
+fn the_next_windows_plan_is_asked_again_later_after_each_failure_in_a_row() {
+    let f = fixture();
+    let (mut w, mission) = f.driving(true);
+    let mut ask = asked(&arrived(&mut w, &mission));
+    let mut wall_s = 1.0;
+    let mut waits = Vec::new();
+    for _ in 0..6 {
+        let refused = WindowEvent::PlanFailed { id: ask.id };
+        assert!(w.handle(refused, at(81.0, wall_s)).is_empty());
+        let refused_at = wall_s;
+        ask = loop {
+            wall_s += 0.25;
+            assert!(wall_s < 100.0, "never asked again");
+            let actions = w.handle(WindowEvent::Tick, at(81.0 + wall_s / 100.0, wall_s));
+            if let Some(WindowAction::RequestPlan(next)) = actions.first() {
+                break *next;
+            }
+        };
+        assert_eq!((ask.from, ask.to), (GOAL, NEXT));
+        waits.push(wall_s - refused_at);
+    }
+    assert_eq!(waits, vec![1.0, 2.0, 4.0, 8.0, 8.0, 8.0]);
+    // An answer at last is the next window's plan.
+    let next_route = line(GOAL, NEXT);
+    let reply = WindowEvent::PlanReply {
+        id: ask.id,
+        plan: Box::new(Plan {
+            shortest: attached(next_route.clone()),
+            ..plan(PlannerModel::Model1, next_route, 50.0)
+        }),
+    };
+    assert!(w.handle(reply, at(90.0, wall_s)).is_empty());
+    let end = ended(&w.handle(WindowEvent::Tick, at(105.0, wall_s + 1.0)));
+    assert!(end.handover.planned_ahead.is_some());
+}
+
+#[test]
+fn the_wait_before_asking_again_doubles_from_plan_retry_s_to_max_plan_retry_s() {
+    let waits: Vec<f64> = (1..=7).map(plan_retry_after_s).collect();
+    assert_eq!(waits, vec![1.0, 2.0, 4.0, 8.0, 8.0, 8.0, 8.0]);
+    assert_eq!(plan_retry_after_s(0), PLAN_RETRY_S);
+    assert_eq!(plan_retry_after_s(u32::MAX), MAX_PLAN_RETRY_S);
+}
+
 #[test]
 fn the_next_window_is_planned_during_the_task() {
     let f = fixture();
