@@ -155,6 +155,23 @@ pub enum PlanError {
 }
 
 impl PlanError {
+    /// A short token for what was refused, for counting refusals by kind (a batch's
+    /// report); the message says it to a person.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            PlanError::OffMap { which: "start", .. } => "start_off_map",
+            PlanError::OffMap { .. } => "goal_off_map",
+            PlanError::Blocked { which: "start", .. } => "start_blocked",
+            PlanError::Blocked { .. } => "goal_blocked",
+            PlanError::NoPath => "no_path",
+            PlanError::Pocket { .. } => "pocket",
+            PlanError::Enclosed { .. } => "enclosed",
+            PlanError::BudgetTooShort { .. } => "budget_too_short",
+            PlanError::Param(_) => "parameter",
+            PlanError::Limit(_) => "limit",
+        }
+    }
+
     pub fn to_reply(&self) -> ErrorReply {
         let message = self.to_string();
         let end = |which: &str, start: Cause, goal: Cause| {

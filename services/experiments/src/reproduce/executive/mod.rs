@@ -24,7 +24,7 @@
 
 pub mod track;
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 
 use roam_controller::controller::Decision;
 use roam_controller::status::controller_status;
@@ -71,9 +71,10 @@ pub struct Step {
 pub trait Io {
     /// The controller takes `mission` (an empty one holds the robot).
     fn send(&mut self, mission: &Mission) -> Result<(), EpisodeError>;
-    /// The planner's answer to `request`, asked at mission time `now_s`; `None` when it
-    /// refuses.
-    fn answer(&mut self, request: &PlanRequest, now_s: f64) -> Option<Plan>;
+    /// The planner's answer to `request`, asked at mission time `now_s`; when it
+    /// refuses, a short token for why (`roam_planner::plan::PlanError::kind`), counted
+    /// in the window's log.
+    fn answer(&mut self, request: &PlanRequest, now_s: f64) -> Result<Plan, &'static str>;
 }
 
 /// Why an executive in process stopped.
@@ -104,6 +105,9 @@ pub struct WindowLog {
     /// machine then goes on as the live executive does on a refusal, and the reports
     /// count them.
     pub refused_plans: u32,
+    /// The same refusals by kind (`roam_planner::plan::PlanError::kind`, or the batch's
+    /// own: `no_patrol`, `news`).
+    pub refusals: BTreeMap<&'static str, u32>,
 }
 
 /// A window that ended with an outcome.
@@ -379,8 +383,14 @@ impl<'a> InProcessExecutive<'a> {
                     WindowAction::RequestPlan(ask) => {
                         log.ga_plans += u32::from(ask.curious);
                         let request = plan_request(self.config, &ask, self.time_model());
-                        let answer = io.answer(&request, now);
-                        log.refused_plans += u32::from(answer.is_none());
+                        let answer = match io.answer(&request, now) {
+                            Ok(plan) => Some(plan),
+                            Err(why) => {
+                                log.refused_plans += 1;
+                                *log.refusals.entry(why).or_default() += 1;
+                                None
+                            }
+                        };
                         let cost_s = if ask.curious {
                             self.plan_wall_s.min(ask.deadline_s) * self.rate
                         } else {

@@ -1,6 +1,8 @@
 //! What the fleet's week is measured by: each window (late, the share driven, the
 //! information driven), the map error every sim minute, every change event, the plans.
 
+use std::collections::BTreeMap;
+
 use roam_controller::controller::{Decision, MissionStatus};
 use roam_mapper::brier::brier;
 use roam_mission::information::gathered;
@@ -32,6 +34,8 @@ pub struct WindowRecord {
     /// Plans the planner refused in the window (`None`: a live window, whose report
     /// does not say).
     pub refused_plans: Option<u32>,
+    /// The same refusals by kind (`roam_planner::plan::PlanError::kind`; empty live).
+    pub refusals: BTreeMap<&'static str, u32>,
 }
 
 impl WindowRecord {
@@ -55,6 +59,7 @@ impl WindowRecord {
             driven_information: track.information(&world.planning, &world.params),
             ga_plans: w.log.ga_plans,
             refused_plans: Some(w.log.refused_plans),
+            refusals: w.log.refusals.clone(),
         }
     }
 }
@@ -87,6 +92,7 @@ impl WindowRecord {
             driven_information: gathered(&world.planning, &world.params, truth),
             ga_plans: report.asks.iter().filter(|a| a.curious).count() as u32,
             refused_plans: None,
+            refusals: BTreeMap::new(),
         }
     }
 }

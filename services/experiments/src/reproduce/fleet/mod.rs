@@ -286,6 +286,14 @@ impl FleetReport {
                 s.wall_s,
             );
         }
+        for s in self.variants.iter().filter(|s| !s.refusals.is_empty()) {
+            let kinds: Vec<String> = s
+                .refusals
+                .iter()
+                .map(|(kind, n)| format!("{kind} {n}"))
+                .collect();
+            let _ = writeln!(out, "refused plans of {}: {}", s.variant, kinds.join(", "));
+        }
         out.push('\n');
         for g in &self.goals {
             let _ = writeln!(

@@ -1,5 +1,7 @@
 //! One variant's week in figures, and each figure's spread over the days.
 
+use std::collections::BTreeMap;
+
 use serde::Serialize;
 
 use crate::reproduce::mission::days::stats::{mean, median};
@@ -60,6 +62,9 @@ pub struct FleetSummary {
     /// they are counted so that a planner or localization error cannot hide as a
     /// fallback.
     pub refused_plans: Option<u64>,
+    /// The refused plans by kind (`roam_planner::plan::PlanError::kind`), so a storm of
+    /// one kind shows what it is.
+    pub refusals: BTreeMap<&'static str, u64>,
     pub localization_errors: Option<u64>,
     /// Curious plans per second of the planner's computing, and their latency.
     pub plans_per_s: Option<f64>,
@@ -158,6 +163,13 @@ pub fn summarize(week: &WeekRecord, shift_s: f64, days: usize) -> FleetSummary {
             .filter_map(|w| w.refused_plans)
             .map(u64::from)
             .reduce(|a, b| a + b),
+        refusals: week.windows.iter().flat_map(|w| &w.refusals).fold(
+            BTreeMap::new(),
+            |mut all, (&kind, &n)| {
+                *all.entry(kind).or_default() += u64::from(n);
+                all
+            },
+        ),
         localization_errors: week.localization_errors,
         plans_per_s: (plan_s > 0.0).then(|| lat.len() as f64 / plan_s),
         plan_p50_ms: quantile(&lat, 0.5).map(|s| s * 1e3),
@@ -179,6 +191,36 @@ mod tests {
         assert_eq!(
             Spread::of([3.0, f64::NAN, 1.0]),
             Some(Spread { min: 1.0, max: 3.0 })
+        );
+    }
+
+    #[test]
+    fn refused_plans_are_summed_by_kind_over_the_windows_that_count_them() {
+        use crate::reproduce::fleet::measure::WindowRecord;
+        use crate::reproduce::fleet::variant::FleetVariant;
+        let window = |refusals: &[(&'static str, u32)]| WindowRecord {
+            robot: 0,
+            day: 0,
+            task: "pick".into(),
+            window_s: 60.0,
+            late: false,
+            share: 0.5,
+            driven_information: 0.0,
+            ga_plans: 1,
+            refused_plans: Some(refusals.iter().map(|r| r.1).sum()),
+            refusals: refusals.iter().copied().collect(),
+        };
+        let mut week = WeekRecord::new(FleetVariant::News, 1);
+        week.windows = vec![
+            window(&[("goal_blocked", 3), ("no_path", 1)]),
+            window(&[]),
+            window(&[("goal_blocked", 2)]),
+        ];
+        let s = summarize(&week, 3600.0, 1);
+        assert_eq!(s.refused_plans, Some(6));
+        assert_eq!(
+            s.refusals.into_iter().collect::<Vec<_>>(),
+            vec![("goal_blocked", 5), ("no_path", 1)]
         );
     }
 }

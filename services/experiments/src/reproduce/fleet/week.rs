@@ -10,7 +10,7 @@ use roam_controller::params::ApfParams;
 use roam_mission::calibration::TimeModel;
 use roam_mission::config::ExecutiveConfig;
 use roam_mission::information::InformationScale;
-use roam_planner::coupling::news_product;
+use roam_planner::coupling::{Coupling, DEFAULT_NEWS_FLOOR};
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
 use roam_proto::controller::Mission;
@@ -108,7 +108,7 @@ impl Io for FleetIo<'_, '_> {
         Ok(())
     }
 
-    fn answer(&mut self, request: &PlanRequest, now_s: f64) -> Option<Plan> {
+    fn answer(&mut self, request: &PlanRequest, now_s: f64) -> Result<Plan, &'static str> {
         let started = Instant::now();
         let answer = self.plan(request, now_s);
         if request.model != PlannerModel::Shortest {
@@ -118,45 +118,49 @@ impl Io for FleetIo<'_, '_> {
     }
 }
 
+/// The planner's own answer on `world`, a refusal as its kind.
+fn answer_on(world: &World, request: &PlanRequest) -> Result<Plan, &'static str> {
+    roam_planner::answer::answer(world, request, 1).map_err(|e| e.kind())
+}
+
 impl FleetIo<'_, '_> {
-    fn plan(&mut self, request: &PlanRequest, now_s: f64) -> Option<Plan> {
+    fn plan(&mut self, request: &PlanRequest, now_s: f64) -> Result<Plan, &'static str> {
         let world = self.planning_world;
         if request.model == PlannerModel::Shortest {
-            return roam_planner::answer::answer(world, request, 1).ok();
+            return answer_on(world, request);
         }
         match self.planning {
-            Planning::Fastest | Planning::Static => {
-                roam_planner::answer::answer(world, request, 1).ok()
-            }
+            Planning::Fastest | Planning::Static => answer_on(world, request),
             Planning::Patrol => self.patrol(request),
             Planning::News { reservations, .. } => {
                 let news = self
                     .mapper
                     .news_scores(self.index, self.robot, now_s, reservations)
-                    .ok()?;
+                    .map_err(|_| "news")?;
                 let mut coupled = world.clone();
-                coupled.information = news_product(&world.information, &news);
+                coupled.information =
+                    Coupling::News.apply(&world.information, &news, DEFAULT_NEWS_FLOOR);
                 coupled.set_heuristic_compression(coupled.heuristic_compression);
-                roam_planner::answer::answer(&coupled, request, 1).ok()
+                answer_on(&coupled, request)
             }
         }
     }
 
     /// The patrol's route as the plan's answer: the planner's own answer for the
     /// shortest path (its fallback and its comparison), with the patrol as its route.
-    fn patrol(&mut self, request: &PlanRequest) -> Option<Plan> {
+    fn patrol(&mut self, request: &PlanRequest) -> Result<Plan, &'static str> {
         let world = self.planning_world;
         let shortest = PlanRequest {
             model: PlannerModel::Shortest,
             ..request.clone()
         };
-        let mut plan = roam_planner::answer::answer(world, &shortest, 1).ok()?;
-        let params = GaParams::with_overrides(&request.params).ok()?;
+        let mut plan = answer_on(world, &shortest)?;
+        let params = GaParams::with_overrides(&request.params).map_err(|_| "parameter")?;
         let model = TimeModel {
             v_lin: params.v_lin,
             v_ang: params.v_ang,
         };
-        let route = self.world.patrol.as_ref()?.route(
+        let route = self.world.patrol.as_ref().ok_or("no_patrol")?.route(
             world,
             model,
             request.start,
@@ -165,7 +169,7 @@ impl FleetIo<'_, '_> {
             *self.patrol_at,
         );
         let Some(route) = route else {
-            return Some(plan);
+            return Ok(plan);
         };
         *self.patrol_at = route.left_at;
         plan.model = request.model;
@@ -179,7 +183,7 @@ impl FleetIo<'_, '_> {
         plan.t_eta_s = route.t_eta_s;
         plan.reaches_goal = true;
         plan.within_budget = true;
-        Some(plan)
+        Ok(plan)
     }
 }
 

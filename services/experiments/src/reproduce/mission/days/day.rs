@@ -166,10 +166,10 @@ impl Io for DayIo<'_, '_> {
         self.robot.send(mission)
     }
 
-    fn answer(&mut self, request: &PlanRequest, now_s: f64) -> Option<Plan> {
+    fn answer(&mut self, request: &PlanRequest, now_s: f64) -> Result<Plan, &'static str> {
         self.planner
             .answer(request, self.robot.change_map(), now_s)
-            .ok()
+            .map_err(|e| e.kind())
     }
 }
 
