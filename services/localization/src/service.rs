@@ -27,7 +27,6 @@ use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, Upd
 use roam_proto::sim::{NamedPoint, RangeScan, SimClock};
 use roam_proto::{keys, ErrorCode, ErrorReply};
 use roam_runtime::warn_limit::WarnLimiter;
-use roam_runtime::world_check::{self, WorldMismatch};
 use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
 use roam_world::epoch::Epochs;
 use roam_world::scenario::load_or_builtin;
@@ -97,8 +96,6 @@ pub enum LocalizationServiceError {
     Scenario(#[from] roam_world::scenario::ScenarioError),
     #[error("the scenario's sensing model is unusable: {0}")]
     Model(#[from] LocalizationError),
-    #[error(transparent)]
-    World(#[from] WorldMismatch),
 }
 
 /// What the localization service's subscribers and queryables share: the session,
@@ -172,7 +169,7 @@ pub async fn run(
     )
     .await?;
     let world = roam_world::world_id::of_scenario(&scenario);
-    let world_guard = world_check::guard(&service, world.clone());
+    service.guard_world(world.clone());
     let fim = FimOptions {
         variance_derivative: config.variance_derivative,
         ..FimOptions::default()
@@ -221,7 +218,6 @@ pub async fn run(
     }
     service.announce().await?;
     service.run_until_stopped().await?;
-    world_guard.outcome()?;
     Ok(())
 }
 

@@ -12,9 +12,10 @@
 //!    the tasks that did not stop, drops the liveliness token and closes the session.
 
 use std::future::Future;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+use roam_proto::map::WorldId;
 use roam_proto::{excerpt, keys};
 use tokio::sync::Semaphore;
 use tokio_util::sync::CancellationToken;
@@ -24,9 +25,11 @@ use zenoh::liveliness::LivelinessToken;
 use zenoh::query::{Query, Queryable};
 use zenoh::Session;
 
+use crate::client::Requester;
 use crate::reply;
 use crate::session::{self, SessionError};
 use crate::warn_limit::WarnLimiter;
+use crate::world_check::{self, WorldMismatch};
 
 /// Queries one queryable handles at once (see [`Service::serve`]).
 pub const MAX_IN_FLIGHT: usize = 32;
@@ -93,6 +96,9 @@ pub enum ServiceError {
         service: &'static str,
         reason: String,
     },
+    /// The service was given another world than the map server's ([`Service::guard_world`]).
+    #[error(transparent)]
+    World(#[from] WorldMismatch),
 }
 
 /// A started service. Dropping it without [`Service::shutdown`] still closes the
@@ -106,6 +112,9 @@ pub struct Service {
     token: Option<LivelinessToken>,
     cancel: CancellationToken,
     tasks: TaskTracker,
+    /// What [`Service::guard_world`] found: the service stopped on it, and its shutdown
+    /// returns it.
+    world_mismatch: Arc<Mutex<Option<WorldMismatch>>>,
 }
 
 impl Service {
@@ -135,7 +144,27 @@ impl Service {
             token: None,
             cancel,
             tasks: TaskTracker::new(),
+            world_mismatch: Arc::default(),
         })
+    }
+
+    /// Checks in the background that the map server holds world `mine`, the world this
+    /// service loaded ([`crate::world_check`]): until a map server answers the service
+    /// runs (a fleet starts in any order); when its world is another, the service stops
+    /// and [`Service::shutdown`] returns [`ServiceError::World`] naming both.
+    pub fn guard_world(&self, mine: WorldId) {
+        let requester = Requester::new(self.session.clone(), world_check::ASK_EVERY);
+        let key = keys::map_index(&self.root);
+        let (name, cancel) = (self.name, self.cancel.clone());
+        let found = self.world_mismatch.clone();
+        self.spawn(async move {
+            if let Some(mismatch) = world_check::check(&requester, &key, name, mine, &cancel).await
+            {
+                tracing::error!("{mismatch}");
+                *crate::lock(&found) = Some(mismatch);
+                cancel.cancel();
+            }
+        });
     }
 
     /// Declares the liveliness token `<root>/@live/<service>/<instance>`: call it once
@@ -426,8 +455,9 @@ impl Service {
     }
 
     /// Stops the service: cancels its loops, waits up to `grace` for in-flight work,
-    /// drops the liveliness token and closes the session. Returns an error naming how
-    /// many tasks did not stop in time (the session is closed all the same).
+    /// drops the liveliness token and closes the session. Returns the world mismatch
+    /// that stopped it ([`Service::guard_world`]), else an error naming how many tasks
+    /// did not stop in time (the session is closed all the same).
     pub async fn shutdown(mut self, grace: Duration) -> Result<(), ServiceError> {
         self.cancel.cancel();
         self.tasks.close();
@@ -451,6 +481,9 @@ impl Service {
                 reason: e.to_string(),
             })?;
         tracing::info!(service = self.name, instance = %self.instance, "service stopped");
+        if let Some(mismatch) = crate::lock(&self.world_mismatch).take() {
+            return Err(mismatch.into());
+        }
         if late {
             return Err(ServiceError::StopTimeout {
                 service: self.name,

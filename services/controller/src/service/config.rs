@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 
 use roam_proto::keys;
-use roam_runtime::world_check::WorldMismatch;
 use roam_runtime::ServiceError;
 use serde::Deserialize;
 
@@ -67,8 +66,6 @@ pub enum ControllerServiceError {
     Scenario(#[from] roam_world::scenario::ScenarioError),
     #[error("invalid config: {0}")]
     Config(String),
-    #[error(transparent)]
-    World(#[from] WorldMismatch),
 }
 
 #[cfg(test)]

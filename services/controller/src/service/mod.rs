@@ -42,7 +42,6 @@ use roam_proto::controller::{Mission, MAX_MISSION_BYTES};
 use roam_proto::keys;
 use roam_proto::localization::PositionEstimate;
 use roam_runtime::warn_limit::WarnLimiter;
-use roam_runtime::world_check;
 use roam_runtime::Service;
 use roam_world::scenario::load_or_builtin;
 use tokio_util::sync::CancellationToken;
@@ -103,7 +102,7 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world_guard = world_check::guard(&service, roam_world::world_id::of_scenario(&scenario));
+    service.guard_world(roam_world::world_id::of_scenario(&scenario));
     let state = Arc::new(ControllerShared {
         root: config.root.clone(),
         session: service.session().clone(),
@@ -174,6 +173,5 @@ pub async fn run(
     service.spawn(async move { watchdog(watched, token).await });
     service.announce().await?;
     service.run_until_stopped().await?;
-    world_guard.outcome()?;
     Ok(())
 }

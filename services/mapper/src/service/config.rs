@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 
 use roam_proto::keys;
-use roam_runtime::world_check::WorldMismatch;
 use roam_runtime::ServiceError;
 use serde::Deserialize;
 
@@ -72,6 +71,4 @@ pub enum MapperServiceError {
     Scenario(#[from] roam_world::scenario::ScenarioError),
     #[error("invalid config: {0}")]
     Config(String),
-    #[error(transparent)]
-    World(#[from] WorldMismatch),
 }

@@ -48,7 +48,6 @@ use roam_proto::controller::{Mission, MAX_MISSION_BYTES};
 use roam_proto::keys;
 use roam_proto::sim::{LocalObservation, SimClock};
 use roam_runtime::warn_limit::WarnLimiter;
-use roam_runtime::world_check;
 use roam_runtime::Service;
 use roam_world::scenario::load_or_builtin;
 use tokio_util::sync::CancellationToken;
@@ -123,7 +122,7 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world_guard = world_check::guard(&service, world);
+    service.guard_world(world);
     let state = Arc::new(MapperShared {
         root: config.root.clone(),
         session: service.session().clone(),
@@ -175,6 +174,5 @@ pub async fn run(
     service.spawn(async move { publish_layers(published, period, token).await });
     service.announce().await?;
     service.run_until_stopped().await?;
-    world_guard.outcome()?;
     Ok(())
 }

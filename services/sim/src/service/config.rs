@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 
 use roam_proto::keys;
-use roam_runtime::world_check::WorldMismatch;
 use roam_runtime::ServiceError;
 use roam_world::scenario::ScenarioError;
 use serde::Deserialize;
@@ -66,6 +65,4 @@ pub enum SimServiceError {
     Config(String),
     #[error(transparent)]
     Snapshot(#[from] SnapshotError),
-    #[error(transparent)]
-    World(#[from] WorldMismatch),
 }

@@ -27,7 +27,6 @@ use std::sync::{Arc, Mutex};
 
 use roam_proto::keys;
 use roam_runtime::warn_limit::WarnLimiter;
-use roam_runtime::world_check;
 use roam_runtime::{Service, ServiceError};
 use roam_world::load_dirs::LoadDirs;
 use roam_world::scenario;
@@ -74,7 +73,7 @@ pub async fn run(
         cancel,
     )
     .await?;
-    let world_guard = world_check::guard(&service, roam_world::world_id::of_scenario(&scenario));
+    service.guard_world(roam_world::world_id::of_scenario(&scenario));
     let state = Arc::new(SimShared {
         root: config.root.clone(),
         session: service.session().clone(),
@@ -139,6 +138,5 @@ pub async fn run(
     service
         .shutdown(roam_runtime::service::DEFAULT_GRACE)
         .await?;
-    world_guard.outcome()?;
     Ok(())
 }
