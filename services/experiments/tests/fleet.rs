@@ -173,3 +173,42 @@ fn two_robots_offered_the_same_news_take_different_cells() {
     // r1's own plan keeps its news for r1.
     assert_eq!(plan_on_news(world, &mapper, 0, "r1").cells, first.cells);
 }
+
+/// The built-in warehouse's patrol, as an operator would lay it out: through every
+/// aisle, but never where the anchors leave the robot without a fix (the north-east
+/// gap), where the controller would hold it.
+#[test]
+fn the_operators_patrol_goes_through_every_aisle_and_round_the_anchor_gap() {
+    let warehouse = world();
+    let patrol = warehouse.patrol.as_ref().expect("the aisle patrol");
+    let planning = &warehouse.planning;
+    let max_peb_m = roam_controller::params::ApfParams::fleet().max_peb_m;
+    let points = patrol.loop_points();
+    let peb_at = |p: &[f64; 2]| {
+        let cell = planning.cell_at(p[0], p[1]).expect("on the map");
+        f64::from(planning.localizability[cell as usize])
+    };
+    let worst = points.iter().map(peb_at).fold(0.0, f64::max);
+    assert!(
+        worst <= max_peb_m,
+        "the patrol drives where the PEB is {worst} m"
+    );
+    // The gap is there (so the test means something): the north main aisle's east end.
+    assert!(peb_at(&[50.0, 34.0]) > max_peb_m);
+    // Every aisle between the racks (x = 7.6 + 4 j) and the east aisle is driven
+    // along its south stretch between the racks.
+    for x in (1..=11).map(|j| 7.6 + 4.0 * f64::from(j)).chain([56.5]) {
+        assert!(
+            points
+                .iter()
+                .any(|p| (p[0] - x).abs() < 0.3 && (10.0..17.0).contains(&p[1])),
+            "aisle x = {x} not patrolled"
+        );
+    }
+    // Aisles the anchors cover end to end are driven to the north main aisle.
+    assert!(points
+        .iter()
+        .any(|p| (p[0] - 11.6).abs() < 0.3 && p[1] > 33.0));
+    // A loop: its last point is its first corner.
+    assert_eq!(points.last(), points.first());
+}

@@ -8,6 +8,15 @@
 //! main aisle, beside the dock: about 410 m. Its legs are the planner's fastest paths
 //! between the loop's corners, laid out once.
 //!
+//! **Where the robots localize.** An operator keeps a patrol where the robots know where
+//! they are: the loop never enters a cell whose PEB (localization's field from the
+//! anchors, [`FleetWorld`](super::world::FleetWorld)'s) is above the controller's
+//! `max_peb_m`, where roam's controller would hold the robot. An aisle that reaches into
+//! the north-east anchor gap is patrolled as far as the anchors reach and left the way
+//! it was entered; the legs go round the gap (by the cross aisle). Driven through the
+//! gap, the patrol lost 4,400 steps a robot-day to PEB holds and 121 of 228 windows
+//! were late (two shifts, seed 0): a patrol no operator would keep.
+//!
 //! **A window's patrol** ([`Patrol::route`]): the robot joins the loop at the corner
 //! nearest to it among the next [`JOIN_AHEAD`] from where its last patrol stopped (so
 //! over the days it covers the whole loop rather than the same stretch), follows the
@@ -55,19 +64,37 @@ pub struct PatrolRoute {
 }
 
 impl Patrol {
-    /// The warehouse's loop (module doc) on `world`.
-    pub fn through_aisles(world: &World) -> Result<Patrol, FleetError> {
+    /// The warehouse's loop (module doc) on `localized`: the planning world with every
+    /// cell where the robots do not localize blocked ([`FleetWorld`](super::world::FleetWorld)
+    /// builds it). Each aisle is driven from the south main aisle north as far as
+    /// `localized` lets it; an aisle cut short is gone up and back down.
+    pub fn through_aisles(localized: &World) -> Result<Patrol, FleetError> {
         let mut corners = Vec::new();
-        for j in 1..=AISLES {
-            let x = aisle_x(j);
-            if j % 2 == 1 {
-                corners.extend([[x, SOUTH_Y], [x, NORTH_Y]]);
+        let mut north_side = false;
+        for x in (1..=AISLES).map(aisle_x).chain([EAST_X]) {
+            let Some(north) = reach_north(localized, x) else {
+                continue;
+            };
+            let (south, whole) = ([x, SOUTH_Y], north[1] >= NORTH_Y);
+            if !whole {
+                // Cut short: up as far as the anchors reach and back down; the loop
+                // is on the south side after it, whichever side it came from.
+                corners.extend([south, north, south]);
+                north_side = false;
+            } else if north_side {
+                corners.extend([north, south]);
+                north_side = false;
             } else {
-                corners.extend([[x, NORTH_Y], [x, SOUTH_Y]]);
+                corners.extend([south, north]);
+                north_side = true;
             }
         }
-        corners.extend([[EAST_X, NORTH_Y], [EAST_X, SOUTH_Y]]);
-        Patrol::through(world, corners)
+        // Home along the south main aisle: the loop's first corner is its last's west.
+        if corners.last().is_some_and(|c| c[1] >= NORTH_Y) {
+            corners.push([EAST_X, SOUTH_Y]);
+        }
+        corners.dedup();
+        Patrol::through(localized, corners)
     }
 
     /// A loop through `corners` in order and back to the first, each leg the planner's
@@ -147,6 +174,32 @@ impl Patrol {
         }
         best
     }
+}
+
+/// How far short of where the anchors stop reaching a patrol turns back in an aisle cut
+/// short, metres: the planning cell at the edge is one a robot can stand in, but part of
+/// it is already without a fix.
+const TURN_BACK_M: f64 = 1.0;
+
+/// The northmost point of the aisle at `x`, from the south main aisle up to the north
+/// one, that `localized` lets a robot drive to along the aisle's centre line, checked
+/// every planning cell, [`TURN_BACK_M`] short of a blocked cell; `None` when the
+/// aisle's south end is blocked.
+fn reach_north(localized: &World, x: f64) -> Option<[f64; 2]> {
+    let step = localized.meta.resolution;
+    let steps = ((NORTH_Y - SOUTH_Y) / step).ceil() as usize;
+    let mut reached = None;
+    for i in 0..=steps {
+        let y = (SOUTH_Y + i as f64 * step).min(NORTH_Y);
+        let free = localized
+            .cell_at(x, y)
+            .is_some_and(|c| localized.is_traversable(c));
+        if !free {
+            return reached.map(|[x, y]: [f64; 2]| [x, (y - TURN_BACK_M).max(SOUTH_Y)]);
+        }
+        reached = Some([x, y]);
+    }
+    reached
 }
 
 /// The fastest path's cell centres from `a` to `b`, `a`'s cell first.

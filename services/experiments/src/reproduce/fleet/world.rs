@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use roam_controller::params::ApfParams;
 use roam_localization::field::{peb_field, GridRegion};
 use roam_localization::{FimOptions, RangingModel};
 use roam_mission::calibration::TimeModel;
@@ -142,7 +143,8 @@ impl FleetWorld {
         let patrol = if !shift.patrol.is_empty() {
             Some(Patrol::through(&planning, shift.patrol.clone())?)
         } else if aisle_patrol {
-            Some(Patrol::through_aisles(&planning)?)
+            let localized = localized_world(&inflated, &scenario.information, &field.peb)?;
+            Some(Patrol::through_aisles(&localized)?)
         } else {
             None
         };
@@ -262,4 +264,31 @@ fn scored_cells(scenario: &Scenario, static_coarse: &Grid<i8>) -> (Vec<usize>, u
         }
     }
     (scored, zone_cells)
+}
+
+/// The planning world with every map cell where the robots do not localize blocked:
+/// its PEB (localization's field, `peb` per map cell) above the fleet controller's
+/// `max_peb_m`, where the controller would hold the robot. The operator's patrol keeps
+/// to it ([`Patrol::through_aisles`]).
+fn localized_world(
+    inflated: &Grid<i8>,
+    information: &Grid<u8>,
+    peb: &[f32],
+) -> Result<World, FleetError> {
+    let max_peb_m = ApfParams::fleet().max_peb_m;
+    let mut localized = inflated.clone();
+    for (cell, &p) in localized.cells.iter_mut().zip(peb) {
+        // A PEB that is not a number is no fix either.
+        let fixed = f64::from(p) <= max_peb_m;
+        if !fixed {
+            *cell = roam_world::grid::occupancy::OCCUPIED;
+        }
+    }
+    World::at_resolution(
+        &localized,
+        information,
+        HEURISTIC_COMPRESSION,
+        PLANNING_RESOLUTION_M,
+    )
+    .map_err(|e| world_error(&e))
 }
