@@ -77,6 +77,17 @@ pub enum MissionState {
     StepLimit,
 }
 
+impl MissionState {
+    /// Whether the mission is over for good (completed or given up): the controller
+    /// drives it no more until a new mission.
+    pub fn is_final(self) -> bool {
+        matches!(
+            self,
+            MissionState::Completed | MissionState::Stuck | MissionState::StepLimit
+        )
+    }
+}
+
 /// The controller's report on a robot's mission, on `<root>/robot/<id>/controller`, after
 /// every estimate and whenever the state changes.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

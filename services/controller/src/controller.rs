@@ -24,7 +24,10 @@
 
 use std::sync::Arc;
 
-use serde::{Deserialize, Serialize};
+/// Where a mission stands: the wire's own state, so the controller, its status message
+/// and the executive say it in one vocabulary.
+pub use roam_proto::controller::MissionState;
+use serde::Serialize;
 
 use crate::carrot::PathTracker;
 use crate::forces::{command, Forces};
@@ -32,41 +35,12 @@ use crate::information::InformationField;
 use crate::obstacle_field::ObstacleField;
 use crate::params::{ApfParams, Follow};
 
-/// Where a mission stands.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MissionStatus {
-    /// No mission (or an empty one).
-    Idle,
-    /// Driving to the current waypoint.
-    Active,
-    /// Every waypoint was reached.
-    Completed,
-    /// No progress toward the current waypoint over the stuck window (a local minimum of
-    /// the potential or an oscillation); final.
-    Stuck,
-    /// The PEB is above `max_peb_m` or unbounded: held while it lasts.
-    HaltedPeb,
-    /// The mission used up `max_steps` updates; final.
-    StepLimit,
-}
-
-impl MissionStatus {
-    /// Whether the mission is over for good (completed or given up).
-    pub fn is_final(self) -> bool {
-        matches!(
-            self,
-            MissionStatus::Completed | MissionStatus::Stuck | MissionStatus::StepLimit
-        )
-    }
-}
-
 /// What the controller decided on one update.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Decision {
     /// The command u of paper 002 Eq. 3; zero unless `status` is Active.
     pub u: [f64; 2],
-    pub status: MissionStatus,
+    pub status: MissionState,
     /// Index of the current waypoint (under `follow: path`, the first one ahead of the
     /// robot's projection onto the path); `None` when idle or completed.
     pub waypoint: Option<usize>,
@@ -93,7 +67,7 @@ pub struct Controller {
     waypoints: Vec<[f64; 2]>,
     /// Index of the current waypoint (== len when completed).
     current: usize,
-    status: MissionStatus,
+    status: MissionState,
     steps: u64,
     /// Updates that were not held for the PEB (the stuck window counts these).
     active_steps: u64,
@@ -126,7 +100,7 @@ impl Controller {
             information,
             waypoints: Vec::new(),
             current: 0,
-            status: MissionStatus::Idle,
+            status: MissionState::Idle,
             steps: 0,
             active_steps: 0,
             halted_updates: 0,
@@ -149,9 +123,9 @@ impl Controller {
             legs_after[i] = legs_after[i + 1] + (b[0] - a[0]).hypot(b[1] - a[1]);
         }
         self.status = if waypoints.is_empty() {
-            MissionStatus::Idle
+            MissionState::Idle
         } else {
-            MissionStatus::Active
+            MissionState::Active
         };
         self.waypoints = waypoints;
         self.legs_after = legs_after;
@@ -179,16 +153,13 @@ impl Controller {
     }
 
     /// The mission's status after the last update.
-    pub fn status(&self) -> MissionStatus {
+    pub fn status(&self) -> MissionState {
         self.status
     }
 
     /// Whether the robot still has a mission to drive (Active or HaltedPeb).
     pub fn is_active(&self) -> bool {
-        matches!(
-            self.status,
-            MissionStatus::Active | MissionStatus::HaltedPeb
-        )
+        matches!(self.status, MissionState::Active | MissionState::HaltedPeb)
     }
 
     pub fn params(&self) -> &ApfParams {
@@ -214,7 +185,7 @@ impl Controller {
     }
 
     fn decision(&self, p: [f64; 2], forces: Option<&Forces>) -> Decision {
-        let active = self.status == MissionStatus::Active;
+        let active = self.status == MissionState::Active;
         Decision {
             u: match forces {
                 Some(f) if active => f.u,
@@ -245,11 +216,11 @@ impl Controller {
     /// toward the current waypoint or the carrot, with the IS force evaluated at
     /// `position`.
     pub fn update(&mut self, position: [f64; 2], peb_m: Option<f64>) -> Decision {
-        if self.status.is_final() || self.status == MissionStatus::Idle {
+        if self.status.is_final() || self.status == MissionState::Idle {
             return self.decision(position, None);
         }
         if self.steps >= self.params.max_steps {
-            self.status = MissionStatus::StepLimit;
+            self.status = MissionState::StepLimit;
             return self.decision(position, None);
         }
         self.steps += 1;
@@ -257,11 +228,11 @@ impl Controller {
         // An unbounded PEB (`None`, or NaN) counts as +∞: held unless the guard is off.
         let peb = peb_m.filter(|p| !p.is_nan()).unwrap_or(f64::INFINITY);
         if !(finite && (self.recovery || peb <= self.params.max_peb_m)) {
-            self.status = MissionStatus::HaltedPeb;
+            self.status = MissionState::HaltedPeb;
             self.halted_updates += 1;
             return self.decision(position, None);
         }
-        self.status = MissionStatus::Active;
+        self.status = MissionState::Active;
         self.halted_updates = 0;
         self.active_steps += 1;
         match self.params.follow {
@@ -288,12 +259,12 @@ impl Controller {
             self.checkpoint = None;
         }
         let Some(&waypoint) = self.waypoints.get(self.current) else {
-            self.status = MissionStatus::Completed;
+            self.status = MissionState::Completed;
             return self.decision(position, None);
         };
         let distance = (waypoint[0] - position[0]).hypot(waypoint[1] - position[1]);
         if self.no_progress(distance) {
-            self.status = MissionStatus::Stuck;
+            self.status = MissionState::Stuck;
             return self.decision(position, None);
         }
         let forces = command(
@@ -324,7 +295,7 @@ impl Controller {
             if points.is_empty() {
                 // Nothing to drive to: as `waypoints` passes every such waypoint.
                 self.current = self.waypoints.len();
-                self.status = MissionStatus::Completed;
+                self.status = MissionState::Completed;
                 return self.decision(position, None);
             }
             // `position` is finite here (`update` holds a robot that is not), and so is
@@ -358,11 +329,11 @@ impl Controller {
             && (end[0] - position[0]).hypot(end[1] - position[1]) <= self.params.g_thres_m
         {
             self.current = self.waypoints.len();
-            self.status = MissionStatus::Completed;
+            self.status = MissionState::Completed;
             return self.decision(position, None);
         }
         if self.no_progress(pursuit.distance_left_m) {
-            self.status = MissionStatus::Stuck;
+            self.status = MissionState::Stuck;
             return self.decision(position, None);
         }
         let forces = command(

@@ -11,7 +11,7 @@ use roam_world::seed::splitmix64;
 
 use crate::controller::tests::fields;
 use crate::params::INDOOR_G_THRES_M;
-use crate::{ApfParams, Controller, MissionStatus, Scheme};
+use crate::{ApfParams, Controller, MissionState, Scheme};
 
 /// The built-in world's step: μ·|u| = 0.2 m at most (the sim's top speed per step).
 const STEP_M: f64 = 0.2;
@@ -44,7 +44,7 @@ fn updates_to_arrive(params: &ApfParams, seed: u64) -> usize {
         let a = TAU * uniform(&mut state);
         let estimate = [truth[0] + r * a.cos(), truth[1] + r * a.sin()];
         let d = c.update(estimate, Some(0.1));
-        if d.status == MissionStatus::Completed {
+        if d.status == MissionState::Completed {
             return update;
         }
         let norm = d.u[0].hypot(d.u[1]);

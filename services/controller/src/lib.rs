@@ -71,7 +71,7 @@ pub mod weights;
 #[cfg(test)]
 mod goal_tolerance_tests;
 
-pub use controller::{Controller, Decision, MissionStatus};
+pub use controller::{Controller, Decision, MissionState};
 pub use information::InformationField;
 pub use obstacle_field::ObstacleField;
 pub use params::{ApfParams, Follow, ParamError};

@@ -2,22 +2,10 @@
 //! publishes it) and the batch experiments (which hand it to the executive's window
 //! machine in process), so both say the same.
 
-use roam_proto::controller::{ControllerStatus, MissionState};
+use roam_proto::controller::ControllerStatus;
 use roam_proto::localization::PositionEstimate;
 
-use crate::controller::{Decision, MissionStatus};
-
-/// The wire's name for a mission status.
-pub fn mission_state(status: MissionStatus) -> MissionState {
-    match status {
-        MissionStatus::Idle => MissionState::Idle,
-        MissionStatus::Active => MissionState::Active,
-        MissionStatus::Completed => MissionState::Completed,
-        MissionStatus::Stuck => MissionState::Stuck,
-        MissionStatus::HaltedPeb => MissionState::HaltedPeb,
-        MissionStatus::StepLimit => MissionState::StepLimit,
-    }
-}
+use crate::controller::Decision;
 
 /// The status of `robot`'s mission `mission` (of `waypoints` waypoints) after
 /// `decision`, made on `estimate`.
@@ -31,7 +19,7 @@ pub fn controller_status(
     ControllerStatus {
         robot: robot.to_owned(),
         mission: Some(mission.to_owned()),
-        state: mission_state(decision.status),
+        state: decision.status,
         waypoint: decision.waypoint,
         waypoints,
         distance_left_m: Some(decision.distance_left_m),

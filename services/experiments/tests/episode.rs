@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use roam_controller::{ApfParams, Follow, MissionStatus, Scheme};
+use roam_controller::{ApfParams, Follow, MissionState, Scheme};
 use roam_experiments::closed_loop::episode::{
     es1_mission, load_scenario, mission_from_waypoints, run_episode, PositionSource, RobotMission,
     Setup,
@@ -42,7 +42,7 @@ fn linear_goes_around_the_thin_route_to_b_and_plain_loses_its_fix() {
     let setup = Setup::new(&load_scenario(&path).expect("es1")).expect("setup");
     let linear = es1_mission(&path, &params(Scheme::Linear), 1).expect("episode");
     let r = &linear.robots[0];
-    assert_eq!(r.status, MissionStatus::Completed);
+    assert_eq!(r.status, MissionState::Completed);
     assert!(r.success && linear.success());
     assert_eq!(
         r.waypoints,
@@ -93,7 +93,7 @@ fn linear_goes_around_the_thin_route_to_b_and_plain_loses_its_fix() {
 
     let plain = es1_mission(&path, &params(Scheme::Plain), 1).expect("episode");
     let r = &plain.robots[0];
-    assert_eq!(r.status, MissionStatus::HaltedPeb);
+    assert_eq!(r.status, MissionState::HaltedPeb);
     assert!(!plain.success());
     // Straight toward B until the fix is lost where a1 drops out of range (x ≈ 14.8 m),
     // then held for the stuck window.
@@ -239,8 +239,8 @@ fn following_the_straight_path_to_b_loses_the_es1_robot_its_fix() {
             ..params(Scheme::Linear)
         };
         let e = es1_mission(&path, &on_path, seed).expect("episode");
-        assert_eq!(e.robots[0].status, MissionStatus::HaltedPeb, "seed {seed}");
+        assert_eq!(e.robots[0].status, MissionState::HaltedPeb, "seed {seed}");
         let e = es1_mission(&path, &params(Scheme::Linear), seed).expect("episode");
-        assert_eq!(e.robots[0].status, MissionStatus::Completed, "seed {seed}");
+        assert_eq!(e.robots[0].status, MissionState::Completed, "seed {seed}");
     }
 }

@@ -47,12 +47,12 @@ const GOOD: Option<f64> = Some(0.1);
 fn idle_until_a_mission_and_after_an_empty_one() {
     let mut c = controller(plain());
     let d = c.update([20.0, 20.0], GOOD);
-    assert_eq!(d.status, MissionStatus::Idle);
+    assert_eq!(d.status, MissionState::Idle);
     assert_eq!((d.u, d.steps, d.waypoint), ([0.0, 0.0], 0, None));
     c.set_mission(vec![[25.0, 20.0]]);
     assert!(c.is_active());
     c.end_mission();
-    assert_eq!(c.update([20.0, 20.0], GOOD).status, MissionStatus::Idle);
+    assert_eq!(c.update([20.0, 20.0], GOOD).status, MissionState::Idle);
 }
 
 #[test]
@@ -60,7 +60,7 @@ fn active_drives_toward_the_waypoint_and_reports_the_distance_left() {
     let mut c = controller(plain());
     c.set_mission(vec![[23.0, 24.0], [23.0, 30.0]]);
     let d = c.update([20.0, 20.0], GOOD);
-    assert_eq!(d.status, MissionStatus::Active);
+    assert_eq!(d.status, MissionState::Active);
     // Far from the walls: u = f_a = (0.6, 0.8).
     assert!((d.u[0] - 0.6).abs() < 1e-12 && (d.u[1] - 0.8).abs() < 1e-12);
     assert_eq!((d.waypoint, d.steps), (Some(0), 1));
@@ -75,13 +75,13 @@ fn waypoints_within_g_thres_pass_in_the_same_update_then_completed() {
     c.set_mission(vec![[20.0, 20.0], [20.05, 20.0], [25.0, 20.0]]);
     // The first two are within 0.1 m: the third is current at once.
     let d = c.update([20.0, 20.0], GOOD);
-    assert_eq!((d.status, d.waypoint), (MissionStatus::Active, Some(2)));
+    assert_eq!((d.status, d.waypoint), (MissionState::Active, Some(2)));
     assert!((d.u[0] - 1.0).abs() < 1e-12);
     assert!((d.distance_left_m - 5.0).abs() < 1e-12);
     // 0.11 m short is not reached, 0.09 m short is (g_thres = 0.10 m).
     assert_eq!(c.update([24.89, 20.0], GOOD).waypoint, Some(2));
     let d = c.update([24.91, 20.0], GOOD);
-    assert_eq!(d.status, MissionStatus::Completed);
+    assert_eq!(d.status, MissionState::Completed);
     assert_eq!(
         (d.u, d.waypoint, d.distance_left_m),
         ([0.0, 0.0], None, 0.0)
@@ -89,7 +89,7 @@ fn waypoints_within_g_thres_pass_in_the_same_update_then_completed() {
     assert_eq!(d.steps, 3);
     // Final: nothing changes any more.
     let again = c.update([0.0, 0.0], GOOD);
-    assert_eq!((again.status, again.steps), (MissionStatus::Completed, 3));
+    assert_eq!((again.status, again.steps), (MissionState::Completed, 3));
 }
 
 #[test]
@@ -106,7 +106,7 @@ fn via_thres_loosens_every_waypoint_but_the_last() {
     assert_eq!(c.update([24.6, 20.0], GOOD).waypoint, Some(1));
     assert_eq!(
         c.update([24.95, 20.0], GOOD).status,
-        MissionStatus::Completed
+        MissionState::Completed
     );
 }
 
@@ -116,12 +116,12 @@ fn a_bad_or_lost_peb_holds_the_robot_until_it_is_good_again() {
     c.set_mission(vec![[25.0, 20.0]]);
     for (peb, n) in [(None, 1), (Some(2.5), 2)] {
         let d = c.update([20.0, 20.0], peb);
-        assert_eq!(d.status, MissionStatus::HaltedPeb);
+        assert_eq!(d.status, MissionState::HaltedPeb);
         assert_eq!((d.u, d.halted_updates, d.steps), ([0.0, 0.0], n, n));
         assert!(c.is_active());
     }
     let d = c.update([20.0, 20.0], Some(2.0));
-    assert_eq!((d.status, d.halted_updates), (MissionStatus::Active, 0));
+    assert_eq!((d.status, d.halted_updates), (MissionState::Active, 0));
     assert_eq!(d.u, [1.0, 0.0]);
 }
 
@@ -130,12 +130,9 @@ fn a_recovery_drives_through_a_bad_peb_and_the_next_mission_is_guarded_again() {
     let mut c = controller(plain());
     c.set_recovery(vec![[25.0, 20.0]]);
     let d = c.update([20.0, 20.0], None);
-    assert_eq!((d.status, d.u), (MissionStatus::Active, [1.0, 0.0]));
+    assert_eq!((d.status, d.u), (MissionState::Active, [1.0, 0.0]));
     c.set_mission(vec![[25.0, 20.0]]);
-    assert_eq!(
-        c.update([20.0, 20.0], None).status,
-        MissionStatus::HaltedPeb
-    );
+    assert_eq!(c.update([20.0, 20.0], None).status, MissionState::HaltedPeb);
 }
 
 #[test]
@@ -146,11 +143,11 @@ fn an_infinite_bound_turns_the_guard_off() {
     });
     c.set_mission(vec![[25.0, 20.0]]);
     for peb in [None, Some(1e9), Some(f64::NAN)] {
-        assert_eq!(c.update([20.0, 20.0], peb).status, MissionStatus::Active);
+        assert_eq!(c.update([20.0, 20.0], peb).status, MissionState::Active);
     }
     // A non-finite position is always held.
     let d = c.update([f64::NAN, 20.0], GOOD);
-    assert_eq!((d.status, d.u), (MissionStatus::HaltedPeb, [0.0, 0.0]));
+    assert_eq!((d.status, d.u), (MissionState::HaltedPeb, [0.0, 0.0]));
 }
 
 #[test]
@@ -162,27 +159,24 @@ fn no_progress_over_the_window_is_stuck_but_halts_do_not_count() {
     });
     c.set_mission(vec![[25.0, 20.0]]);
     // The first update sets the checkpoint (5 m); 0.2 m of progress is not enough.
-    assert_eq!(c.update([20.0, 20.0], GOOD).status, MissionStatus::Active);
+    assert_eq!(c.update([20.0, 20.0], GOOD).status, MissionState::Active);
     for k in 1..10 {
         assert_eq!(
             c.update([20.0 + 0.02 * k as f64, 20.0], GOOD).status,
-            MissionStatus::Active
+            MissionState::Active
         );
         // Halted updates do not advance the window.
-        assert_eq!(
-            c.update([20.0, 20.0], None).status,
-            MissionStatus::HaltedPeb
-        );
+        assert_eq!(c.update([20.0, 20.0], None).status, MissionState::HaltedPeb);
     }
     let d = c.update([20.2, 20.0], GOOD);
-    assert_eq!(d.status, MissionStatus::Stuck);
+    assert_eq!(d.status, MissionState::Stuck);
     assert_eq!(d.u, [0.0, 0.0]);
     assert_eq!(d.steps, 20);
-    assert_eq!(c.update([24.0, 20.0], GOOD).status, MissionStatus::Stuck);
+    assert_eq!(c.update([24.0, 20.0], GOOD).status, MissionState::Stuck);
     // A new mission starts afresh.
     c.set_mission(vec![[25.0, 20.0]]);
     let d = c.update([20.0, 20.0], GOOD);
-    assert_eq!((d.status, d.steps), (MissionStatus::Active, 1));
+    assert_eq!((d.status, d.steps), (MissionState::Active, 1));
 }
 
 #[test]
@@ -197,7 +191,7 @@ fn progress_moves_the_window() {
         let x = 20.0 + 0.3 * (k / 9) as f64;
         assert_eq!(
             c.update([x, 20.0], GOOD).status,
-            MissionStatus::Active,
+            MissionState::Active,
             "{k}"
         );
     }
@@ -211,17 +205,14 @@ fn the_step_limit_ends_the_mission() {
     });
     c.set_mission(vec![[30.0, 20.0]]);
     for _ in 0..3 {
-        assert_eq!(c.update([20.0, 20.0], GOOD).status, MissionStatus::Active);
+        assert_eq!(c.update([20.0, 20.0], GOOD).status, MissionState::Active);
     }
     let d = c.update([20.0, 20.0], GOOD);
     assert_eq!(
         (d.status, d.steps, d.u),
-        (MissionStatus::StepLimit, 3, [0.0, 0.0])
+        (MissionState::StepLimit, 3, [0.0, 0.0])
     );
-    assert_eq!(
-        c.update([30.0, 20.0], GOOD).status,
-        MissionStatus::StepLimit
-    );
+    assert_eq!(c.update([30.0, 20.0], GOOD).status, MissionState::StepLimit);
 }
 
 #[test]
@@ -266,7 +257,7 @@ fn under_follow_path_f_a_pulls_toward_the_carrot_along_the_path() {
     // An L from where the robot is: east 4 m, then north 4 m.
     c.set_mission(vec![[22.0, 20.0], [24.0, 20.0], [24.0, 24.0]]);
     let d = c.update([20.0, 20.0], GOOD);
-    assert_eq!((d.status, d.waypoint), (MissionStatus::Active, Some(0)));
+    assert_eq!((d.status, d.waypoint), (MissionState::Active, Some(0)));
     // On the path: the carrot is 0.4 m ahead, straight east.
     assert!(
         (d.u[0] - 1.0).abs() < 1e-12 && d.u[1].abs() < 1e-12,
@@ -310,10 +301,10 @@ fn under_follow_path_the_mission_completes_at_the_last_point_only() {
         [20.05, 20.05],
     ]);
     let d = c.update([20.0, 20.0], GOOD);
-    assert_eq!(d.status, MissionStatus::Active);
+    assert_eq!(d.status, MissionState::Active);
     // Along the way, then within g_thres of the end with the carrot there.
     for x in [20.4, 20.8, 21.2, 21.6, 22.0, 22.4, 22.8] {
-        assert_eq!(c.update([x, 20.0], GOOD).status, MissionStatus::Active);
+        assert_eq!(c.update([x, 20.0], GOOD).status, MissionState::Active);
     }
     for p in [
         [23.0, 20.2],
@@ -322,25 +313,22 @@ fn under_follow_path_the_mission_completes_at_the_last_point_only() {
         [21.8, 20.5],
         [21.4, 20.5],
     ] {
-        assert_eq!(c.update(p, GOOD).status, MissionStatus::Active);
+        assert_eq!(c.update(p, GOOD).status, MissionState::Active);
     }
     for x in [21.0, 20.6, 20.2] {
-        assert_eq!(c.update([x, 20.5], GOOD).status, MissionStatus::Active);
+        assert_eq!(c.update([x, 20.5], GOOD).status, MissionState::Active);
     }
     // 0.11 m short is not reached; 0.09 m is.
-    assert_eq!(c.update([20.05, 20.16], GOOD).status, MissionStatus::Active);
+    assert_eq!(c.update([20.05, 20.16], GOOD).status, MissionState::Active);
     let d = c.update([20.05, 20.14], GOOD);
-    assert_eq!(d.status, MissionStatus::Completed);
+    assert_eq!(d.status, MissionState::Completed);
     assert_eq!(
         (d.u, d.waypoint, d.distance_left_m),
         ([0.0, 0.0], None, 0.0)
     );
     // A one-waypoint mission where the robot stands is complete at once.
     c.set_mission(vec![[20.05, 20.0]]);
-    assert_eq!(
-        c.update([20.0, 20.0], GOOD).status,
-        MissionStatus::Completed
-    );
+    assert_eq!(c.update([20.0, 20.0], GOOD).status, MissionState::Completed);
 }
 
 #[test]
@@ -356,18 +344,18 @@ fn under_follow_path_progress_along_the_path_is_what_the_stuck_rule_counts() {
         let y = if k % 2 == 0 { 20.1 } else { 19.9 };
         assert_eq!(
             c.update([20.0, y], GOOD).status,
-            MissionStatus::Active,
+            MissionState::Active,
             "{k}"
         );
     }
-    assert_eq!(c.update([20.0, 20.1], GOOD).status, MissionStatus::Stuck);
+    assert_eq!(c.update([20.0, 20.1], GOOD).status, MissionState::Stuck);
     // 0.3 m along the path per 9 updates: never stuck.
     c.set_mission(vec![[40.0, 20.0]]);
     for k in 0..150 {
         let x = 10.0 + 0.3 * (k / 9) as f64;
         assert_eq!(
             c.update([x, 20.0], GOOD).status,
-            MissionStatus::Active,
+            MissionState::Active,
             "{k}"
         );
     }
@@ -378,13 +366,10 @@ fn under_follow_path_a_waypoint_that_is_not_finite_is_left_out() {
     let mut c = controller(path_params());
     c.set_mission(vec![[f64::NAN, 0.0], [22.0, 20.0]]);
     let d = c.update([20.0, 20.0], GOOD);
-    assert_eq!((d.status, d.waypoint), (MissionStatus::Active, Some(1)));
+    assert_eq!((d.status, d.waypoint), (MissionState::Active, Some(1)));
     assert!((d.u[0] - 1.0).abs() < 1e-12);
     c.set_mission(vec![[f64::INFINITY, 0.0]]);
-    assert_eq!(
-        c.update([20.0, 20.0], GOOD).status,
-        MissionStatus::Completed
-    );
+    assert_eq!(c.update([20.0, 20.0], GOOD).status, MissionState::Completed);
 }
 
 #[test]
@@ -392,10 +377,7 @@ fn under_follow_path_the_path_starts_where_the_first_driven_update_is() {
     let mut c = controller(path_params());
     c.set_mission(vec![[24.0, 20.0]]);
     // Held for the PEB at first: the path starts at the first update that drives.
-    assert_eq!(
-        c.update([10.0, 10.0], None).status,
-        MissionStatus::HaltedPeb
-    );
+    assert_eq!(c.update([10.0, 10.0], None).status, MissionState::HaltedPeb);
     let d = c.update([20.0, 24.0], GOOD);
     // The carrot is 0.4 m along the segment (20, 24) → (24, 20): diagonal.
     let s = std::f64::consts::FRAC_1_SQRT_2;

@@ -7,7 +7,7 @@ use roam_proto::keys;
 use roam_proto::localization::PositionEstimate;
 use roam_runtime::{limited_warn, routing};
 
-use crate::controller::{Decision, MissionStatus};
+use crate::controller::{Decision, MissionState};
 
 use super::missions::install_mission;
 use super::shared::{ControlledRobot, ControllerShared};
@@ -45,7 +45,7 @@ pub(super) fn on_estimate(state: &ControllerShared, key: &str, estimate: Positio
         let status = status_of(robot, driven, &decision, Some(&estimate));
         driven.last = Some(status.clone());
         let u = match decision.status {
-            MissionStatus::Idle => None,
+            MissionState::Idle => None,
             _ => Some(decision.u),
         };
         (status, u)

@@ -27,7 +27,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use roam_controller::controller::{Decision, MissionStatus};
+use roam_controller::controller::{Decision, MissionState};
 use roam_controller::params::ApfParams;
 use roam_sim::SimParams;
 use roam_world::scenario::Scenario;
@@ -50,7 +50,7 @@ pub struct RobotTrack {
     pub robot: String,
     pub waypoints: Vec<[f64; 2]>,
     /// The mission's status when the episode ended.
-    pub status: MissionStatus,
+    pub status: MissionState,
     /// Every waypoint reached.
     pub success: bool,
     /// Updates of the mission until it ended (the sim step at which it completed, when
@@ -92,10 +92,10 @@ impl RobotTrack {
         self.status = decision.status;
         self.steps = decision.steps;
         self.held_updates = decision.halted_updates;
-        self.success = decision.status == MissionStatus::Completed;
+        self.success = decision.status == MissionState::Completed;
         decision.status.is_final()
-            || decision.status == MissionStatus::Idle
-            || (decision.status == MissionStatus::HaltedPeb
+            || decision.status == MissionState::Idle
+            || (decision.status == MissionState::HaltedPeb
                 && decision.halted_updates >= stuck_window_steps)
     }
 }
@@ -155,7 +155,7 @@ pub fn run_episode_with(
         let track = RobotTrack {
             robot: m.robot.clone(),
             waypoints: m.waypoints.clone(),
-            status: MissionStatus::Idle,
+            status: MissionState::Idle,
             success: done,
             steps: 0,
             distance_m: 0.0,

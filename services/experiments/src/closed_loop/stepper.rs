@@ -30,7 +30,7 @@ use roam_sim::messages::{robot_messages, RobotMessages};
 use roam_sim::{Command, Sim, SimParams};
 
 use crate::closed_loop::setup::{EpisodeError, PositionSource, Setup};
-use roam_controller::controller::{Controller, Decision, MissionStatus};
+use roam_controller::controller::{Controller, Decision, MissionState};
 use roam_controller::params::ApfParams;
 
 /// What one robot did in one step.
@@ -185,7 +185,7 @@ impl Stepper {
                 }
                 _ => None,
             };
-            if let Some(d) = decision.filter(|d| d.status == MissionStatus::Active) {
+            if let Some(d) = decision.filter(|d| d.status == MissionState::Active) {
                 self.commands.push(Command {
                     robot: r.name.clone(),
                     u: d.u,
@@ -264,7 +264,7 @@ mod tests {
                 track: RobotTrack {
                     robot: m.robot.clone(),
                     waypoints: m.waypoints.clone(),
-                    status: MissionStatus::Idle,
+                    status: MissionState::Idle,
                     success: m.waypoints.is_empty(),
                     steps: 0,
                     distance_m: 0.0,
@@ -306,7 +306,7 @@ mod tests {
                     &decision,
                     params.stuck_window_steps,
                 );
-                if decision.status == MissionStatus::Active {
+                if decision.status == MissionState::Active {
                     commands.push(Command {
                         robot: r.name.clone(),
                         u: decision.u,
@@ -434,7 +434,7 @@ mod tests {
                 break;
             }
         }
-        assert_eq!(last.map(|d| d.status), Some(MissionStatus::Completed));
+        assert_eq!(last.map(|d| d.status), Some(MissionState::Completed));
         let at = s.sim().robot("robot").expect("robot").position();
         assert!(
             (at[0] + 8.0).hypot(at[1] + 8.0) < 0.2,

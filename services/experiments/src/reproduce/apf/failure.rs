@@ -159,7 +159,7 @@ mod tests {
 
     use super::*;
     use crate::closed_loop::episode::load_scenario;
-    use roam_controller::controller::MissionStatus;
+    use roam_controller::controller::MissionState;
 
     fn es1() -> Setup {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenarios/es1.yaml");
@@ -185,9 +185,9 @@ mod tests {
             robot: "robot".into(),
             waypoints: vec![[60.0, 16.0]],
             status: if success {
-                MissionStatus::Completed
+                MissionState::Completed
             } else {
-                MissionStatus::StepLimit
+                MissionState::StepLimit
             },
             success,
             steps: 10,

@@ -2,7 +2,7 @@
 //! PEB, its estimate errors, its halted steps) and its legs (each route sent, and how
 //! far along it the controller got).
 
-use roam_controller::controller::MissionStatus;
+use roam_controller::controller::MissionState;
 use roam_mission::information::gathered;
 use roam_mission::path::distance;
 use roam_planner::params::GaParams;
@@ -38,7 +38,7 @@ impl Track {
         }
         if step
             .decision
-            .is_some_and(|d| d.status == MissionStatus::HaltedPeb)
+            .is_some_and(|d| d.status == MissionState::HaltedPeb)
         {
             self.halted_steps += 1;
         }

@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use roam_controller::controller::{Decision, MissionStatus};
+use roam_controller::controller::{Decision, MissionState};
 use roam_mapper::brier::brier;
 use roam_mission::information::gathered;
 use roam_proto::mission::WindowReport;
@@ -179,7 +179,7 @@ impl WeekRecord {
 
     /// Robot `robot`'s controller decided `decision` this step.
     pub fn robot_step(&mut self, robot: usize, decision: Option<&Decision>) {
-        if decision.is_some_and(|d| d.status == MissionStatus::HaltedPeb) {
+        if decision.is_some_and(|d| d.status == MissionState::HaltedPeb) {
             if let Some(h) = self.halted_steps.get_mut(robot) {
                 *h += 1;
             }
