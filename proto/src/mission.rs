@@ -33,7 +33,10 @@ pub struct WindowReport {
     pub peb_mean_m: Option<f64>,
     /// Plans after the first (blocked, pushed off the path, ETA slipping).
     pub replans: u32,
-    /// Why each replan happened, in order.
+    /// Why each replan happened, in order, as tokens a program can branch on:
+    /// `silent`, `stuck`, `late`, `off_path`, `slack`, `behind`, `last_safe_moment`,
+    /// `recovered`, `no_planner`, `set_off` (`roam_mission::watch::Reason::name`), and
+    /// `no_plan` alone for a window given up before any plan came.
     pub replan_reasons: Vec<String>,
     /// The time model (paper 000 Eq. 2) the window was planned with, and how well it
     /// predicted what the robot drove.

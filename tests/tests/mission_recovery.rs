@@ -195,7 +195,7 @@ async fn a_robot_the_peb_guard_holds_is_recovered_and_on_time() {
         day.recoveries,
         day.on_recoveries
     );
-    let recovered = Reason::Recovered.as_str();
+    let recovered = Reason::Recovered.name();
     assert!(
         reports
             .iter()

@@ -112,7 +112,9 @@ impl Reason {
         Reason::SetOff,
     ];
 
-    /// The reason's token, as reports and tables name it.
+    /// The reason's token: what the window's report carries on the wire
+    /// (`WindowReport::replan_reasons`), stable, for a program to branch on, and what
+    /// tables name it.
     pub fn name(self) -> &'static str {
         match self {
             Reason::ControllerSilent => "silent",
@@ -128,13 +130,13 @@ impl Reason {
         }
     }
 
-    /// The reason whose sentence ([`Reason::as_str`]) is `sentence`.
-    pub fn of_sentence(sentence: &str) -> Option<Reason> {
-        Reason::ALL.into_iter().find(|r| r.as_str() == sentence)
+    /// The reason whose token ([`Reason::name`]) is `name`.
+    pub fn of_name(name: &str) -> Option<Reason> {
+        Reason::ALL.into_iter().find(|r| r.name() == name)
     }
 
-    /// The sentence the window's report gives for the replan.
-    pub fn as_str(self) -> &'static str {
+    /// The reason said to a person (the demo's progress, logs).
+    pub fn sentence(self) -> &'static str {
         match self {
             Reason::ControllerSilent => "the controller went silent on the mission",
             Reason::Stuck => "stuck: the path is blocked",

@@ -90,7 +90,7 @@ impl Executive<'_> {
                     }),
                     WindowAction::Replanned { reason } => progress(Progress::Replanned {
                         window,
-                        reason: reason.as_str().to_owned(),
+                        reason: reason.sentence().to_owned(),
                     }),
                     WindowAction::Recovering { held_s } => {
                         progress(Progress::Recovering { window, held_s })

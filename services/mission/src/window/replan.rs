@@ -98,7 +98,7 @@ impl DowntimeWindow<'_> {
             Follows::Straight => drive.watch.straight(path.clone(), t, wall),
             Follows::Replan(kind) => drive.watch.replanned(path.clone(), kind, t, wall),
         }
-        drive.reasons.push(reason.as_str().to_owned());
+        drive.reasons.push(reason.name().to_owned());
         drive.waypoints = mission_waypoints(&route.points, spacing);
         drive.route_curious = route.curious && follows != Follows::Straight;
         drive.plans.push(route.points);

@@ -139,7 +139,7 @@ impl DowntimeWindow<'_> {
         let shortest = route.points.clone();
         let mut actions = self.start_driving(route, shortest, budget, time_left, now);
         if let Phase::Driving(drive) = &mut self.phase {
-            drive.reasons.push(Reason::NoPlanner.as_str().to_owned());
+            drive.reasons.push(Reason::NoPlanner.name().to_owned());
         }
         actions.insert(
             0,

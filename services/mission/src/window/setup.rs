@@ -59,8 +59,9 @@ pub const MIN_DEADLINE_S: f64 = 0.05;
 /// whether it fits.
 pub(super) const LEAST_T_EXEC_S: f64 = 1e-3;
 
-/// The report's reason for a window given up before any plan came.
-pub const NO_PLAN_REASON: &str = "no planner answered before the window was given up";
+/// The report's reason (a token, as [`crate::watch::Reason::name`]) for a window given
+/// up before any plan came: no planner answered before the window was given up.
+pub const NO_PLAN_REASON: &str = "no_plan";
 
 /// The executive's rules a window follows (from [`ExecutiveConfig`]).
 #[derive(Debug, Clone, Copy, PartialEq)]

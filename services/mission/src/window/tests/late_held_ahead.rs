@@ -42,7 +42,7 @@ fn at_the_last_safe_moment_the_robot_goes_straight_and_stays_straight() {
     assert!(r.on_time);
     assert_eq!(
         r.replan_reasons,
-        vec![Reason::LastSafeMoment.as_str().to_owned()]
+        vec![Reason::LastSafeMoment.name().to_owned()]
     );
 }
 

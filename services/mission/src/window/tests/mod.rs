@@ -596,7 +596,7 @@ fn stuck_replans_the_shortest_way_and_the_report_counts_it() {
     assert!(close(drive.took_s, 24.0));
     let r = report(&w.handle(WindowEvent::Tick, at(105.0, 0.6)));
     assert_eq!(r.replans, 1);
-    assert_eq!(r.replan_reasons, vec![Reason::Stuck.as_str().to_owned()]);
+    assert_eq!(r.replan_reasons, vec![Reason::Stuck.name().to_owned()]);
     // The share driven counts from the first mission (1 s), the time model's from the
     // last (6 s).
     let time_model = r.time_model.expect("time model");
@@ -673,10 +673,7 @@ fn a_failed_slack_replan_leaves_the_robot_on_its_path_then_the_fastest_path() {
     let actions = answer_status(&mut w, &straight, MissionState::Completed, at(50.0, 0.5));
     assert!(matches!(actions[0], WindowAction::Arrived { .. }));
     let r = report(&w.handle(WindowEvent::Tick, at(105.0, 0.6)));
-    assert_eq!(
-        r.replan_reasons,
-        vec![Reason::NoPlanner.as_str().to_owned()]
-    );
+    assert_eq!(r.replan_reasons, vec![Reason::NoPlanner.name().to_owned()]);
 }
 
 #[test]
@@ -742,7 +739,7 @@ fn a_lost_mission_is_sent_again_from_where_the_robot_is() {
     let r = report(&w.handle(WindowEvent::Tick, at(105.0, 3.3)));
     assert_eq!(
         r.replan_reasons,
-        vec![Reason::ControllerSilent.as_str().to_owned()]
+        vec![Reason::ControllerSilent.name().to_owned()]
     );
 }
 

@@ -41,7 +41,7 @@ fn without_a_plan_made_ahead_the_robot_sets_off_while_the_curious_plan_is_made()
     let arrived = answer_status(&mut w, &curious, MissionState::Completed, at(60.0, 1.0));
     let ended = w.handle(WindowEvent::Tick, at(106.0, 2.0));
     let report = report(&[arrived, ended].concat());
-    assert_eq!(report.replan_reasons, vec![Reason::SetOff.as_str()]);
+    assert_eq!(report.replan_reasons, vec![Reason::SetOff.name()]);
     assert!(report.planned_information > 0.0);
     assert!(close(report.budget_s, margin().budget(99.0)));
 }

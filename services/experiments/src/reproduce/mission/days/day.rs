@@ -7,6 +7,7 @@ use roam_controller::params::ApfParams;
 use roam_mission::config::ExecutiveConfig;
 use roam_mission::information::InformationScale;
 use roam_mission::watch::Reason;
+use roam_mission::window::NO_PLAN_REASON;
 use roam_proto::controller::Mission;
 use roam_proto::mission::WindowReport;
 use roam_proto::planner::{Plan, PlanRequest};
@@ -291,7 +292,7 @@ impl<'a> DayRun<'a> {
             replans: report
                 .replan_reasons
                 .iter()
-                .map(|s| Reason::of_sentence(s).map_or("no_plan", Reason::name))
+                .map(|s| Reason::of_name(s).map_or(NO_PLAN_REASON, Reason::name))
                 .collect(),
             time_model,
         }
