@@ -12,6 +12,7 @@
 //! - [`mapper`]: change-map observation updates per second;
 //! - [`scaling`]: the planner's cost as the map gets finer, and its memory;
 //! - [`peer`]: the greedy planner against Model I at equal wall time;
+//! - [`optimality`]: the planners' plans against the exact optimum on small instances;
 //! - [`fleet`]: robots in closed loop through Zenoh.
 
 pub mod fleet;
@@ -19,6 +20,7 @@ pub mod load;
 pub mod localization;
 pub mod map;
 pub mod mapper;
+pub mod optimality;
 pub mod peer;
 pub mod planner;
 pub mod process;

@@ -21,7 +21,9 @@
 //!   path the robot drives on the map's cells; [`fine`]: the map it is derived from,
 //!   and the limits of a planning resolution;
 //! - [`limits`]: what one plan may cost (path length from Eq. 2, memory, work);
-//! - [`plan`]: one request end to end, with the checks that refuse bad requests.
+//! - [`plan`]: one request end to end, with the checks that refuse bad requests;
+//! - [`exact`]: the best possible plan of a small instance, by branch and bound, to
+//!   measure the planners' gap to it.
 //!
 //! [`service`] is the thin Zenoh adapter, with what it needs against other clients:
 //! [`queue`] (a bounded queue served in order, admission by expected wait),
@@ -42,6 +44,7 @@ pub mod config;
 pub mod coupling;
 pub mod curiosity;
 pub mod eta;
+pub mod exact;
 pub mod fine;
 pub mod ga;
 pub mod greedy;

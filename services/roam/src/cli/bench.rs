@@ -106,6 +106,13 @@ pub(crate) enum BenchCommand {
         /// Instead: model greedy against Model I at equal wall time on several worlds.
         #[arg(long)]
         peer: bool,
+        /// Instead: the greedy planner's and Model I's plans at the default deadline
+        /// against the exact optimum (distinct information) on small seeded instances.
+        #[arg(long, conflicts_with_all = ["scaling", "peer"])]
+        optimality: bool,
+        /// Seeded instances for --optimality (each at three budgets).
+        #[arg(long, default_value_t = 10)]
+        instances: u64,
     },
 }
 
@@ -198,9 +205,23 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
             paper_init,
             scaling,
             peer,
+            optimality,
+            instances,
         } => {
             if runs == 0 {
                 bail!("--runs must be at least 1");
+            }
+            if optimality {
+                if instances == 0 {
+                    bail!("--instances must be at least 1");
+                }
+                let result = tokio::task::spawn_blocking(move || {
+                    let progress = Progress::new("bench planner --optimality", quiet);
+                    let shown = progress.callback();
+                    roam_bench::optimality::optimality(instances, &shown)
+                })
+                .await??;
+                return print_json(&result, json);
             }
             if scaling {
                 let result = tokio::task::spawn_blocking(move || {
