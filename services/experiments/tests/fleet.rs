@@ -79,6 +79,10 @@ fn a_short_shift_is_on_time_repeatable_and_curious() {
     assert_eq!((t.variant, n.variant), ("tasks_only", "news"));
     assert_eq!(t.curious_plans, 0);
     assert!(n.curious_plans > 0, "{n:?}");
+    // The static map knows no change: its score is the world's alone, the same for
+    // every variant on common random numbers, and above zero once objects are out.
+    assert_eq!(t.brier_static, n.brier_static);
+    assert!(t.brier_static.is_some_and(|b| b > 0.0 && b < 1.0), "{t:?}");
     let information = |s: &fleet::FleetSummary| s.information_per_robot_hour.unwrap_or(0.0);
 
     // The pictures hold what their legends say.

@@ -773,6 +773,11 @@ fn roam_demo_fleet_writes_the_fleets_report_and_pictures() {
     // Map samples at 60, 120, ... s of the sim: a Brier score between 0 and 1.
     let brier = summary["brier"].as_f64().expect("the map was scored");
     assert!((0.0..=1.0).contains(&brier), "{summary}");
+    // Beside the static map's, the reference a map that never looks gets.
+    let never_looks = summary["brier_static"]
+        .as_f64()
+        .expect("the static map scored");
+    assert!((0.0..=1.0).contains(&never_looks), "{summary}");
     // Each curious plan's answer time is counted (none may come back curious in a debug
     // build on a loaded machine: then there is no p99).
     let curious = summary["curious_plans"].as_u64().expect("plans");

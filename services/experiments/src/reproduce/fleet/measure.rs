@@ -106,11 +106,18 @@ pub struct MapSample {
     pub zones: f64,
     pub others: f64,
     pub all: f64,
+    /// The same score of the static map alone (occupied where the scenario's map is,
+    /// free elsewhere: a map that knows no change) over all the scored cells: the
+    /// reference the fleet's belief must beat, and what the world's own churn costs a
+    /// map that never looks (it moves with how many objects are out, not with the
+    /// fleet).
+    pub static_map: f64,
 }
 
 impl MapSample {
     /// The belief (per coarse cell) scored against the truth (occupied or not, per
-    /// coarse cell: [`FleetWorld::semi_static_truth`]) over the world's scored cells.
+    /// coarse cell: [`FleetWorld::semi_static_truth`]) over the world's scored cells,
+    /// beside the static map's score.
     pub fn score(
         world: &FleetWorld,
         t_s: f64,
@@ -122,11 +129,19 @@ impl MapSample {
                 .map_err(|e| FleetError::Mapper(e.to_string()))
         };
         let (zones, others) = world.scored.split_at(world.zone_cells);
+        let static_map: Vec<f64> = world
+            .static_coarse
+            .cells
+            .iter()
+            .map(|&c| if c == 0 { 0.0 } else { 1.0 })
+            .collect();
         Ok(MapSample {
             t_s,
             zones: score(zones)?,
             others: score(others)?,
             all: score(&world.scored)?,
+            static_map: brier(&static_map, truth, world.scored.iter().copied())
+                .map_err(|e| FleetError::Mapper(e.to_string()))?,
         })
     }
 }

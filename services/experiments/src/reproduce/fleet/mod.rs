@@ -250,16 +250,16 @@ impl FleetReport {
         );
         let _ = writeln!(
             out,
-            "| variant | late | share | changes | seen ≤10 min | seen ≤1 h | detection median s (by day) | Brier (by day) | Brier zones / others | information / robot-hour (by day) | halted / robot-day | plans | refused plans / scans | p50 / p99 ms | wall s |"
+            "| variant | late | share | changes | seen ≤10 min | seen ≤1 h | detection median s (by day) | Brier (by day) | static map's Brier (by day) | Brier zones / others | information / robot-hour (by day) | halted / robot-day | plans | refused plans / scans | p50 / p99 ms | wall s |"
         );
         let _ = writeln!(
             out,
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
         );
         for s in &self.variants {
             let _ = writeln!(
                 out,
-                "| {} | {}/{} | {} | {} | {} | {} | {}{} | {}{} | {} / {} | {}{} | {:.1} | {} | {} / {} | {} / {} | {:.0} |",
+                "| {} | {}/{} | {} | {} | {} | {} | {}{} | {}{} | {}{} | {} / {} | {}{} | {:.1} | {} | {} / {} | {} / {} | {:.0} |",
                 s.variant,
                 s.late,
                 s.windows,
@@ -271,6 +271,8 @@ impl FleetReport {
                 spread(s.detection_median_by_day, 0),
                 num(s.brier, 4),
                 spread(s.brier_by_day, 4),
+                num(s.brier_static, 4),
+                spread(s.brier_static_by_day, 4),
                 num(s.brier_zones, 4),
                 num(s.brier_others, 4),
                 num(s.information_per_robot_hour, 0),

@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use crate::reproduce::mission::days::stats::{mean, median};
 
-use super::measure::WeekRecord;
+use super::measure::{MapSample, WeekRecord};
 
 /// Detection within this long counts as "soon", seconds: ten minutes, and an hour.
 pub const SOON_S: [f64; 2] = [600.0, 3600.0];
@@ -53,6 +53,10 @@ pub struct FleetSummary {
     pub brier_zones: Option<f64>,
     pub brier_others: Option<f64>,
     pub brier_by_day: Option<Spread>,
+    /// The static map's mean Brier score over the same samples ([`MapSample::static_map`]):
+    /// below it, the fleet's belief knows more than a map that never looks.
+    pub brier_static: Option<f64>,
+    pub brier_static_by_day: Option<Spread>,
     pub information_per_robot_hour: Option<f64>,
     pub information_per_robot_hour_by_day: Option<Spread>,
     pub halted_steps_per_robot_day: f64,
@@ -125,12 +129,12 @@ pub fn summarize(week: &WeekRecord, shift_s: f64, days: usize) -> FleetSummary {
             .sum::<f64>()
             / hours
     };
-    let brier_day = |d: usize| {
+    let brier_day = |d: usize, of: fn(&MapSample) -> f64| {
         mean(
             week.maps
                 .iter()
                 .filter(|m| day_of(m.t_s - 1e-9) == d)
-                .map(|m| m.all),
+                .map(of),
         )
     };
     let mut lat = week.plan_latencies_s.clone();
@@ -150,7 +154,9 @@ pub fn summarize(week: &WeekRecord, shift_s: f64, days: usize) -> FleetSummary {
         brier: mean(week.maps.iter().map(|m| m.all)),
         brier_zones: mean(week.maps.iter().map(|m| m.zones)),
         brier_others: mean(week.maps.iter().map(|m| m.others)),
-        brier_by_day: Spread::of((0..days).filter_map(brier_day)),
+        brier_by_day: Spread::of((0..days).filter_map(|d| brier_day(d, |m| m.all))),
+        brier_static: mean(week.maps.iter().map(|m| m.static_map)),
+        brier_static_by_day: Spread::of((0..days).filter_map(|d| brier_day(d, |m| m.static_map))),
         information_per_robot_hour: (hours > 0.0 && days > 0)
             .then(|| info_total / (hours * days as f64)),
         information_per_robot_hour_by_day: Spread::of((0..days).map(info_day)),
