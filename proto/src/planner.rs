@@ -21,6 +21,13 @@ pub enum PlannerModel {
     /// with local improvement, within the budget; scored with Model I (Eq. 9). roam's
     /// peer for the GA (issue 16), not paper 000's.
     Greedy,
+    /// Anytime: the greedy planner's answer at once (milliseconds), then the GA with
+    /// Model I, its first population seeded with that answer, until the deadline or its
+    /// generations; the fitter of the two by Model I's fitness (Eq. 1), reported in
+    /// [`Plan::found_by`]. roam's, not paper 000's: the greedy answer alone leaves about
+    /// a sixth of the best possible information on small instances (`roam bench planner
+    /// --optimality`), the GA alone needs its time to start well.
+    Anytime,
 }
 
 impl PlannerModel {
@@ -31,6 +38,7 @@ impl PlannerModel {
             PlannerModel::Model1 => "model1",
             PlannerModel::Model2 => "model2",
             PlannerModel::Greedy => "greedy",
+            PlannerModel::Anytime => "anytime",
         }
     }
 }
@@ -242,6 +250,11 @@ pub struct Plan {
     /// ask never sees the field.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shortest: Option<ShortestPath>,
+    /// What produced the returned path, of what the planner tried: `ga`, `greedy`,
+    /// `shortest` (the fastest path, unchanged) or `via_seed` (a via-point seed,
+    /// unchanged). Absent from planners before the field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub found_by: Option<String>,
 }
 
 /// The shortest path a plan reply carries ([`Plan::shortest`]): what `model: shortest`

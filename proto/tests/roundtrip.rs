@@ -275,6 +275,8 @@ mod planner_messages {
             Just(PlannerModel::Model0),
             Just(PlannerModel::Model1),
             Just(PlannerModel::Model2),
+            Just(PlannerModel::Greedy),
+            Just(PlannerModel::Anytime),
         ]
     }
 
@@ -415,6 +417,7 @@ mod planner_messages {
                         cpu_grant_s,
                         seed,
                         map_version,
+                        found_by: instance.is_empty().then(|| "greedy".to_owned()),
                         instance,
                         shortest,
                     }

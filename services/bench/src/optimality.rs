@@ -3,8 +3,9 @@
 //! On seeded instances small enough to solve exactly (10 × 10 planning cells at 0.2 m,
 //! a few walls, information in blobs of 0–100, start and goal in opposite corners,
 //! budgets of 1.5, 2 and 3 times the fastest path's ETA: about 15 to 30 moves), the
-//! greedy planner and the GA (Model I, 2000 generations) each plan at the executive's
-//! default deadline (1 s), and the exact search (`roam_planner::exact`, branch and
+//! greedy planner, the GA (Model I, 2000 generations) and the anytime portfolio (the
+//! greedy answer, then the GA seeded with it) each plan at the executive's default
+//! deadline (1 s), and the exact search (`roam_planner::exact`, branch and
 //! bound, both plans as its first incumbents) finds the path that sees the most
 //! distinct information within the budget. Both sides are measured on the same
 //! objective, the distinct information Σ I over the cells the path perceives (what the
@@ -57,6 +58,11 @@ pub struct Instance {
     pub model1: f64,
     pub model1_share: f64,
     pub model1_ms: f64,
+    pub anytime: f64,
+    pub anytime_share: f64,
+    pub anytime_ms: f64,
+    /// What produced the anytime plan (`greedy`, `ga`, …).
+    pub anytime_found_by: &'static str,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -68,6 +74,8 @@ pub struct OptimalityBench {
     pub greedy_share_min: f64,
     pub model1_share_median: f64,
     pub model1_share_min: f64,
+    pub anytime_share_median: f64,
+    pub anytime_share_min: f64,
     /// The best of the two planners' shares, per instance: what a portfolio would get.
     pub best_of_both_share_median: f64,
     pub deadline_s: f64,
@@ -162,6 +170,7 @@ pub fn optimality(instances: u64, progress: Progress<'_>) -> Result<OptimalityBe
             };
             let (greedy, greedy_ms) = run(PlannerModel::Greedy, 1)?;
             let (model1, model1_ms) = run(PlannerModel::Model1, 2000)?;
+            let (anytime, anytime_ms) = run(PlannerModel::Anytime, 2000)?;
             let params = GaParams::default();
             let (s, g) = (world_cell(&world, start)?, world_cell(&world, goal)?);
             let started = Instant::now();
@@ -171,7 +180,7 @@ pub fn optimality(instances: u64, progress: Progress<'_>) -> Result<OptimalityBe
                 s,
                 g,
                 t_exec_s,
-                &[&greedy.path, &model1.path],
+                &[&greedy.path, &model1.path, &anytime.path],
                 NODE_LIMIT,
             )
             .map_err(setup)?;
@@ -183,7 +192,7 @@ pub fn optimality(instances: u64, progress: Progress<'_>) -> Result<OptimalityBe
                     0.0
                 }
             };
-            let (gv, mv) = (value(&greedy), value(&model1));
+            let (gv, mv, av) = (value(&greedy), value(&model1), value(&anytime));
             let share = |v: f64| {
                 if exact.distinct_information > 0.0 {
                     v / exact.distinct_information
@@ -205,6 +214,10 @@ pub fn optimality(instances: u64, progress: Progress<'_>) -> Result<OptimalityBe
                 model1: mv,
                 model1_share: share(mv),
                 model1_ms,
+                anytime: av,
+                anytime_share: share(av),
+                anytime_ms,
+                anytime_found_by: anytime.source.as_str(),
             });
             progress(Done::of("instances", "instances", out.len(), total));
         }
@@ -221,6 +234,7 @@ pub fn optimality(instances: u64, progress: Progress<'_>) -> Result<OptimalityBe
     let (greedy_median, greedy_min) = stat(&|i| i.greedy_share);
     let (model1_median, model1_min) = stat(&|i| i.model1_share);
     let (both_median, _) = stat(&|i| i.greedy_share.max(i.model1_share));
+    let (anytime_median, anytime_min) = stat(&|i| i.anytime_share);
     Ok(OptimalityBench {
         proven: proven.len(),
         instances: out,
@@ -228,6 +242,8 @@ pub fn optimality(instances: u64, progress: Progress<'_>) -> Result<OptimalityBe
         greedy_share_min: greedy_min,
         model1_share_median: model1_median,
         model1_share_min: model1_min,
+        anytime_share_median: anytime_median,
+        anytime_share_min: anytime_min,
         best_of_both_share_median: both_median,
         deadline_s: DEADLINE_S,
         objective: "distinct information: sum of I over the cells the path perceives (Eq. 3's window), within t_exec (Eq. 2)",

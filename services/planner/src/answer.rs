@@ -89,5 +89,6 @@ pub fn to_message(
         map_version,
         instance: instance.to_owned(),
         shortest,
+        found_by: Some(outcome.source.as_str().to_owned()),
     }
 }

@@ -21,6 +21,20 @@ pub enum PlanSource {
     Shortest,
     /// Via-point seed number `n` ([`crate::seeds::ViaSeeds::paths`]), unchanged.
     ViaSeed(usize),
+    /// The greedy planner's route ([`crate::greedy`]).
+    Greedy,
+}
+
+impl PlanSource {
+    /// Its name on the wire ([`roam_proto::planner::Plan::found_by`]).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            PlanSource::Ga => "ga",
+            PlanSource::Shortest => "shortest",
+            PlanSource::ViaSeed(_) => "via_seed",
+            PlanSource::Greedy => "greedy",
+        }
+    }
 }
 
 /// A path with its fitness and where it comes from.

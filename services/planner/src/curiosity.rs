@@ -51,8 +51,9 @@ impl Model {
             PlannerModel::Model0 => Some(Model::Coverage),
             PlannerModel::Model1 => Some(Model::Novelty),
             PlannerModel::Model2 => Some(Model::Heterogeneity),
-            // The greedy planner scores with Model I (crate::greedy).
-            PlannerModel::Greedy => Some(Model::Novelty),
+            // The greedy planner scores with Model I (crate::greedy), and the anytime
+            // portfolio with it (its GA runs Model I).
+            PlannerModel::Greedy | PlannerModel::Anytime => Some(Model::Novelty),
         }
     }
 }

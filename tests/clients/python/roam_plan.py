@@ -18,7 +18,7 @@ import sys
 
 import zenoh
 
-MODELS = ("shortest", "model0", "model1", "model2", "greedy")
+MODELS = ("shortest", "model0", "model1", "model2", "greedy", "anytime")
 
 
 def point(text):

@@ -73,6 +73,9 @@ pub fn plan(
         Some(_) if model == PlannerModel::Greedy => {
             models::greedy(world, params, &checked, deadline, cancel, progress)
         }
+        Some(_) if model == PlannerModel::Anytime => {
+            models::anytime(world, spec, &checked, deadline, cancel, progress)
+        }
         Some(curiosity) => models::ga(world, spec, &checked, curiosity, deadline, cancel, progress),
     };
     let driven = driven::drive(world, spec, &checked, found.scoring, found.ranked);

@@ -86,7 +86,7 @@ pub(super) fn greedy(
     let found = Scored {
         path: result.path,
         evaluation: result.evaluation,
-        source: PlanSource::Ga,
+        source: PlanSource::Greedy,
     };
     let mut evaluator = Evaluator::new(world, params, Model::Novelty, goal, budget);
     Found {
@@ -112,6 +112,70 @@ pub(super) fn ga(
     cancel: &AtomicBool,
     progress: impl FnMut(u32, f64),
 ) -> Found {
+    ga_from(
+        world, spec, checked, model, None, deadline, cancel, progress,
+    )
+}
+
+/// The anytime portfolio: the greedy planner's route at once, then the GA under Model I
+/// with that route in its first population until the deadline; both ranked together
+/// (the greedy route first on a tie, so a GA that only kept it reports `greedy`).
+pub(super) fn anytime(
+    world: &World,
+    spec: &PlanSpec,
+    checked: &Checked,
+    deadline: Instant,
+    cancel: &AtomicBool,
+    mut progress: impl FnMut(u32, f64),
+) -> Found {
+    let quick = greedy(
+        world,
+        &spec.params,
+        checked,
+        deadline,
+        cancel,
+        &mut progress,
+    );
+    let route = quick.ranked.iter().find(|s| s.source == PlanSource::Greedy);
+    let seed = route.map(|s| s.path.clone());
+    let mut found = ga_from(
+        world,
+        spec,
+        checked,
+        Model::Novelty,
+        seed,
+        deadline,
+        cancel,
+        progress,
+    );
+    let mut all = quick.ranked;
+    all.extend(found.ranked);
+    // Stable: on a tie the greedy route (listed first) stays ahead of the GA's copy.
+    all.sort_by(|a, b| {
+        b.evaluation
+            .fitness
+            .total
+            .total_cmp(&a.evaluation.fitness.total)
+    });
+    found.ranked = all;
+    found.evaluations += quick.evaluations;
+    found.evaluated_genes += quick.evaluated_genes;
+    found
+}
+
+/// [`ga`], with `extra_seed` (a route found otherwise) in the first population after
+/// the shortest path.
+#[allow(clippy::too_many_arguments)]
+fn ga_from(
+    world: &World,
+    spec: &PlanSpec,
+    checked: &Checked,
+    model: Model,
+    extra_seed: Option<Vec<crate::world::Cell>>,
+    deadline: Instant,
+    cancel: &AtomicBool,
+    progress: impl FnMut(u32, f64),
+) -> Found {
     let params = &spec.params;
     let (goal, budget) = (checked.goal, checked.planning_budget_s);
     let field = distance_field(world, goal);
@@ -130,6 +194,8 @@ pub(super) fn ga(
     if !strict {
         seed_paths.push(checked.shortest.clone());
     }
+    let extra = usize::from(extra_seed.is_some());
+    seed_paths.extend(extra_seed);
     seed_paths.extend(seeds);
     let problem = Problem {
         world,
@@ -166,7 +232,14 @@ pub(super) fn ga(
         vec![found]
     } else {
         let mut evaluator = Evaluator::new(world, params, model, goal, budget);
-        ranked(&mut evaluator, found, &checked.shortest, &seed_paths[1..])
+        // The via-point seeds after the shortest path and the extra route (which its
+        // planner ranks itself).
+        ranked(
+            &mut evaluator,
+            found,
+            &checked.shortest,
+            &seed_paths[1 + extra..],
+        )
     };
     Found {
         ranked,

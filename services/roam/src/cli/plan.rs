@@ -67,8 +67,9 @@ pub(crate) fn parse_model(text: &str) -> Result<PlannerModel, String> {
         "2" | "model2" => Ok(PlannerModel::Model2),
         "shortest" => Ok(PlannerModel::Shortest),
         "greedy" => Ok(PlannerModel::Greedy),
+        "anytime" => Ok(PlannerModel::Anytime),
         other => Err(format!(
-            "'{other}' is not a model; use 0, 1, 2, greedy or shortest"
+            "'{other}' is not a model; use 0, 1, 2, greedy, anytime or shortest"
         )),
     }
 }

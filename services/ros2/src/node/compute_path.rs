@@ -80,6 +80,7 @@ pub const PLANNER_IDS: &[(&str, PlannerModel)] = &[
     ("model1", PlannerModel::Model1),
     ("model2", PlannerModel::Model2),
     ("greedy", PlannerModel::Greedy),
+    ("anytime", PlannerModel::Anytime),
 ];
 
 #[derive(Debug)]

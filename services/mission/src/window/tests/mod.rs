@@ -236,6 +236,7 @@ fn plan(model: PlannerModel, points: Vec<[f64; 2]>, t_eta_s: f64) -> Plan {
         },
         instance: "planner".into(),
         shortest: None,
+        found_by: None,
     }
 }
 
