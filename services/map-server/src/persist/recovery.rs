@@ -37,7 +37,7 @@ pub struct Recovered {
 }
 
 /// Loads every layer of `dir` (see [`DataDir::load_all`]).
-pub(super) fn load_all(dir: &mut DataDir) -> Loaded {
+pub(crate) fn load_all(dir: &mut DataDir) -> Loaded {
     let mut loaded = Loaded::default();
     match tombstones::read(&dir.tombstones_path()) {
         Ok(t) => loaded.tombstones = t,
@@ -129,7 +129,7 @@ pub(super) fn load_all(dir: &mut DataDir) -> Loaded {
 }
 
 /// Recovers layer `name`: its content, what it says, and the state of its log.
-pub(super) fn recover(
+pub(crate) fn recover(
     dir: &DataDir,
     name: &str,
     warnings: &mut Vec<String>,
