@@ -21,7 +21,7 @@ use super::spec::PlanSpec;
 
 /// What one planner found, before it is driven.
 #[derive(Debug)]
-pub(super) struct Found {
+pub(crate) struct Found {
     /// Its plan and the plans it started from, fittest first.
     pub ranked: Vec<Scored>,
     /// The model the candidates are scored with when driven.
@@ -37,7 +37,7 @@ pub(super) struct Found {
 
 /// The fastest path. Its fitness terms are scored with Model I, the paper's best, so
 /// that they compare with the curious plans.
-pub(super) fn fastest(world: &World, params: &GaParams, checked: &Checked) -> Found {
+pub(crate) fn fastest(world: &World, params: &GaParams, checked: &Checked) -> Found {
     let budget = checked.planning_budget_s;
     let mut evaluator = Evaluator::new(world, params, Model::Novelty, checked.goal, budget);
     let evaluation = evaluator.evaluate(&checked.fastest);
@@ -57,7 +57,7 @@ pub(super) fn fastest(world: &World, params: &GaParams, checked: &Checked) -> Fo
 }
 
 /// The greedy peer ([`crate::greedy`]), from the shortest path that fits.
-pub(super) fn greedy(
+pub(crate) fn greedy(
     world: &World,
     params: &GaParams,
     checked: &Checked,
@@ -103,7 +103,7 @@ pub(super) fn greedy(
 /// Paper 000's GA under `model`, its first population seeded with the shortest path and
 /// the via-point seeds ([`crate::seeds`]) unless the spec asks for the paper's random
 /// walks only.
-pub(super) fn ga(
+pub(crate) fn ga(
     world: &World,
     spec: &PlanSpec,
     checked: &Checked,

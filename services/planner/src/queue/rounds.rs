@@ -7,52 +7,52 @@ use super::client::ClientId;
 use super::rate::Rate;
 
 #[derive(Debug, Clone)]
-pub(super) struct Job {
-    pub(super) id: u64,
-    pub(super) client: ClientId,
+pub(crate) struct Job {
+    pub(crate) id: u64,
+    pub(crate) client: ClientId,
     /// Its fair-share round: the queue serves rounds in order.
-    pub(super) round: u64,
+    pub(crate) round: u64,
     /// Arrival order, within a round.
-    pub(super) seq: u64,
+    pub(crate) seq: u64,
     /// Expected seconds of planning.
-    pub(super) expected_s: f64,
+    pub(crate) expected_s: f64,
     /// When it started planning (running) or was admitted (waiting).
-    pub(super) since: Instant,
+    pub(crate) since: Instant,
 }
 
 impl Job {
-    pub(super) fn order(&self) -> (u64, u64) {
+    pub(crate) fn order(&self) -> (u64, u64) {
         (self.round, self.seq)
     }
 }
 
 /// A client's place in the rounds.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct Share {
+pub(crate) struct Share {
     /// The round its next request takes at the earliest.
-    pub(super) next_round: u64,
+    pub(crate) next_round: u64,
     /// Its requests running or waiting (the entry goes at 0).
-    pub(super) jobs: usize,
+    pub(crate) jobs: usize,
 }
 
 #[derive(Debug, Default)]
-pub(super) struct Inner {
-    pub(super) running: Vec<Job>,
+pub(crate) struct Inner {
+    pub(crate) running: Vec<Job>,
     /// In `(round, seq)` order.
-    pub(super) waiting: VecDeque<Job>,
+    pub(crate) waiting: VecDeque<Job>,
     /// The round of the request that started last.
-    pub(super) round: u64,
-    pub(super) clients: HashMap<ClientId, Share>,
+    pub(crate) round: u64,
+    pub(crate) clients: HashMap<ClientId, Share>,
     /// Requests that lost their place to a request of an earlier round.
-    pub(super) displaced: HashSet<u64>,
-    pub(super) rate: Rate,
-    pub(super) next_id: u64,
+    pub(crate) displaced: HashSet<u64>,
+    pub(crate) rate: Rate,
+    pub(crate) next_id: u64,
 }
 
 impl Inner {
     /// Forgets a request (running or waiting) and its client's share when it was the
     /// client's last.
-    pub(super) fn remove(&mut self, id: u64) {
+    pub(crate) fn remove(&mut self, id: u64) {
         let gone = if let Some(at) = self.running.iter().position(|j| j.id == id) {
             Some(self.running.swap_remove(at))
         } else if let Some(at) = self.waiting.iter().position(|j| j.id == id) {
@@ -74,7 +74,7 @@ impl Inner {
     /// Queues `job` in its place. A request that reached the queue after a later one
     /// of the same client (requests are checked concurrently) takes that one's round,
     /// and the client's later requests move one round on.
-    pub(super) fn insert(&mut self, mut job: Job) {
+    pub(crate) fn insert(&mut self, mut job: Job) {
         let later_of_client = self
             .waiting
             .iter()

@@ -16,9 +16,9 @@ pub struct QueueConfig {
 /// The queue of one instance.
 #[derive(Debug)]
 pub struct PlanQueue {
-    pub(super) config: QueueConfig,
+    pub(crate) config: QueueConfig,
     inner: Mutex<Inner>,
-    pub(super) changed: tokio::sync::Notify,
+    pub(crate) changed: tokio::sync::Notify,
 }
 
 impl PlanQueue {
@@ -37,7 +37,7 @@ impl PlanQueue {
         }
     }
 
-    pub(super) fn lock(&self) -> std::sync::MutexGuard<'_, Inner> {
+    pub(crate) fn lock(&self) -> std::sync::MutexGuard<'_, Inner> {
         roam_runtime::lock(&self.inner)
     }
 
