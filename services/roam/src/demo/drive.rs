@@ -27,7 +27,7 @@ use super::error::{write_error, DemoError};
 use super::options::{DemoOptions, DEMO_W_LOC};
 use super::report::{markdown, DemoReport};
 
-pub(super) async fn drive(
+pub(crate) async fn drive(
     stack: &Stack,
     options: &DemoOptions,
     world: &Path,
