@@ -99,7 +99,7 @@ struct Server {
 
 /// Declares the action `action` (relative to the node's namespace): its three services
 /// and two publishers, each with its liveliness token.
-pub(super) async fn declare(
+pub(crate) async fn declare(
     service: &Service,
     out: Arc<Output>,
     root: &str,

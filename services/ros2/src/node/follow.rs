@@ -84,7 +84,7 @@ fn decode_sample<T: Message>(out: &Output, sample: &Sample, max: usize) -> Optio
     }
 }
 
-pub(super) async fn run(
+pub(crate) async fn run(
     session: Session,
     root: String,
     subscriptions: FleetStreams,

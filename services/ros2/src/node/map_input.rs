@@ -43,7 +43,7 @@ struct GridHead {
     info: MapMetaData,
 }
 
-pub(super) async fn declare(
+pub(crate) async fn declare(
     service: &Service,
     out: Arc<Output>,
     config: &Ros2Config,

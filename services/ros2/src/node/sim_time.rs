@@ -27,7 +27,7 @@ impl MissionClock {
 }
 
 /// Follows `topic` and republishes it as roam's clock.
-pub(super) async fn declare(
+pub(crate) async fn declare(
     service: &Service,
     out: Arc<Output>,
     root: &str,

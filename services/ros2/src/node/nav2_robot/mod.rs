@@ -48,7 +48,7 @@ use state::Robot;
 
 /// Declares robot `config`'s subscriptions and action client and drives it until the
 /// service stops.
-pub(super) async fn declare(
+pub(crate) async fn declare(
     service: &Service,
     out: Arc<Output>,
     root: &str,
