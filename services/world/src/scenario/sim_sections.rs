@@ -200,7 +200,7 @@ fn on_free_cell(
 }
 
 /// Checks the sim world's sections against the map.
-pub(super) fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldIssue> {
+pub(crate) fn validate_sim(file: &ScenarioFile, occupancy: &Grid<i8>) -> Result<(), FieldIssue> {
     let meta = &occupancy.meta;
     let on_map = |f: String, what: &str, at: [f64; 2]| cell_on_map(meta, f, what, at);
     let on_free_cell = |f: String, what: &str, at: [f64; 2]| on_free_cell(occupancy, f, what, at);
