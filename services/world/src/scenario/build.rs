@@ -4,7 +4,7 @@ use std::path::Path;
 
 use roam_proto::map::{GridMeta, Origin};
 
-use super::{GridSpec, InformationSpec};
+use super::file::{GridSpec, InformationSpec};
 use crate::grid::{cell_center, occupancy, Grid};
 use crate::load_dirs::Access;
 
