@@ -13,7 +13,8 @@ use serde::Serialize;
 use zenoh::liveliness::LivelinessToken;
 use zenoh::query::{ConsolidationMode, QueryTarget};
 
-use super::{Output, Ros2Error};
+use super::error::Ros2Error;
+use super::output::Output;
 use crate::attachment::{self, Attachment};
 use crate::msg::{CancelGoalRequest, CancelGoalResponse, GoalInfo, Time, Uuid};
 use crate::names::{EntityKind, Qos};

@@ -35,7 +35,8 @@ use roam_runtime::{ClientError, Service};
 use serde::Serialize;
 use zenoh::query::Query;
 
-use super::{Output, Ros2Error};
+use super::error::Ros2Error;
+use super::output::Output;
 use crate::attachment::{self, Attachment};
 use crate::convert;
 use crate::msg::{GetPlanRequest, GetPlanResponse, PlanDowntimeRequest, Time};

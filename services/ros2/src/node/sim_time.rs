@@ -10,7 +10,8 @@ use roam_proto::sim::SimClock;
 use roam_proto::{encode, keys};
 use roam_runtime::{Delivery, Service};
 
-use super::{Output, Ros2Error};
+use super::error::Ros2Error;
+use super::output::Output;
 use crate::msg::Clock;
 use crate::names::Qos;
 use crate::types;
