@@ -358,7 +358,10 @@ fn the_check_sees_a_circle_and_ignores_comments_strings_and_tests() {
     );
     // A child the parent names by a relative path (`use shelf::Shelf`) importing the
     // parent back: a circle too.
-    write("store/shelf.rs", "use super::CellEdits;\npub struct Shelf;\n");
+    write(
+        "store/shelf.rs",
+        "use super::CellEdits;\npub struct Shelf;\n",
+    );
     write("edits.rs", "fn f() { let _ = crate::store::OCCUPANCY; }\n");
     // Names the store only in a doc link, a comment, a string and test code: no import.
     write(
@@ -391,7 +394,10 @@ fn the_check_sees_a_circle_and_ignores_comments_strings_and_tests() {
     let circle = |files: [&str; 2]| files.map(str::to_owned).into_iter().collect();
     assert_eq!(
         names,
-        BTreeSet::from([circle(["edits.rs", "mod.rs"]), circle(["mod.rs", "shelf.rs"])]),
+        BTreeSet::from([
+            circle(["edits.rs", "mod.rs"]),
+            circle(["mod.rs", "shelf.rs"])
+        ]),
         "{found:?}"
     );
     let quiet = src.join("quiet.rs");
