@@ -196,6 +196,10 @@ impl<'ast> Visit<'ast> for Named<'_> {
         }
     }
 
+    /// `pub(super)` and `pub(in crate::x)` name a module to say who may see an item, not
+    /// to use it: no import.
+    fn visit_visibility(&mut self, _: &'ast syn::Visibility) {}
+
     fn visit_path(&mut self, p: &'ast syn::Path) {
         let segments: Vec<String> = p.segments.iter().map(|s| s.ident.to_string()).collect();
         self.push(&segments);
@@ -350,7 +354,7 @@ fn the_check_sees_a_circle_and_ignores_comments_strings_and_tests() {
     );
     write(
         "store/mod.rs",
-        "use crate::edits::CellEdits;\npub mod stage;\npub mod shelf;\nuse shelf::Shelf;\n",
+        "use crate::edits::CellEdits;\npub mod stage;\npub mod shelf;\nuse shelf::Shelf;\nmod bin;\nuse bin::Bin;\n",
     );
     write(
         "store/stage.rs",
@@ -361,6 +365,11 @@ fn the_check_sees_a_circle_and_ignores_comments_strings_and_tests() {
     write(
         "store/shelf.rs",
         "use super::CellEdits;\npub struct Shelf;\n",
+    );
+    // A visibility naming the parent is no import of it.
+    write(
+        "store/bin.rs",
+        "pub(super) struct Bin;\npub(in crate::store) fn b() {}\n",
     );
     write("edits.rs", "fn f() { let _ = crate::store::OCCUPANCY; }\n");
     // Names the store only in a doc link, a comment, a string and test code: no import.
