@@ -21,7 +21,7 @@ fn status_of(
     crate::status::controller_status(robot, &driven.mission, driven.waypoints, decision, estimate)
 }
 
-pub(crate) fn on_estimate(state: &ControllerShared, key: &str, estimate: PositionEstimate) {
+pub(super) fn on_estimate(state: &ControllerShared, key: &str, estimate: PositionEstimate) {
     let robot = match routing::robot_for(&state.root, key, &estimate.robot) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "ignoring an estimate: {e}"),

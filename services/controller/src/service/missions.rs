@@ -37,7 +37,7 @@ fn check_mission(mission: &Mission) -> Result<(), String> {
     Ok(())
 }
 
-pub(crate) fn on_mission(state: &ControllerShared, key: &str, mission: Mission) {
+pub(super) fn on_mission(state: &ControllerShared, key: &str, mission: Mission) {
     let robot = match routing::robot_for(&state.root, key, &mission.robot) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "mission refused: {e}"),
@@ -71,7 +71,7 @@ pub(crate) fn on_mission(state: &ControllerShared, key: &str, mission: Mission) 
 }
 
 /// Makes `mission` the robot's current one and publishes its first status.
-pub(crate) fn install_mission(state: &ControllerShared, robot: &str, mission: &Mission) {
+pub(super) fn install_mission(state: &ControllerShared, robot: &str, mission: &Mission) {
     let mut robots = state.robots();
     if robots.len() >= MAX_ROBOTS && !robots.contains_key(robot) {
         return limited_warn!(

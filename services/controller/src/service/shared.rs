@@ -22,59 +22,59 @@ pub const MAX_ROBOTS: usize = 1000;
 pub const MAX_HELD_MISSIONS: usize = 64;
 
 /// One robot under control.
-pub(crate) struct ControlledRobot {
-    pub(crate) controller: Controller,
-    pub(crate) mission: String,
-    pub(crate) waypoints: usize,
-    pub(crate) last_estimate: Instant,
-    pub(crate) stale: bool,
-    pub(crate) last: Option<ControllerStatus>,
+pub(super) struct ControlledRobot {
+    pub(super) controller: Controller,
+    pub(super) mission: String,
+    pub(super) waypoints: usize,
+    pub(super) last_estimate: Instant,
+    pub(super) stale: bool,
+    pub(super) last: Option<ControllerStatus>,
 }
 
 /// What the controller's subscribers share: the session, the fields the controllers
 /// steer by, and the robots under control.
-pub(crate) struct ControllerShared {
-    pub(crate) root: String,
-    pub(crate) session: zenoh::Session,
-    pub(crate) params: ApfParams,
-    pub(crate) obstacles: Arc<ObstacleField>,
-    pub(crate) information: Arc<InformationField>,
-    pub(crate) stale_after: Duration,
-    pub(crate) release_after: Duration,
+pub(super) struct ControllerShared {
+    pub(super) root: String,
+    pub(super) session: zenoh::Session,
+    pub(super) params: ApfParams,
+    pub(super) obstacles: Arc<ObstacleField>,
+    pub(super) information: Arc<InformationField>,
+    pub(super) stale_after: Duration,
+    pub(super) release_after: Duration,
     /// The robots this instance may drive; empty: any.
-    pub(crate) allowed: Vec<String>,
-    pub(crate) robots: Mutex<HashMap<String, ControlledRobot>>,
+    pub(super) allowed: Vec<String>,
+    pub(super) robots: Mutex<HashMap<String, ControlledRobot>>,
     /// The robots the scenario has: a mission for one is taken at once.
-    pub(crate) scenario_robots: Vec<String>,
+    pub(super) scenario_robots: Vec<String>,
     /// When each robot's last estimate came (robots without a mission too), at most
     /// [`MAX_ROBOTS`]: with the scenario's robots, what "a robot the world has" means
     /// to the controller.
-    pub(crate) seen: Mutex<HashMap<String, Instant>>,
+    pub(super) seen: Mutex<HashMap<String, Instant>>,
     /// The step of each robot's last estimate answered, kept with `seen`.
-    pub(crate) answered: Mutex<HashMap<String, u64>>,
+    pub(super) answered: Mutex<HashMap<String, u64>>,
     /// Missions decided on an estimate this controller has not answered yet
     /// ([`Mission::after_step`]), one per robot (the latest), for robots the world has:
     /// each starts once that estimate is answered.
-    pub(crate) queued: Mutex<HashMap<String, Mission>>,
+    pub(super) queued: Mutex<HashMap<String, Mission>>,
     /// Missions for robots not yet heard of, waiting for their first estimate: at most
     /// [`MAX_HELD_MISSIONS`], the oldest dropped first, each for `release_after`.
-    pub(crate) held: Mutex<HashMap<String, (Instant, Mission)>>,
+    pub(super) held: Mutex<HashMap<String, (Instant, Mission)>>,
     /// Refused missions and estimates, logged a few per key and window.
-    pub(crate) warnings: WarnLimiter,
+    pub(super) warnings: WarnLimiter,
 }
 
 impl ControllerShared {
-    pub(crate) fn robots(&self) -> MutexGuard<'_, HashMap<String, ControlledRobot>> {
+    pub(super) fn robots(&self) -> MutexGuard<'_, HashMap<String, ControlledRobot>> {
         roam_runtime::lock(&self.robots)
     }
 
-    pub(crate) fn seen(&self) -> MutexGuard<'_, HashMap<String, Instant>> {
+    pub(super) fn seen(&self) -> MutexGuard<'_, HashMap<String, Instant>> {
         roam_runtime::lock(&self.seen)
     }
 
     /// Notes an estimate of `robot`; when [`MAX_ROBOTS`] robots are noted, the one
     /// heard from longest ago makes room.
-    pub(crate) fn note_seen(&self, robot: &str) {
+    pub(super) fn note_seen(&self, robot: &str) {
         let mut seen = self.seen();
         if !seen.contains_key(robot) && seen.len() >= MAX_ROBOTS {
             if let Some(oldest) = seen.iter().min_by_key(|(_, t)| **t).map(|(r, _)| r.clone()) {
@@ -85,7 +85,7 @@ impl ControllerShared {
     }
 
     /// Whether `mission` waits for an estimate `robot`'s controller has not answered.
-    pub(crate) fn waits(&self, robot: &str, mission: &Mission) -> bool {
+    pub(super) fn waits(&self, robot: &str, mission: &Mission) -> bool {
         let Some(after) = mission.after_step else {
             return false;
         };
@@ -96,7 +96,7 @@ impl ControllerShared {
 
     /// The mission queued for `robot` if it may start before (`before: true`) or after
     /// answering the estimate of `step`.
-    pub(crate) fn take_queued(&self, robot: &str, step: u64, before: bool) -> Option<Mission> {
+    pub(super) fn take_queued(&self, robot: &str, step: u64, before: bool) -> Option<Mission> {
         let mut queued = roam_runtime::lock(&self.queued);
         let after = queued.get(robot)?.after_step.unwrap_or(0);
         let due = if before { after < step } else { after <= step };
@@ -108,7 +108,7 @@ impl ControllerShared {
     }
 
     /// Holds a mission until the robot's first estimate.
-    pub(crate) fn hold(&self, robot: &str, mission: Mission) {
+    pub(super) fn hold(&self, robot: &str, mission: Mission) {
         let mut held = roam_runtime::lock(&self.held);
         if !held.contains_key(robot) && held.len() >= MAX_HELD_MISSIONS {
             if let Some(oldest) = held
@@ -123,7 +123,7 @@ impl ControllerShared {
     }
 
     /// The mission held for `robot`, if one is and it has not expired.
-    pub(crate) fn take_held(&self, robot: &str) -> Option<Mission> {
+    pub(super) fn take_held(&self, robot: &str) -> Option<Mission> {
         let mut held = roam_runtime::lock(&self.held);
         let (at, mission) = held.remove(robot)?;
         (at.elapsed() < self.release_after).then_some(mission)
@@ -131,7 +131,7 @@ impl ControllerShared {
 
     /// Whether the world has `robot`: the scenario names it, or localization reported
     /// it within `release_after`.
-    pub(crate) fn is_present(&self, robot: &str) -> bool {
+    pub(super) fn is_present(&self, robot: &str) -> bool {
         self.scenario_robots.iter().any(|r| r == robot)
             || self
                 .seen()
@@ -140,11 +140,11 @@ impl ControllerShared {
     }
 
     /// Commands, goals and statuses are state a robot must not miss: delivered.
-    pub(crate) fn put<T: Message>(&self, key: &str, message: &T) {
+    pub(super) fn put<T: Message>(&self, key: &str, message: &T) {
         roam_runtime::publish_wait(&self.session, key, message, Delivery::Reliable);
     }
 
-    pub(crate) fn command(&self, robot: &str, u: [f64; 2], step: Option<u64>) {
+    pub(super) fn command(&self, robot: &str, u: [f64; 2], step: Option<u64>) {
         self.put(
             &keys::robot_command(&self.root, robot),
             &RobotCommand { u, step },

@@ -11,7 +11,7 @@ use super::shared::ControllerShared;
 
 /// Holds every robot whose estimates have stopped: a zero command and `halted_stale`;
 /// forgets a robot whose estimates have stopped for `release_after_s` (it is gone).
-pub(crate) async fn watchdog(state: Arc<ControllerShared>, cancel: CancellationToken) {
+pub(super) async fn watchdog(state: Arc<ControllerShared>, cancel: CancellationToken) {
     let tick = (state.stale_after / 4).max(Duration::from_millis(5));
     loop {
         tokio::select! {

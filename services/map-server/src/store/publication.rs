@@ -34,7 +34,7 @@ impl Publication {
 
 /// The publication of `edits` to `layer` (as it is before them), which make `version`:
 /// a delta when it is small enough, else the whole layer.
-pub(crate) fn of_edits(layer: &Layer, version: u64, edits: &CellEdits) -> Publication {
+pub(super) fn of_edits(layer: &Layer, version: u64, edits: &CellEdits) -> Publication {
     let dtype = layer.cells.dtype().size() as u64;
     let delta_bytes = edits.len() as u64 * (8 + dtype);
     let layer_bytes = layer.cells.len() as u64 * dtype;

@@ -122,7 +122,7 @@ fn f32_cells(cells: Vec<f64>) -> Vec<f32> {
 }
 
 /// Sends the layers to the map server at most once per period.
-pub(crate) async fn publish_layers(
+pub(super) async fn publish_layers(
     state: Arc<MapperShared>,
     period: Duration,
     cancel: CancellationToken,

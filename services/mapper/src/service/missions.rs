@@ -10,7 +10,7 @@ use super::shared::MapperShared;
 
 /// A robot's new mission replaces its reservation ([`crate::news`]); an empty one
 /// releases it.
-pub(crate) fn on_mission(state: &MapperShared, key: &str, mission: Mission) {
+pub(super) fn on_mission(state: &MapperShared, key: &str, mission: Mission) {
     let robot = match routing::robot_for(&state.root, key, &mission.robot) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "ignoring a mission: {e}"),

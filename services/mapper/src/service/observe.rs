@@ -53,7 +53,7 @@ fn cell_centre(meta: &GridMeta, (x, y): (u32, u32)) -> [f64; 2] {
     ]
 }
 
-pub(crate) fn on_observation(state: &MapperShared, key: &str, o: LocalObservation) {
+pub(super) fn on_observation(state: &MapperShared, key: &str, o: LocalObservation) {
     let robot = match routing::robot_for(&state.root, key, &o.robot) {
         Ok(robot) => robot,
         Err(e) => return limited_warn!(state.warnings, key, "ignoring an observation: {e}"),

@@ -20,63 +20,63 @@ use crate::news::{NewsMap, NewsParams};
 use super::config::MapperServiceError;
 
 /// What observations and missions change, on one world's grid.
-pub(crate) struct Mapping {
+pub(super) struct Mapping {
     /// The world the layers are of, sent with their updates.
-    pub(crate) world: roam_proto::map::WorldId,
+    pub(super) world: roam_proto::map::WorldId,
     /// Its grid.
-    pub(crate) meta: GridMeta,
+    pub(super) meta: GridMeta,
     /// Its static occupancy: the map now's prior for cells never seen.
-    pub(crate) static_map: Grid<i8>,
-    pub(crate) map: ChangeMap,
+    pub(super) static_map: Grid<i8>,
+    pub(super) map: ChangeMap,
     /// The robots' reservations (their current missions).
-    pub(crate) news: NewsMap,
+    pub(super) news: NewsMap,
     /// Each robot's last observed position, where its mission's path starts; kept for
     /// the first [`MAX_RESERVING_ROBOTS`] robots heard (a mission of any other starts at
     /// its first waypoint).
-    pub(crate) positions: BTreeMap<String, [f64; 2]>,
-    pub(crate) explorers: BTreeMap<String, Explorer>,
+    pub(super) positions: BTreeMap<String, [f64; 2]>,
+    pub(super) explorers: BTreeMap<String, Explorer>,
     /// The exploration goal last published per robot: a goal is published when it changes.
-    pub(crate) published_goals: BTreeMap<String, ExplorationGoal>,
-    pub(crate) observations: u64,
-    pub(crate) map_changes: u64,
-    pub(crate) features: (f64, f64),
+    pub(super) published_goals: BTreeMap<String, ExplorationGoal>,
+    pub(super) observations: u64,
+    pub(super) map_changes: u64,
+    pub(super) features: (f64, f64),
     /// Mapper time ([`Epochs`]) of the newest observation.
-    pub(crate) now_s: f64,
+    pub(super) now_s: f64,
     /// Something was observed since the layers were last sent.
-    pub(crate) dirty: bool,
-    pub(crate) layers_sent: u64,
+    pub(super) dirty: bool,
+    pub(super) layers_sent: u64,
     /// Observation times against the sim clock; resets as epochs.
-    pub(crate) epochs: Epochs,
+    pub(super) epochs: Epochs,
 }
 
 /// What the mapper's subscribers, publisher and queryable share: the session and the
 /// mapping under its lock.
-pub(crate) struct MapperShared {
-    pub(crate) root: String,
-    pub(crate) session: zenoh::Session,
-    pub(crate) mapping: Mutex<Mapping>,
+pub(super) struct MapperShared {
+    pub(super) root: String,
+    pub(super) session: zenoh::Session,
+    pub(super) mapping: Mutex<Mapping>,
     /// What a world's mapping is made of, for the world the map server moves to.
-    pub(crate) spec: MappingSpec,
+    pub(super) spec: MappingSpec,
     /// Refused observations, logged a few per key and window.
-    pub(crate) warnings: WarnLimiter,
-    pub(crate) belief: BeliefParams,
+    pub(super) warnings: WarnLimiter,
+    pub(super) belief: BeliefParams,
     /// How far a robot sees along its mission's path, metres, and how fast it drives it.
-    pub(crate) reserve_radius_m: f64,
-    pub(crate) reserve_s_per_m: f64,
+    pub(super) reserve_radius_m: f64,
+    pub(super) reserve_s_per_m: f64,
 }
 
 /// What a world's mapping is made of besides its grid.
-pub(crate) struct MappingSpec {
-    pub(crate) map: MapParams,
-    pub(crate) news: NewsParams,
-    pub(crate) explorer: ExplorerParams,
-    pub(crate) seed: u64,
-    pub(crate) explore: BTreeSet<String>,
+pub(super) struct MappingSpec {
+    pub(super) map: MapParams,
+    pub(super) news: NewsParams,
+    pub(super) explorer: ExplorerParams,
+    pub(super) seed: u64,
+    pub(super) explore: BTreeSet<String>,
 }
 
 impl MappingSpec {
     /// A fresh mapping of `world`, whose static occupancy is `static_map`.
-    pub(crate) fn build(
+    pub(super) fn build(
         &self,
         world: roam_proto::map::WorldId,
         static_map: Grid<i8>,
@@ -118,12 +118,12 @@ impl MappingSpec {
 }
 
 impl MapperShared {
-    pub(crate) fn mapping(&self) -> MutexGuard<'_, Mapping> {
+    pub(super) fn mapping(&self) -> MutexGuard<'_, Mapping> {
         roam_runtime::lock(&self.mapping)
     }
 
     /// Commands, goals and statuses are state a robot must not miss: delivered.
-    pub(crate) fn put<T: Message>(&self, key: &str, message: &T) {
+    pub(super) fn put<T: Message>(&self, key: &str, message: &T) {
         roam_runtime::publish_wait(&self.session, key, message, Delivery::Reliable);
     }
 }

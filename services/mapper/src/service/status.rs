@@ -41,7 +41,7 @@ fn status(state: &MapperShared) -> MapperStatus {
     }
 }
 
-pub(crate) async fn answer_status(state: Arc<MapperShared>, query: Query) {
+pub(super) async fn answer_status(state: Arc<MapperShared>, query: Query) {
     let result: Result<MapperStatus, ErrorReply> = Ok(status(&state));
     reply::send_result(&query, result).await;
 }

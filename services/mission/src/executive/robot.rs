@@ -31,47 +31,47 @@ const CLOCK_WAIT: Duration = Duration::from_secs(2);
 
 /// The executive on one robot while it runs its tasks: its Zenoh ends, and what it
 /// keeps from window to window.
-pub(crate) struct Executive<'a> {
-    pub(crate) session: &'a zenoh::Session,
-    pub(crate) root: &'a str,
-    pub(crate) config: &'a ExecutiveConfig,
-    pub(crate) planner: Arc<PlannerClient>,
-    pub(crate) inputs: Inputs,
+pub(super) struct Executive<'a> {
+    pub(super) session: &'a zenoh::Session,
+    pub(super) root: &'a str,
+    pub(super) config: &'a ExecutiveConfig,
+    pub(super) planner: Arc<PlannerClient>,
+    pub(super) inputs: Inputs,
     /// The robot's last good estimate.
-    pub(crate) position: Option<[f64; 2]>,
+    pub(super) position: Option<[f64; 2]>,
     /// The robot's time calibration, fitted as it drives.
-    pub(crate) calibration: Calibration,
+    pub(super) calibration: Calibration,
     /// Wall seconds the recent curious plans took (request to reply), the slowest.
-    pub(crate) plan_wall_s: Option<f64>,
+    pub(super) plan_wall_s: Option<f64>,
     /// What the last window handed the next (the arrival margin, the mission and ask
     /// counts, the next window's plan).
-    pub(crate) handover: Handover,
+    pub(super) handover: Handover,
     /// This executive's own tag in its mission ids (from its Zenoh session id), so a
     /// restarted executive never reuses an id its predecessor sent: the controller's
     /// statuses on an old mission are not taken for a new one's.
-    pub(crate) tag: String,
+    pub(super) tag: String,
     /// What it heard last, for its status.
-    pub(crate) heard: Heard,
+    pub(super) heard: Heard,
 }
 
 /// The sim steps of the last estimate and controller status the loop handled.
 #[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Heard {
-    pub(crate) estimate_step: Option<u64>,
-    pub(crate) status_step: Option<u64>,
+pub(super) struct Heard {
+    pub(super) estimate_step: Option<u64>,
+    pub(super) status_step: Option<u64>,
 }
 
 /// A plan request's answer as the loop gets it back: the ask's id, whether it was
 /// curious, the wall seconds it took, and the reply.
-pub(crate) type Answered = (u64, bool, f64, Result<Plan, ClientError>);
+pub(super) type Answered = (u64, bool, f64, Result<Plan, ClientError>);
 
 impl Executive<'_> {
-    pub(crate) fn now(&self) -> f64 {
+    pub(super) fn now(&self) -> f64 {
         lock(&self.inputs.clock).now_s()
     }
 
     /// The model plans are made with: the fit, or Table I when not calibrating.
-    pub(crate) fn time_model(&self) -> TimeModel {
+    pub(super) fn time_model(&self) -> TimeModel {
         if self.config.calibrate {
             self.calibration.model()
         } else {
@@ -95,7 +95,7 @@ impl Executive<'_> {
 
     /// The machine's time: the mission clock, wall seconds since `began`, what a plan
     /// costs now, and the clock's rate.
-    pub(crate) fn moment(&self, began: Instant) -> Now {
+    pub(super) fn moment(&self, began: Instant) -> Now {
         Now {
             mission_s: self.now(),
             wall_s: began.elapsed().as_secs_f64(),
@@ -106,7 +106,7 @@ impl Executive<'_> {
 
     /// Sends the request `ask` describes ([`plan_request`]) without waiting: its answer
     /// joins `in_flight`.
-    pub(crate) fn ask(&self, ask: &PlanAsk, in_flight: &mut JoinSet<Answered>) {
+    pub(super) fn ask(&self, ask: &PlanAsk, in_flight: &mut JoinSet<Answered>) {
         let request = plan_request(self.config, ask, self.time_model());
         let planner = self.planner.clone();
         let (id, curious) = (ask.id, ask.curious);
@@ -118,7 +118,7 @@ impl Executive<'_> {
     }
 
     /// Learns what a curious plan costs from one that came back.
-    pub(crate) fn took(&mut self, plan: &Plan, took_s: f64) {
+    pub(super) fn took(&mut self, plan: &Plan, took_s: f64) {
         // Only what the GA took says what a curious plan costs (a fallback to the
         // shortest path is answered at once).
         if plan.model != PlannerModel::Shortest {
@@ -129,7 +129,7 @@ impl Executive<'_> {
 
     /// Sends `mission`, decided on the last estimate heard: the controller starts it
     /// after answering that estimate ([`Mission::after_step`]), as the batch does.
-    pub(crate) fn publish(&self, mission: &Mission) {
+    pub(super) fn publish(&self, mission: &Mission) {
         let key = keys::robot_mission(self.root, &self.config.robot);
         let mission = Mission {
             after_step: self.heard.estimate_step,
@@ -141,7 +141,7 @@ impl Executive<'_> {
     /// What the executive is doing, for operators and for lock-step drivers: the sim
     /// steps of the last estimate and controller status it handled, and the plans in
     /// flight.
-    pub(crate) fn publish_status(&self, window: usize, asks: usize) {
+    pub(super) fn publish_status(&self, window: usize, asks: usize) {
         let heard = self.heard;
         let key = keys::robot_executive(self.root, &self.config.robot);
         let status = ExecutiveStatus {
@@ -157,7 +157,7 @@ impl Executive<'_> {
     /// Waits briefly for the sim's clock, so that an executive restarted mid-mission
     /// sees the mission time and skips the tasks that ended while it was down. Without
     /// a sim (a real fleet on wall time) it goes on after the wait.
-    pub(crate) async fn hear_the_clock(
+    pub(super) async fn hear_the_clock(
         &self,
         cancel: &CancellationToken,
     ) -> Result<(), ExecutiveError> {
@@ -171,7 +171,7 @@ impl Executive<'_> {
         Ok(())
     }
 
-    pub(crate) async fn first_position(
+    pub(super) async fn first_position(
         &mut self,
         cancel: &CancellationToken,
     ) -> Result<[f64; 2], ExecutiveError> {
@@ -208,7 +208,7 @@ impl Executive<'_> {
     /// The calibration learns from the mission that arrived (its Σd and Σθ as Eq. 2
     /// counts them on the cells, and how long driving it took) and keeps the fit in the
     /// calibration file.
-    pub(crate) fn calibrate(&mut self, window: usize, drive: &DrivenMission) {
+    pub(super) fn calibrate(&mut self, window: usize, drive: &DrivenMission) {
         if !self.config.calibrate {
             return;
         }

@@ -42,7 +42,7 @@ pub const CARRIED_TRACK_POINTS: usize = 600;
 
 /// The last [`CARRIED_TRACK_POINTS`] of `driven` and `fix` as an index into them (the
 /// oldest kept point when the fix is older).
-pub(crate) fn carried(driven: &[[f64; 2]], fix: usize) -> (Vec<[f64; 2]>, usize) {
+pub(super) fn carried(driven: &[[f64; 2]], fix: usize) -> (Vec<[f64; 2]>, usize) {
     let start = driven.len().saturating_sub(CARRIED_TRACK_POINTS);
     (driven[start..].to_vec(), fix.saturating_sub(start))
 }

@@ -57,7 +57,7 @@ pub const MIN_DEADLINE_S: f64 = 0.05;
 /// The least driving budget a request carries: the planner takes only positive ones. A
 /// window with no time left asks for the shortest path, for which the budget only says
 /// whether it fits.
-pub(crate) const LEAST_T_EXEC_S: f64 = 1e-3;
+pub(super) const LEAST_T_EXEC_S: f64 = 1e-3;
 
 /// The report's reason (a token, as [`crate::watch::Reason::name`]) for a window given
 /// up before any plan came: no planner answered before the window was given up.

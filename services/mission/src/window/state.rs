@@ -14,15 +14,15 @@ use super::setup::WindowSetup;
 
 /// The missions of a window, numbered on from the previous windows'.
 #[derive(Debug, Clone)]
-pub(crate) struct MissionIds {
-    pub(crate) robot: String,
-    pub(crate) tag: String,
-    pub(crate) window: usize,
-    pub(crate) sent: u64,
+pub(super) struct MissionIds {
+    pub(super) robot: String,
+    pub(super) tag: String,
+    pub(super) window: usize,
+    pub(super) sent: u64,
 }
 
 impl MissionIds {
-    pub(crate) fn next(&mut self, waypoints: Vec<[f64; 2]>, recovery: bool) -> Mission {
+    pub(super) fn next(&mut self, waypoints: Vec<[f64; 2]>, recovery: bool) -> Mission {
         self.sent += 1;
         Mission {
             after_step: None,
@@ -39,7 +39,7 @@ impl MissionIds {
 
 /// The drive's request in flight and what its reply is for.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum DriveAsk {
+pub(super) enum DriveAsk {
     FirstPlan {
         budget_s: f64,
         time_left_s: f64,
@@ -53,7 +53,7 @@ pub(crate) enum DriveAsk {
 
 /// How the watch takes a new route.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Follows {
+pub(super) enum Follows {
     /// A replan, counted as `Replanned` says.
     Replan(Replanned),
     /// Straight to the task, curious no more.
@@ -62,46 +62,46 @@ pub(crate) enum Follows {
 
 /// The next window's request in flight.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct AheadAsk {
-    pub(crate) budget_s: f64,
-    pub(crate) time_left_s: f64,
-    pub(crate) leave_at_s: f64,
+pub(super) struct AheadAsk {
+    pub(super) budget_s: f64,
+    pub(super) time_left_s: f64,
+    pub(super) leave_at_s: f64,
 }
 
 /// The robot on its way.
 #[derive(Debug, Clone)]
-pub(crate) struct Drive {
-    pub(crate) budget_s: f64,
-    pub(crate) shortest: Vec<[f64; 2]>,
+pub(super) struct Drive {
+    pub(super) budget_s: f64,
+    pub(super) shortest: Vec<[f64; 2]>,
     /// Of the window's first route.
-    pub(crate) planned_information: f64,
-    pub(crate) late_probability: f64,
+    pub(super) planned_information: f64,
+    pub(super) late_probability: f64,
     /// Every route sent, in order.
-    pub(crate) plans: Vec<Vec<[f64; 2]>>,
+    pub(super) plans: Vec<Vec<[f64; 2]>>,
     /// The current route's waypoints.
-    pub(crate) waypoints: Vec<[f64; 2]>,
+    pub(super) waypoints: Vec<[f64; 2]>,
     /// The current mission's id: statuses on any other are not about this route.
-    pub(crate) mission: String,
+    pub(super) mission: String,
     /// The current route is a curious one (the last-safe-moment rule watches it).
-    pub(crate) route_curious: bool,
-    pub(crate) first_sent_at_s: f64,
-    pub(crate) sent_at_s: f64,
+    pub(super) route_curious: bool,
+    pub(super) first_sent_at_s: f64,
+    pub(super) sent_at_s: f64,
     /// The current route from where it was sent.
-    pub(crate) path: Vec<[f64; 2]>,
-    pub(crate) watch: Watch,
-    pub(crate) reasons: Vec<String>,
-    pub(crate) safe_checked_at_s: f64,
+    pub(super) path: Vec<[f64; 2]>,
+    pub(super) watch: Watch,
+    pub(super) reasons: Vec<String>,
+    pub(super) safe_checked_at_s: f64,
     /// The current mission is a recovery back to the last fix.
-    pub(crate) recovering: bool,
+    pub(super) recovering: bool,
     /// Since when the PEB guard holds the robot, if it does.
-    pub(crate) held_since_s: Option<f64>,
-    pub(crate) holds: u32,
-    pub(crate) held_s: f64,
-    pub(crate) recoveries: u32,
+    pub(super) held_since_s: Option<f64>,
+    pub(super) holds: u32,
+    pub(super) held_s: f64,
+    pub(super) recoveries: u32,
 }
 
 #[derive(Debug, Clone)]
-pub(crate) enum Phase {
+pub(super) enum Phase {
     /// Waiting for the window's first plan, asked again at `retry_at_wall_s` after a
     /// failure.
     FirstPlan {
@@ -123,30 +123,30 @@ pub(crate) enum Phase {
 /// One downtime window, from its first plan to the end of its task.
 #[derive(Debug, Clone)]
 pub struct DowntimeWindow<'a> {
-    pub(crate) setup: WindowSetup<'a>,
-    pub(crate) margin: ArrivalMargin,
-    pub(crate) ids: MissionIds,
-    pub(crate) asks_made: u64,
+    pub(super) setup: WindowSetup<'a>,
+    pub(super) margin: ArrivalMargin,
+    pub(super) ids: MissionIds,
+    pub(super) asks_made: u64,
     /// The next window's plan, once made.
-    pub(crate) planned_ahead: Option<PlannedAhead>,
-    pub(crate) began_s: f64,
+    pub(super) planned_ahead: Option<PlannedAhead>,
+    pub(super) began_s: f64,
     /// The robot's last good estimate.
-    pub(crate) here: [f64; 2],
+    pub(super) here: [f64; 2],
     /// The previous window's track end (`carried` points, for recoveries: see
     /// [`Handover::track`]), then where this window began and every good estimate
     /// until the robot arrived.
-    pub(crate) driven: Vec<[f64; 2]>,
-    pub(crate) carried: usize,
+    pub(super) driven: Vec<[f64; 2]>,
+    pub(super) carried: usize,
     /// The index in `driven` of the last estimate with a fix.
-    pub(crate) last_fix: usize,
+    pub(super) last_fix: usize,
     /// The track handed to the next window, kept when the drive's outcome is made.
-    pub(crate) track_out: Option<(Vec<[f64; 2]>, usize)>,
-    pub(crate) pebs: Vec<f64>,
-    pub(crate) drive_ask: Option<(u64, DriveAsk)>,
-    pub(crate) ahead_ask: Option<(u64, AheadAsk)>,
+    pub(super) track_out: Option<(Vec<[f64; 2]>, usize)>,
+    pub(super) pebs: Vec<f64>,
+    pub(super) drive_ask: Option<(u64, DriveAsk)>,
+    pub(super) ahead_ask: Option<(u64, AheadAsk)>,
     /// The window's requests, for its report (at most [`MAX_REPORTED_ASKS`]), and how
     /// many it made.
-    pub(crate) asks: Vec<AskReport>,
-    pub(crate) asks_in_window: u32,
-    pub(crate) phase: Phase,
+    pub(super) asks: Vec<AskReport>,
+    pub(super) asks_in_window: u32,
+    pub(super) phase: Phase,
 }

@@ -13,7 +13,7 @@ use crate::path::distance;
 /// The fastest path from `from` to `to` on the scale's map under `model` (paper 000
 /// Eq. 2 with turns, the planner's own search): the route and its ETA. `None` when
 /// either end is not a free cell or the task cannot be reached.
-pub(crate) fn fastest_route(
+pub(super) fn fastest_route(
     scale: &InformationScale<'_>,
     model: TimeModel,
     from: [f64; 2],
@@ -39,7 +39,7 @@ pub(crate) fn fastest_route(
 /// The point `lead_m` further along `path` than the path's point nearest to `here`
 /// (its last point when the path is shorter): where the robot will be when a plan asked
 /// now comes, if it drives on.
-pub(crate) fn point_ahead(path: &[[f64; 2]], here: [f64; 2], lead_m: f64) -> [f64; 2] {
+pub(super) fn point_ahead(path: &[[f64; 2]], here: [f64; 2], lead_m: f64) -> [f64; 2] {
     let Some(nearest) = nearest(path, here) else {
         return here;
     };
@@ -64,7 +64,7 @@ fn nearest(path: &[[f64; 2]], here: [f64; 2]) -> Option<usize> {
 
 /// What is left of `path` from `here`: `here`, then the path from its point nearest to
 /// `here` on.
-pub(crate) fn route_left(path: &[[f64; 2]], here: [f64; 2]) -> Vec<[f64; 2]> {
+pub(super) fn route_left(path: &[[f64; 2]], here: [f64; 2]) -> Vec<[f64; 2]> {
     let from = nearest(path, here).unwrap_or(path.len());
     std::iter::once(here)
         .chain(path[from..].iter().copied())
@@ -74,7 +74,7 @@ pub(crate) fn route_left(path: &[[f64; 2]], here: [f64; 2]) -> Vec<[f64; 2]> {
 /// The way back along `driven` (oldest first) from its end past its point `fix` (the
 /// last with a fix) until at least `back_m` metres were covered: the robot's own track
 /// in reverse, to where it last had a fix and a little beyond.
-pub(crate) fn back_along(driven: &[[f64; 2]], fix: usize, back_m: f64) -> Vec<[f64; 2]> {
+pub(super) fn back_along(driven: &[[f64; 2]], fix: usize, back_m: f64) -> Vec<[f64; 2]> {
     let mut out: Vec<[f64; 2]> = Vec::new();
     let mut covered = 0.0;
     for (i, &p) in driven.iter().enumerate().rev() {

@@ -9,7 +9,7 @@ use super::problem::Chromosome;
 const PARALLEL_MIN: usize = 32;
 
 /// Evaluates the chromosomes at `dirty`, in order, on up to `evaluators.len()` threads.
-pub(crate) fn evaluate_dirty(
+pub(super) fn evaluate_dirty(
     evaluators: &mut [Evaluator<'_>],
     population: &[Chromosome],
     dirty: &[usize],

@@ -10,7 +10,7 @@ use super::problem::{Chromosome, GaOptions, Problem};
 
 /// Layered selection: top third twice, middle third once, bottom third dropped; the
 /// best so far first.
-pub(crate) fn layered_selection(
+pub(super) fn layered_selection(
     mut population: Vec<Chromosome>,
     best: Option<&Chromosome>,
 ) -> Vec<Chromosome> {
@@ -39,7 +39,7 @@ pub(crate) fn layered_selection(
 }
 
 /// Reusable buffers for crossover: the position of each cell in the first parent.
-pub(crate) struct Scratch {
+pub(super) struct Scratch {
     position: Vec<u32>,
     stamp: Vec<u32>,
     current: u32,
@@ -47,7 +47,7 @@ pub(crate) struct Scratch {
 }
 
 impl Scratch {
-    pub(crate) fn new(cells: usize) -> Self {
+    pub(super) fn new(cells: usize) -> Self {
         Scratch {
             position: vec![0; cells],
             stamp: vec![0; cells],
@@ -66,7 +66,7 @@ impl Scratch {
 }
 
 /// Crosses chromosomes `a` and `b` at a shared gene other than S and G (§II.A.4).
-pub(crate) fn crossover(
+pub(super) fn crossover(
     population: &mut [Chromosome],
     a: usize,
     b: usize,
@@ -116,7 +116,7 @@ pub(crate) fn crossover(
 }
 
 /// Mutates a share p_m of the genes of one chromosome (§II.A.4).
-pub(crate) fn mutate(
+pub(super) fn mutate(
     chromosome: &mut Chromosome,
     problem: &Problem<'_>,
     options: &GaOptions,

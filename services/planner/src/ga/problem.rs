@@ -51,9 +51,9 @@ pub struct GaResult {
 }
 
 #[derive(Debug, Clone)]
-pub(crate) struct Chromosome {
-    pub(crate) genes: Vec<Cell>,
-    pub(crate) fitness: Option<f64>,
+pub(super) struct Chromosome {
+    pub(super) genes: Vec<Cell>,
+    pub(super) fitness: Option<f64>,
 }
 
 /// The inputs of one GA run.

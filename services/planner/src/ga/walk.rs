@@ -11,7 +11,7 @@ use crate::world::{Cell, MOVES};
 use super::problem::{GaOptions, Problem};
 
 /// A random walk from S (§II.A.1), see the module doc for roam's two choices.
-pub(crate) fn initial_walk(
+pub(super) fn initial_walk(
     problem: &Problem<'_>,
     options: &GaOptions,
     rng: &mut ChaCha8Rng,

@@ -157,37 +157,37 @@ fn sized_params(spec: &PlanSpec) -> GaParams {
 }
 
 /// A request that passed every check before planning.
-pub(crate) struct Checked {
-    pub(crate) start: Cell,
-    pub(crate) goal: Cell,
+pub(super) struct Checked {
+    pub(super) start: Cell,
+    pub(super) goal: Cell,
     /// The path of least Eq. 2 time ([`fastest_path`]): the floor every budget is
     /// checked against, and what the `shortest` baseline returns.
-    pub(crate) fastest: Vec<Cell>,
+    pub(super) fastest: Vec<Cell>,
     /// Its Eq. 2 time as driven, and whether the budget fits it (it does unless the
     /// spec asked for the fastest path as a fallback).
-    pub(crate) fastest_t_eta_s: f64,
-    pub(crate) budget_fits: bool,
+    pub(super) fastest_t_eta_s: f64,
+    pub(super) budget_fits: bool,
     /// The path the GA's first population holds and [`best_of`] never falls below: the
     /// distance-shortest path when it fits the budget (the paper's floor, which the
     /// reproductions pin bit for bit), else the fastest path.
-    pub(crate) shortest: Vec<Cell>,
+    pub(super) shortest: Vec<Cell>,
     /// The GA's size; `None` for the baseline.
-    pub(crate) size: Option<PlanSize>,
+    pub(super) size: Option<PlanSize>,
     /// On a world at a coarser planning resolution: how the start and goal join the
     /// planning grid, and the fastest path as the robot drives it (the floor).
-    pub(crate) anchors: Option<(Anchor, Anchor)>,
-    pub(crate) fastest_driven: Option<Vec<FineCell>>,
+    pub(super) anchors: Option<(Anchor, Anchor)>,
+    pub(super) fastest_driven: Option<Vec<FineCell>>,
     /// The budget the planning grid plans with: t_exec less what driving the fastest
     /// path on the map's cells takes beyond its planning-grid ETA (the legs to and from
     /// the start's and goal's map cells), so that plans fit when driven. t_exec itself
     /// at the map's resolution.
-    pub(crate) planning_budget_s: f64,
+    pub(super) planning_budget_s: f64,
 }
 
 impl Checked {
     /// The longest chromosome. The shortest path is in the first population and fits
     /// the budget, so the bound holds it (the max only guards rounding).
-    pub(crate) fn max_path_cells(&self, world: &World) -> usize {
+    pub(super) fn max_path_cells(&self, world: &World) -> usize {
         self.size
             .map_or(world.cell_count(), |s| s.path_cells)
             .max(self.shortest.len())
@@ -197,7 +197,7 @@ impl Checked {
 /// Everything [`plan`] refuses before any work, and the shortest path: the one place
 /// where "shortest" is decided, for the refusal, the GA's seed, the fallback and the
 /// path attached to the reply.
-pub(crate) fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
+pub(super) fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError> {
     check_spec(spec)?;
     let (start, start_anchor) = locate(world, "start", spec.start)?;
     let (goal, goal_anchor) = locate(world, "goal", spec.goal)?;
@@ -265,7 +265,7 @@ pub fn via_seeds(world: &World, spec: &PlanSpec) -> Result<ViaSeeds, PlanError> 
     Ok(seeds_for(world, spec, &checked, &field, &|| false))
 }
 
-pub(crate) fn seeds_for(
+pub(super) fn seeds_for(
     world: &World,
     spec: &PlanSpec,
     checked: &Checked,

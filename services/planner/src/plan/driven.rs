@@ -13,7 +13,7 @@ use super::spec::{PlanSpec, ShortestOutcome};
 
 /// [`ShortestOutcome`] of a checked request: its fastest path as driven, measured as
 /// the `shortest` baseline measures it.
-pub(crate) fn fastest_as_driven(
+pub(super) fn fastest_as_driven(
     world: &World,
     params: &GaParams,
     checked: &Checked,
@@ -40,12 +40,12 @@ pub(crate) fn fastest_as_driven(
 }
 
 /// The plan as the robot drives it.
-pub(crate) struct Driven {
-    pub(crate) chosen: Scored,
-    pub(crate) t_eta_s: f64,
-    pub(crate) metrics: PathMetrics,
-    pub(crate) cells: Vec<[u32; 2]>,
-    pub(crate) points: Vec<[f64; 2]>,
+pub(super) struct Driven {
+    pub(super) chosen: Scored,
+    pub(super) t_eta_s: f64,
+    pub(super) metrics: PathMetrics,
+    pub(super) cells: Vec<[u32; 2]>,
+    pub(super) points: Vec<[f64; 2]>,
 }
 
 /// How many of the fittest candidates are driven on the map's cells, at most, before
@@ -59,7 +59,7 @@ pub const MAX_DRIVEN_CANDIDATES: usize = 8;
 /// is the last resort. Its fitness is scored on the planning cells the driven path
 /// passes through, with the time terms (Eqs. 4, 6, 7) of the driven t_ETA, and U_ges,
 /// D and the distinct information on those planning cells (Eqs. 11, 12).
-pub(crate) fn drive(
+pub(super) fn drive(
     world: &World,
     spec: &PlanSpec,
     checked: &Checked,

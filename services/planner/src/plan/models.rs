@@ -21,7 +21,7 @@ use super::spec::PlanSpec;
 
 /// What one planner found, before it is driven.
 #[derive(Debug)]
-pub(crate) struct Found {
+pub(super) struct Found {
     /// Its plan and the plans it started from, fittest first.
     pub ranked: Vec<Scored>,
     /// The model the candidates are scored with when driven.
@@ -37,7 +37,7 @@ pub(crate) struct Found {
 
 /// The fastest path. Its fitness terms are scored with Model I, the paper's best, so
 /// that they compare with the curious plans.
-pub(crate) fn fastest(world: &World, params: &GaParams, checked: &Checked) -> Found {
+pub(super) fn fastest(world: &World, params: &GaParams, checked: &Checked) -> Found {
     let budget = checked.planning_budget_s;
     let mut evaluator = Evaluator::new(world, params, Model::Novelty, checked.goal, budget);
     let evaluation = evaluator.evaluate(&checked.fastest);
@@ -57,7 +57,7 @@ pub(crate) fn fastest(world: &World, params: &GaParams, checked: &Checked) -> Fo
 }
 
 /// The greedy peer ([`crate::greedy`]), from the shortest path that fits.
-pub(crate) fn greedy(
+pub(super) fn greedy(
     world: &World,
     params: &GaParams,
     checked: &Checked,
@@ -103,7 +103,7 @@ pub(crate) fn greedy(
 /// Paper 000's GA under `model`, its first population seeded with the shortest path and
 /// the via-point seeds ([`crate::seeds`]) unless the spec asks for the paper's random
 /// walks only.
-pub(crate) fn ga(
+pub(super) fn ga(
     world: &World,
     spec: &PlanSpec,
     checked: &Checked,

@@ -7,52 +7,52 @@ use super::client::ClientId;
 use super::rate::Rate;
 
 #[derive(Debug, Clone)]
-pub(crate) struct Job {
-    pub(crate) id: u64,
-    pub(crate) client: ClientId,
+pub(super) struct Job {
+    pub(super) id: u64,
+    pub(super) client: ClientId,
     /// Its fair-share round: the queue serves rounds in order.
-    pub(crate) round: u64,
+    pub(super) round: u64,
     /// Arrival order, within a round.
-    pub(crate) seq: u64,
+    pub(super) seq: u64,
     /// Expected seconds of planning.
-    pub(crate) expected_s: f64,
+    pub(super) expected_s: f64,
     /// When it started planning (running) or was admitted (waiting).
-    pub(crate) since: Instant,
+    pub(super) since: Instant,
 }
 
 impl Job {
-    pub(crate) fn order(&self) -> (u64, u64) {
+    pub(super) fn order(&self) -> (u64, u64) {
         (self.round, self.seq)
     }
 }
 
 /// A client's place in the rounds.
 #[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Share {
+pub(super) struct Share {
     /// The round its next request takes at the earliest.
-    pub(crate) next_round: u64,
+    pub(super) next_round: u64,
     /// Its requests running or waiting (the entry goes at 0).
-    pub(crate) jobs: usize,
+    pub(super) jobs: usize,
 }
 
 #[derive(Debug, Default)]
-pub(crate) struct Inner {
-    pub(crate) running: Vec<Job>,
+pub(super) struct Inner {
+    pub(super) running: Vec<Job>,
     /// In `(round, seq)` order.
-    pub(crate) waiting: VecDeque<Job>,
+    pub(super) waiting: VecDeque<Job>,
     /// The round of the request that started last.
-    pub(crate) round: u64,
-    pub(crate) clients: HashMap<ClientId, Share>,
+    pub(super) round: u64,
+    pub(super) clients: HashMap<ClientId, Share>,
     /// Requests that lost their place to a request of an earlier round.
-    pub(crate) displaced: HashSet<u64>,
-    pub(crate) rate: Rate,
-    pub(crate) next_id: u64,
+    pub(super) displaced: HashSet<u64>,
+    pub(super) rate: Rate,
+    pub(super) next_id: u64,
 }
 
 impl Inner {
     /// Forgets a request (running or waiting) and its client's share when it was the
     /// client's last.
-    pub(crate) fn remove(&mut self, id: u64) {
+    pub(super) fn remove(&mut self, id: u64) {
         let gone = if let Some(at) = self.running.iter().position(|j| j.id == id) {
             Some(self.running.swap_remove(at))
         } else if let Some(at) = self.waiting.iter().position(|j| j.id == id) {
@@ -74,7 +74,7 @@ impl Inner {
     /// Queues `job` in its place. A request that reached the queue after a later one
     /// of the same client (requests are checked concurrently) takes that one's round,
     /// and the client's later requests move one round on.
-    pub(crate) fn insert(&mut self, mut job: Job) {
+    pub(super) fn insert(&mut self, mut job: Job) {
         let later_of_client = self
             .waiting
             .iter()

@@ -16,9 +16,9 @@ pub struct QueueConfig {
 /// The queue of one instance.
 #[derive(Debug)]
 pub struct PlanQueue {
-    pub(crate) config: QueueConfig,
+    pub(super) config: QueueConfig,
     inner: Mutex<Inner>,
-    pub(crate) changed: tokio::sync::Notify,
+    pub(super) changed: tokio::sync::Notify,
 }
 
 impl PlanQueue {
@@ -37,7 +37,7 @@ impl PlanQueue {
         }
     }
 
-    pub(crate) fn lock(&self) -> std::sync::MutexGuard<'_, Inner> {
+    pub(super) fn lock(&self) -> std::sync::MutexGuard<'_, Inner> {
         roam_runtime::lock(&self.inner)
     }
 

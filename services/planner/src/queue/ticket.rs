@@ -12,16 +12,16 @@ use super::state::PlanQueue;
 /// refused later, or done).
 #[derive(Debug)]
 pub struct Ticket<'a> {
-    pub(crate) queue: &'a PlanQueue,
-    pub(crate) id: u64,
+    pub(super) queue: &'a PlanQueue,
+    pub(super) id: u64,
     /// When it arrived: its deadline counts from here.
     pub arrived: Instant,
     pub expected_wait_s: f64,
     pub expected_plan_s: f64,
     /// Whether it had to queue (no slot was free for it on arrival).
     pub queued: bool,
-    pub(crate) units: f64,
-    pub(crate) started: Option<Instant>,
+    pub(super) units: f64,
+    pub(super) started: Option<Instant>,
 }
 
 /// What [`Ticket::wait_turn`] ended with.
@@ -38,7 +38,7 @@ pub enum Turn {
 impl Ticket<'_> {
     /// Moves this request from the queue to a slot if it is first in line and a slot
     /// is free.
-    pub(crate) fn try_start(&mut self, now: Instant) -> Option<Turn> {
+    pub(super) fn try_start(&mut self, now: Instant) -> Option<Turn> {
         let queue = self.queue;
         let mut inner = queue.lock();
         if inner.displaced.remove(&self.id) {

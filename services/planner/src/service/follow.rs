@@ -15,7 +15,7 @@ use crate::maps::DeltaOutcome;
 
 use super::instance::PlannerInstance;
 
-pub(crate) fn take_layer(state: &PlannerInstance, layer: Layer) {
+pub(super) fn take_layer(state: &PlannerInstance, layer: Layer) {
     if let Some(version) = state.maps().update(layer) {
         tracing::info!(
             inflated = version.inflated,
@@ -27,7 +27,7 @@ pub(crate) fn take_layer(state: &PlannerInstance, layer: Layer) {
 
 /// A delta of a followed layer: applied, or (when it does not apply to the version
 /// held) the whole layer is asked for.
-pub(crate) fn take_delta(state: &PlannerInstance, delta: &LayerDelta) {
+pub(super) fn take_delta(state: &PlannerInstance, delta: &LayerDelta) {
     match state.maps().apply_delta(delta) {
         DeltaOutcome::Applied(Some(version)) => tracing::info!(
             inflated = version.inflated,
@@ -44,7 +44,7 @@ pub(crate) fn take_delta(state: &PlannerInstance, delta: &LayerDelta) {
 }
 
 /// Gets each layer a delta could not be applied to, whole.
-pub(crate) async fn fetch_wanted(
+pub(super) async fn fetch_wanted(
     state: Arc<PlannerInstance>,
     requester: Requester,
     cancel: CancellationToken,
@@ -71,7 +71,7 @@ pub(crate) async fn fetch_wanted(
 }
 
 /// Gets the two layers from the map server, retrying until both arrive.
-pub(crate) async fn fetch_maps(
+pub(super) async fn fetch_maps(
     state: Arc<PlannerInstance>,
     requester: Requester,
     cancel: CancellationToken,

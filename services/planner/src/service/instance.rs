@@ -14,7 +14,7 @@ use crate::maps::MapCache;
 use crate::queue::PlanQueue;
 
 /// Largest cancel decoded, bytes: an id and a token.
-pub(crate) const MAX_CANCEL_BYTES: usize = 4 * 1024;
+pub(super) const MAX_CANCEL_BYTES: usize = 4 * 1024;
 
 /// Largest plan request accepted, in bytes.
 pub const MAX_REQUEST_BYTES: usize = 64 * 1024;
@@ -27,40 +27,40 @@ pub const PROGRESS_PERIOD: Duration = Duration::from_millis(50);
 
 /// This planner instance, shared by its queryables and subscribers: its maps, its queue
 /// and the plans it has in flight, its limits and its CPU budget.
-pub(crate) struct PlannerInstance {
-    pub(crate) root: String,
-    pub(crate) instance: String,
-    pub(crate) session: zenoh::Session,
-    pub(crate) maps: Mutex<MapCache>,
+pub(super) struct PlannerInstance {
+    pub(super) root: String,
+    pub(super) instance: String,
+    pub(super) session: zenoh::Session,
+    pub(super) maps: Mutex<MapCache>,
     /// Plans running and queued (`max_concurrent_plans`, `max_queued_plans`).
-    pub(crate) queue: PlanQueue,
+    pub(super) queue: PlanQueue,
     /// Plan requests received so far: each one's number is its place in the queue.
-    pub(crate) arrivals: AtomicU64,
-    pub(crate) plans: InFlight,
-    pub(crate) limits: PlanLimits,
-    pub(crate) budget: CpuBudget,
+    pub(super) arrivals: AtomicU64,
+    pub(super) plans: InFlight,
+    pub(super) limits: PlanLimits,
+    pub(super) budget: CpuBudget,
     /// Refused and unknown cancels, logged a few per window (`roam_runtime::warn_limit`).
-    pub(crate) cancel_warnings: WarnLimiter,
+    pub(super) cancel_warnings: WarnLimiter,
     /// Layers to get whole (a delta did not apply to the version held), and the wake-up
     /// of the task that gets them: a burst of such deltas costs one `get` per layer.
-    pub(crate) wanted: Mutex<BTreeSet<String>>,
-    pub(crate) want: tokio::sync::Notify,
+    pub(super) wanted: Mutex<BTreeSet<String>>,
+    pub(super) want: tokio::sync::Notify,
     /// Deltas ignored (a body naming another layer than its key), logged a few per
     /// window.
-    pub(crate) delta_warnings: WarnLimiter,
+    pub(super) delta_warnings: WarnLimiter,
 }
 
 impl PlannerInstance {
-    pub(crate) fn maps(&self) -> MutexGuard<'_, MapCache> {
+    pub(super) fn maps(&self) -> MutexGuard<'_, MapCache> {
         roam_runtime::lock(&self.maps)
     }
 }
 
 /// Removes a request from the table of plans in flight however it ends.
-pub(crate) struct Registration<'a> {
-    pub(crate) plans: &'a InFlight,
+pub(super) struct Registration<'a> {
+    pub(super) plans: &'a InFlight,
     /// The plan's cancel key, which it is registered under.
-    pub(crate) key: String,
+    pub(super) key: String,
 }
 
 impl Drop for Registration<'_> {

@@ -30,7 +30,7 @@ use super::instance::{
 /// A cancel heard on `key`: honoured only for the plan registered under that key, with
 /// the plan's own token ([`InFlight::cancel`]); refusals are logged, rate-limited, with
 /// the id cut to an excerpt and never the token.
-pub(crate) fn take_cancel(state: &PlannerInstance, key: &str, request: &CancelPlan) {
+pub(super) fn take_cancel(state: &PlannerInstance, key: &str, request: &CancelPlan) {
     let verdict = state.plans.cancel(key, request.token.as_deref());
     let id = || excerpt(&request.request_id).to_string();
     match verdict {
@@ -59,7 +59,7 @@ pub(crate) fn take_cancel(state: &PlannerInstance, key: &str, request: &CancelPl
     }
 }
 
-pub(crate) async fn answer_plan(
+pub(super) async fn answer_plan(
     state: Arc<PlannerInstance>,
     query: Query,
     seq: u64,

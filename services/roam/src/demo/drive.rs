@@ -27,7 +27,7 @@ use super::error::{write_error, DemoError};
 use super::options::{DemoOptions, DEMO_W_LOC};
 use super::report::{markdown, DemoReport};
 
-pub(crate) async fn drive(
+pub(super) async fn drive(
     stack: &Stack,
     options: &DemoOptions,
     world: &Path,

@@ -36,7 +36,7 @@ pub struct DemoReport {
     pub driven_path: Vec<[f64; 2]>,
 }
 
-pub(crate) fn markdown(r: &DemoReport) -> String {
+pub(super) fn markdown(r: &DemoReport) -> String {
     let mut out = String::from("# roam demo\n\n");
     out.push_str(&format!(
         "One robot, a day of {} tasks in {} (`world.yaml`), the sim at {}x (seed {}), {:.1} s of wall time.\n\n",

@@ -26,31 +26,31 @@ use zenoh::pubsub::Subscriber;
 use crate::demo::DemoError;
 
 /// What the run records from the wire while the executives drive.
-pub(crate) struct Recorder {
-    pub(crate) names: Vec<String>,
-    pub(crate) shift_s: f64,
-    pub(crate) step_s: f64,
+pub(super) struct Recorder {
+    pub(super) names: Vec<String>,
+    pub(super) shift_s: f64,
+    pub(super) step_s: f64,
     /// The newest sim time heard.
-    pub(crate) now_s: f64,
-    pub(crate) changes: ChangeLog,
-    pub(crate) landed: Vec<ObjectTruth>,
+    pub(super) now_s: f64,
+    pub(super) changes: ChangeLog,
+    pub(super) landed: Vec<ObjectTruth>,
     /// Each robot's true positions with their times (the windows' information).
-    pub(crate) truth: Vec<Vec<(f64, [f64; 2])>>,
+    pub(super) truth: Vec<Vec<(f64, [f64; 2])>>,
     /// Each robot's path for the picture, every [`PATH_EVERY_STEPS`]th step.
-    pub(crate) paths: Vec<Vec<[f64; 2]>>,
-    pub(crate) halted_steps: Vec<u64>,
+    pub(super) paths: Vec<Vec<[f64; 2]>>,
+    pub(super) halted_steps: Vec<u64>,
     /// Each robot's last controller state and distance left: said when a window is
     /// given up.
-    pub(crate) last_status: Vec<Option<(MissionState, Option<f64>)>>,
+    pub(super) last_status: Vec<Option<(MissionState, Option<f64>)>>,
     /// Each robot's last event from the sim (a collision, a push by a moving obstacle)
     /// and its step: said with the controller's state when a window is given up.
-    pub(crate) last_event: Vec<Option<(u64, String)>>,
-    pub(crate) plan_latencies_s: Vec<f64>,
-    pub(crate) maps: Vec<MapSample>,
+    pub(super) last_event: Vec<Option<(u64, String)>>,
+    pub(super) plan_latencies_s: Vec<f64>,
+    pub(super) maps: Vec<MapSample>,
 }
 
 impl Recorder {
-    pub(crate) fn robot(&self, name: &str) -> Option<usize> {
+    pub(super) fn robot(&self, name: &str) -> Option<usize> {
         self.names.iter().position(|n| n == name)
     }
 
@@ -69,7 +69,7 @@ impl Recorder {
         }
     }
 
-    pub(crate) fn window_truth(&self, robot: usize, report: &WindowReport) -> Vec<[f64; 2]> {
+    pub(super) fn window_truth(&self, robot: usize, report: &WindowReport) -> Vec<[f64; 2]> {
         let end = report.arrival_s.unwrap_or(report.task_start_s);
         self.truth[robot]
             .iter()
@@ -79,7 +79,7 @@ impl Recorder {
     }
 }
 
-pub(crate) type Shared = Arc<Mutex<Recorder>>;
+pub(super) type Shared = Arc<Mutex<Recorder>>;
 
 /// A sim event in a few words.
 fn event_name(e: &RobotEventKind) -> String {
@@ -92,7 +92,7 @@ fn event_name(e: &RobotEventKind) -> String {
 }
 
 /// The subscribers that feed the recorder; dropped, they stop.
-pub(crate) async fn listen(
+pub(super) async fn listen(
     session: &zenoh::Session,
     root: &str,
     recorder: &Shared,
@@ -172,7 +172,7 @@ async fn follow<T: Message>(
 
 /// Every sim minute, the mapper's `occupied_now` layer scored against the sim's
 /// objects, as the batch scores its mapper's belief ([`MapSample::score`]).
-pub(crate) async fn sample_maps(
+pub(super) async fn sample_maps(
     requester: Requester,
     root: String,
     world: Arc<FleetWorld>,

@@ -28,7 +28,7 @@ impl LiveGoal {
         }
     }
 
-    pub(crate) fn at_most(goal: &'static str, figure: Option<f64>, at_most: f64) -> LiveGoal {
+    pub(super) fn at_most(goal: &'static str, figure: Option<f64>, at_most: f64) -> LiveGoal {
         LiveGoal {
             goal,
             figure,
@@ -57,7 +57,7 @@ pub struct FleetDemoReport {
     pub pictures: Vec<PathBuf>,
 }
 
-pub(crate) fn write_reports(
+pub(super) fn write_reports(
     dir: &Path,
     report: &FleetDemoReport,
     table: &str,

@@ -53,13 +53,13 @@ macro_rules! action_parts {
     };
 }
 
-pub(crate) const COMPUTE_PATH_PARTS: [MsgDef; 5] = action_parts!(
+pub(super) const COMPUTE_PATH_PARTS: [MsgDef; 5] = action_parts!(
     "nav2_msgs/action/ComputePathToPose",
     COMPUTE_PATH_GOAL,
     COMPUTE_PATH_RESULT,
     COMPUTE_PATH_FEEDBACK
 );
-pub(crate) const FOLLOW_PATH_PARTS: [MsgDef; 5] = action_parts!(
+pub(super) const FOLLOW_PATH_PARTS: [MsgDef; 5] = action_parts!(
     "nav2_msgs/action/FollowPath",
     FOLLOW_PATH_GOAL,
     FOLLOW_PATH_RESULT,

@@ -45,7 +45,7 @@ pub struct MsgDef {
     pub fields: &'static [Field],
 }
 
-pub(crate) const fn f(name: &'static str, base: Base) -> Field {
+pub(super) const fn f(name: &'static str, base: Base) -> Field {
     Field {
         name,
         base,
@@ -53,6 +53,6 @@ pub(crate) const fn f(name: &'static str, base: Base) -> Field {
     }
 }
 
-pub(crate) const fn shaped(name: &'static str, base: Base, shape: Shape) -> Field {
+pub(super) const fn shaped(name: &'static str, base: Base, shape: Shape) -> Field {
     Field { name, base, shape }
 }

@@ -19,7 +19,7 @@ use super::replies::{scenario_error, sim_error};
 use super::shared::SimShared;
 use super::step::{publish, step_once};
 
-pub(crate) async fn answer_control(state: Arc<SimShared>, query: Query) {
+pub(super) async fn answer_control(state: Arc<SimShared>, query: Query) {
     let request = match reply::decode_request::<SimControl>(&query, MAX_REQUEST_BYTES) {
         Ok(r) => r,
         Err(e) => return reply::send_error(&query, &e).await,

@@ -24,7 +24,7 @@ fn step_period(step_s: f64, rate: f64) -> Duration {
 /// rate 0. A step whose messages are not out before the next one is due counts as late.
 /// Every control request wakes it ([`SimShared::wake`]), so a pause, a reset or a new rate
 /// takes effect at once, whatever the period was.
-pub(crate) async fn free_run(state: Arc<SimShared>, cancel: CancellationToken) {
+pub(super) async fn free_run(state: Arc<SimShared>, cancel: CancellationToken) {
     let mut next = Instant::now();
     loop {
         let (running, period) = {

@@ -22,7 +22,7 @@ pub const MAX_COMMAND_BYTES: usize = 1024;
 /// How often a stepping sim writes its snapshot (wall time): what a crash can cost.
 pub const SNAPSHOT_PERIOD: Duration = Duration::from_millis(500);
 
-pub(crate) fn check_rate(rate: f64) -> Result<(), ErrorReply> {
+pub(super) fn check_rate(rate: f64) -> Result<(), ErrorReply> {
     if rate == 0.0 || (rate.is_finite() && (MIN_RATE..=MAX_RATE).contains(&rate)) {
         Ok(())
     } else {

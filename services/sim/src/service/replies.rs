@@ -6,7 +6,7 @@ use roam_world::scenario::ScenarioError;
 
 use crate::sim::SimError;
 
-pub(crate) fn sim_error(e: &SimError) -> ErrorReply {
+pub(super) fn sim_error(e: &SimError) -> ErrorReply {
     let message = e.to_string();
     match e {
         SimError::UnknownRobot(_) => ErrorReply::new(ErrorCode::NotFound, message),
@@ -19,7 +19,7 @@ pub(crate) fn sim_error(e: &SimError) -> ErrorReply {
 
 /// The reply to a peer's load of `requested`: refusals name the file as the peer gave
 /// it, other errors name files relative to their load directory.
-pub(crate) fn scenario_error(e: &ScenarioError, requested: &str, dirs: &LoadDirs) -> ErrorReply {
+pub(super) fn scenario_error(e: &ScenarioError, requested: &str, dirs: &LoadDirs) -> ErrorReply {
     let message = dirs.redact(&e.to_string());
     match e {
         ScenarioError::Refused(refused)

@@ -21,45 +21,45 @@ fn shown_name(scenario: &str) -> String {
 }
 
 /// What control requests change.
-pub(crate) struct Control {
-    pub(crate) sim: Sim,
-    pub(crate) scenario: String,
-    pub(crate) running: bool,
-    pub(crate) rate: f64,
+pub(super) struct Control {
+    pub(super) sim: Sim,
+    pub(super) scenario: String,
+    pub(super) running: bool,
+    pub(super) rate: f64,
     /// The latest command per robot, taken by the next step.
-    pub(crate) pending: BTreeMap<String, RobotCommand>,
-    pub(crate) late_steps: u64,
-    pub(crate) free_steps: u64,
+    pub(super) pending: BTreeMap<String, RobotCommand>,
+    pub(super) late_steps: u64,
+    pub(super) free_steps: u64,
     /// The ids of the objects landed at the last `sim/objects` message: the next goes
     /// out when they differ.
-    pub(crate) objects_published: Vec<u64>,
+    pub(super) objects_published: Vec<u64>,
 }
 
 /// What the sim's control queryable, command subscriber and free run share.
-pub(crate) struct SimShared {
-    pub(crate) root: String,
-    pub(crate) session: zenoh::Session,
-    pub(crate) control: Mutex<Control>,
-    pub(crate) load_dirs: LoadDirs,
+pub(super) struct SimShared {
+    pub(super) root: String,
+    pub(super) session: zenoh::Session,
+    pub(super) control: Mutex<Control>,
+    pub(super) load_dirs: LoadDirs,
     /// Held by whoever steps and publishes (the free run, one `step` request), so the
     /// messages of two steps never interleave and two lock-step drivers cannot pile up.
-    pub(crate) stepper: tokio::sync::Mutex<()>,
+    pub(super) stepper: tokio::sync::Mutex<()>,
     /// Held by the step request being served: a second one is told `busy` at once,
     /// while one that only meets the free run's last step (just paused) waits for it.
-    pub(crate) step_request: tokio::sync::Mutex<()>,
+    pub(super) step_request: tokio::sync::Mutex<()>,
     /// Woken by every control request, so the free run sees a pause, a new rate or a
     /// reset at once instead of after the sleep it was in.
-    pub(crate) wake: tokio::sync::Notify,
+    pub(super) wake: tokio::sync::Notify,
     /// Refused commands, logged a few per robot and window.
-    pub(crate) warnings: WarnLimiter,
+    pub(super) warnings: WarnLimiter,
 }
 
 impl SimShared {
-    pub(crate) fn control(&self) -> MutexGuard<'_, Control> {
+    pub(super) fn control(&self) -> MutexGuard<'_, Control> {
         roam_runtime::lock(&self.control)
     }
 
-    pub(crate) fn status(&self) -> SimStatus {
+    pub(super) fn status(&self) -> SimStatus {
         let c = self.control();
         let (robots, anchors) = points(&c.sim);
         SimStatus {

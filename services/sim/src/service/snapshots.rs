@@ -14,7 +14,7 @@ use super::shared::SimShared;
 
 /// Resumes `sim` from the snapshot at `path` when it is of this scenario and seed; a
 /// snapshot of another run is left alone (and overwritten at the first save).
-pub(crate) fn resume_from(
+pub(super) fn resume_from(
     sim: &mut Sim,
     name: &str,
     seed: u64,
@@ -43,7 +43,7 @@ pub(crate) fn resume_from(
 
 /// Writes the snapshot every [`SNAPSHOT_PERIOD`] while the step count changes, and once
 /// more at shutdown.
-pub(crate) async fn keep_snapshots(
+pub(super) async fn keep_snapshots(
     state: Arc<SimShared>,
     path: PathBuf,
     cancel: CancellationToken,

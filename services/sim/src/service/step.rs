@@ -15,7 +15,7 @@ use super::shared::SimShared;
 
 /// Stores a command for the next step; commands for unknown robots or with non-finite
 /// values are dropped (logged), so the pending map never outgrows the robots.
-pub(crate) fn take_command(state: &SimShared, key: &str, payload: &[u8]) {
+pub(super) fn take_command(state: &SimShared, key: &str, payload: &[u8]) {
     let Some(robot) = keys::robot_of(&state.root, key) else {
         return;
     };
@@ -47,7 +47,7 @@ pub(crate) fn take_command(state: &SimShared, key: &str, payload: &[u8]) {
 }
 
 /// What one step has to publish once the lock is released.
-pub(crate) struct Stepped {
+pub(super) struct Stepped {
     clock: SimClock,
     robots: Vec<RobotMessages>,
     /// The landed objects, when one landed or left in the step.
@@ -55,7 +55,7 @@ pub(crate) struct Stepped {
 }
 
 /// One step under the lock; returns the messages to publish after it is released.
-pub(crate) fn step_once(state: &SimShared) -> Result<Stepped, ErrorReply> {
+pub(super) fn step_once(state: &SimShared) -> Result<Stepped, ErrorReply> {
     let mut control = state.control();
     let commands: Vec<Command> = std::mem::take(&mut control.pending)
         .into_iter()
@@ -97,7 +97,7 @@ async fn put<T: Message>(state: &SimShared, key: &str, message: &T) {
     roam_runtime::publish(&state.session, key, message, Delivery::Reliable).await;
 }
 
-pub(crate) async fn publish(state: &SimShared, stepped: Stepped) {
+pub(super) async fn publish(state: &SimShared, stepped: Stepped) {
     let root = &state.root;
     let Stepped {
         clock,

@@ -22,25 +22,25 @@ use super::samples::{check_robot, decode_sample, Ring, SimRobots};
 use super::topics::RobotTopics;
 
 /// One robot's driven path and whether it changed since it was last logged.
-pub(crate) struct LoggedPath {
+pub(super) struct LoggedPath {
     path: DrivenPath,
     dirty: bool,
 }
 
 /// True positions, estimates, missions and driven paths.
-pub(crate) struct Robots {
-    pub(crate) out: Arc<Outputs>,
-    pub(crate) root: String,
-    pub(crate) topics: RobotTopics,
+pub(super) struct Robots {
+    pub(super) out: Arc<Outputs>,
+    pub(super) root: String,
+    pub(super) topics: RobotTopics,
     /// The robots whose missions are drawn (the drawings are kept in the latch).
-    pub(crate) missions: Roster<()>,
-    pub(crate) driven: Roster<LoggedPath>,
-    pub(crate) driven_dirty: bool,
-    pub(crate) sim: watch::Receiver<SimRobots>,
+    pub(super) missions: Roster<()>,
+    pub(super) driven: Roster<LoggedPath>,
+    pub(super) driven_dirty: bool,
+    pub(super) sim: watch::Receiver<SimRobots>,
 }
 
 impl Robots {
-    pub(crate) async fn run(
+    pub(super) async fn run(
         mut self,
         truth: Ring,
         estimate: Ring,

@@ -11,13 +11,13 @@ use zenoh::sample::Sample;
 use crate::output::Outputs;
 use crate::wire::{decode_bounded, shown};
 
-pub(crate) type Ring = LatestSamples;
+pub(super) type Ring = LatestSamples;
 
 /// The names of the robots in the sim's last status.
-pub(crate) type SimRobots = Arc<BTreeSet<String>>;
+pub(super) type SimRobots = Arc<BTreeSet<String>>;
 
 /// Decodes a sample's payload of at most `max` bytes, or counts it dropped.
-pub(crate) fn decode_sample<T: Message>(out: &Outputs, sample: &Sample, max: usize) -> Option<T> {
+pub(super) fn decode_sample<T: Message>(out: &Outputs, sample: &Sample, max: usize) -> Option<T> {
     match decode_bounded::<T>(sample.payload(), max) {
         Ok(message) => Some(message),
         Err(e) => {
@@ -29,7 +29,7 @@ pub(crate) fn decode_sample<T: Message>(out: &Outputs, sample: &Sample, max: usi
 
 /// Checks that `robot` is a valid robot name and the one `key` (`<root>/robot/<id>/…`)
 /// is for: a message about robot A put on robot B's key is not believed.
-pub(crate) fn check_robot(root: &str, key: &str, robot: &str) -> Result<(), String> {
+pub(super) fn check_robot(root: &str, key: &str, robot: &str) -> Result<(), String> {
     if keys::check_name("robot", robot).is_err() {
         return Err(format!(
             "the robot name \"{}\" is not a key segment (1 to {} of a-z, A-Z, 0-9, '_', '-')",

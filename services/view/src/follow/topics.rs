@@ -12,15 +12,15 @@ pub const DRIVEN_TOPIC: &str = "/robots/driven";
 pub const ANCHORS_TOPIC: &str = "/anchors";
 
 /// The fixed robot topics.
-pub(crate) struct RobotTopics {
-    pub(crate) truth: Topic,
-    pub(crate) estimate: Topic,
-    pub(crate) mission: Topic,
-    pub(crate) driven: Topic,
+pub(super) struct RobotTopics {
+    pub(super) truth: Topic,
+    pub(super) estimate: Topic,
+    pub(super) mission: Topic,
+    pub(super) driven: Topic,
 }
 
 impl RobotTopics {
-    pub(crate) fn new(out: &Outputs) -> Self {
+    pub(super) fn new(out: &Outputs) -> Self {
         RobotTopics {
             truth: out.topic::<SceneUpdate>(TRUTH_TOPIC, false),
             estimate: out.topic::<SceneUpdate>(ESTIMATE_TOPIC, false),

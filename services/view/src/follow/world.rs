@@ -29,7 +29,7 @@ use super::samples::{decode_sample, Ring, SimRobots};
 
 /// A layer shown: its topic, its version, the layer itself when it is small enough to
 /// keep for deltas ([`MAX_LAYER_BYTES_KEPT`]) and the bytes its cells take.
-pub(crate) struct Shown {
+pub(super) struct Shown {
     topic: Topic,
     version: u64,
     layer: Option<Layer>,
@@ -37,22 +37,22 @@ pub(crate) struct Shown {
 }
 
 /// The map layers, the anchors and the sim's robot list.
-pub(crate) struct World {
-    pub(crate) out: Arc<Outputs>,
-    pub(crate) root: String,
-    pub(crate) session: Session,
-    pub(crate) layers: BTreeMap<String, Shown>,
+pub(super) struct World {
+    pub(super) out: Arc<Outputs>,
+    pub(super) root: String,
+    pub(super) session: Session,
+    pub(super) layers: BTreeMap<String, Shown>,
     /// The bytes of cells of every layer shown.
-    pub(crate) layer_bytes: usize,
-    pub(crate) anchors_topic: Topic,
-    pub(crate) truth_topic: Topic,
-    pub(crate) anchors: Option<Vec<NamedPoint>>,
-    pub(crate) robots: Option<Vec<NamedPoint>>,
-    pub(crate) sim: watch::Sender<SimRobots>,
+    pub(super) layer_bytes: usize,
+    pub(super) anchors_topic: Topic,
+    pub(super) truth_topic: Topic,
+    pub(super) anchors: Option<Vec<NamedPoint>>,
+    pub(super) robots: Option<Vec<NamedPoint>>,
+    pub(super) sim: watch::Sender<SimRobots>,
 }
 
 impl World {
-    pub(crate) async fn run(mut self, layers: Ring, deltas: Ring, cancel: CancellationToken) {
+    pub(super) async fn run(mut self, layers: Ring, deltas: Ring, cancel: CancellationToken) {
         let mut refresh = tokio::time::interval(REFRESH_PERIOD);
         refresh.set_missed_tick_behavior(MissedTickBehavior::Delay);
         loop {

@@ -14,7 +14,7 @@ use super::config::Nav2Robot;
 
 /// What the goal tasks tell the robot's loop.
 #[derive(Debug)]
-pub(crate) enum GoalEvent {
+pub(super) enum GoalEvent {
     Accepted {
         mission: String,
         goal: Uuid,
@@ -27,22 +27,22 @@ pub(crate) enum GoalEvent {
 }
 
 /// One Nav2 robot as its loop drives it.
-pub(crate) struct Robot {
-    pub(crate) out: Arc<Output>,
-    pub(crate) follow_path: ActionClient,
-    pub(crate) config: Nav2Robot,
-    pub(crate) mission_clock: MissionClock,
-    pub(crate) estimate_key: String,
-    pub(crate) status_key: String,
+pub(super) struct Robot {
+    pub(super) out: Arc<Output>,
+    pub(super) follow_path: ActionClient,
+    pub(super) config: Nav2Robot,
+    pub(super) mission_clock: MissionClock,
+    pub(super) estimate_key: String,
+    pub(super) status_key: String,
     /// The mission being driven.
-    pub(crate) mission: Option<Mission>,
+    pub(super) mission: Option<Mission>,
     /// Its FollowPath goal, once accepted.
-    pub(crate) goal: Option<Uuid>,
-    pub(crate) state: MissionState,
-    pub(crate) position: Option<[f64; 2]>,
-    pub(crate) last_pose: Option<Instant>,
-    pub(crate) step: u64,
-    pub(crate) steps: u64,
-    pub(crate) peb_m: Option<f64>,
-    pub(crate) distance_to_goal: Option<f64>,
+    pub(super) goal: Option<Uuid>,
+    pub(super) state: MissionState,
+    pub(super) position: Option<[f64; 2]>,
+    pub(super) last_pose: Option<Instant>,
+    pub(super) step: u64,
+    pub(super) steps: u64,
+    pub(super) peb_m: Option<f64>,
+    pub(super) distance_to_goal: Option<f64>,
 }

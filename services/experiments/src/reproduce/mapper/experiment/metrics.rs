@@ -41,7 +41,7 @@ pub fn map_quality_of(map: &ChangeMap, sim: &Sim) -> f64 {
     right as f64 / (w * h).max(1) as f64
 }
 
-pub(crate) fn mean_curve<'a>(curves: impl Iterator<Item = &'a [f64]>) -> Vec<f64> {
+pub(super) fn mean_curve<'a>(curves: impl Iterator<Item = &'a [f64]>) -> Vec<f64> {
     let mut sum: Vec<f64> = Vec::new();
     let mut n = 0usize;
     for c in curves {

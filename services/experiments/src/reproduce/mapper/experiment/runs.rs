@@ -16,12 +16,12 @@ use super::options::{ExperimentOptions, MappingError};
 use super::output::RunSummary;
 
 /// One run's summary, curves and rewards, as [`super::run`] averages them.
-pub(crate) struct RunResult {
-    pub(crate) summary: RunSummary,
-    pub(crate) rate_error: Vec<f64>,
-    pub(crate) map_quality: Vec<f64>,
-    pub(crate) time_s: Vec<f64>,
-    pub(crate) rewards: (f64, u64),
+pub(super) struct RunResult {
+    pub(super) summary: RunSummary,
+    pub(super) rate_error: Vec<f64>,
+    pub(super) map_quality: Vec<f64>,
+    pub(super) time_s: Vec<f64>,
+    pub(super) rewards: (f64, u64),
 }
 
 /// The seed of repetition `repetition`, the same for every mode (common random
@@ -55,7 +55,7 @@ pub fn trace(
     run_one(scenario, &truth, options, mode, repetition, watch).map(|r| r.summary)
 }
 
-pub(crate) fn run_one(
+pub(super) fn run_one(
     scenario: &Scenario,
     truth: &TrueRates,
     options: &ExperimentOptions,
