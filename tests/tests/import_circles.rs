@@ -3,7 +3,8 @@
 //!
 //! Each file is parsed with `syn` (the parser Rust's own derive macros use), so what
 //! counts is code, never a comment, a doc link or a string. A file's imports are the
-//! `crate::…`, `super::…` and `self::…` paths in its items, its `use` trees (groups
+//! `crate::…`, `super::…` and `self::…` paths, and the paths that start with a module
+//! the file declares (`mod child;` then `use child::X`), in its items, its `use` trees (groups
 //! nested to any depth) and the tokens of its macro calls (`tracing::warn!(…
 //! crate::x::LIMIT)`), each resolved to the file of the longest module path it names.
 //! Test code (`#[cfg(test)]` items and the files of `#[cfg(test)] mod x;`) is left out:
@@ -70,20 +71,24 @@ fn is_test(attrs: &[syn::Attribute]) -> bool {
 /// modules it declares test-only in files of their own.
 struct Named<'m> {
     module: &'m [String],
+    /// The modules this file declares (`mod child;`, shipped code): a path may start
+    /// with one of them, relative to this file's module.
+    children: BTreeSet<String>,
     paths: Vec<Vec<String>>,
     test_modules: Vec<String>,
 }
 
 impl Named<'_> {
-    /// `segments` as a path from the crate's root, when it starts at `crate`, `super`
-    /// or `self` (any other path is another crate's or a local name).
+    /// `segments` as a path from the crate's root, when it starts at `crate`, `super`,
+    /// `self` or a module this file declares (any other path is another crate's or a
+    /// local name).
     fn push(&mut self, segments: &[String]) {
-        let mut base = match segments.first().map(String::as_str) {
-            Some("crate") => Vec::new(),
-            Some("super" | "self") => self.module.to_vec(),
+        let (mut base, mut rest) = match segments.first().map(String::as_str) {
+            Some("crate") => (Vec::new(), &segments[1..]),
+            Some("super" | "self") => (self.module.to_vec(), &segments[1..]),
+            Some(child) if self.children.contains(child) => (self.module.to_vec(), segments),
             _ => return,
         };
-        let mut rest = &segments[1..];
         if segments[0] == "super" {
             base.pop();
             while rest.first().is_some_and(|s| s == "super") {
@@ -191,6 +196,10 @@ impl<'ast> Visit<'ast> for Named<'_> {
         }
     }
 
+    /// `pub(super)` and `pub(in crate::x)` name a module to say who may see an item, not
+    /// to use it: no import.
+    fn visit_visibility(&mut self, _: &'ast syn::Visibility) {}
+
     fn visit_path(&mut self, p: &'ast syn::Path) {
         let segments: Vec<String> = p.segments.iter().map(|s| s.ident.to_string()).collect();
         self.push(&segments);
@@ -217,8 +226,19 @@ fn import_graph(src: &Path) -> BTreeMap<PathBuf, BTreeSet<PathBuf>> {
         let text = std::fs::read_to_string(file).expect("a source file");
         let parsed = syn::parse_file(&text).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
         let module = module_path(src, file);
+        let children = parsed
+            .items
+            .iter()
+            .filter_map(|item| match item {
+                syn::Item::Mod(m) if m.content.is_none() && !is_test(&m.attrs) => {
+                    Some(m.ident.to_string())
+                }
+                _ => None,
+            })
+            .collect();
         let mut visitor = Named {
             module: &module,
+            children,
             paths: Vec::new(),
             test_modules: Vec::new(),
         };
@@ -334,11 +354,22 @@ fn the_check_sees_a_circle_and_ignores_comments_strings_and_tests() {
     );
     write(
         "store/mod.rs",
-        "use crate::edits::CellEdits;\npub mod stage;\n",
+        "use crate::edits::CellEdits;\npub mod stage;\npub mod shelf;\nuse shelf::Shelf;\nmod bin;\nuse bin::Bin;\n",
     );
     write(
         "store/stage.rs",
         "use super::super::quiet as _;\nconst J: &str = r#\"a \"crate::store\" b\"#;\n",
+    );
+    // A child the parent names by a relative path (`use shelf::Shelf`) importing the
+    // parent back: a circle too.
+    write(
+        "store/shelf.rs",
+        "use super::CellEdits;\npub struct Shelf;\n",
+    );
+    // A visibility naming the parent is no import of it.
+    write(
+        "store/bin.rs",
+        "pub(super) struct Bin;\npub(in crate::store) fn b() {}\n",
     );
     write("edits.rs", "fn f() { let _ = crate::store::OCCUPANCY; }\n");
     // Names the store only in a doc link, a comment, a string and test code: no import.
@@ -355,22 +386,28 @@ fn the_check_sees_a_circle_and_ignores_comments_strings_and_tests() {
     );
     let graph = import_graph(&src);
     let found = circles(&graph);
-    assert_eq!(found.len(), 1, "{found:?}");
-    let names: BTreeSet<String> = found[0]
+    let names: BTreeSet<BTreeSet<String>> = found
         .iter()
-        .map(|f| {
-            f.file_name()
-                .unwrap_or_default()
-                .to_string_lossy()
-                .into_owned()
+        .map(|circle| {
+            circle
+                .iter()
+                .map(|f| {
+                    f.file_name()
+                        .unwrap_or_default()
+                        .to_string_lossy()
+                        .into_owned()
+                })
+                .collect()
         })
         .collect();
+    let circle = |files: [&str; 2]| files.map(str::to_owned).into_iter().collect();
     assert_eq!(
         names,
-        ["edits.rs", "mod.rs"]
-            .map(str::to_owned)
-            .into_iter()
-            .collect()
+        BTreeSet::from([
+            circle(["edits.rs", "mod.rs"]),
+            circle(["mod.rs", "shelf.rs"])
+        ]),
+        "{found:?}"
     );
     let quiet = src.join("quiet.rs");
     assert!(

@@ -26,8 +26,8 @@ use std::path::Path;
 use roam_proto::cells::{Cells, Dtype};
 use serde::{Deserialize, Serialize};
 
+use super::error::PersistError;
 use super::snapshot::describe_json_error;
-use super::PersistError;
 use crate::edits::CellEdits;
 
 const FORMAT: &str = "roam-layer-log";

@@ -16,6 +16,8 @@
 //! snapshot (at least 64 KiB) or 1,048,576 records ([`Compaction`]), so a layer's files
 //! stay within about 2.5 times its size and a restore replays a bounded log.
 
+mod error;
+mod loaded;
 pub mod log;
 mod recovery;
 mod small_file;
@@ -24,28 +26,20 @@ pub mod tombstones;
 pub mod world;
 
 use std::collections::BTreeMap;
-use std::fs::{self, File};
+use std::fs;
 use std::path::{Path, PathBuf};
 
 use roam_proto::map::Layer;
 
+pub use error::PersistError;
+pub use loaded::{Loaded, Recovered};
 pub use log::Record;
-pub use recovery::Recovered;
 pub use tombstones::{Tombstone, MAX_TOMBSTONES};
+
+use small_file::sync_dir;
 
 use crate::derived::Derivation;
 use crate::edits::CellEdits;
-
-/// Why a layer file could not be written or read. Each variant names the file.
-#[derive(Debug, thiserror::Error)]
-pub enum PersistError {
-    #[error("cannot write {path}: {reason}")]
-    Write { path: PathBuf, reason: String },
-    #[error("cannot read {path}: {reason}")]
-    Read { path: PathBuf, reason: String },
-    #[error("{path} is corrupt: {reason}")]
-    Corrupt { path: PathBuf, reason: String },
-}
 
 /// When a log is compacted into a fresh snapshot.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -93,18 +87,6 @@ pub struct DataDir {
     max_layer_cells: u64,
     compaction: Compaction,
     logs: BTreeMap<String, LogState>,
-}
-
-/// What loading the data directory found.
-#[derive(Debug, Default)]
-pub struct Loaded {
-    pub layers: Vec<Recovered>,
-    /// Deleted layers and their last versions.
-    pub tombstones: Vec<Tombstone>,
-    /// One sentence per problem: corrupt files, fallbacks, torn records.
-    pub warnings: Vec<String>,
-    /// Whether any layer file was there at all, readable or not.
-    pub found: bool,
 }
 
 /// The file kinds of a layer, by suffix; a name with one of them is a layer's.
@@ -385,12 +367,6 @@ impl DataDir {
     pub fn save_tombstones(&self, tombstones: &[Tombstone]) -> Result<(), PersistError> {
         tombstones::write(&self.tombstones_path(), tombstones)
     }
-
-    /// Loads every layer. Never fails as a whole: each problem becomes a warning. Files
-    /// of a deleted layer (a crash during its deletion) are removed.
-    pub fn load_all(&mut self) -> Loaded {
-        recovery::load_all(self)
-    }
 }
 
 fn remove_if_exists(path: &Path) -> Result<(), PersistError> {
@@ -402,14 +378,4 @@ fn remove_if_exists(path: &Path) -> Result<(), PersistError> {
             reason: e.to_string(),
         }),
     }
-}
-
-/// Makes renames and new files in `dir` durable.
-fn sync_dir(dir: &Path) -> Result<(), PersistError> {
-    File::open(dir)
-        .and_then(|d| d.sync_all())
-        .map_err(|e| PersistError::Write {
-            path: dir.to_owned(),
-            reason: format!("fsync of the folder failed: {e}"),
-        })
 }

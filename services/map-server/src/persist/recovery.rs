@@ -14,30 +14,15 @@ use std::fs;
 use std::path::Path;
 
 use roam_proto::keys;
-use roam_proto::map::Layer;
 
+use super::loaded::{Loaded, Recovered};
 use super::log::{self, Tail};
 use super::snapshot::{self, Snapshot};
-use super::{tombstones, DataDir, Loaded, LogState, LAYER_SUFFIXES, TEMP_SUFFIXES};
-use crate::derived::Derivation;
-
-/// What the files of one layer gave.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Recovered {
-    pub name: String,
-    /// The newest content the files hold, with its derivation; `None` when no copy of
-    /// the layer could be read.
-    pub layer: Option<(Layer, Option<Derivation>)>,
-    /// The highest version any readable header or record showed: above `layer`'s own
-    /// version when acknowledged changes could not be recovered.
-    pub highest_seen: u64,
-    /// Whether the files are not what a clean run leaves (a fallback, a repaired log),
-    /// so a fresh snapshot should be written.
-    pub rewrite: bool,
-}
+use super::tombstones;
+use super::{DataDir, LogState, LAYER_SUFFIXES, TEMP_SUFFIXES};
 
 /// Loads every layer of `dir` (see [`DataDir::load_all`]).
-pub(super) fn load_all(dir: &mut DataDir) -> Loaded {
+pub(crate) fn load_all(dir: &mut DataDir) -> Loaded {
     let mut loaded = Loaded::default();
     match tombstones::read(&dir.tombstones_path()) {
         Ok(t) => loaded.tombstones = t,
@@ -129,7 +114,7 @@ pub(super) fn load_all(dir: &mut DataDir) -> Loaded {
 }
 
 /// Recovers layer `name`: its content, what it says, and the state of its log.
-pub(super) fn recover(
+pub(crate) fn recover(
     dir: &DataDir,
     name: &str,
     warnings: &mut Vec<String>,
@@ -314,5 +299,14 @@ fn cut_back(path: &Path, good_bytes: u64, is_current: bool, state: &mut LogState
             state.needs_snapshot |= is_current;
             format!("; cutting it back failed ({e})")
         }
+    }
+}
+
+// The data dir's entry point to recovery.
+impl DataDir {
+    /// Loads every layer. Never fails as a whole: each problem becomes a warning. Files
+    /// of a deleted layer (a crash during its deletion) are removed.
+    pub fn load_all(&mut self) -> Loaded {
+        load_all(self)
     }
 }

@@ -5,7 +5,7 @@ use std::fs::{self, File};
 use std::io::{Read, Write};
 use std::path::Path;
 
-use super::PersistError;
+use super::error::PersistError;
 
 /// The file's bytes, `None` when it does not exist; refused (as corrupt) when it is not
 /// a regular file of at most `max_bytes`.
@@ -52,7 +52,17 @@ pub(crate) fn write(path: &Path, body: &[u8]) -> Result<(), PersistError> {
     file.sync_all().map_err(|e| write_err(&tmp, e))?;
     fs::rename(&tmp, path).map_err(|e| write_err(path, e))?;
     if let Some(dir) = path.parent() {
-        super::sync_dir(dir)?;
+        sync_dir(dir)?;
     }
     Ok(())
+}
+
+/// Makes renames and new files in `dir` durable.
+pub(crate) fn sync_dir(dir: &Path) -> Result<(), PersistError> {
+    File::open(dir)
+        .and_then(|d| d.sync_all())
+        .map_err(|e| PersistError::Write {
+            path: dir.to_owned(),
+            reason: format!("fsync of the folder failed: {e}"),
+        })
 }

@@ -21,7 +21,7 @@ use roam_proto::keys;
 use roam_proto::map::{GridMeta, Layer};
 use serde::{Deserialize, Serialize};
 
-use super::PersistError;
+use super::error::PersistError;
 use crate::derived::Derivation;
 
 const FORMAT: &str = "roam-layer";

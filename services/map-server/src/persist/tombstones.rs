@@ -11,8 +11,9 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use super::error::PersistError;
+use super::small_file;
 use super::snapshot::describe_json_error;
-use super::{small_file, PersistError};
 
 const FORMAT: &str = "roam-deleted-layers";
 const FORMAT_VERSION: u32 = 1;

@@ -8,8 +8,9 @@ use std::path::Path;
 use roam_proto::map::WorldId;
 use serde::{Deserialize, Serialize};
 
+use super::error::PersistError;
+use super::small_file;
 use super::snapshot::describe_json_error;
-use super::{small_file, PersistError};
 
 const FORMAT: &str = "roam-world";
 const FORMAT_VERSION: u32 = 1;

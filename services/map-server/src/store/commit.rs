@@ -8,8 +8,8 @@
 
 use std::sync::Arc;
 
+use super::pending::{Change, Pending, Staged};
 use super::publication::{self, Publication};
-use super::stage::{Change, Pending, Staged};
 use super::{LayerStore, StoreError};
 
 impl LayerStore {

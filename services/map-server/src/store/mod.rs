@@ -20,6 +20,7 @@ mod budget;
 mod commit;
 mod error;
 mod limits;
+mod pending;
 mod publication;
 pub mod restore;
 mod stage;
@@ -43,8 +44,8 @@ use crate::derived::Derivation;
 use crate::edits::CellEdits;
 use crate::persist::{DataDir, Tombstone, MAX_TOMBSTONES};
 use error::limit;
+use pending::Pending;
 use roam_world::grid::Grid;
-use stage::Pending;
 
 pub use roam_proto::map::{
     HEURISTIC_LAYER as HEURISTIC, INFLATED_LAYER as INFLATED, INFORMATION_LAYER as INFORMATION,

@@ -23,7 +23,7 @@ use std::sync::Arc;
 use roam_proto::cells::Cells;
 use roam_proto::map::Layer;
 
-use super::stage::{Change, Pending, Staged};
+use super::pending::{Change, Pending, Staged};
 use super::{
     derived_source, names, remember, LayerStore, StoreError, HEURISTIC, INFLATED, INFORMATION,
     OCCUPANCY,

@@ -56,8 +56,10 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::config::CalibrationConfig;
+use super::error::CalibrationError;
 use super::stretch::{chunks, Chunk, Stretch};
-use super::{CalibrationConfig, CalibrationError, TimeModel};
+use super::time_model::TimeModel;
 
 /// The fewest chunks of a kind (straight, corner) for a stretch's own reference.
 const MIN_REFERENCE_CHUNKS: usize = 3;

@@ -23,8 +23,10 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::config::CalibrationConfig;
+use super::error::CalibrationError;
 use super::fit::{Calibration, Statistics};
-use super::{CalibrationConfig, CalibrationError, TimeModel};
+use super::time_model::TimeModel;
 
 /// The format tag in every calibration file.
 pub const FORMAT: &str = "roam-time-calibration";

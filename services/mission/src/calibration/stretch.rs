@@ -23,7 +23,8 @@
 //! Turns gentler than `straight_rad` per `spacing_m` (curvature radius above about 3 m
 //! with the defaults) are not counted: the noise floor.
 
-use super::{CalibrationConfig, CalibrationError};
+use super::config::CalibrationConfig;
+use super::error::CalibrationError;
 use crate::path::distance;
 
 /// The most samples one stretch holds (limit `max_stretch_samples`): an hour of

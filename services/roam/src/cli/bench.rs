@@ -4,7 +4,7 @@ use anyhow::bail;
 use clap::{Args, Subcommand};
 use roam_bench as benches;
 
-use super::print_json;
+use super::json::print_json;
 use super::progress::Progress;
 
 /// `roam bench [--quiet] <benchmark>`.

@@ -7,7 +7,7 @@ use roam_proto::keys;
 use roam_proto::map::{LayerList, LoadMap};
 use roam_world::ros_map;
 
-use super::{connect, ClientArgs};
+use super::client::{connect, ClientArgs};
 
 #[derive(Debug, Subcommand)]
 pub(crate) enum MapCommand {

@@ -2,6 +2,8 @@
 //! experiment runners. Each submodule holds one group of commands.
 
 mod bench;
+mod client;
+mod json;
 mod map;
 mod plan;
 mod progress;
@@ -9,17 +11,11 @@ mod reproduce;
 mod reproduce_fleet;
 mod roles;
 mod ros2;
+mod service_args;
 mod sim;
 mod view;
 
-use std::path::PathBuf;
-use std::time::Duration;
-
-use anyhow::bail;
-use clap::{Args, Parser, Subcommand};
-use roam_proto::keys;
-use roam_runtime::{Requester, SessionArgs};
-use roam_stack::{Role, RoleConfig};
+use clap::{Parser, Subcommand};
 
 use bench::BenchArgs;
 use map::MapCommand;
@@ -151,58 +147,6 @@ enum Command {
     Reproduce(ReproduceArgs),
 }
 
-#[derive(Debug, Args)]
-pub(crate) struct ServiceArgs {
-    /// The service's YAML config file.
-    #[arg(long, value_name = "FILE")]
-    pub(crate) config: Option<PathBuf>,
-    /// Key root for every key expression.
-    #[arg(long, env = "ROAM_ROOT")]
-    pub(crate) root: Option<String>,
-    /// Instance name in the liveliness token (default: the Zenoh session id).
-    #[arg(long)]
-    pub(crate) instance: Option<String>,
-    #[command(flatten)]
-    pub(crate) session: SessionArgs,
-}
-
-impl ServiceArgs {
-    /// The role's config: its file (or the defaults), then `--root` and `--instance`.
-    pub(crate) fn load_config<T: RoleConfig>(&self) -> anyhow::Result<T> {
-        let mut config: T = match &self.config {
-            Some(path) => roam_runtime::config_file::load(path)?,
-            None => T::default(),
-        };
-        if let Some(root) = &self.root {
-            *config.root_mut() = root.clone();
-        }
-        if let Some(instance) = &self.instance {
-            *config.instance_mut() = Some(instance.clone());
-        }
-        Ok(config)
-    }
-
-    /// Runs `role` until SIGINT or SIGTERM, on the Zenoh config of its file section,
-    /// `ZENOH_CONFIG`, then the flags.
-    pub(crate) async fn run(&self, role: Role) -> anyhow::Result<()> {
-        let zenoh = self.session.zenoh_config(role.zenoh())?;
-        role.run(zenoh, roam_runtime::signals::cancel_on_signal())
-            .await
-            .map_err(anyhow::Error::msg)
-    }
-}
-
-#[derive(Debug, Args)]
-pub(crate) struct ClientArgs {
-    #[arg(long, env = "ROAM_ROOT", default_value = keys::DEFAULT_ROOT)]
-    pub(crate) root: String,
-    /// Seconds to wait for an answer.
-    #[arg(long, default_value_t = 5.0)]
-    pub(crate) timeout: f64,
-    #[command(flatten)]
-    pub(crate) session: SessionArgs,
-}
-
 pub async fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::MapServer(args) => roles::map_server(args).await,
@@ -222,25 +166,4 @@ pub async fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Bench(args) => bench::bench(args).await,
         Command::Reproduce(args) => reproduce::reproduce(args).await,
     }
-}
-
-pub(crate) async fn connect(client: &ClientArgs) -> anyhow::Result<(Requester, zenoh::Session)> {
-    if !(client.timeout.is_finite() && client.timeout > 0.0) {
-        bail!("--timeout must be a positive number of seconds");
-    }
-    let session = roam_runtime::session::open(client.session.zenoh_config(None)?).await?;
-    Ok((
-        Requester::new(session.clone(), Duration::from_secs_f64(client.timeout)),
-        session,
-    ))
-}
-
-/// Prints `value` as JSON on stdout: one line when `compact`, else indented.
-pub(crate) fn print_json<T: serde::Serialize>(value: &T, compact: bool) -> anyhow::Result<()> {
-    if compact {
-        println!("{}", serde_json::to_string(value)?);
-    } else {
-        println!("{}", serde_json::to_string_pretty(value)?);
-    }
-    Ok(())
 }

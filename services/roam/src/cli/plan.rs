@@ -13,7 +13,7 @@ use roam_runtime::Requester;
 use roam_world::grid::Grid;
 use roam_world::render;
 
-use super::{connect, ClientArgs};
+use super::client::{connect, ClientArgs};
 
 #[derive(Debug, Args)]
 pub(crate) struct PlanArgs {

@@ -7,7 +7,7 @@ use clap::Args;
 use roam_ros2::node::Ros2Config;
 use roam_stack::Role;
 
-use super::ServiceArgs;
+use super::service_args::ServiceArgs;
 
 /// The ROS 2 side of the node: shared by `roam ros2`, `roam stack` and `roam demo`.
 #[derive(Debug, Args, Clone)]

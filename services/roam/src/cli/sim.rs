@@ -10,7 +10,7 @@ use roam_world::scenario::load_or_builtin;
 
 use roam_stack::Role;
 
-use super::ServiceArgs;
+use super::service_args::ServiceArgs;
 
 #[derive(Debug, Args)]
 #[command(args_conflicts_with_subcommands = true)]

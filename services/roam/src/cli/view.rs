@@ -9,7 +9,7 @@ use clap::Args;
 use roam_runtime::signals;
 use roam_view::{Access, Token, ViewConfig, TOKEN_ENV};
 
-use super::{connect, ClientArgs};
+use super::client::{connect, ClientArgs};
 
 /// Who may connect to the live view: shared by `roam view` and `roam demo --view`.
 #[derive(Debug, Args)]

@@ -13,7 +13,8 @@ use serde::Serialize;
 use zenoh::liveliness::LivelinessToken;
 use zenoh::query::{ConsolidationMode, QueryTarget};
 
-use super::{Output, Ros2Error};
+use super::error::Ros2Error;
+use super::output::Output;
 use crate::attachment::{self, Attachment};
 use crate::msg::{CancelGoalRequest, CancelGoalResponse, GoalInfo, Time, Uuid};
 use crate::names::{EntityKind, Qos};
@@ -100,7 +101,7 @@ impl ServiceClient {
 /// A client of one action: `send_goal` and `get_result` of `send_type` and
 /// `result_type`, and action_msgs' `cancel_goal`.
 #[derive(Debug, Clone)]
-pub(super) struct ActionClient {
+pub(crate) struct ActionClient {
     session: zenoh::Session,
     send_goal: Arc<ServiceClient>,
     get_result: Arc<ServiceClient>,
@@ -109,7 +110,7 @@ pub(super) struct ActionClient {
 
 impl ActionClient {
     /// The client of action `action` (a name in the node's namespace).
-    pub(super) async fn declare(
+    pub(crate) async fn declare(
         out: &Output,
         action: &str,
         send_type: &'static str,
@@ -129,7 +130,7 @@ impl ActionClient {
     }
 
     /// Sends a goal (`request`, carrying its UUID); the server's acceptance.
-    pub(super) async fn send_goal<Req: Serialize>(
+    pub(crate) async fn send_goal<Req: Serialize>(
         &self,
         request: &Req,
         within: Duration,
@@ -138,7 +139,7 @@ impl ActionClient {
     }
 
     /// The goal's result, once the server has it (it answers when the goal ends).
-    pub(super) async fn get_result<Resp: DeserializeOwned>(
+    pub(crate) async fn get_result<Resp: DeserializeOwned>(
         &self,
         goal_id: Uuid,
         within: Duration,
@@ -148,7 +149,7 @@ impl ActionClient {
     }
 
     /// Asks the server to cancel goal `goal_id`.
-    pub(super) async fn cancel(
+    pub(crate) async fn cancel(
         &self,
         goal_id: Uuid,
         within: Duration,

@@ -46,9 +46,10 @@ use tokio::sync::watch;
 use tokio_util::sync::CancellationToken;
 use zenoh::query::Query;
 
+use super::error::Ros2Error;
+use super::output::Output;
 use super::poses::RobotPoses;
 use super::services::{self, answer_call, now};
-use super::{Output, Ros2Error};
 use crate::action::GoalTable;
 use crate::convert;
 use crate::msg::{
@@ -100,7 +101,7 @@ struct Server {
 
 /// Declares the action `action` (relative to the node's namespace): its three services
 /// and two publishers, each with its liveliness token.
-pub(super) async fn declare(
+pub(crate) async fn declare(
     service: &Service,
     out: Arc<Output>,
     root: &str,

@@ -26,8 +26,8 @@ use tokio_util::sync::CancellationToken;
 use zenoh::sample::Sample;
 use zenoh::Session;
 
+use super::output::Output;
 use super::poses::RobotPoses;
-use super::Output;
 use crate::convert::{self, LAYER_TOPICS};
 use crate::msg::Time;
 use crate::names::{self, Qos};
@@ -84,7 +84,7 @@ fn decode_sample<T: Message>(out: &Output, sample: &Sample, max: usize) -> Optio
     }
 }
 
-pub(super) async fn run(
+pub(crate) async fn run(
     session: Session,
     root: String,
     subscriptions: FleetStreams,

@@ -24,7 +24,9 @@ use serde::Deserialize;
 use zenoh::sample::Sample;
 use zenoh_ext::{AdvancedSubscriberBuilderExt, HistoryConfig};
 
-use super::{Output, Ros2Config, Ros2Error};
+use super::config::Ros2Config;
+use super::error::Ros2Error;
+use super::output::Output;
 use crate::attachment::Attachment;
 use crate::convert;
 use crate::msg::{Header, MapMetaData, OccupancyGrid};
@@ -43,7 +45,7 @@ struct GridHead {
     info: MapMetaData,
 }
 
-pub(super) async fn declare(
+pub(crate) async fn declare(
     service: &Service,
     out: Arc<Output>,
     config: &Ros2Config,

@@ -11,7 +11,10 @@
 
 mod action_client;
 mod compute_path;
+mod config;
+mod error;
 mod follow;
+mod limits;
 mod map_input;
 mod nav2_robot;
 mod output;
@@ -19,10 +22,9 @@ mod poses;
 mod services;
 mod sim_time;
 
-use std::path::PathBuf;
 use std::sync::Arc;
 
-use roam_runtime::{Service, ServiceError};
+use roam_runtime::Service;
 use tokio_util::sync::CancellationToken;
 
 use crate::names::{self, NodeInfo};
@@ -30,7 +32,10 @@ use crate::names::{self, NodeInfo};
 pub use compute_path::{
     DEFAULT_ACTION as COMPUTE_PATH_ACTION, MAX_GOALS, MAX_RUNNING_GOALS, PLANNER_IDS,
 };
-pub use nav2_robot::{Nav2Robot, MAX_NAV2_ROBOTS};
+pub use config::{Ros2Config, MAX_LAYER_CELLS};
+pub use error::Ros2Error;
+pub use limits::{MAX_DOMAIN_ID, MAX_NAV2_ROBOTS};
+pub use nav2_robot::Nav2Robot;
 pub use output::Output;
 /// What every call to the node's services is promised (see `services`).
 pub use services::{
@@ -39,93 +44,6 @@ pub use services::{
 
 /// The role's name in `<root>/@live/ros2/<instance>`.
 pub const SERVICE_NAME: &str = "ros2";
-
-/// What `roam ros2` does (its config file, `roam ros2 --config`, as every role's).
-#[derive(Debug, Clone, serde::Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Ros2Config {
-    /// roam's key root.
-    pub root: String,
-    /// roam's instance name (default: the Zenoh session id).
-    pub instance: Option<String>,
-    /// `ROS_DOMAIN_ID`: the first segment of every ROS key.
-    pub domain: u32,
-    /// The node's namespace (`/` or `/site1`): relative topic names are resolved in it.
-    pub namespace: String,
-    /// The node's name.
-    pub node_name: String,
-    /// Declare the node, its topics and services to ROS 2 (off: only record).
-    pub offer: bool,
-    /// Take the map server's occupancy from this ROS 2 topic (nav_msgs/msg/OccupancyGrid).
-    pub map_input: Option<String>,
-    /// Serve `nav2_msgs/action/ComputePathToPose` under this name (Nav2's own,
-    /// `compute_path_to_pose`, by default; `null`: not served).
-    pub compute_path_action: Option<String>,
-    /// The robot whose latest estimate starts a ComputePathToPose goal without
-    /// `use_start` (default: the only robot localized, if there is one).
-    pub robot: Option<String>,
-    /// Robots on Nav2 that roam's executive drives: their poses become roam's
-    /// estimates, their missions FollowPath goals ([`Nav2Robot`]).
-    pub nav2_robots: Vec<Nav2Robot>,
-    /// Take roam's mission clock from this ROS 2 topic (rosgraph_msgs/msg/Clock: a
-    /// simulator's `/clock`); absent: wall time.
-    pub clock: Option<String>,
-    /// The map server's `max_layer_cells`: a received map above it is refused.
-    pub max_layer_cells: u64,
-    /// Record every message published to this new rosbag2 directory.
-    pub rosbag: Option<PathBuf>,
-    /// A Zenoh config fragment, lowest precedence (see `roam_runtime::session`).
-    pub zenoh: Option<serde_json::Value>,
-}
-
-impl Default for Ros2Config {
-    fn default() -> Self {
-        Ros2Config {
-            root: roam_proto::keys::DEFAULT_ROOT.to_owned(),
-            instance: None,
-            domain: 0,
-            namespace: "/".to_owned(),
-            node_name: "roam".to_owned(),
-            offer: true,
-            map_input: None,
-            compute_path_action: Some(compute_path::DEFAULT_ACTION.to_owned()),
-            robot: None,
-            nav2_robots: Vec::new(),
-            clock: None,
-            max_layer_cells: MAX_LAYER_CELLS,
-            rosbag: None,
-            zenoh: None,
-        }
-    }
-}
-
-/// The map server's default `max_layer_cells` (4096²).
-pub const MAX_LAYER_CELLS: u64 = 16_777_216;
-
-/// The largest ROS domain id (ROS 2 allows 0 to 232).
-pub const MAX_DOMAIN_ID: u32 = 232;
-
-#[derive(Debug, thiserror::Error)]
-pub enum Ros2Error {
-    #[error(transparent)]
-    Service(#[from] ServiceError),
-    #[error(transparent)]
-    Name(#[from] names::NameError),
-    #[error("ROS_DOMAIN_ID {0} is out of range: ROS 2 uses 0 to {MAX_DOMAIN_ID}")]
-    Domain(u32),
-    #[error("roam ros2 has nothing to do: it neither offers topics to ROS 2 nor records")]
-    NothingToDo,
-    #[error("{0} Nav2 robots; one node drives at most {MAX_NAV2_ROBOTS}")]
-    TooManyRobots(usize),
-    #[error(transparent)]
-    Bag(#[from] crate::bag::BagError),
-    #[error("cannot declare {what} on '{key}': {reason}")]
-    Declare {
-        what: &'static str,
-        key: String,
-        reason: String,
-    },
-}
 
 /// Runs the role until `cancel`; the liveliness token `<root>/@live/ros2/<instance>`
 /// appears once every topic, service and subscription is declared.

@@ -15,7 +15,7 @@ use zenoh::sample::Sample;
 use zenoh::Session;
 use zenoh_ext::{AdvancedPublisher, AdvancedPublisherBuilderExt, CacheConfig, MissDetectionConfig};
 
-use super::Ros2Error;
+use super::error::Ros2Error;
 use crate::attachment::{self, Attachment};
 use crate::bag::{Bag, BagSummary};
 use crate::names::{self, Durability, EntityKind, NodeInfo, Qos};

@@ -35,7 +35,8 @@ use roam_runtime::{ClientError, Service};
 use serde::Serialize;
 use zenoh::query::Query;
 
-use super::{Output, Ros2Error};
+use super::error::Ros2Error;
+use super::output::Output;
 use crate::attachment::{self, Attachment};
 use crate::convert;
 use crate::msg::{GetPlanRequest, GetPlanResponse, PlanDowntimeRequest, Time};
@@ -78,7 +79,7 @@ impl State {
     }
 }
 
-pub(super) async fn declare(
+pub(crate) async fn declare(
     service: &Service,
     out: Arc<Output>,
     root: &str,
@@ -120,7 +121,7 @@ pub(super) async fn declare(
 }
 
 /// The request's attachment, or a Zenoh error reply saying why it cannot be answered.
-pub(super) async fn request_attachment(
+pub(crate) async fn request_attachment(
     out: &Output,
     query: &Query,
     key: &str,
@@ -144,7 +145,7 @@ pub(super) async fn request_attachment(
 /// error reply; otherwise the request is decoded (up to [`MAX_REQUEST_BYTES`]; a request
 /// that is not valid CDR is logged and given to `answer` as the error), `answer` makes
 /// the response, and the reply echoes the request's sequence number and GID.
-pub(super) async fn answer_call<Req, Resp, Fut>(
+pub(crate) async fn answer_call<Req, Resp, Fut>(
     out: &Output,
     query: Query,
     key: &str,
@@ -167,7 +168,7 @@ pub(super) async fn answer_call<Req, Resp, Fut>(
 }
 
 /// Replies with `response` on the service's key, the request's sequence number and GID.
-pub(super) async fn reply<T: Serialize>(
+pub(crate) async fn reply<T: Serialize>(
     out: &Output,
     query: &Query,
     key: &str,
@@ -192,18 +193,18 @@ pub(super) async fn reply<T: Serialize>(
     }
 }
 
-pub(super) fn payload(query: &Query) -> Vec<u8> {
+pub(crate) fn payload(query: &Query) -> Vec<u8> {
     query
         .payload()
         .map(|p| p.to_bytes().to_vec())
         .unwrap_or_default()
 }
 
-pub(super) fn now() -> Time {
+pub(crate) fn now() -> Time {
     Time::from_nanos(attachment::now_ns())
 }
 
-pub(super) fn client_error(e: ClientError) -> ErrorReply {
+pub(crate) fn client_error(e: ClientError) -> ErrorReply {
     match e {
         ClientError::Refused(reply) => reply,
         other => ErrorReply::new(
@@ -246,7 +247,7 @@ async fn plan_downtime(state: State, query: Query, key: String) {
 /// GetPlan's budget rule, shared with ComputePathToPose: the shortest path's ETA (a
 /// probe with the planner's `shortest` model) times [`GET_PLAN_BUDGET_FACTOR`] is the
 /// budget of a `model` plan; `shortest` is the probe itself.
-pub(super) async fn plan_by_budget_rule(
+pub(crate) async fn plan_by_budget_rule(
     planner: &PlannerClient,
     start: [f64; 2],
     goal: [f64; 2],

@@ -10,7 +10,8 @@ use roam_proto::sim::SimClock;
 use roam_proto::{encode, keys};
 use roam_runtime::{Delivery, Service};
 
-use super::{Output, Ros2Error};
+use super::error::Ros2Error;
+use super::output::Output;
 use crate::msg::Clock;
 use crate::names::Qos;
 use crate::types;
@@ -27,7 +28,7 @@ impl MissionClock {
 }
 
 /// Follows `topic` and republishes it as roam's clock.
-pub(super) async fn declare(
+pub(crate) async fn declare(
     service: &Service,
     out: Arc<Output>,
     root: &str,

@@ -4,11 +4,11 @@ use std::path::Path;
 
 use roam_proto::map::{GridMeta, Origin};
 
-use super::{GridSpec, InformationSpec};
+use super::file::{GridSpec, InformationSpec};
 use crate::grid::{cell_center, occupancy, Grid};
 use crate::load_dirs::Access;
 
-pub(super) fn build_grid(spec: &GridSpec, max_cells: u64) -> Result<Grid<i8>, String> {
+pub(crate) fn build_grid(spec: &GridSpec, max_cells: u64) -> Result<Grid<i8>, String> {
     let [wm, hm] = spec.size_m;
     if !(spec.resolution.is_finite() && spec.resolution > 0.0) {
         return Err(format!(
@@ -55,7 +55,7 @@ pub(super) fn build_grid(spec: &GridSpec, max_cells: u64) -> Result<Grid<i8>, St
     Ok(grid)
 }
 
-pub(super) fn build_information(
+pub(crate) fn build_information(
     spec: &InformationSpec,
     meta: &GridMeta,
     base: &Path,

@@ -21,7 +21,7 @@
 
 use serde::Deserialize;
 
-use super::FieldIssue;
+use super::field_issue::FieldIssue;
 
 /// Zones in one scenario at most (limit `changes`).
 pub const MAX_CHANGE_ZONES: usize = 256;

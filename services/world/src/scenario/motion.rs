@@ -4,7 +4,7 @@
 
 use serde::Deserialize;
 
-use super::FieldIssue;
+use super::field_issue::FieldIssue;
 
 /// Paper 002 §4's step size μ: 0.2.
 pub const DEFAULT_STEP_MU: f64 = 0.2;

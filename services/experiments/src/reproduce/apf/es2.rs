@@ -14,7 +14,10 @@
 use roam_world::scenario::Scenario;
 use serde::Serialize;
 
-use super::{run_parallel, run_seed, summarize, ApfError, RunOptions, RunSummary, Trajectory};
+use super::error::ApfError;
+use super::runs::{run_parallel, run_seed, RunOptions};
+use super::summary::{summarize, RunSummary};
+use super::trajectory::Trajectory;
 use crate::closed_loop::episode::{mission_from_waypoints, run_episode, PositionSource, Setup};
 use crate::progress::Done;
 use roam_controller::params::ApfParams;

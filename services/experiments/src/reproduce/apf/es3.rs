@@ -29,9 +29,10 @@ use roam_world::noise::uniform;
 use roam_world::scenario::Scenario;
 use serde::Serialize;
 
-use super::{
-    run_parallel, run_seed, summarize, ApfError, FailureCauses, RunOptions, RunSummary, Summary,
-};
+use super::error::ApfError;
+use super::failure::FailureCauses;
+use super::runs::{run_parallel, run_seed, RunOptions};
+use super::summary::{summarize, RunSummary, Summary};
 use crate::closed_loop::episode::{run_episode, PositionSource, RobotMission, Setup};
 use crate::progress::Done;
 use roam_controller::params::ApfParams;
@@ -184,7 +185,7 @@ pub fn es3(
     missions: usize,
 ) -> Result<Es3Outcome, ApfError> {
     options.check()?;
-    if !(1..=super::MAX_MISSIONS).contains(&missions) {
+    if !(1..=super::runs::MAX_MISSIONS).contains(&missions) {
         return Err(ApfError::BadOption {
             name: "missions",
             value: missions,

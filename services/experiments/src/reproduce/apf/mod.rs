@@ -48,252 +48,26 @@ pub mod paper;
 pub mod render;
 pub mod runner;
 
+mod error;
+mod runs;
+mod summary;
+mod trajectory;
+
 use roam_world::scenario::Scenario;
 
-use crate::parallel::run_in_order;
 use crate::progress::{Done, Progress};
 use serde::Serialize;
 
-use crate::closed_loop::episode::{Episode, EpisodeError, Setup};
-use roam_controller::params::{ApfParams, ParamError};
-use roam_controller::weights::Scheme;
+use roam_controller::params::ApfParams;
 
+pub use error::ApfError;
 pub use es1::{es1, Es1Outcome, Es1Row};
 pub use es2::{es2, Es2Outcome, Es2Row};
 pub use es3::{es3, Es3Outcome, Es3Row};
 pub use failure::{FailureCause, FailureCauses};
-
-/// How many runs, from which seed, on how many threads, reporting progress how.
-#[derive(Clone, Copy)]
-pub struct RunOptions<'a> {
-    /// Runs per configuration (ES1: per scheme; ES2: per scheme and z_is; ES3: per
-    /// scheme and mission).
-    pub runs: usize,
-    /// The base seed every run's seed is derived from.
-    pub seed: u64,
-    /// Worker threads (at least one is used).
-    pub threads: usize,
-    /// The controller's parameters; each experiment sets the scheme and z_is (and what
-    /// else it says) on top.
-    pub params: &'a ApfParams,
-    /// Called after every finished run: the experiment (`es1`, `es2`, `es3`) as the
-    /// stage, runs done and runs in total.
-    pub progress: Progress<'a>,
-}
-
-impl std::fmt::Debug for RunOptions<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("RunOptions")
-            .field("runs", &self.runs)
-            .field("seed", &self.seed)
-            .field("threads", &self.threads)
-            .field("params", self.params)
-            .finish_non_exhaustive()
-    }
-}
-
-/// The most runs one configuration may have.
-pub const MAX_RUNS: usize = 100_000;
-/// The most ES3 missions.
-pub const MAX_MISSIONS: usize = 10_000;
-
-/// Why an experiment could not run.
-#[derive(Debug, thiserror::Error)]
-pub enum ApfError {
-    #[error(transparent)]
-    Episode(#[from] EpisodeError),
-    #[error(transparent)]
-    Params(#[from] ParamError),
-    #[error("{name} is {value}: {expected}")]
-    BadOption {
-        name: &'static str,
-        value: usize,
-        expected: &'static str,
-    },
-    #[error("scenario {scenario}: {reason}")]
-    Scenario { scenario: String, reason: String },
-}
-
-impl RunOptions<'_> {
-    pub(crate) fn check(&self) -> Result<(), ApfError> {
-        if !(1..=MAX_RUNS).contains(&self.runs) {
-            return Err(ApfError::BadOption {
-                name: "runs",
-                value: self.runs,
-                expected: "use 1 to 100000 runs",
-            });
-        }
-        self.params.check()?;
-        Ok(())
-    }
-}
-
-/// The seed of one run: a hash of the base seed and the run's place (experiment,
-/// mission, run), so a run's noise does not depend on which other runs exist. The scheme
-/// is left out on purpose: every scheme meets the same noise (common random numbers,
-/// module doc).
-pub fn run_seed(base: u64, experiment: &str, mission: usize, run: usize) -> u64 {
-    roam_world::seed::labelled(base, &format!("{experiment}/{mission}/{run}"))
-}
-
-/// Runs `job` on every element of `jobs` over up to `threads` threads, the results in
-/// the order of `jobs` ([`crate::parallel::run_in_order`]); `progress(done)` after each.
-pub(crate) fn run_parallel<J: Sync, R: Send>(
-    jobs: &[J],
-    threads: usize,
-    job: impl Fn(&J) -> R + Sync,
-    progress: impl Fn(usize) + Sync,
-) -> Vec<R> {
-    run_in_order(jobs, threads, job, |_| false, |done, _| progress(done))
-        .into_iter()
-        .flatten()
-        .collect()
-}
-
-/// One run reduced to what the summaries need.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RunSummary {
-    pub success: bool,
-    /// Sim steps until every robot's mission ended (completed or given up).
-    pub steps: u64,
-    /// The robots' true path lengths, summed, metres.
-    pub distance_m: f64,
-    /// The squared localization error at each step, averaged over the robots still on
-    /// their missions then (module doc).
-    pub squared_error: Vec<f64>,
-    /// Why the run failed ([`failure`]); `None` when it succeeded.
-    pub failure: Option<FailureCause>,
-    /// Scans localization refused ([`Episode::localization_errors`]).
-    pub localization_errors: u64,
-}
-
-impl RunSummary {
-    /// `episode` summarised; `setup` is its scenario's, for the coverage where a failed
-    /// robot ended.
-    pub fn of(episode: &Episode, setup: &Setup) -> RunSummary {
-        let longest = episode
-            .robots
-            .iter()
-            .map(|r| r.error_m.len())
-            .max()
-            .unwrap_or(0);
-        let squared_error = (0..longest)
-            .map(|k| {
-                let (sum, n) = episode
-                    .robots
-                    .iter()
-                    .filter_map(|r| r.error_m.get(k))
-                    .fold((0.0, 0usize), |(s, n), e| (s + e * e, n + 1));
-                sum / n.max(1) as f64
-            })
-            .collect();
-        RunSummary {
-            success: episode.success(),
-            steps: episode.robots.iter().map(|r| r.steps).max().unwrap_or(0),
-            distance_m: episode.robots.iter().map(|r| r.distance_m).sum(),
-            squared_error,
-            failure: failure::cause(episode, setup),
-            localization_errors: episode.localization_errors,
-        }
-    }
-}
-
-/// The summary of one configuration's runs (module doc).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Summary {
-    pub runs: usize,
-    /// Share of runs in which every robot reached every waypoint.
-    pub success_rate: f64,
-    /// The mission RMSE of the successful runs (module doc), metres.
-    pub rmse_m: Option<f64>,
-    /// The mission RMSE of all runs, metres; `None` without any sample.
-    pub rmse_all_m: Option<f64>,
-    /// Mean steps of the successful runs.
-    pub steps: Option<f64>,
-    /// Mean distance of the successful runs, metres.
-    pub distance_m: Option<f64>,
-    /// Runs in which some robot missed a waypoint.
-    pub failures: usize,
-    /// Mean steps of all runs (failed runs until given up).
-    pub steps_all: Option<f64>,
-    /// Mean distance of all runs, metres.
-    pub distance_all_m: Option<f64>,
-    /// The failed runs by cause ([`failure`]).
-    pub causes: FailureCauses,
-}
-
-/// The paper's mission RMSE over `runs` (module doc): RMSE^k over the runs still going
-/// at k, averaged over k; `None` without any sample.
-fn mission_rmse(runs: &[&RunSummary]) -> Option<f64> {
-    let longest = runs
-        .iter()
-        .map(|r| r.squared_error.len())
-        .max()
-        .unwrap_or(0);
-    let sum: f64 = (0..longest)
-        .map(|k| {
-            let (sum, n) = runs
-                .iter()
-                .filter_map(|r| r.squared_error.get(k))
-                .fold((0.0, 0usize), |(s, n), e| (s + e, n + 1));
-            (sum / n.max(1) as f64).sqrt()
-        })
-        .sum();
-    (longest > 0).then(|| sum / longest as f64)
-}
-
-/// Summarises runs given in run order (module doc).
-pub fn summarize(runs: &[RunSummary]) -> Summary {
-    let ok: Vec<&RunSummary> = runs.iter().filter(|r| r.success).collect();
-    let mean = |values: Vec<f64>| {
-        (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
-    };
-    Summary {
-        runs: runs.len(),
-        success_rate: if runs.is_empty() {
-            0.0
-        } else {
-            ok.len() as f64 / runs.len() as f64
-        },
-        rmse_m: mission_rmse(&ok),
-        rmse_all_m: mission_rmse(&runs.iter().collect::<Vec<_>>()),
-        steps: mean(ok.iter().map(|r| r.steps as f64).collect()),
-        distance_m: mean(ok.iter().map(|r| r.distance_m).collect()),
-        failures: runs.len() - ok.len(),
-        steps_all: mean(runs.iter().map(|r| r.steps as f64).collect()),
-        distance_all_m: mean(runs.iter().map(|r| r.distance_m).collect()),
-        causes: FailureCauses {
-            localization_errors: runs.iter().map(|r| r.localization_errors).sum(),
-            ..FailureCauses::count(runs.iter().filter_map(|r| r.failure))
-        },
-    }
-}
-
-/// A robot's true path in one run, for the figures.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Trajectory {
-    pub scheme: Scheme,
-    pub z_is: f64,
-    pub robot: String,
-    pub success: bool,
-    pub truth: Vec<[f64; 2]>,
-}
-
-impl Trajectory {
-    pub(crate) fn of(scheme: Scheme, z_is: f64, episode: &Episode) -> Vec<Trajectory> {
-        episode
-            .robots
-            .iter()
-            .map(|r| Trajectory {
-                scheme,
-                z_is,
-                robot: r.robot.clone(),
-                success: r.success,
-                truth: r.truth.clone(),
-            })
-            .collect()
-    }
-}
+pub use runs::{run_seed, RunOptions, MAX_MISSIONS, MAX_RUNS};
+pub use summary::{summarize, RunSummary, Summary};
+pub use trajectory::Trajectory;
 
 /// The whole reproduction: what `roam reproduce controller` prints and writes.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -396,6 +170,7 @@ pub fn reproduce(
 
 #[cfg(test)]
 mod tests {
+    use super::runs::run_parallel;
     use super::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
 

@@ -22,11 +22,11 @@
 //! --days`) and a fleet's shift (`roam reproduce fleet`) are both this, one executive
 //! per robot.
 
+mod step;
 pub mod track;
 
 use std::collections::{BTreeMap, VecDeque};
 
-use roam_controller::controller::Decision;
 use roam_controller::status::controller_status;
 use roam_mission::calibration::{
     path_measure, Calibration, CalibrationConfig, CalibrationError, TimeModel,
@@ -40,11 +40,11 @@ use roam_mission::window::{
     WindowRules, WindowSetup,
 };
 use roam_proto::controller::Mission;
-use roam_proto::localization::PositionEstimate;
 use roam_proto::mission::WindowReport;
 use roam_proto::planner::{Plan, PlanRequest};
 
 use crate::closed_loop::setup::EpisodeError;
+pub use step::Step;
 use track::{Leg, Track};
 
 /// The steps an executive waits for its robot's first fix.
@@ -52,20 +52,6 @@ pub const FIRST_FIX_STEPS: usize = 100;
 
 /// The mission tag of an executive in process (a live one takes its Zenoh session's).
 pub const BATCH_TAG: &str = "batch";
-
-/// What one sim step showed of a robot.
-#[derive(Debug, Clone)]
-pub struct Step {
-    /// Sim time at the end of the step, seconds.
-    pub time_s: f64,
-    /// Its true position.
-    pub truth: [f64; 2],
-    /// The localization's estimate (what the executive hears); `None` when the scan
-    /// was refused.
-    pub estimate: Option<PositionEstimate>,
-    /// The controller's decision on this step.
-    pub decision: Option<Decision>,
-}
 
 /// What an executive in process asks of the world around it.
 pub trait Io {

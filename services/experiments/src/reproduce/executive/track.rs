@@ -8,7 +8,7 @@ use roam_mission::path::distance;
 use roam_planner::params::GaParams;
 use roam_planner::world::World;
 
-use super::Step;
+use super::step::Step;
 
 /// The window's drive, step by step.
 #[derive(Debug, Default)]

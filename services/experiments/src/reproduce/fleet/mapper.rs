@@ -20,8 +20,8 @@ use roam_mapper::reserve::cells_along;
 use roam_proto::cells::Cells;
 use roam_proto::sim::LocalObservation;
 
+use super::error::FleetError;
 use super::world::FleetWorld;
-use super::FleetError;
 
 /// The cells one reservation holds at most (a plan's reach).
 const MAX_RESERVED: usize = 1 << 16;

@@ -12,10 +12,10 @@ use serde::Serialize;
 use crate::reproduce::executive::track::Track;
 use crate::reproduce::executive::FinishedWindow;
 
+use super::error::FleetError;
 use super::events::{ChangeEvent, ChangeLog};
 use super::variant::FleetVariant;
 use super::world::FleetWorld;
-use super::FleetError;
 
 /// One robot's window.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -30,7 +30,7 @@ use roam_planner::params::GaParams;
 use roam_planner::search::fastest_path;
 use roam_planner::world::World;
 
-use super::FleetError;
+use super::error::FleetError;
 
 /// Corners ahead of the robot's last one among which it joins the loop.
 pub const JOIN_AHEAD: usize = 3;

@@ -20,8 +20,8 @@ use roam_proto::cells::Cells;
 use roam_proto::map::Layer;
 use roam_world::grid::occupancy;
 
+use super::error::FleetError;
 use super::world::{FleetWorld, PLANNING_RESOLUTION_M};
-use super::FleetError;
 
 /// Sim seconds between two refreshes: the mapper's `publish_period_s` (1 s of wall
 /// time) at `roam demo --fleet`'s rate of 10.

@@ -22,13 +22,14 @@ use crate::closed_loop::episode::{EpisodeError, PositionSource};
 use crate::closed_loop::stepper::Stepper;
 use crate::reproduce::executive::{InProcessExecutive, Io, Step};
 
+use super::error::FleetError;
 use super::events::ChangeLog;
 use super::mapper::FleetMapper;
 use super::measure::{MapSample, WeekRecord, WindowRecord, PATH_EVERY_STEPS};
+use super::options::FleetOptions;
 use super::seen::SeenWorld;
 use super::variant::{FleetVariant, Planning};
 use super::world::FleetWorld;
-use super::{FleetError, FleetOptions};
 
 /// Sim seconds between two samples of the map error.
 pub const MAP_SAMPLE_S: f64 = 60.0;

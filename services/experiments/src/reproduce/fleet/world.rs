@@ -24,8 +24,8 @@ use roam_world::DEFAULT_MAX_CELLS;
 use crate::closed_loop::episode::Setup;
 use crate::closed_loop::stepper::Stepper;
 
+use super::error::FleetError;
 use super::patrol::Patrol;
-use super::FleetError;
 
 /// The planner's (and the fleet mapper's) resolution, metres: paper 000's grid.
 pub const PLANNING_RESOLUTION_M: f64 = 0.2;

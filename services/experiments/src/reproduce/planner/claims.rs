@@ -7,7 +7,8 @@
 //! the paper's; **no data** when a goal has no figure (no configuration qualified, e.g.
 //! none of a model's configurations kept every run within budget).
 
-use super::{Row, GOALS};
+use super::row::Row;
+use super::setup::GOALS;
 use crate::verdict::{percent_change, Comparison, PaperFigure};
 
 fn find<'a>(rows: &'a [Row], goal: &str, ratio: &str, model: &str) -> Option<&'a Row> {

@@ -54,21 +54,14 @@ pub fn builtin_world() -> Result<World, ExperimentError> {
 }
 
 mod claims;
+mod row;
 mod seeding;
+mod setup;
 
 pub use crate::verdict::{Comparison, PaperFigure, Verdict};
+pub use row::Row;
 pub use seeding::SeedingRow;
-
-/// The start and the paper's two goals (Fig. 5).
-pub const START: [f64; 2] = [-8.0, -8.0];
-pub const GOALS: [(&str, [f64; 2]); 2] = [("goal1", [-2.0, 4.0]), ("goal2", [6.0, -7.0])];
-/// t_plan / t_exec splits of T (§III.B).
-pub const RATIOS: [(&str, f64); 3] = [("20/80", 0.2), ("40/60", 0.4), ("60/40", 0.6)];
-pub const MODELS: [PlannerModel; 3] = [
-    PlannerModel::Model0,
-    PlannerModel::Model1,
-    PlannerModel::Model2,
-];
+pub use setup::{GOALS, MODELS, RATIOS, START};
 
 /// How the GA's first population is built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -105,24 +98,6 @@ pub struct ReproduceOptions {
     /// The initializations to run, in order; the first one's paths are drawn as
     /// `model{0,1,2}.png`, the others' as `<name>-model{0,1,2}.png`.
     pub initializations: Vec<Initialization>,
-}
-
-/// One configuration's results, as the JSON names them.
-#[derive(Debug, Clone, Serialize)]
-pub struct Row {
-    pub goal: String,
-    pub ratio: String,
-    pub model: String,
-    pub u_ges_median: f64,
-    pub u_ges_mean: f64,
-    pub d_median: f64,
-    pub distinct_information_median: f64,
-    /// Share of runs whose t_ETA fits t_exec.
-    pub within_budget: f64,
-    /// Share of runs whose path ends at the goal.
-    pub reached_goal: f64,
-    pub generations: u32,
-    pub t_exec_s: f64,
 }
 
 /// One initialization's rows and the paper's claims judged on them.

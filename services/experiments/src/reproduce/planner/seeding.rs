@@ -9,7 +9,7 @@
 
 use serde::Serialize;
 
-use super::Row;
+use super::row::Row;
 
 /// One configuration under both initializations.
 #[derive(Debug, Clone, Serialize)]

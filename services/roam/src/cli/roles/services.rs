@@ -8,7 +8,7 @@ use roam_map_server::MapServerConfig;
 use roam_planner::PlannerConfig;
 use roam_stack::Role;
 
-use crate::cli::ServiceArgs;
+use crate::cli::service_args::ServiceArgs;
 
 #[derive(Debug, Args)]
 pub(crate) struct MapServerArgs {

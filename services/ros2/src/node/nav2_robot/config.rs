@@ -38,9 +38,6 @@ impl Default for Nav2Robot {
     }
 }
 
-/// The most Nav2 robots one node drives.
-pub const MAX_NAV2_ROBOTS: usize = 64;
-
 impl Nav2Robot {
     /// The config's numbers and names, checked.
     pub fn check(&self) -> Result<(), String> {

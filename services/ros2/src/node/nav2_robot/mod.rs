@@ -38,17 +38,17 @@ use roam_runtime::Service;
 
 use crate::names::Qos;
 use crate::node::action_client::ActionClient;
+use crate::node::error::Ros2Error;
 use crate::node::output::Output;
 use crate::node::sim_time::MissionClock;
-use crate::node::Ros2Error;
 use crate::types;
 
-pub use config::{Nav2Robot, MAX_NAV2_ROBOTS};
+pub use config::Nav2Robot;
 use state::Robot;
 
 /// Declares robot `config`'s subscriptions and action client and drives it until the
 /// service stops.
-pub(super) async fn declare(
+pub(crate) async fn declare(
     service: &Service,
     out: Arc<Output>,
     root: &str,

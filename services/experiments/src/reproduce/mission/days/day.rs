@@ -14,12 +14,13 @@ use roam_proto::planner::{Plan, PlanRequest};
 use roam_world::seed::splitmix64;
 use serde::Serialize;
 
+use super::error::DaysError;
 use super::measure::{TimeModelUse, WindowResult};
+use super::options::DaysOptions;
 use super::planning::Planner;
 use super::robot::Robot;
 use super::variant::Variant;
 use super::world::DayWorld;
-use super::{DaysError, DaysOptions};
 use crate::closed_loop::setup::EpisodeError;
 use crate::reproduce::executive::track::planned_path;
 use crate::reproduce::executive::{FinishedWindow, InProcessExecutive, Io};

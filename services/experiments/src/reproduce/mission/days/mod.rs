@@ -38,6 +38,9 @@ pub mod table;
 pub mod variant;
 pub mod world;
 
+mod error;
+mod options;
+
 #[cfg(test)]
 mod tests;
 
@@ -47,13 +50,12 @@ use crate::progress::{Done, Progress};
 use serde::Serialize;
 
 pub use day::DayResult;
+pub use error::DaysError;
 pub use goals::{Goal, Verdict};
+pub use options::DaysOptions;
 pub use summary::{Effect, Paired, VariantSummary};
 pub use variant::Variant;
 pub use world::DayWorld;
-
-use roam_mission::calibration::CalibrationError;
-use roam_mission::site::Site;
 
 /// The most days one batch runs.
 pub const MAX_DAYS: usize = 10_000;
@@ -63,65 +65,6 @@ pub const MAX_PLAN_WALL_S: f64 = 600.0;
 
 /// The fastest clock a batch may assume, mission seconds per wall second.
 pub const MAX_RATE: f64 = 1000.0;
-
-/// What to run.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DaysOptions {
-    pub days: usize,
-    pub seed: u64,
-    /// GA generations per curious plan (the executive's `max_generations`).
-    pub generations: u32,
-    /// W_loc of the PEB cost (as `roam reproduce mission`: 2000).
-    pub w_loc: f64,
-    /// What a curious plan costs, wall seconds, before its deadline cuts it (measured
-    /// in the demo: see services/mission/README.md).
-    pub plan_wall_s: f64,
-    /// The clock's rate, mission seconds per wall second (the demo's 20×).
-    pub rate: f64,
-    pub variants: Vec<Variant>,
-    /// Threads the days run on (the report does not depend on it).
-    pub jobs: usize,
-    /// The world and the day's tasks: the demo's day, or a user's map and day file.
-    pub site: Site,
-}
-
-impl Default for DaysOptions {
-    fn default() -> Self {
-        DaysOptions {
-            days: 50,
-            seed: 0,
-            generations: 1000,
-            w_loc: 2000.0,
-            plan_wall_s: 0.4,
-            rate: 20.0,
-            variants: Variant::ALL.to_vec(),
-            jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
-            site: Site::builtin_day(),
-        }
-    }
-}
-
-/// Why a batch could not run.
-#[derive(Debug, thiserror::Error)]
-pub enum DaysError {
-    /// An option out of its range, named as [`DaysOptions`] spells it.
-    #[error("{field} is {value}; give {limit}")]
-    Invalid {
-        field: &'static str,
-        value: String,
-        limit: String,
-    },
-    #[error("the day's world: {0}")]
-    World(String),
-    #[error("driving: {0}")]
-    Drive(#[from] crate::closed_loop::episode::EpisodeError),
-    #[error("the time model: {0}")]
-    Calibration(#[from] CalibrationError),
-    #[error("the change map: {0}")]
-    Mapper(String),
-    #[error("the executive: {0}")]
-    Executive(#[from] crate::reproduce::executive::ExecutiveError),
-}
 
 /// The batch's report: the options, the figures, the goals, every window.
 #[derive(Debug, Clone, PartialEq, Serialize)]

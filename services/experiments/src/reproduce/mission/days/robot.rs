@@ -9,8 +9,8 @@ use crate::reproduce::executive::Step;
 use roam_controller::params::ApfParams;
 use roam_mapper::change_map::{ChangeMap, MapParams, ObservationWindow};
 
+use super::error::DaysError;
 use super::world::DayWorld;
-use super::DaysError;
 use roam_proto::controller::Mission;
 
 /// One robot through its day.

@@ -13,7 +13,7 @@ use roam_planner::world::World;
 use roam_world::grid::Grid;
 use roam_world::scenario::Scenario;
 
-use super::DaysError;
+use super::error::DaysError;
 use roam_mission::calibration::TimeModel;
 use roam_mission::site::{inflated_map, Site, HEURISTIC_COMPRESSION};
 use roam_mission::tasks::Task;
