@@ -102,7 +102,11 @@ fn quantile(sorted: &[f64], q: f64) -> Option<f64> {
 
 /// The figures of `week`, whose shifts are `shift_s` long and days `days`.
 pub fn summarize(week: &WeekRecord, shift_s: f64, days: usize) -> FleetSummary {
-    let day_of = |t: f64| (t / shift_s).floor().max(0.0) as usize;
+    // The last shift runs until its last window ends, past `days × shift_s` (a live
+    // run's `--shift-s` is where its tasks stop starting): what comes after counts in
+    // it, so the by-day figures cover every sample and change.
+    let last_day = days.saturating_sub(1);
+    let day_of = |t: f64| ((t / shift_s).floor().max(0.0) as usize).min(last_day);
     let latencies: Vec<Option<f64>> = week.events.iter().map(|e| e.latency_s()).collect();
     let within = |s: f64| {
         (!latencies.is_empty()).then(|| {
@@ -228,5 +232,26 @@ mod tests {
             s.refusals.into_iter().collect::<Vec<_>>(),
             vec![("goal_blocked", 5), ("no_path", 1)]
         );
+    }
+
+    #[test]
+    fn what_comes_after_the_last_shift_counts_in_it() {
+        let mut week = WeekRecord::new(crate::reproduce::fleet::variant::FleetVariant::News, 1);
+        let sample = |t_s: f64, all: f64| MapSample {
+            t_s,
+            zones: all,
+            others: all,
+            all,
+            static_map: all,
+        };
+        // One shift of 900 s, the last sample at 960 s (the last window ran on).
+        week.maps = vec![sample(60.0, 0.01), sample(900.0, 0.02), sample(960.0, 0.03)];
+        let s = summarize(&week, 900.0, 1);
+        let by_day = s.brier_by_day.expect("a day");
+        assert!(
+            (by_day.min - 0.02).abs() < 1e-12 && by_day.max == by_day.min,
+            "{by_day:?}"
+        );
+        assert!((s.brier.expect("scored") - 0.02).abs() < 1e-12);
     }
 }
