@@ -13,7 +13,8 @@
 //! anchors, [`FleetWorld`](super::world::FleetWorld)'s) is above the controller's
 //! `max_peb_m`, where roam's controller would hold the robot. An aisle that reaches into
 //! the north-east anchor gap is patrolled as far as the anchors reach and left the way
-//! it was entered; the legs go round the gap (by the cross aisle). Driven through the
+//! it was entered; the legs go round the gap (by the cross aisle), and so do the ways
+//! onto the loop and off it to the task where they can. Driven through the
 //! gap, the patrol lost 4,400 steps a robot-day to PEB holds and 121 of 228 windows
 //! were late (two shifts, seed 0): a patrol no operator would keep.
 //!
@@ -52,6 +53,9 @@ pub struct Patrol {
     /// The fastest path from each corner to the next (the last back to the first),
     /// the corner itself first.
     legs: Vec<Vec<[f64; 2]>>,
+    /// Where the robots localize ([`Patrol::through_aisles`]): the ways onto the loop
+    /// and off it to the task go there too when they can. `None` for a site's own loop.
+    localized: Option<World>,
 }
 
 /// A window's patrol route.
@@ -94,7 +98,9 @@ impl Patrol {
             corners.push([EAST_X, SOUTH_Y]);
         }
         corners.dedup();
-        Patrol::through(localized, corners)
+        let mut patrol = Patrol::through(localized, corners)?;
+        patrol.localized = Some(localized.clone());
+        Ok(patrol)
     }
 
     /// A loop through `corners` in order and back to the first, each leg the planner's
@@ -109,7 +115,11 @@ impl Patrol {
                 })
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(Patrol { corners, legs })
+        Ok(Patrol {
+            corners,
+            legs,
+            localized: None,
+        })
     }
 
     pub fn corners(&self) -> &[[f64; 2]] {
@@ -146,7 +156,15 @@ impl Patrol {
             roam_mission::path::distance(self.corners[a], from)
                 .total_cmp(&roam_mission::path::distance(self.corners[b], from))
         })?;
-        let mut so_far = path(world, &params, from, self.corners[join])?;
+        // Onto the loop and off it where the robots localize when that is possible (a
+        // task's place may itself be where they do not), else on `world`.
+        let way = |a: [f64; 2], b: [f64; 2]| {
+            self.localized
+                .as_ref()
+                .and_then(|l| path(l, &params, a, b))
+                .or_else(|| path(world, &params, a, b))
+        };
+        let mut so_far = way(from, self.corners[join])?;
         let mut best: Option<PatrolRoute> = None;
         let mut at = join;
         for _ in 0..=n {
@@ -157,7 +175,7 @@ impl Patrol {
             if lower > budget_s {
                 break;
             }
-            if let Some(home) = path(world, &params, self.corners[at], to) {
+            if let Some(home) = way(self.corners[at], to) {
                 let mut points = so_far.clone();
                 points.extend(home.iter().skip(1));
                 let t = eta(&points);
