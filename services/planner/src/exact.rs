@@ -61,6 +61,8 @@ pub enum ExactError {
     Blocked,
     #[error("no path from the start reaches the goal within the budget t_exec = {t_exec_s} s")]
     Infeasible { t_exec_s: f64 },
+    #[error("the search stopped at its limit of {node_limit} nodes before it found any path to the goal; give an incumbent or a higher limit")]
+    NodeLimit { node_limit: u64 },
 }
 
 /// The best path found and whether it is proven best.
@@ -143,7 +145,11 @@ pub fn best_path(
     );
     let finished = search.expand(start, None, 0.0, seen, value);
     let Some((value, path, t_eta_s)) = search.best else {
-        return Err(ExactError::Infeasible { t_exec_s });
+        return Err(if finished {
+            ExactError::Infeasible { t_exec_s }
+        } else {
+            ExactError::NodeLimit { node_limit }
+        });
     };
     Ok(ExactAnswer {
         path,
@@ -199,7 +205,9 @@ impl Search<'_> {
         if self.dominated(cell, dir, time, &seen) {
             return true;
         }
-        let mut moves: Vec<(u32, usize, Cell, f64)> = (0..8)
+        // Each move with what it sees: the next state is made once, ordered, then
+        // searched.
+        let mut moves: Vec<(u32, usize, Cell, f64, Seen)> = (0..8)
             .filter_map(|d| {
                 let next = self.world.step(cell, d)?;
                 let t = time + step_time(self.world, self.params, dir, d);
@@ -210,19 +218,13 @@ impl Search<'_> {
                         &self.windows[next as usize],
                         &self.world.information,
                     );
-                    (gain, d, next, t)
+                    (gain, d, next, t, after)
                 })
             })
             .collect();
         // Most new information first; ties by direction, so the order is fixed.
         moves.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
-        for (gain, d, next, t) in moves {
-            let mut after = seen;
-            see(
-                &mut after,
-                &self.windows[next as usize],
-                &self.world.information,
-            );
+        for (gain, d, next, t, after) in moves {
             self.path.push(next);
             let finished = self.expand(next, Some(d), t, after, value + gain);
             self.path.pop();

@@ -173,6 +173,11 @@ fn an_incumbent_is_kept_when_nothing_beats_it_and_a_node_limit_says_not_proven()
     // Cut short: not proven, and no better than the optimum.
     let cut = best_path(&world, &params, start, goal, t_exec_s, &[], 50).expect("some path");
     assert!(!cut.proven && cut.distinct_information <= full.distinct_information);
+    // Cut before any path reached the goal: said so, not "infeasible".
+    assert_eq!(
+        best_path(&world, &params, start, goal, t_exec_s, &[], 1),
+        Err(ExactError::NodeLimit { node_limit: 1 })
+    );
 }
 
 #[test]
