@@ -129,19 +129,18 @@ impl MapSample {
                 .map_err(|e| FleetError::Mapper(e.to_string()))
         };
         let (zones, others) = world.scored.split_at(world.zone_cells);
-        let static_map: Vec<f64> = world
-            .static_coarse
-            .cells
-            .iter()
-            .map(|&c| if c == 0 { 0.0 } else { 1.0 })
-            .collect();
         Ok(MapSample {
             t_s,
             zones: score(zones)?,
             others: score(others)?,
             all: score(&world.scored)?,
-            static_map: brier(&static_map, truth, world.scored.iter().copied())
-                .map_err(|e| FleetError::Mapper(e.to_string()))?,
+            // The static map's occupancy values are its beliefs (0 free, 100 occupied).
+            static_map: brier(
+                &world.static_coarse.cells,
+                truth,
+                world.scored.iter().copied(),
+            )
+            .map_err(|e| FleetError::Mapper(e.to_string()))?,
         })
     }
 }
