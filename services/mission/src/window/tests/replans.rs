@@ -1,0 +1,142 @@
+//! Replans while the robot drives: slack, and what a failed replan leaves (the shortest
+//! path, then the window's own fastest path), and a lost mission sent again.
+
+use super::*;
+
+/// The robot on the curious path at 7 s, 2 m from the task: at the model's 0.5 m/s it
+/// arrives at 11 s, 89 s early. Slack.
+fn slack(w: &mut DowntimeWindow<'_>, mission: &Mission) -> Vec<WindowAction> {
+    assert!(w.handle(estimate([0.1, 0.9], 0.1), at(6.0, 0.1)).is_empty());
+    w.handle(status(&mission.id, MissionState::Active, 2.0), at(7.0, 0.2))
+}
+
+#[test]
+fn slack_replans_from_where_the_robot_will_be_while_it_drives_on() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    let actions = slack(&mut w, &first);
+    // No hold: the robot drives on, and the plan starts 0.5 m (1 s at 0.5 m/s) further
+    // along its route than where it is: 0.2 m north to the corner, 0.3 m east.
+    assert!(!actions.iter().any(|a| matches!(a, WindowAction::Drive(_))));
+    let ask = asked(&actions);
+    assert!(ask.curious);
+    assert!(distance(ask.from, [0.4, 1.1]) < 1e-9, "{ask:?}");
+    assert!(close(ask.t_exec_s, margin().budget(92.0)));
+    let actions = answer(&mut w, curious_reply(true), at(8.0, 0.3));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::Slack
+        }
+    );
+    assert_eq!(sent(&actions).id, "robot-tag-w0-m2");
+}
+
+#[test]
+fn no_slack_replan_near_the_windows_end() {
+    let f = fixture();
+    let mut setup = f.setup(0, FROM, false);
+    setup.watch.min_replan_window_s = 95.0;
+    let (mut w, actions) = DowntimeWindow::begin(setup, Handover::first(margin()), at(0.0, 0.0));
+    assert!(asked(&actions).curious);
+    let first = sent(&answer(&mut w, curious_reply(true), at(1.0, 0.0)));
+    // 93 s left at 7 s: less than the 95 s a slack replan needs.
+    assert!(slack(&mut w, &first).is_empty());
+}
+
+#[test]
+fn a_failed_slack_replan_leaves_the_robot_on_its_path_then_the_fastest_path() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    slack(&mut w, &first);
+    // The curious request fails: the shortest path is asked for, from the same place.
+    let actions = answer(&mut w, failed(), at(8.0, 0.3));
+    let ask = asked(&actions);
+    assert!(!ask.curious);
+    // That fails too: the window's own fastest path from where the robot is.
+    let actions = answer(&mut w, failed(), at(8.1, 0.4));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::NoPlanner
+        }
+    );
+    let straight = sent(&actions);
+    assert_eq!(straight.id, "robot-tag-w0-m2");
+    assert_eq!(
+        straight.waypoints.last().copied(),
+        Some(GOAL),
+        "{straight:?}"
+    );
+    let actions = answer_status(&mut w, &straight, MissionState::Completed, at(50.0, 0.5));
+    assert!(matches!(actions[0], WindowAction::Arrived { .. }));
+    let r = report(&w.handle(WindowEvent::Tick, at(105.0, 0.6)));
+    assert_eq!(r.replan_reasons, vec![Reason::NoPlanner.name().to_owned()]);
+}
+
+#[test]
+fn a_failed_curious_replan_falls_back_to_the_shortest_path() {
+    let f = fixture();
+    let (mut w, _) = f.driving(false);
+    let pushed = [2.0, 2.5];
+    let actions = w.handle(estimate(pushed, 0.1), at(3.0, 0.1));
+    assert!(asked(&actions).curious);
+    let actions = answer(&mut w, failed(), at(3.5, 0.2));
+    let ask = asked(&actions);
+    assert_eq!((ask.from, ask.curious), (pushed, false));
+    let actions = answer(&mut w, shortest_reply(pushed), at(3.6, 0.3));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::PushedOffPath
+        }
+    );
+    assert_eq!(
+        sent(&actions).waypoints,
+        mission_waypoints(&shortest_points(pushed), 1.0)
+    );
+}
+
+#[test]
+fn a_failed_shortest_replan_drives_the_windows_own_fastest_path() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    let actions = w.handle(status(&first.id, MissionState::Stuck, 5.0), at(4.0, 0.1));
+    assert!(!asked(&actions).curious);
+    let actions = answer(&mut w, failed(), at(4.1, 0.2));
+    let straight = sent(&actions);
+    assert_ne!(straight.id, first.id);
+    // The first mission is watched no more.
+    let stale = status(&first.id, MissionState::Completed, 0.0);
+    assert!(w.handle(stale, at(40.0, 0.3)).is_empty());
+}
+
+#[test]
+fn a_lost_mission_is_sent_again_from_where_the_robot_is() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    // The controller said nothing for 3 wall seconds.
+    assert!(w.handle(WindowEvent::Tick, at(2.0, 2.9)).is_empty());
+    let actions = w.handle(WindowEvent::Tick, at(2.2, 3.0));
+    let ask = asked(&actions);
+    assert_eq!((ask.from, ask.curious), (FROM, true));
+    let actions = answer(&mut w, curious_reply(true), at(2.5, 3.1));
+    assert_eq!(
+        actions[0],
+        WindowAction::Replanned {
+            reason: Reason::ControllerSilent
+        }
+    );
+    let again = sent(&actions);
+    assert_ne!(again.id, first.id);
+    let actions = w.handle(
+        status(&again.id, MissionState::Completed, 0.0),
+        at(50.0, 3.2),
+    );
+    assert!(matches!(actions[0], WindowAction::Arrived { .. }));
+    let r = report(&w.handle(WindowEvent::Tick, at(105.0, 3.3)));
+    assert_eq!(
+        r.replan_reasons,
+        vec![Reason::ControllerSilent.name().to_owned()]
+    );
+}
