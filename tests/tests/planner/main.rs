@@ -423,3 +423,38 @@ async fn made_up_request_ids_are_distinct_and_32_hex_characters() {
     assert_eq!(ids.len(), 3);
     running.stop().await;
 }
+
+/// `model: anytime` through the service: the greedy answer, then the GA seeded with it;
+/// the reply names what found its path, as every reply does, and it is never less fit
+/// than the greedy planner's own answer to the same request.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn an_anytime_plan_is_at_least_the_greedy_one_and_names_its_source() {
+    let running = boot(&[("solo", 2)]).await;
+    let client = running.harness.client().await;
+    let root = &running.harness.root;
+    let anytime = PlanRequest {
+        model: PlannerModel::Anytime,
+        ..request([-8.0, -8.0], [6.0, -7.0], 70.0, 100)
+    };
+    let greedy = PlanRequest {
+        model: PlannerModel::Greedy,
+        ..anytime.clone()
+    };
+    let a = ask(&client, root, &anytime).await.expect("an anytime plan");
+    let g = ask(&client, root, &greedy).await.expect("a greedy plan");
+    assert_eq!(a.model, PlannerModel::Anytime);
+    assert!(a.within_budget && a.reaches_goal, "{a:?}");
+    assert!(
+        a.fitness.total >= g.fitness.total,
+        "anytime {} below greedy {}",
+        a.fitness.total,
+        g.fitness.total
+    );
+    assert_eq!(g.found_by.as_deref(), Some("greedy"));
+    let source = a.found_by.as_deref().expect("found_by");
+    assert!(
+        ["ga", "greedy", "via_seed", "shortest"].contains(&source),
+        "{source}"
+    );
+    running.stop().await;
+}
