@@ -17,6 +17,7 @@ use roam_map_server::MapServerConfig;
 use roam_mapper::service::MapperConfig;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
+use roam_runtime::service_config::ServiceConfig;
 use roam_runtime::wait_for_liveliness;
 use roam_runtime::{Requester, SessionArgs};
 use roam_sim::service::SimConfig;
@@ -226,7 +227,7 @@ impl Harness {
     /// A map server config under this harness's root, built-in world, no persistence.
     pub fn map_server_config(&self) -> MapServerConfig {
         MapServerConfig {
-            root: self.root.clone(),
+            service: ServiceConfig::at(self.root.clone()),
             ..MapServerConfig::default()
         }
     }
@@ -234,8 +235,10 @@ impl Harness {
     /// A planner config under this harness's root with the given instance name.
     pub fn planner_config(&self, instance: &str) -> PlannerConfig {
         PlannerConfig {
-            root: self.root.clone(),
-            instance: Some(instance.to_owned()),
+            service: ServiceConfig {
+                instance: Some(instance.to_owned()),
+                ..ServiceConfig::at(self.root.clone())
+            },
             ..PlannerConfig::default()
         }
     }
@@ -245,7 +248,7 @@ impl Harness {
     /// (`config/scenarios`, by name).
     pub fn sim_config(&self, scenario: Option<&str>) -> SimConfig {
         SimConfig {
-            root: self.root.clone(),
+            service: ServiceConfig::at(self.root.clone()),
             scenario: scenario.map(repo_path),
             rate: None,
             load_dirs: vec![repo_path("config/scenarios")],
@@ -258,7 +261,7 @@ impl Harness {
     /// `None`).
     pub fn localization_config(&self, scenario: Option<&str>) -> LocalizationConfig {
         LocalizationConfig {
-            root: self.root.clone(),
+            service: ServiceConfig::at(self.root.clone()),
             scenario: scenario.map(repo_path),
             ..LocalizationConfig::default()
         }
@@ -286,7 +289,7 @@ impl Harness {
     /// A controller config under this harness's root (built-in world, paper defaults).
     pub fn controller_config(&self) -> ControllerConfig {
         ControllerConfig {
-            root: self.root.clone(),
+            service: ServiceConfig::at(self.root.clone()),
             ..ControllerConfig::default()
         }
     }
@@ -294,7 +297,7 @@ impl Harness {
     /// A mapper config under this harness's root (built-in world, drives no robot).
     pub fn mapper_config(&self) -> MapperConfig {
         MapperConfig {
-            root: self.root.clone(),
+            service: ServiceConfig::at(self.root.clone()),
             ..MapperConfig::default()
         }
     }

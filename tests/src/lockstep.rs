@@ -18,6 +18,7 @@ use roam_proto::controller::{ControllerStatus, Mission, MissionState};
 use roam_proto::mission::{ExecutiveStatus, WindowReport};
 use roam_proto::sim::{RobotCommand, SimControl, SimStatus};
 use roam_proto::{decode, keys, Message};
+use roam_runtime::service_config::ServiceConfig;
 use roam_runtime::Requester;
 use zenoh::handlers::FifoChannelHandler;
 use zenoh::pubsub::Subscriber;
@@ -129,7 +130,7 @@ impl LockstepDay {
         services.push(
             harness
                 .start_role(MissionConfig {
-                    root: root.clone(),
+                    service: ServiceConfig::at(root.clone()),
                     executive: config,
                     scenario: Some(repo_path(scenario)),
                     ..MissionConfig::default()

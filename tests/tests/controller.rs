@@ -278,11 +278,14 @@ async fn a_controller_on_board_one_robot_leaves_the_others_alone() {
     let _localization = harness
         .start_role(harness.localization_config(Some(scenario)))
         .await;
-    let on_board = |robot: &str| ControllerConfig {
-        scenario: Some(repo_path(scenario)),
-        robots: vec![robot.to_owned()],
-        instance: Some(format!("on-{robot}")),
-        ..harness.controller_config()
+    let on_board = |robot: &str| {
+        let mut config = ControllerConfig {
+            scenario: Some(repo_path(scenario)),
+            robots: vec![robot.to_owned()],
+            ..harness.controller_config()
+        };
+        config.service.instance = Some(format!("on-{robot}"));
+        config
     };
     let other = harness.start_role(on_board("other")).await;
     let client = harness.client().await;

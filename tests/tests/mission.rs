@@ -11,6 +11,7 @@ use roam_mission::executive::ExecutiveConfig;
 use roam_mission::service::MissionConfig;
 use roam_proto::mission::WindowReport;
 use roam_proto::{decode, keys};
+use roam_runtime::service_config::ServiceConfig;
 use roam_tests::{within, Harness};
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
@@ -41,7 +42,7 @@ async fn the_demo_mission_is_on_time_and_more_curious_than_the_shortest_path() {
     .expect("subscriber");
     let _mission = harness
         .start_role(MissionConfig {
-            root: harness.root.clone(),
+            service: ServiceConfig::at(harness.root.clone()),
             executive: ExecutiveConfig {
                 // A pessimistic prior (a stale datasheet: the robot drives a metre in
                 // 2 s, the executive believes 3 s), so the first window's plan would

@@ -7,6 +7,7 @@ use std::time::Duration;
 use roam_mission::config::ExecutiveConfig;
 use roam_mission::service::MissionConfig;
 use roam_mission::tasks::Task;
+use roam_runtime::service_config::ServiceConfig;
 use roam_tests::{repo_path, Harness};
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
@@ -27,7 +28,7 @@ async fn a_day_whose_tasks_cannot_be_reached_in_time_is_refused_naming_them() {
     };
     let mission = harness
         .start_role(MissionConfig {
-            root: harness.root.clone(),
+            service: ServiceConfig::at(harness.root.clone()),
             executive: ExecutiveConfig {
                 tasks: vec![
                     task("goal1", [-2.0, 4.0], 75.0),

@@ -31,9 +31,9 @@ async fn boot(map: Option<&str>, planners: Vec<PlannerConfig>) -> Running {
     planner_client::boot_on(map, |harness| {
         planners
             .into_iter()
-            .map(|config| PlannerConfig {
-                root: harness.root.clone(),
-                ..config
+            .map(|mut config| {
+                config.service.root = harness.root.clone();
+                config
             })
             .collect()
     })
@@ -41,10 +41,9 @@ async fn boot(map: Option<&str>, planners: Vec<PlannerConfig>) -> Running {
 }
 
 fn planner(name: &str) -> PlannerConfig {
-    PlannerConfig {
-        instance: Some(name.to_owned()),
-        ..PlannerConfig::default()
-    }
+    let mut config = PlannerConfig::default();
+    config.service.instance = Some(name.to_owned());
+    config
 }
 
 /// The depot is a 5 cm map; the planner plans at its default 0.2 m. Through Zenoh the
@@ -344,11 +343,11 @@ async fn a_planning_resolution_finer_than_the_map_is_refused_in_every_reply() {
             ..harness.map_server_config()
         })
         .await;
-    let config = PlannerConfig {
-        root: harness.root.clone(),
+    let mut config = PlannerConfig {
         planning_resolution_m: Some(0.02),
         ..planner("fine")
     };
+    config.service.root = harness.root.clone();
     let cancel = tokio_util::sync::CancellationToken::new();
     let service = tokio::spawn(roam_planner::run(
         config,

@@ -16,6 +16,7 @@ use roam_ros2::attachment::Attachment;
 use roam_ros2::msg::{MapMetaData, OccupancyGrid, Pose};
 use roam_ros2::node::Ros2Config;
 use roam_ros2::{cdr, hash, names, types};
+use roam_runtime::service_config::ServiceConfig;
 use roam_tests::{within, Harness};
 
 #[derive(Clone, Default)]
@@ -89,7 +90,7 @@ async fn a_ros2_map_becomes_occupancy_and_bad_maps_are_refused() {
     let h = Harness::start().await;
     let _map_server = h.start_role(h.map_server_config()).await;
     let config = Ros2Config {
-        root: h.root.clone(),
+        service: ServiceConfig::at(h.root.clone()),
         map_input: Some("/map".into()),
         ..Ros2Config::default()
     };
@@ -196,7 +197,7 @@ async fn a_ros2_map_of_another_size_reaches_every_service() {
     let _mapper = h.start_role(h.mapper_config()).await;
     let _planner = h.start_role(h.planner_config("p1")).await;
     let ros2 = Ros2Config {
-        root: h.root.clone(),
+        service: ServiceConfig::at(h.root.clone()),
         map_input: Some("/map".into()),
         ..Ros2Config::default()
     };

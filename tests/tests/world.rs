@@ -9,6 +9,7 @@ use roam_localization::service::LocalizationConfig;
 use roam_proto::cells::Cells;
 use roam_proto::map::{LayerChange, LayerList, LayerUpdate, UpdateAck, WorldId};
 use roam_proto::{keys, ErrorCode};
+use roam_runtime::service_config::ServiceConfig;
 use roam_runtime::{ClientError, Requester};
 use roam_stack::stack::{Stack, StackOptions};
 use roam_tests::{repo_path, within, Harness};
@@ -92,7 +93,7 @@ async fn a_service_given_another_world_refuses_it_naming_both() {
     let server = harness.start_role(harness.map_server_config()).await;
     // Localization on ES1's world, beside a map server on the built-in one.
     let config = LocalizationConfig {
-        root: harness.root.clone(),
+        service: ServiceConfig::at(harness.root.clone()),
         scenario: Some(repo_path("config/scenarios/es1.yaml")),
         ..LocalizationConfig::default()
     };

@@ -30,6 +30,7 @@ use roam_localization::service::LocalizationConfig;
 use roam_proto::controller::Mission;
 use roam_proto::sim::{RobotCommand, SimClock, SimControl, SimStatus};
 use roam_proto::{decode, encode, keys};
+use roam_runtime::service_config::ServiceConfig;
 use roam_runtime::{Requester, SessionArgs};
 use roam_sim::service::SimConfig;
 use roam_world::grid::cell_center;
@@ -99,7 +100,7 @@ pub async fn fleet(
     {
         let (config, zenoh, token) = (
             SimConfig {
-                root: root.clone(),
+                service: ServiceConfig::at(root.clone()),
                 rate: None,
                 ..SimConfig::default()
             },
@@ -115,7 +116,7 @@ pub async fn fleet(
     {
         let (config, zenoh, token) = (
             LocalizationConfig {
-                root: root.clone(),
+                service: ServiceConfig::at(root.clone()),
                 publish_peb_layer: false,
                 ..LocalizationConfig::default()
             },
@@ -131,7 +132,7 @@ pub async fn fleet(
     {
         let (config, zenoh, token) = (
             ControllerConfig {
-                root: root.clone(),
+                service: ServiceConfig::at(root.clone()),
                 ..ControllerConfig::default()
             },
             client_config()?,

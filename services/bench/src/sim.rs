@@ -13,6 +13,7 @@ use std::time::{Duration, Instant};
 
 use roam_proto::keys;
 use roam_proto::sim::{SimControl, SimStatus};
+use roam_runtime::service_config::ServiceConfig;
 use roam_runtime::{Requester, SessionArgs};
 use roam_sim::service::SimConfig;
 use roam_world::grid::cell_center;
@@ -50,7 +51,7 @@ pub async fn sim(
     let root = "roam-bench-sim".to_owned();
     let cancel = CancellationToken::new();
     let config = SimConfig {
-        root: root.clone(),
+        service: ServiceConfig::at(root.clone()),
         rate: None,
         ..SimConfig::default()
     };

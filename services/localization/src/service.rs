@@ -26,6 +26,7 @@ use roam_proto::localization::{CrbCells, PebAt, PebQuery, PebReply, PebWhere};
 use roam_proto::map::{GridMeta, LayerChange, LayerList, LayerUpdate, Origin, UpdateAck};
 use roam_proto::sim::{NamedPoint, RangeScan, SimClock};
 use roam_proto::{keys, ErrorCode, ErrorReply};
+use roam_runtime::service_config::{ServiceConfig, UnknownFields};
 use roam_runtime::warn_limit::WarnLimiter;
 use roam_runtime::{limited_warn, reply, routing, Requester, Service, ServiceError};
 use roam_world::epoch::Epochs;
@@ -65,25 +66,27 @@ pub const PEB_LAYER: &str = "peb";
 /// publish_peb_layer: true               # send the PEB field over the map to the map server
 /// ```
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(default)]
 pub struct LocalizationConfig {
-    pub root: String,
-    pub instance: Option<String>,
+    /// `root`, `instance` and `zenoh`, as every service names them.
+    #[serde(flatten)]
+    pub service: ServiceConfig,
     pub scenario: Option<PathBuf>,
     pub variance_derivative: bool,
     pub publish_peb_layer: bool,
-    pub zenoh: Option<serde_json::Value>,
+    /// Refuses a field this config does not name.
+    #[serde(flatten)]
+    pub unknown: UnknownFields,
 }
 
 impl Default for LocalizationConfig {
     fn default() -> Self {
         LocalizationConfig {
-            root: keys::DEFAULT_ROOT.to_owned(),
-            instance: None,
+            service: ServiceConfig::default(),
             scenario: None,
             variance_derivative: true,
             publish_peb_layer: true,
-            zenoh: None,
+            unknown: UnknownFields,
         }
     }
 }
@@ -162,8 +165,8 @@ pub async fn run(
     model_of(&anchors.iter().map(|a| a.at).collect::<Vec<_>>(), &sensing)?;
     let mut service = Service::start(
         SERVICE_NAME,
-        &config.root,
-        config.instance.as_deref(),
+        &config.service.root,
+        config.service.instance.as_deref(),
         zenoh_config,
         cancel,
     )
@@ -176,7 +179,7 @@ pub async fn run(
     };
     let state = Arc::new(LocalizationShared {
         world: world.clone(),
-        root: config.root.clone(),
+        root: config.service.root.clone(),
         session: service.session().clone(),
         sensing,
         anchors,
@@ -188,7 +191,7 @@ pub async fn run(
     });
     service
         .subscribe_with(
-            &keys::sim_clock(&config.root),
+            &keys::sim_clock(&config.service.root),
             MAX_CLOCK_BYTES,
             state.clone(),
             |state: &Arc<LocalizationShared>, _key: &str, clock: SimClock| {
@@ -198,14 +201,14 @@ pub async fn run(
         .await?;
     service
         .subscribe_with(
-            &keys::robot_ranges_any(&config.root),
+            &keys::robot_ranges_any(&config.service.root),
             MAX_SCAN_BYTES,
             state.clone(),
             |state: &Arc<LocalizationShared>, key: &str, scan: RangeScan| on_scan(state, key, scan),
         )
         .await?;
     let peb = service
-        .declare_queryable(&keys::localization_peb(&config.root))
+        .declare_queryable(&keys::localization_peb(&config.service.root))
         .await?;
     service.serve(
         peb,

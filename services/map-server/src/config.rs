@@ -17,15 +17,17 @@
 
 use std::path::PathBuf;
 
+use roam_runtime::service_config::{ServiceConfig, UnknownFields};
 use serde::Deserialize;
 
 use crate::store::Limits;
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(default)]
 pub struct MapServerConfig {
-    pub root: String,
-    pub instance: Option<String>,
+    /// `root`, `instance` and `zenoh`, as every service names them.
+    #[serde(flatten)]
+    pub service: ServiceConfig,
     pub map: Option<PathBuf>,
     pub data_dir: Option<PathBuf>,
     /// The directories a `<root>/map/load` request may read from (names relative to
@@ -35,15 +37,15 @@ pub struct MapServerConfig {
     pub heuristic_compression: f64,
     pub lethal_threshold: i8,
     pub limits: Limits,
-    /// A Zenoh config fragment, lowest precedence (see `roam_runtime::session`).
-    pub zenoh: Option<serde_json::Value>,
+    /// Refuses a field this config does not name.
+    #[serde(flatten)]
+    pub unknown: UnknownFields,
 }
 
 impl Default for MapServerConfig {
     fn default() -> Self {
         MapServerConfig {
-            root: roam_proto::keys::DEFAULT_ROOT.to_owned(),
-            instance: None,
+            service: ServiceConfig::default(),
             map: None,
             data_dir: None,
             load_dirs: Vec::new(),
@@ -51,7 +53,7 @@ impl Default for MapServerConfig {
             heuristic_compression: 0.25,
             lethal_threshold: 65,
             limits: Limits::default(),
-            zenoh: None,
+            unknown: UnknownFields,
         }
     }
 }

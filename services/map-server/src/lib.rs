@@ -8,6 +8,7 @@
 //! layers on disk (snapshots and change logs, see the crate's README). [`service`] is
 //! the thin Zenoh adapter around the store.
 
+#[cfg(feature = "zenoh")]
 pub mod config;
 pub mod derived;
 pub mod edits;
@@ -17,6 +18,7 @@ pub mod persist;
 pub mod service;
 pub mod store;
 
+#[cfg(feature = "zenoh")]
 pub use config::MapServerConfig;
 #[cfg(feature = "zenoh")]
 pub use service::{run, MapServerError, SERVICE_NAME};

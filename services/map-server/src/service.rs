@@ -225,14 +225,14 @@ pub async fn run(
         LoadDirs::new(&config.load_dirs).map_err(|e| MapServerError::Config(e.to_string()))?;
     let mut service = Service::start(
         SERVICE_NAME,
-        &config.root,
-        config.instance.as_deref(),
+        &config.service.root,
+        config.service.instance.as_deref(),
         zenoh_config,
         cancel,
     )
     .await?;
     let state = Arc::new(MapServerShared {
-        root: config.root.clone(),
+        root: config.service.root.clone(),
         store: Mutex::new(store),
         encoded: Mutex::new(HashMap::new()),
         robot_radius_override: config.robot_radius_m,
@@ -240,7 +240,7 @@ pub async fn run(
         warnings: WarnLimiter::new(),
         session: service.session().clone(),
     });
-    let root = config.root.as_str();
+    let root = config.service.root.as_str();
     let layer_q = service
         .declare_queryable(&keys::map_layer_any(root))
         .await?;

@@ -13,6 +13,6 @@ fn config_dir() -> std::path::PathBuf {
 fn the_map_server_config_example_parses() {
     let config: MapServerConfig =
         roam_runtime::config_file::load(&config_dir().join("map-server.yaml")).expect("config");
-    assert_eq!(config.root, "roam");
+    assert_eq!(config.service.root, "roam");
     assert_eq!(config.limits, DEFAULT_LIMITS);
 }

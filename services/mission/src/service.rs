@@ -7,6 +7,7 @@ use roam_runtime::Delivery;
 use std::path::PathBuf;
 
 use roam_proto::keys;
+use roam_runtime::service_config::{ServiceConfig, UnknownFields};
 use roam_runtime::{Service, ServiceError};
 use serde::Deserialize;
 use tokio_util::sync::CancellationToken;
@@ -30,24 +31,26 @@ pub const SERVICE_NAME: &str = "mission";
 ///   peb_free_m: 0.5      # the PEB (m) that cost forgives (default 0: every decimetre costs)
 /// ```
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(default)]
 pub struct MissionConfig {
-    pub root: String,
-    pub instance: Option<String>,
+    /// `root`, `instance` and `zenoh`, as every service names them.
+    #[serde(flatten)]
+    pub service: ServiceConfig,
     pub executive: ExecutiveConfig,
     /// Unused here; kept so every role's config has the same shape.
     pub scenario: Option<PathBuf>,
-    pub zenoh: Option<serde_json::Value>,
+    /// Refuses a field this config does not name.
+    #[serde(flatten)]
+    pub unknown: UnknownFields,
 }
 
 impl Default for MissionConfig {
     fn default() -> Self {
         MissionConfig {
-            root: keys::DEFAULT_ROOT.to_owned(),
-            instance: None,
+            service: ServiceConfig::default(),
             executive: ExecutiveConfig::default(),
             scenario: None,
-            zenoh: None,
+            unknown: UnknownFields,
         }
     }
 }
@@ -109,21 +112,21 @@ pub async fn run(
     crate::tasks::check(&config.executive.tasks).map_err(ExecutiveError::from)?;
     let mut service = Service::start(
         SERVICE_NAME,
-        &config.root,
-        config.instance.as_deref(),
+        &config.service.root,
+        config.service.instance.as_deref(),
         zenoh_config,
         cancel.clone(),
     )
     .await?;
     service.announce().await?;
     let session = service.session().clone();
-    let key = keys::robot_mission_report(&config.root, &config.executive.robot);
+    let key = keys::robot_mission_report(&config.service.root, &config.executive.robot);
     let publish = |outcome: &executive::WindowOutcome| {
         roam_runtime::publish_wait(&session, &key, &outcome.report, Delivery::Reliable);
     };
     match executive::run(
         &session,
-        &config.root,
+        &config.service.root,
         &config.executive,
         &cancel,
         &log,

@@ -23,6 +23,7 @@
 //! zenoh: { mode: client, connect: { endpoints: ["tcp/router:7447"] } }
 //! ```
 
+use roam_runtime::service_config::{ServiceConfig, UnknownFields};
 use serde::Deserialize;
 
 use crate::budget::BudgetConfig;
@@ -30,10 +31,11 @@ use crate::coupling::Coupling;
 use crate::limits::PlanLimits;
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(default)]
 pub struct PlannerConfig {
-    pub root: String,
-    pub instance: Option<String>,
+    /// `root`, `instance` and `zenoh`, as every service names them.
+    #[serde(flatten)]
+    pub service: ServiceConfig,
     /// Plans computed at once by this instance; the next requests wait in its queue
     /// ([`crate::queue`]).
     pub max_concurrent_plans: usize,
@@ -88,7 +90,9 @@ pub struct PlannerConfig {
     pub plan_seconds_per_second: f64,
     /// Plan-seconds the CPU budget holds at most.
     pub plan_seconds_burst: f64,
-    pub zenoh: Option<serde_json::Value>,
+    /// Refuses a field this config does not name.
+    #[serde(flatten)]
+    pub unknown: UnknownFields,
 }
 
 impl Default for PlannerConfig {
@@ -96,8 +100,7 @@ impl Default for PlannerConfig {
         let limits = PlanLimits::default();
         let budget = BudgetConfig::default();
         PlannerConfig {
-            root: roam_proto::keys::DEFAULT_ROOT.to_owned(),
-            instance: None,
+            service: ServiceConfig::default(),
             max_concurrent_plans: 2,
             max_queued_plans: 64,
             map_history: 4,
@@ -113,7 +116,7 @@ impl Default for PlannerConfig {
             max_plan_seconds: budget.max_plan_seconds,
             plan_seconds_per_second: budget.plan_seconds_per_second,
             plan_seconds_burst: budget.plan_seconds_burst,
-            zenoh: None,
+            unknown: UnknownFields,
         }
     }
 }

@@ -6,6 +6,8 @@
 //!   graceful stop;
 //! - [`signals`]: SIGINT / SIGTERM as a cancellation;
 //! - [`config_file`]: reading a service's YAML/JSON config file with errors that name it;
+//! - [`service_config`]: the fields every service's config file has (root, instance,
+//!   zenoh), embedded in each, and the refusal of fields a config does not name;
 //! - [`reply`] and [`client`]: the two ends of a query, with roam's codec and error reply;
 //! - [`routing`]: the robot a message is for is the one its key names;
 //! - [`telemetry`]: tracing from `RUST_LOG`;
@@ -26,6 +28,7 @@ pub mod publish;
 pub mod reply;
 pub mod routing;
 pub mod service;
+pub mod service_config;
 pub mod session;
 pub mod signals;
 pub mod subscribe;

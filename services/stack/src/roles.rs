@@ -37,19 +37,19 @@ macro_rules! role_config {
     ($($config:ty),*) => {$(
         impl RoleConfig for $config {
             fn root(&self) -> &str {
-                &self.root
+                &self.service.root
             }
             fn root_mut(&mut self) -> &mut String {
-                &mut self.root
+                &mut self.service.root
             }
             fn instance(&self) -> Option<&str> {
-                self.instance.as_deref()
+                self.service.instance.as_deref()
             }
             fn instance_mut(&mut self) -> &mut Option<String> {
-                &mut self.instance
+                &mut self.service.instance
             }
             fn zenoh(&self) -> Option<&serde_json::Value> {
-                self.zenoh.as_ref()
+                self.service.zenoh.as_ref()
             }
         }
     )*};
@@ -192,20 +192,63 @@ role_from!(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use roam_runtime::service_config::ServiceConfig;
 
     #[test]
     fn a_named_instance_is_awaited_by_its_own_token() {
         let planner = Role::from(PlannerConfig {
-            root: "r".into(),
-            instance: Some("p-1".into()),
+            service: ServiceConfig {
+                instance: Some("p-1".into()),
+                ..ServiceConfig::at("r")
+            },
             ..PlannerConfig::default()
         });
         assert_eq!(planner.name(), "planner");
         assert_eq!(planner.live_key(), keys::liveliness("r", "planner", "p-1"));
         let sim = Role::from(SimConfig {
-            root: "r".into(),
+            service: ServiceConfig::at("r"),
             ..SimConfig::default()
         });
         assert_eq!(sim.live_key(), keys::liveliness_of("r", "sim"));
+    }
+
+    /// Every role's config file takes the common fields beside its own and refuses a
+    /// field it does not name, with the field's name: the flattened
+    /// [`ServiceConfig`] does not let a typo through.
+    #[test]
+    fn every_role_config_takes_the_common_fields_and_refuses_a_typo() {
+        use roam_runtime::config_file::parse;
+        use std::path::Path;
+
+        fn check<C: RoleConfig + serde::de::DeserializeOwned>(role: &str) {
+            let path = Path::new("role.yaml");
+            let text = "root: site\ninstance: one\nzenoh: { mode: client }\n";
+            let config: C = parse(path, text).unwrap_or_else(|e| panic!("{role}: {e}"));
+            assert_eq!(config.root(), "site", "{role}");
+            assert_eq!(config.instance(), Some("one"), "{role}");
+            assert_eq!(
+                config.zenoh(),
+                Some(&serde_json::json!({ "mode": "client" })),
+                "{role}"
+            );
+            for typo in ["rot: site", "instnce: one", "zenho: {}"] {
+                let e = parse::<C>(path, typo)
+                    .err()
+                    .unwrap_or_else(|| panic!("{role} took {typo}"));
+                let name = typo.split(':').next().unwrap_or_default();
+                assert!(
+                    e.to_string().contains(&format!("unknown field `{name}`")),
+                    "{role}: {e}"
+                );
+            }
+        }
+        check::<MapServerConfig>("map_server");
+        check::<PlannerConfig>("planner");
+        check::<SimConfig>("sim");
+        check::<LocalizationConfig>("localization");
+        check::<ControllerConfig>("controller");
+        check::<MapperConfig>("mapper");
+        check::<MissionConfig>("mission");
+        check::<Ros2Config>("ros2");
     }
 }

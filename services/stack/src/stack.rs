@@ -19,6 +19,7 @@ use roam_mapper::service::MapperConfig;
 use roam_planner::coupling::Coupling;
 use roam_planner::PlannerConfig;
 use roam_proto::keys;
+use roam_runtime::service_config::ServiceConfig;
 use roam_runtime::{wait_for_liveliness, LivelinessWait, SessionArgs};
 use roam_sim::service::SimConfig;
 use tokio::task::JoinSet;
@@ -64,7 +65,7 @@ impl StackOptions {
     /// when asked for.
     pub fn roles(&self, root: &str) -> Vec<Role> {
         let mut roles = vec![Role::from(MapServerConfig {
-            root: root.to_owned(),
+            service: ServiceConfig::at(root),
             map: self.map.clone(),
             data_dir: self.data_dir.clone(),
             load_dirs: self.load_dirs.clone(),
@@ -72,8 +73,10 @@ impl StackOptions {
         })];
         roles.extend((0..self.planners.max(1)).map(|index| {
             Role::from(PlannerConfig {
-                root: root.to_owned(),
-                instance: Some(format!("planner-{index}")),
+                service: ServiceConfig {
+                    instance: Some(format!("planner-{index}")),
+                    ..ServiceConfig::at(root)
+                },
                 change_layer: Some(
                     match self.coupling {
                         Coupling::Max => roam_proto::mapper::CHANGE_INFORMATION_LAYER,
@@ -89,33 +92,32 @@ impl StackOptions {
             })
         }));
         roles.push(Role::from(SimConfig {
-            root: root.to_owned(),
+            service: ServiceConfig::at(root),
             scenario: self.map.clone(),
             rate: Some(self.sim_rate.unwrap_or(1.0)),
             load_dirs: self.load_dirs.clone(),
             ..SimConfig::default()
         }));
         roles.push(Role::from(LocalizationConfig {
-            root: root.to_owned(),
+            service: ServiceConfig::at(root),
             scenario: self.map.clone(),
             ..LocalizationConfig::default()
         }));
         roles.push(Role::from(ControllerConfig {
-            root: root.to_owned(),
+            service: ServiceConfig::at(root),
             scenario: self.map.clone(),
             apf: self.apf.clone().unwrap_or_default(),
             ..ControllerConfig::default()
         }));
         roles.push(Role::from(MapperConfig {
-            root: root.to_owned(),
+            service: ServiceConfig::at(root),
             scenario: self.map.clone(),
             ..MapperConfig::default()
         }));
         if let Some(ros2) = &self.ros2 {
-            roles.push(Role::from(roam_ros2::node::Ros2Config {
-                root: root.to_owned(),
-                ..ros2.clone()
-            }));
+            let mut ros2 = ros2.clone();
+            ros2.service.root = root.to_owned();
+            roles.push(Role::from(ros2));
         }
         roles
     }

@@ -31,6 +31,7 @@ use roam_proto::mission::WindowReport;
 use roam_proto::sim::RobotCommand;
 use roam_proto::{decode, encode, keys, ErrorCode};
 use roam_ros2::node::Ros2Config;
+use roam_runtime::service_config::ServiceConfig;
 use roam_runtime::{ClientError, Requester};
 use roam_tests::{within, RunningService};
 
@@ -331,7 +332,7 @@ async fn every_role_does_its_job_through_the_secure_router() {
     services.push(
         harness
             .start_role(Ros2Config {
-                root: ROOT.to_owned(),
+                service: ServiceConfig::at(ROOT),
                 ..Ros2Config::default()
             })
             .await,
@@ -345,7 +346,7 @@ async fn every_role_does_its_job_through_the_secure_router() {
             .start_role_as(
                 "mission-robot",
                 MissionConfig {
-                    root: ROOT.to_owned(),
+                    service: ServiceConfig::at(ROOT),
                     ..MissionConfig::default()
                 },
             )

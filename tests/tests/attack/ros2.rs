@@ -20,6 +20,7 @@ use roam_ros2::msg::{
 };
 use roam_ros2::node::{Ros2Config, GET_PLAN_ANSWER_S, MAX_CONCURRENT_CALLS};
 use roam_ros2::{cdr, hash, names, types};
+use roam_runtime::service_config::ServiceConfig;
 use roam_runtime::Requester;
 use roam_tests::{within, Harness};
 use zenoh::query::{ConsolidationMode, QueryTarget};
@@ -117,7 +118,7 @@ pub(crate) async fn services(harness: &Harness, client: &Requester) {
     let planner = harness.start_role(harness.planner_config("p1")).await;
     let node = harness
         .start_role(Ros2Config {
-            root: harness.root.clone(),
+            service: ServiceConfig::at(harness.root.clone()),
             ..Ros2Config::default()
         })
         .await;
@@ -279,7 +280,7 @@ pub(crate) async fn map_input(harness: &Harness, client: &Requester, log: &Captu
     let map_server = harness.start_role(harness.map_server_config()).await;
     let node = harness
         .start_role(Ros2Config {
-            root: harness.root.clone(),
+            service: ServiceConfig::at(harness.root.clone()),
             map_input: Some("/map".into()),
             ..Ros2Config::default()
         })

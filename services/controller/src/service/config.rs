@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use roam_proto::keys;
+use roam_runtime::service_config::{ServiceConfig, UnknownFields};
 use roam_runtime::ServiceError;
 use serde::Deserialize;
 
@@ -21,10 +21,11 @@ use crate::params::ApfParams;
 ///   z_is: 0.8
 /// ```
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(default)]
 pub struct ControllerConfig {
-    pub root: String,
-    pub instance: Option<String>,
+    /// `root`, `instance` and `zenoh`, as every service names them.
+    #[serde(flatten)]
+    pub service: ServiceConfig,
     pub scenario: Option<PathBuf>,
     pub stale_after_s: f64,
     /// A robot whose estimates have stopped this long (wall time; at least twice
@@ -40,20 +41,21 @@ pub struct ControllerConfig {
     /// another robot when a fleet runs one controller per robot.
     pub robots: Vec<String>,
     pub apf: ApfParams,
-    pub zenoh: Option<serde_json::Value>,
+    /// Refuses a field this config does not name.
+    #[serde(flatten)]
+    pub unknown: UnknownFields,
 }
 
 impl Default for ControllerConfig {
     fn default() -> Self {
         ControllerConfig {
-            root: keys::DEFAULT_ROOT.to_owned(),
-            instance: None,
+            service: ServiceConfig::default(),
             scenario: None,
             stale_after_s: 1.0,
             release_after_s: 30.0,
             robots: Vec::new(),
             apf: ApfParams::default(),
-            zenoh: None,
+            unknown: UnknownFields,
         }
     }
 }

@@ -96,15 +96,15 @@ pub async fn run(
     let obstacles = Arc::new(ObstacleField::new(&scenario.occupancy));
     let mut service = Service::start(
         SERVICE_NAME,
-        &config.root,
-        config.instance.as_deref(),
+        &config.service.root,
+        config.service.instance.as_deref(),
         zenoh_config,
         cancel,
     )
     .await?;
     service.guard_world(roam_world::world_id::of_scenario(&scenario));
     let state = Arc::new(ControllerShared {
-        root: config.root.clone(),
+        root: config.service.root.clone(),
         session: service.session().clone(),
         params: config.apf.clone(),
         obstacles,
@@ -130,8 +130,8 @@ pub async fn run(
     });
     let (mission_keys, estimate_keys): (Vec<String>, Vec<String>) = if config.robots.is_empty() {
         (
-            vec![keys::robot_mission_any(&config.root)],
-            vec![keys::robot_estimate_any(&config.root)],
+            vec![keys::robot_mission_any(&config.service.root)],
+            vec![keys::robot_estimate_any(&config.service.root)],
         )
     } else {
         config
@@ -139,8 +139,8 @@ pub async fn run(
             .iter()
             .map(|r| {
                 (
-                    keys::robot_mission(&config.root, r),
-                    keys::robot_estimate(&config.root, r),
+                    keys::robot_mission(&config.service.root, r),
+                    keys::robot_estimate(&config.service.root, r),
                 )
             })
             .unzip()

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use roam_proto::keys;
+use roam_runtime::service_config::{ServiceConfig, UnknownFields};
 use roam_runtime::ServiceError;
 use serde::Deserialize;
 
@@ -27,10 +27,11 @@ use crate::news::NewsParams;
 ///   unseen_occupied: 0.5                    # a cell never seen where the static map has no value
 /// ```
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(default)]
 pub struct MapperConfig {
-    pub root: String,
-    pub instance: Option<String>,
+    /// `root`, `instance` and `zenoh`, as every service names them.
+    #[serde(flatten)]
+    pub service: ServiceConfig,
     pub scenario: Option<PathBuf>,
     pub explore: Vec<String>,
     pub publish_period_s: f64,
@@ -42,14 +43,15 @@ pub struct MapperConfig {
     pub news: NewsParams,
     /// The map now's prior.
     pub belief: BeliefParams,
-    pub zenoh: Option<serde_json::Value>,
+    /// Refuses a field this config does not name.
+    #[serde(flatten)]
+    pub unknown: UnknownFields,
 }
 
 impl Default for MapperConfig {
     fn default() -> Self {
         MapperConfig {
-            root: keys::DEFAULT_ROOT.to_owned(),
-            instance: None,
+            service: ServiceConfig::default(),
             scenario: None,
             explore: Vec::new(),
             publish_period_s: 1.0,
@@ -58,7 +60,7 @@ impl Default for MapperConfig {
             map: MapParams::default(),
             news: NewsParams::default(),
             belief: BeliefParams::default(),
-            zenoh: None,
+            unknown: UnknownFields,
         }
     }
 }

@@ -116,15 +116,15 @@ pub async fn run(
     let mapping = spec.build(world.clone(), scenario.occupancy.clone())?;
     let mut service = Service::start(
         SERVICE_NAME,
-        &config.root,
-        config.instance.as_deref(),
+        &config.service.root,
+        config.service.instance.as_deref(),
         zenoh_config,
         cancel,
     )
     .await?;
     service.guard_world(world);
     let state = Arc::new(MapperShared {
-        root: config.root.clone(),
+        root: config.service.root.clone(),
         session: service.session().clone(),
         mapping: Mutex::new(mapping),
         spec,
@@ -135,7 +135,7 @@ pub async fn run(
     });
     service
         .subscribe_with(
-            &keys::sim_clock(&config.root),
+            &keys::sim_clock(&config.service.root),
             MAX_CLOCK_BYTES,
             state.clone(),
             |state: &Arc<MapperShared>, _key: &str, clock: SimClock| {
@@ -145,7 +145,7 @@ pub async fn run(
         .await?;
     service
         .subscribe_with(
-            &keys::robot_observation_any(&config.root),
+            &keys::robot_observation_any(&config.service.root),
             MAX_OBSERVATION_BYTES,
             state.clone(),
             |state: &Arc<MapperShared>, key: &str, o: LocalObservation| {
@@ -155,7 +155,7 @@ pub async fn run(
         .await?;
     service
         .subscribe_with(
-            &keys::robot_mission_any(&config.root),
+            &keys::robot_mission_any(&config.service.root),
             MAX_MISSION_BYTES,
             state.clone(),
             |state: &Arc<MapperShared>, key: &str, mission: Mission| {
@@ -164,7 +164,7 @@ pub async fn run(
         )
         .await?;
     let status_queryable = service
-        .declare_queryable(&keys::mapper_status(&config.root))
+        .declare_queryable(&keys::mapper_status(&config.service.root))
         .await?;
     service.serve(status_queryable, state.clone(), |s, q| async move {
         answer_status(s, q).await

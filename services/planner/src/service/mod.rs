@@ -60,14 +60,14 @@ pub async fn run(
     check_config(&config)?;
     let mut service = Service::start(
         SERVICE_NAME,
-        &config.root,
-        config.instance.as_deref(),
+        &config.service.root,
+        config.service.instance.as_deref(),
         zenoh_config,
         cancel,
     )
     .await?;
     let state = Arc::new(PlannerInstance {
-        root: config.root.clone(),
+        root: config.service.root.clone(),
         instance: service.instance().to_owned(),
         session: service.session().clone(),
         maps: Mutex::new(
@@ -93,7 +93,7 @@ pub async fn run(
         want: tokio::sync::Notify::new(),
         delta_warnings: WarnLimiter::new(),
     });
-    let root = config.root.as_str();
+    let root = config.service.root.as_str();
 
     // Maps: follow publications, and fetch the current layers until we have them.
     let layers = state.maps().layers();

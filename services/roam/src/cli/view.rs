@@ -94,7 +94,7 @@ pub(crate) async fn view(args: ViewArgs) -> anyhow::Result<()> {
     let recorder = match &args.rosbag {
         Some(dir) => {
             let ros2 = roam_ros2::node::Ros2Config {
-                root: args.client.root.clone(),
+                service: roam_runtime::service_config::ServiceConfig::at(args.client.root.clone()),
                 offer: false,
                 rosbag: Some(dir.clone()),
                 ..roam_ros2::node::Ros2Config::default()

@@ -2,17 +2,18 @@
 
 use std::path::PathBuf;
 
+use roam_runtime::service_config::{ServiceConfig, UnknownFields};
+
 use super::compute_path;
 use super::nav2_robot::Nav2Robot;
 
 /// What `roam ros2` does (its config file, `roam ros2 --config`, as every role's).
 #[derive(Debug, Clone, serde::Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(default)]
 pub struct Ros2Config {
-    /// roam's key root.
-    pub root: String,
-    /// roam's instance name (default: the Zenoh session id).
-    pub instance: Option<String>,
+    /// `root`, `instance` and `zenoh`, as every service names them.
+    #[serde(flatten)]
+    pub service: ServiceConfig,
     /// `ROS_DOMAIN_ID`: the first segment of every ROS key.
     pub domain: u32,
     /// The node's namespace (`/` or `/site1`): relative topic names are resolved in it.
@@ -39,15 +40,15 @@ pub struct Ros2Config {
     pub max_layer_cells: u64,
     /// Record every message published to this new rosbag2 directory.
     pub rosbag: Option<PathBuf>,
-    /// A Zenoh config fragment, lowest precedence (see `roam_runtime::session`).
-    pub zenoh: Option<serde_json::Value>,
+    /// Refuses a field this config does not name.
+    #[serde(flatten)]
+    pub unknown: UnknownFields,
 }
 
 impl Default for Ros2Config {
     fn default() -> Self {
         Ros2Config {
-            root: roam_proto::keys::DEFAULT_ROOT.to_owned(),
-            instance: None,
+            service: ServiceConfig::default(),
             domain: 0,
             namespace: "/".to_owned(),
             node_name: "roam".to_owned(),
@@ -59,7 +60,7 @@ impl Default for Ros2Config {
             clock: None,
             max_layer_cells: MAX_LAYER_CELLS,
             rosbag: None,
-            zenoh: None,
+            unknown: UnknownFields,
         }
     }
 }

@@ -92,7 +92,7 @@ pub(crate) async fn declare(
     let input = MapInput {
         out,
         requester: Requester::new(session, UPDATE_TIMEOUT),
-        root: config.root.clone(),
+        root: config.service.root.clone(),
         max_cells: config.max_layer_cells,
         key: endpoint.key.clone(),
         topic: endpoint.qualified_name.clone(),

@@ -70,8 +70,8 @@ pub async fn run(
         .transpose()?;
     let mut service = Service::start(
         SERVICE_NAME,
-        &config.root,
-        config.instance.as_deref(),
+        &config.service.root,
+        config.service.instance.as_deref(),
         zenoh,
         cancel,
     )
@@ -101,15 +101,15 @@ pub async fn run(
     } else {
         None
     };
-    let subscriptions = roam_runtime::FleetStreams::declare(&session, &config.root).await?;
+    let subscriptions = roam_runtime::FleetStreams::declare(&session, &config.service.root).await?;
     let poses = Arc::new(poses::RobotPoses::default());
     if config.offer {
-        services::declare(&service, output.clone(), &config.root).await?;
+        services::declare(&service, output.clone(), &config.service.root).await?;
         if let Some(action) = &config.compute_path_action {
             compute_path::declare(
                 &service,
                 output.clone(),
-                &config.root,
+                &config.service.root,
                 action,
                 config.robot.clone(),
                 poses.clone(),
@@ -121,20 +121,26 @@ pub async fn run(
         map_input::declare(&service, output.clone(), &config, topic).await?;
     }
     let mission_clock = match &config.clock {
-        Some(topic) => sim_time::declare(&service, output.clone(), &config.root, topic).await?,
+        Some(topic) => {
+            sim_time::declare(&service, output.clone(), &config.service.root, topic).await?
+        }
         None => sim_time::MissionClock::default(),
     };
     for robot in &config.nav2_robots {
         nav2_robot::declare(
             &service,
             output.clone(),
-            &config.root,
+            &config.service.root,
             robot.clone(),
             mission_clock.clone(),
         )
         .await?;
     }
-    let (root, out, stop) = (config.root.clone(), output.clone(), service.cancel_token());
+    let (root, out, stop) = (
+        config.service.root.clone(),
+        output.clone(),
+        service.cancel_token(),
+    );
     service.spawn(follow::run(
         session.clone(),
         root,

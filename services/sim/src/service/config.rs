@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use roam_proto::keys;
+use roam_runtime::service_config::{ServiceConfig, UnknownFields};
 use roam_runtime::ServiceError;
 use roam_world::scenario::ScenarioError;
 use serde::Deserialize;
@@ -20,10 +20,11 @@ use crate::snapshot::SnapshotError;
 /// state_file: /var/lib/roam/sim.json    # snapshot here; a restart resumes from it
 /// ```
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(default)]
 pub struct SimConfig {
-    pub root: String,
-    pub instance: Option<String>,
+    /// `root`, `instance` and `zenoh`, as every service names them.
+    #[serde(flatten)]
+    pub service: ServiceConfig,
     pub scenario: Option<PathBuf>,
     pub seed: u64,
     pub rate: Option<f64>,
@@ -35,20 +36,21 @@ pub struct SimConfig {
     /// The directories a control `load` may read scenarios from (names relative to
     /// them; see `roam_world::load_dirs`). Empty: loads from the wire are off.
     pub load_dirs: Vec<PathBuf>,
-    pub zenoh: Option<serde_json::Value>,
+    /// Refuses a field this config does not name.
+    #[serde(flatten)]
+    pub unknown: UnknownFields,
 }
 
 impl Default for SimConfig {
     fn default() -> Self {
         SimConfig {
-            root: keys::DEFAULT_ROOT.to_owned(),
-            instance: None,
+            service: ServiceConfig::default(),
             scenario: None,
             seed: 0,
             rate: Some(1.0),
             state_file: None,
             load_dirs: Vec::new(),
-            zenoh: None,
+            unknown: UnknownFields,
         }
     }
 }

@@ -67,15 +67,15 @@ pub async fn run(
     }
     let mut service = Service::start(
         SERVICE_NAME,
-        &config.root,
-        config.instance.as_deref(),
+        &config.service.root,
+        config.service.instance.as_deref(),
         zenoh_config,
         cancel,
     )
     .await?;
     service.guard_world(roam_world::world_id::of_scenario(&scenario));
     let state = Arc::new(SimShared {
-        root: config.root.clone(),
+        root: config.service.root.clone(),
         session: service.session().clone(),
         control: Mutex::new(Control {
             sim,
@@ -97,7 +97,7 @@ pub async fn run(
     // Commands: a callback, so a command is pending as soon as it arrives (the status names
     // it, for a lock-step driver: a command and a step request from another session
     // arrive in no promised order).
-    let command_key = keys::robot_command_any(&config.root);
+    let command_key = keys::robot_command_any(&config.service.root);
     let commands = {
         let state = state.clone();
         service
@@ -119,7 +119,7 @@ pub async fn run(
     };
 
     let control = service
-        .declare_queryable(&keys::sim_control(&config.root))
+        .declare_queryable(&keys::sim_control(&config.service.root))
         .await?;
     service.serve(control, state.clone(), |s, q| async move {
         answer_control(s, q).await

@@ -13,6 +13,7 @@ use futures_util::{SinkExt, StreamExt};
 use roam_map_server::MapServerConfig;
 use roam_proto::keys;
 use roam_proto::map::Layer;
+use roam_runtime::service_config::ServiceConfig;
 use roam_runtime::{Requester, SessionArgs};
 use roam_sim::service::SimConfig;
 use roam_stack::{Role, Router};
@@ -110,7 +111,7 @@ impl Stack {
     pub async fn start_map_server(&mut self) {
         let root = self.root.clone();
         self.start_role(MapServerConfig {
-            root,
+            service: ServiceConfig::at(root),
             ..MapServerConfig::default()
         })
         .await;
@@ -120,7 +121,7 @@ impl Stack {
     pub async fn start_sim(&mut self, rate: f64) {
         let root = self.root.clone();
         self.start_role(SimConfig {
-            root,
+            service: ServiceConfig::at(root),
             rate: Some(rate),
             ..SimConfig::default()
         })
