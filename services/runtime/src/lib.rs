@@ -9,6 +9,8 @@
 //! - [`service_config`]: the fields every service's config file has (root, instance,
 //!   zenoh), embedded in each, and the refusal of fields a config does not name;
 //! - [`reply`] and [`client`]: the two ends of a query, with roam's codec and error reply;
+//! - [`layer_follow`]: following the map server's layers from outside it (published,
+//!   deltas applied, fetched when missed), for the live view and the ROS 2 node;
 //! - [`routing`]: the robot a message is for is the one its key names;
 //! - [`telemetry`]: tracing from `RUST_LOG`;
 //! - [`warn_limit`]: warnings about wire data, a few lines per source and a count;
@@ -23,6 +25,7 @@
 
 pub mod client;
 pub mod config_file;
+pub mod layer_follow;
 pub mod liveliness;
 pub mod publish;
 pub mod reply;

@@ -1,11 +1,11 @@
 //! roam → ROS 2: follows the map server's layers and the robots' estimates, missions and
 //! true positions on roam's keys, and publishes them as ROS topics.
 //!
-//! Layers: each publication on `<root>/map/layer/*`, each delta on `<root>/map/delta/*`
-//! (applied to the layer last published when it is the delta's base version, else the
-//! whole layer is fetched), and at start and every [`REFRESH_PERIOD`] a look at
-//! `<root>/map/layers`, fetching any layer whose version was not published yet (a node
-//! started after the map server catches up). Robots: their
+//! Layers: followed by `roam_runtime::layer_follow` (each publication on
+//! `<root>/map/layer/*`, each delta on `<root>/map/delta/*` applied to the layer last
+//! published when it is the delta's base version, else the whole layer fetched, and at
+//! start and every [`roam_runtime::layer_follow::REFRESH_PERIOD`] a look at `<root>/map/layers`), each of
+//! [`LAYER_TOPICS`] published as its grid. Robots: their
 //! estimates (`/<robot>/pose`), missions (`/<robot>/plan`) and true positions (the path
 //! driven, `/<robot>/driven`, at most every [`DRIVEN_PERIOD`]); each estimate is also
 //! the transform `map → <robot>/base_link` on `/tf`.
@@ -15,12 +15,12 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use roam_proto::controller::{Mission, MAX_MISSION_BYTES, MAX_WAYPOINTS};
-use roam_proto::layer_delta::{LayerDelta, MAX_DELTA_BYTES};
 use roam_proto::localization::PositionEstimate;
 use roam_proto::map::{Layer, LayerList};
 use roam_proto::sim::GroundTruth;
 use roam_proto::{decode, keys, Message};
-use roam_runtime::{FleetStreams, LatestSamples, Requester};
+use roam_runtime::layer_follow::{follow_layers, LayerSink};
+use roam_runtime::{ClientError, FleetStreams, LatestSamples, Requester};
 use tokio::time::MissedTickBehavior;
 use tokio_util::sync::CancellationToken;
 use zenoh::sample::Sample;
@@ -33,8 +33,6 @@ use crate::msg::Time;
 use crate::names::{self, Qos};
 use crate::{attachment, types};
 
-/// How often the layer index is looked at.
-pub const REFRESH_PERIOD: Duration = Duration::from_secs(5);
 /// How long one of its queries may take.
 const QUERY_TIMEOUT: Duration = Duration::from_secs(5);
 /// The driven paths are published at most this often.
@@ -99,12 +97,13 @@ pub(crate) async fn run(
         mission,
         truth,
     } = subscriptions;
-    let world = Layers {
+    let mut world = Layers {
         out: out.clone(),
         root: root.clone(),
         requester: Requester::new(session, QUERY_TIMEOUT),
         published: BTreeMap::new(),
     };
+    let world_root = root.clone();
     let robots = Robots {
         out,
         root,
@@ -112,7 +111,7 @@ pub(crate) async fn run(
         driven: BTreeMap::new(),
     };
     tokio::join!(
-        world.run(layers, deltas, cancel.clone()),
+        follow_layers(&mut world, &world_root, layers, deltas, cancel.clone()),
         robots.run(estimate, mission, truth, cancel)
     );
 }
@@ -125,43 +124,22 @@ struct Layers {
     published: BTreeMap<String, Layer>,
 }
 
-impl Layers {
-    async fn run(mut self, layers: Ring, deltas: Ring, cancel: CancellationToken) {
-        let mut refresh = tokio::time::interval(REFRESH_PERIOD);
-        refresh.set_missed_tick_behavior(MissedTickBehavior::Delay);
-        loop {
-            tokio::select! {
-                biased;
-                _ = cancel.cancelled() => break,
-                sample = layers.recv_async() => match sample {
-                    Ok(sample) => {
-                        let key = sample.key_expr().as_str().to_owned();
-                        if let Some(layer) = decode_sample::<Layer>(&self.out, &sample, MAX_LAYER_BYTES) {
-                            if key == keys::map_layer(&self.root, &layer.name) {
-                                self.publish(layer).await;
-                            } else {
-                                self.out.refuse(&key, "a layer named for another key");
-                            }
-                        }
-                    }
-                    Err(_) => break,
-                },
-                sample = deltas.recv_async() => match sample {
-                    Ok(sample) => self.on_delta(&sample).await,
-                    Err(_) => break,
-                },
-                _ = refresh.tick() => {
-                    tokio::select! {
-                        _ = cancel.cancelled() => break,
-                        _ = self.refresh() => {}
-                    }
-                }
-            }
-        }
+impl LayerSink for Layers {
+    type Error = ClientError;
+    const MAX_LAYER_BYTES: usize = MAX_LAYER_BYTES;
+    const MAX_LAYERS: usize = LAYER_TOPICS.len();
+
+    /// The layers with a ROS topic ([`LAYER_TOPICS`]).
+    fn follows(&self, name: &str) -> bool {
+        LAYER_TOPICS.iter().any(|(layer, ..)| *layer == name)
     }
 
-    /// Publishes a layer of [`LAYER_TOPICS`], and keeps it.
-    async fn publish(&mut self, layer: Layer) {
+    fn held(&self, name: &str) -> Option<(u64, Option<&Layer>)> {
+        self.published.get(name).map(|l| (l.version, Some(l)))
+    }
+
+    /// Publishes a layer as its topic's grid, and keeps it.
+    async fn show(&mut self, layer: Layer, _published: bool) {
         let Some((_, topic, scale)) = LAYER_TOPICS.iter().find(|(name, ..)| *name == layer.name)
         else {
             return;
@@ -180,67 +158,26 @@ impl Layers {
         }
     }
 
-    /// A delta of a layer published: applied to it when it is the delta's base version;
-    /// ignored when the node already holds the delta's version or a later one (a delta
-    /// that arrived late; a map server restarted with lower versions is caught up by
-    /// the refresh); otherwise (the node missed a delta) the whole layer is fetched.
-    async fn on_delta(&mut self, sample: &Sample) {
-        let Some(delta) = decode_sample::<LayerDelta>(&self.out, sample, MAX_DELTA_BYTES) else {
-            return;
-        };
-        let key = sample.key_expr().as_str();
-        if key != keys::map_delta(&self.root, &delta.name) {
-            return self.out.refuse(key, "a delta named for another key");
-        }
-        if !LAYER_TOPICS.iter().any(|(name, ..)| *name == delta.name) {
-            return;
-        }
-        let Some(mut layer) = self.published.remove(&delta.name) else {
-            return self.fetch(&delta.name).await;
-        };
-        if layer.version >= delta.version {
-            self.published.insert(delta.name.clone(), layer);
-            return;
-        }
-        match delta.apply(&mut layer) {
-            Ok(()) => self.publish(layer).await,
-            Err(e) => {
-                tracing::debug!(layer = %delta.name, "roam ros2: {e}");
-                self.published.insert(delta.name.clone(), layer);
-                self.fetch(&delta.name).await;
-            }
-        }
+    fn decode<T: Message>(&self, sample: &Sample, max: usize) -> Option<T> {
+        decode_sample(&self.out, sample, max)
     }
 
-    /// Fetches layer `name` whole and publishes it.
-    async fn fetch(&mut self, name: &str) {
-        let key = keys::map_layer(&self.root, name);
-        match self.requester.request::<Layer, Layer>(&key, None).await {
-            Ok(layer) if layer.name == name => self.publish(layer).await,
-            Ok(_) => self.out.refuse(&key, "a layer named for another key"),
-            Err(e) => tracing::debug!(%key, "roam ros2: layer not fetched: {e}"),
-        }
+    fn refuse(&self, key: &str, reason: &str) {
+        self.out.refuse(key, reason);
     }
 
-    async fn refresh(&mut self) {
-        let index = keys::map_index(&self.root);
-        let list = match self
-            .requester
-            .request::<LayerList, LayerList>(&index, None)
+    fn unread(&self, key: &str, error: &ClientError) {
+        tracing::debug!(%key, "roam ros2: layer not fetched: {error}");
+    }
+
+    async fn query_layer(&self, key: &str) -> Result<Layer, ClientError> {
+        self.requester.request::<Layer, Layer>(key, None).await
+    }
+
+    async fn query_index(&self, key: &str) -> Result<LayerList, ClientError> {
+        self.requester
+            .request::<LayerList, LayerList>(key, None)
             .await
-        {
-            Ok(list) => list,
-            Err(e) => return tracing::debug!("roam ros2: no layer index yet: {e}"),
-        };
-        for (name, ..) in LAYER_TOPICS {
-            let Some(info) = list.layers.iter().find(|l| l.name == name) else {
-                continue;
-            };
-            if self.published.get(name).map(|l| l.version) == Some(info.version) {
-                continue;
-            }
-            self.fetch(name).await;
-        }
     }
 }
 

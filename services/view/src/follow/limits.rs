@@ -22,6 +22,6 @@ pub const DRIVEN_STEP_M: f64 = 0.05;
 /// The driven paths are logged at most this often.
 pub const DRIVEN_PERIOD: Duration = Duration::from_millis(250);
 /// How often the world loop looks at the layer index and the sim's status.
-pub const REFRESH_PERIOD: Duration = Duration::from_secs(5);
+pub const REFRESH_PERIOD: Duration = roam_runtime::layer_follow::REFRESH_PERIOD;
 /// How long one of its queries may take.
 pub const QUERY_TIMEOUT: Duration = Duration::from_secs(2);

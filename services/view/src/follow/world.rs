@@ -1,17 +1,18 @@
-//! The world loop: the map server's layers (published, deltas, fetched), the anchors
-//! and the sim's robots.
+//! The world loop: the map server's layers (followed by `roam_runtime::layer_follow`:
+//! published, deltas, fetched), the anchors and the sim's robots.
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::future::Future;
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
 use foxglove::messages::{Grid, Timestamp};
 use roam_proto::keys;
-use roam_proto::layer_delta::{LayerDelta, MAX_DELTA_BYTES};
 use roam_proto::map::{Layer, LayerList};
 use roam_proto::sim::{GroundTruth, NamedPoint, SimControl, SimStatus};
+use roam_proto::Message;
+use roam_runtime::layer_follow::{follow_layers, LayerSink};
 use tokio::sync::watch;
-use tokio::time::MissedTickBehavior;
 use tokio_util::sync::CancellationToken;
 use zenoh::sample::Sample;
 use zenoh::Session;
@@ -19,11 +20,10 @@ use zenoh::Session;
 use crate::convert;
 use crate::output::{Outputs, Topic};
 use crate::roster::MAX_ROBOTS;
-use crate::wire::{self, clipped, shown};
+use crate::wire::{self, clipped, shown, WireError};
 
 use super::limits::{
     MAX_LAYERS, MAX_LAYER_BYTES_KEPT, MAX_LAYER_BYTES_SHOWN, MAX_LAYER_CELLS, QUERY_TIMEOUT,
-    REFRESH_PERIOD,
 };
 use super::samples::{decode_sample, Ring, SimRobots};
 
@@ -53,109 +53,8 @@ pub(super) struct World {
 
 impl World {
     pub(super) async fn run(mut self, layers: Ring, deltas: Ring, cancel: CancellationToken) {
-        let mut refresh = tokio::time::interval(REFRESH_PERIOD);
-        refresh.set_missed_tick_behavior(MissedTickBehavior::Delay);
-        loop {
-            tokio::select! {
-                biased;
-                _ = cancel.cancelled() => break,
-                sample = layers.recv_async() => match sample {
-                    Ok(sample) => self.on_layer(&sample),
-                    Err(_) => break,
-                },
-                sample = deltas.recv_async() => match sample {
-                    Ok(sample) => {
-                        tokio::select! {
-                            _ = cancel.cancelled() => break,
-                            _ = self.on_delta(&sample) => {}
-                        }
-                    }
-                    Err(_) => break,
-                },
-                _ = refresh.tick() => {
-                    tokio::select! {
-                        _ = cancel.cancelled() => break,
-                        _ = self.refresh() => {}
-                    }
-                }
-            }
-        }
-    }
-
-    fn on_layer(&mut self, sample: &Sample) {
-        let key = sample.key_expr().as_str();
-        let Some(layer) = decode_sample::<Layer>(&self.out, sample, wire::MAX_LAYER_BYTES) else {
-            return;
-        };
-        if key != keys::map_layer(&self.root, &layer.name) {
-            self.out.counters.dropped(
-                key,
-                &format!("a layer named \"{}\" on another key", shown(&layer.name)),
-            );
-            return;
-        }
-        self.show_layer(layer, true);
-    }
-
-    /// A delta of a layer shown: applied to it when it is the delta's base version;
-    /// ignored when the view already shows the delta's version or a later one (a delta
-    /// that arrived late; a map server restarted with lower versions is caught up by the
-    /// refresh); otherwise (the view missed a delta, shows nothing of the layer, or did
-    /// not keep a layer that large) the whole layer is fetched.
-    async fn on_delta(&mut self, sample: &Sample) {
-        let key = sample.key_expr().as_str();
-        let Some(delta) = decode_sample::<LayerDelta>(&self.out, sample, MAX_DELTA_BYTES) else {
-            return;
-        };
-        if key != keys::map_delta(&self.root, &delta.name) {
-            return self.out.counters.dropped(
-                key,
-                &format!("a delta of \"{}\" on another key", shown(&delta.name)),
-            );
-        }
-        let Some(held) = self.layers.get(&delta.name) else {
-            return self.fetch(&delta.name).await;
-        };
-        if held.version >= delta.version {
-            return;
-        }
-        let Some(mut layer) = held.layer.clone() else {
-            return self.fetch(&delta.name).await;
-        };
-        match delta.apply(&mut layer) {
-            Ok(()) => self.show_layer(layer, true),
-            Err(e) => {
-                tracing::debug!(layer = %delta.name, "roam view: {e}");
-                self.fetch(&delta.name).await;
-            }
-        }
-    }
-
-    /// Fetches layer `name` whole and shows it when its version is not the one shown.
-    async fn fetch(&mut self, name: &str) {
-        // A name that is not a key segment would make a key of its own (a wildcard, say).
-        let index = keys::map_index(&self.root);
-        if keys::check_name("layer", name).is_err() {
-            let reason = format!("a layer named \"{}\"", shown(name));
-            return self.out.counters.dropped(&index, &reason);
-        }
-        let key = keys::map_layer(&self.root, name);
-        let fetched = wire::query::<Layer, Layer>(
-            &self.session,
-            &key,
-            None,
-            wire::MAX_LAYER_BYTES,
-            QUERY_TIMEOUT,
-        )
-        .await;
-        match fetched {
-            Ok(layer) if layer.name == name => self.show_layer(layer, false),
-            Ok(layer) => self
-                .out
-                .counters
-                .dropped(&key, &format!("a layer named \"{}\"", shown(&layer.name))),
-            Err(e) => self.out.counters.unread(&key, &e),
-        }
+        let root = self.root.clone();
+        follow_layers(&mut self, &root, layers, deltas, cancel).await;
     }
 
     /// Shows a layer unless this version is already shown. A published layer is always
@@ -218,36 +117,8 @@ impl World {
         self.layer_bytes = others + bytes;
     }
 
-    /// Fetches every layer not shown at its current version, and the sim's status.
-    async fn refresh(&mut self) {
-        let index = keys::map_index(&self.root);
-        match wire::query::<Layer, LayerList>(
-            &self.session,
-            &index,
-            None,
-            wire::MAX_LAYER_LIST_BYTES,
-            QUERY_TIMEOUT,
-        )
-        .await
-        {
-            Ok(list) => {
-                for info in list.layers.iter().take(MAX_LAYERS) {
-                    // A name that is not a key segment would make a key of its own
-                    // (a wildcard, say) for the query below.
-                    if keys::check_name("layer", &info.name).is_err() {
-                        let reason = format!("a layer named \"{}\"", shown(&info.name));
-                        self.out.counters.dropped(&index, &reason);
-                        continue;
-                    }
-                    let version = self.layers.get(&info.name).map(|s| s.version);
-                    if version == Some(info.version) {
-                        continue;
-                    }
-                    self.fetch(&info.name).await;
-                }
-            }
-            Err(e) => tracing::debug!("roam view: no layer index yet: {}", clipped(&e.to_string())),
-        }
+    /// Asks the sim for its anchors and robots (each refresh, after the layers).
+    async fn refresh_sim(&mut self) {
         match wire::query::<SimControl, SimStatus>(
             &self.session,
             &keys::sim_control(&self.root),
@@ -299,5 +170,62 @@ impl World {
                 .log(&self.anchors_topic, &convert::anchors(&status.anchors, now));
             self.anchors = Some(status.anchors);
         }
+    }
+}
+
+impl LayerSink for World {
+    type Error = WireError;
+    const MAX_LAYER_BYTES: usize = wire::MAX_LAYER_BYTES;
+    const MAX_LAYERS: usize = MAX_LAYERS;
+
+    fn follows(&self, _name: &str) -> bool {
+        true
+    }
+
+    fn held(&self, name: &str) -> Option<(u64, Option<&Layer>)> {
+        self.layers.get(name).map(|s| (s.version, s.layer.as_ref()))
+    }
+
+    fn show(&mut self, layer: Layer, published: bool) -> impl Future<Output = ()> + Send {
+        self.show_layer(layer, published);
+        std::future::ready(())
+    }
+
+    fn decode<T: Message>(&self, sample: &Sample, max: usize) -> Option<T> {
+        decode_sample(&self.out, sample, max)
+    }
+
+    fn refuse(&self, key: &str, reason: &str) {
+        self.out.counters.dropped(key, &reason);
+    }
+
+    fn unread(&self, key: &str, error: &WireError) {
+        self.out.counters.unread(key, error);
+    }
+
+    fn query_layer(&self, key: &str) -> impl Future<Output = Result<Layer, WireError>> + Send {
+        let (session, key) = (self.session.clone(), key.to_owned());
+        async move {
+            wire::query::<Layer, Layer>(&session, &key, None, wire::MAX_LAYER_BYTES, QUERY_TIMEOUT)
+                .await
+        }
+    }
+
+    fn query_index(&self, key: &str) -> impl Future<Output = Result<LayerList, WireError>> + Send {
+        let (session, key) = (self.session.clone(), key.to_owned());
+        async move {
+            wire::query::<Layer, LayerList>(
+                &session,
+                &key,
+                None,
+                wire::MAX_LAYER_LIST_BYTES,
+                QUERY_TIMEOUT,
+            )
+            .await
+        }
+    }
+
+    fn refreshed(&mut self) -> impl Future<Output = ()> + Send {
+        self.refresh_sim()
     }
 }
