@@ -12,9 +12,11 @@
 //! - [`mapper`]: change-map observation updates per second;
 //! - [`scaling`]: the planner's cost as the map gets finer, and its memory;
 //! - [`peer`]: the greedy planner against Model I at equal wall time;
+//! - [`anytime`]: the anytime planner's plan at each deadline against the best known;
 //! - [`optimality`]: the planners' plans against the exact optimum on small instances;
 //! - [`fleet`]: robots in closed loop through Zenoh.
 
+pub mod anytime;
 pub mod fleet;
 pub mod load;
 pub mod localization;

@@ -100,7 +100,7 @@ fn trip(
     goal: [f64; 2],
     runs: usize,
 ) -> Result<PeerTrip, BenchError> {
-    let floor = once_outcome_eta(world, start, goal)?;
+    let floor = fastest_eta(world, start, goal)?;
     let budget_s = if start == goal { 60.0 } else { 2.0 * floor };
     let model1 = median_run(
         (0..runs as u64)
@@ -145,7 +145,11 @@ fn trip(
     })
 }
 
-fn once_outcome_eta(world: &World, start: [f64; 2], goal: [f64; 2]) -> Result<f64, BenchError> {
+pub(crate) fn fastest_eta(
+    world: &World,
+    start: [f64; 2],
+    goal: [f64; 2],
+) -> Result<f64, BenchError> {
     let spec = PlanSpec::batch(start, goal, 86_400.0, PlannerModel::Shortest, 1, 0);
     Ok(plan(world, &spec, &AtomicBool::new(false), |_, _| {})
         .map_err(setup)?
@@ -154,7 +158,7 @@ fn once_outcome_eta(world: &World, start: [f64; 2], goal: [f64; 2]) -> Result<f6
 
 /// The depot scenario (Nav2's depot map at 5 cm with zones of interest), planned at
 /// 0.2 m.
-fn depot() -> Result<World, BenchError> {
+pub(crate) fn depot() -> Result<World, BenchError> {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/scenarios/depot.yaml");
     let scenario =

@@ -163,14 +163,7 @@ pub async fn run(
         .collect();
     // Refuse a sensing model that cannot work before going live.
     model_of(&anchors.iter().map(|a| a.at).collect::<Vec<_>>(), &sensing)?;
-    let mut service = Service::start(
-        SERVICE_NAME,
-        &config.service.root,
-        config.service.instance.as_deref(),
-        zenoh_config,
-        cancel,
-    )
-    .await?;
+    let mut service = Service::start(SERVICE_NAME, &config.service, zenoh_config, cancel).await?;
     let world = roam_world::world_id::of_scenario(&scenario);
     service.guard_world(world.clone());
     let fim = FimOptions {

@@ -223,14 +223,7 @@ pub async fn run(
     let store = open_store(&config)?;
     let load_dirs =
         LoadDirs::new(&config.load_dirs).map_err(|e| MapServerError::Config(e.to_string()))?;
-    let mut service = Service::start(
-        SERVICE_NAME,
-        &config.service.root,
-        config.service.instance.as_deref(),
-        zenoh_config,
-        cancel,
-    )
-    .await?;
+    let mut service = Service::start(SERVICE_NAME, &config.service, zenoh_config, cancel).await?;
     let state = Arc::new(MapServerShared {
         root: config.service.root.clone(),
         store: Mutex::new(store),

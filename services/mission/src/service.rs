@@ -110,14 +110,8 @@ pub async fn run(
     cancel: CancellationToken,
 ) -> Result<(), MissionServiceError> {
     crate::tasks::check(&config.executive.tasks).map_err(ExecutiveError::from)?;
-    let mut service = Service::start(
-        SERVICE_NAME,
-        &config.service.root,
-        config.service.instance.as_deref(),
-        zenoh_config,
-        cancel.clone(),
-    )
-    .await?;
+    let mut service =
+        Service::start(SERVICE_NAME, &config.service, zenoh_config, cancel.clone()).await?;
     service.announce().await?;
     let session = service.session().clone();
     let key = keys::robot_mission_report(&config.service.root, &config.executive.robot);

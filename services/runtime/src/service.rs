@@ -27,6 +27,7 @@ use zenoh::Session;
 
 use crate::client::Requester;
 use crate::reply;
+use crate::service_config::ServiceConfig;
 use crate::session::{self, SessionError};
 use crate::warn_limit::WarnLimiter;
 use crate::world_check::{self, WorldMismatch};
@@ -118,21 +119,23 @@ pub struct Service {
 }
 
 impl Service {
-    /// Opens the session. `instance` defaults to the session's Zenoh id, which is
+    /// Opens the session under the root and instance of the service's config
+    /// (`common`); `zenoh` is the session's config as layered from it
+    /// ([`crate::session`]). The instance defaults to the session's Zenoh id, which is
     /// unique. The service stops when `cancel` is cancelled.
     pub async fn start(
         name: &'static str,
-        root: &str,
-        instance: Option<&str>,
-        config: zenoh::Config,
+        common: &ServiceConfig,
+        zenoh: zenoh::Config,
         cancel: CancellationToken,
     ) -> Result<Self, ServiceError> {
+        let (root, instance) = (common.root.as_str(), common.instance.as_deref());
         keys::check_root(root)?;
         keys::check_name("service name", name)?;
         if let Some(instance) = instance {
             keys::check_name("instance name", instance)?;
         }
-        let session = session::open(config).await?;
+        let session = session::open(zenoh).await?;
         let instance = instance
             .map(str::to_owned)
             .unwrap_or_else(|| session.zid().to_string());

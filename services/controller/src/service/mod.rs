@@ -94,14 +94,7 @@ pub async fn run(
         .map_err(|e| ControllerServiceError::Config(format!("the scenario's sensing: {e}")))?;
     let information = Arc::new(InformationField::new(model, FimOptions::default()));
     let obstacles = Arc::new(ObstacleField::new(&scenario.occupancy));
-    let mut service = Service::start(
-        SERVICE_NAME,
-        &config.service.root,
-        config.service.instance.as_deref(),
-        zenoh_config,
-        cancel,
-    )
-    .await?;
+    let mut service = Service::start(SERVICE_NAME, &config.service, zenoh_config, cancel).await?;
     service.guard_world(roam_world::world_id::of_scenario(&scenario));
     let state = Arc::new(ControllerShared {
         root: config.service.root.clone(),

@@ -114,14 +114,7 @@ pub async fn run(
     };
     let world = roam_world::world_id::of_scenario(&scenario);
     let mapping = spec.build(world.clone(), scenario.occupancy.clone())?;
-    let mut service = Service::start(
-        SERVICE_NAME,
-        &config.service.root,
-        config.service.instance.as_deref(),
-        zenoh_config,
-        cancel,
-    )
-    .await?;
+    let mut service = Service::start(SERVICE_NAME, &config.service, zenoh_config, cancel).await?;
     service.guard_world(world);
     let state = Arc::new(MapperShared {
         root: config.service.root.clone(),

@@ -58,14 +58,7 @@ pub async fn run(
     cancel: CancellationToken,
 ) -> Result<(), PlannerError> {
     check_config(&config)?;
-    let mut service = Service::start(
-        SERVICE_NAME,
-        &config.service.root,
-        config.service.instance.as_deref(),
-        zenoh_config,
-        cancel,
-    )
-    .await?;
+    let mut service = Service::start(SERVICE_NAME, &config.service, zenoh_config, cancel).await?;
     let state = Arc::new(PlannerInstance {
         root: config.service.root.clone(),
         instance: service.instance().to_owned(),

@@ -113,6 +113,15 @@ pub(crate) enum BenchCommand {
         /// Seeded instances for --optimality (each at three budgets).
         #[arg(long, default_value_t = 10)]
         instances: u64,
+        /// Instead: the anytime planner's plan with each checkpoint as its deadline, on
+        /// four trips, against the best any planner finds in 10x the last checkpoint
+        /// (--runs seeds each).
+        #[arg(long, conflicts_with_all = ["scaling", "peer", "optimality"])]
+        anytime: bool,
+        /// The deadlines for --anytime, milliseconds, increasing (at most 16, each at
+        /// most 60000).
+        #[arg(long, value_delimiter = ',', default_values_t = roam_bench::anytime::DEFAULT_CHECKPOINTS_MS)]
+        checkpoints: Vec<f64>,
     },
 }
 
@@ -207,9 +216,23 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
             peer,
             optimality,
             instances,
+            anytime,
+            checkpoints,
         } => {
             if runs == 0 {
                 bail!("--runs must be at least 1");
+            }
+            if anytime {
+                if let Err(e) = roam_bench::anytime::check_checkpoints(&checkpoints) {
+                    bail!("--checkpoints: {e}");
+                }
+                let result = tokio::task::spawn_blocking(move || {
+                    let progress = Progress::new("bench planner --anytime", quiet);
+                    let shown = progress.callback();
+                    roam_bench::anytime::anytime(&checkpoints, runs, &shown)
+                })
+                .await??;
+                return print_json(&result, json);
             }
             if optimality {
                 if instances == 0 {

@@ -349,6 +349,34 @@ fn bench_mapper_prints_updates_per_second() {
     assert!(value["updates_with_features_per_s"].as_f64().expect("rate") > 0.0);
 }
 
+#[test]
+fn bench_arguments_out_of_their_limits_are_refused_naming_the_limit() {
+    let cases: [(&[&str], &str); 4] = [
+        (
+            &["bench", "planner", "--anytime", "--checkpoints", "30,10"],
+            "checkpoints must increase: 30 ms then 10 ms",
+        ),
+        (
+            &["bench", "planner", "--anytime", "--checkpoints", "0"],
+            "checkpoint 0 ms is not in (0, 60000] ms",
+        ),
+        (
+            &["bench", "fleet", "--robots", "0"],
+            "--robots must be 1..=1000",
+        ),
+        (
+            &["bench", "fleet", "--robots", "1001"],
+            "--robots must be 1..=1000",
+        ),
+    ];
+    for (args, expected) in cases {
+        let output = Command::new(ROAM).args(args).output().expect("run");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success(), "{args:?} ran");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+    }
+}
+
 /// Every legend swatch of `frame` has its colour where `layout` puts it, and every
 /// ink pixel of the title's letters is ink in `picture`.
 fn legend_and_title_are_drawn(

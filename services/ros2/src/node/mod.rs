@@ -68,14 +68,7 @@ pub async fn run(
         .as_deref()
         .map(crate::bag::Bag::create)
         .transpose()?;
-    let mut service = Service::start(
-        SERVICE_NAME,
-        &config.service.root,
-        config.service.instance.as_deref(),
-        zenoh,
-        cancel,
-    )
-    .await?;
+    let mut service = Service::start(SERVICE_NAME, &config.service, zenoh, cancel).await?;
     let session = service.session().clone();
     let node = NodeInfo {
         domain: config.domain,

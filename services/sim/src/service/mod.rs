@@ -65,14 +65,7 @@ pub async fn run(
     if let Some(path) = &config.state_file {
         resume_from(&mut sim, &name, config.seed, path)?;
     }
-    let mut service = Service::start(
-        SERVICE_NAME,
-        &config.service.root,
-        config.service.instance.as_deref(),
-        zenoh_config,
-        cancel,
-    )
-    .await?;
+    let mut service = Service::start(SERVICE_NAME, &config.service, zenoh_config, cancel).await?;
     service.guard_world(roam_world::world_id::of_scenario(&scenario));
     let state = Arc::new(SimShared {
         root: config.service.root.clone(),
