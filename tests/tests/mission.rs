@@ -1,7 +1,8 @@
 //! The downtime mission through Zenoh: the map server, the planner, the sim (faster than
 //! real time), localization, the controller and the mission executive as separate
 //! services on loopback; the executive's window reports say the robot was on time at
-//! both tasks and gathered more information than the shortest paths would have.
+//! both tasks and gathered more information than the shortest paths would have, and,
+//! with no planner on the bus, that it drove its own fastest paths on time.
 
 use std::time::Duration;
 
@@ -90,4 +91,62 @@ async fn the_demo_mission_is_on_time_and_more_curious_than_the_shortest_path() {
         driven > shortest,
         "driven {driven} against the shortest paths' {shortest}"
     );
+}
+
+/// Degrade, don't stop: with no planner on the bus, the executive drives the fastest
+/// path it computes itself (on the map it fetched), says so in its reports, and is on
+/// time at both tasks.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn without_a_planner_the_executive_drives_its_own_fastest_path_on_time() {
+    let harness = Harness::start().await;
+    let _map_server = harness.start_role(harness.map_server_config()).await;
+    let mut sim_config = harness.sim_config(None);
+    sim_config.rate = Some(10.0);
+    let _sim = harness.start_role(sim_config).await;
+    let _localization = harness.start_role(harness.localization_config(None)).await;
+    let _controller = harness
+        .start_role(ControllerConfig {
+            apf: roam::demo::indoor_apf(),
+            ..harness.controller_config()
+        })
+        .await;
+    let client = harness.client().await;
+    let reports = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::robot_mission_report(&harness.root, "robot")),
+    )
+    .await
+    .expect("subscriber");
+    let _mission = harness
+        .start_role(MissionConfig {
+            service: ServiceConfig::at(harness.root.clone()),
+            ..MissionConfig::default()
+        })
+        .await;
+    let mut windows = Vec::new();
+    for _ in 0..2 {
+        let sample = tokio::time::timeout(Duration::from_secs(90), reports.recv_async())
+            .await
+            .expect("a window report within 90 s")
+            .expect("sample");
+        let report: WindowReport = decode(&sample.payload().to_bytes()).expect("report");
+        windows.push(report);
+    }
+    assert_eq!(
+        windows.iter().map(|w| w.task.as_str()).collect::<Vec<_>>(),
+        ["goal1", "goal2"]
+    );
+    for w in &windows {
+        assert!(
+            w.on_time && w.arrival_s.is_some(),
+            "late at {}: {w:?}",
+            w.task
+        );
+        // It says why it drove what it drove: no planner answered.
+        assert!(w.replan_reasons.iter().any(|r| r == "no_planner"), "{w:?}");
+        // What it planned is the fastest path's information: no curious plan came.
+        assert_eq!(w.planned_information, w.shortest_information, "{w:?}");
+    }
 }
