@@ -150,3 +150,86 @@ async fn without_a_planner_the_executive_drives_its_own_fastest_path_on_time() {
         assert_eq!(w.planned_information, w.shortest_information, "{w:?}");
     }
 }
+
+/// A restarted executive picks up its robot's time calibration: the first executive
+/// saves its fit after its first arrival and is stopped; its successor, started with the
+/// same `calibration_file`, plans the next window with that fit, not with the prior.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_restarted_executive_plans_with_the_fit_its_predecessor_saved() {
+    let harness = Harness::start().await;
+    let _map_server = harness.start_role(harness.map_server_config()).await;
+    let _planner = harness
+        .start_role(harness.planner_config("planner-0"))
+        .await;
+    let mut sim_config = harness.sim_config(None);
+    sim_config.rate = Some(10.0);
+    let _sim = harness.start_role(sim_config).await;
+    let _localization = harness.start_role(harness.localization_config(None)).await;
+    let _controller = harness
+        .start_role(ControllerConfig {
+            apf: roam::demo::indoor_apf(),
+            ..harness.controller_config()
+        })
+        .await;
+    let client = harness.client().await;
+    let reports = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::robot_mission_report(&harness.root, "robot")),
+    )
+    .await
+    .expect("subscriber");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = dir.path().join("robot.calibration.json");
+    let config = MissionConfig {
+        service: ServiceConfig::at(harness.root.clone()),
+        executive: ExecutiveConfig {
+            calibration_file: Some(file.clone()),
+            ..ExecutiveConfig::default()
+        },
+        ..MissionConfig::default()
+    };
+    let next_report = || async {
+        let sample = tokio::time::timeout(Duration::from_secs(90), reports.recv_async())
+            .await
+            .expect("a window report within 90 s")
+            .expect("sample");
+        decode::<WindowReport>(&sample.payload().to_bytes()).expect("report")
+    };
+    let first = harness.start_role(config.clone()).await;
+    let goal1 = next_report().await;
+    assert_eq!(goal1.task, "goal1");
+    let (_, stopped) = first.stop().await;
+    stopped.expect("the first executive stops cleanly");
+
+    let prior = ExecutiveConfig::default().time_model_prior;
+    let (saved, _) = roam_mission::calibration::store::load(
+        &file,
+        "robot",
+        prior,
+        roam_mission::calibration::CalibrationConfig::default(),
+    )
+    .expect("the first executive saved its fit");
+    let saved = saved.model();
+    assert_ne!(
+        saved, prior,
+        "the fit learned nothing from the first window"
+    );
+
+    let _second = harness.start_role(config).await;
+    // The successor may report the task it was restarted in first (late: its arrival is
+    // the restart's time); the window after it is planned with the restored fit.
+    let goal2 = loop {
+        let report = next_report().await;
+        if report.task == "goal2" {
+            break report;
+        }
+    };
+    let planned_with = goal2.time_model.as_ref().expect("a time model");
+    assert_eq!(
+        (planned_with.v_lin, planned_with.v_ang),
+        (saved.v_lin, saved.v_ang),
+        "goal2 planned with {planned_with:?}, the saved fit is {saved:?}"
+    );
+}
