@@ -13,34 +13,59 @@ use roam_mission::service::MissionConfig;
 use roam_proto::mission::WindowReport;
 use roam_proto::{decode, keys};
 use roam_runtime::service_config::ServiceConfig;
-use roam_tests::{within, Harness};
+use roam_runtime::Requester;
+use roam_tests::{within, Harness, RunningService};
+use zenoh::handlers::FifoChannelHandler;
+use zenoh::pubsub::Subscriber;
+use zenoh::sample::Sample;
+
+type Reports = Subscriber<FifoChannelHandler<Sample>>;
+
+/// The roles a test started, kept running while it holds them, and the client session
+/// its subscriber lives on.
+type Running = (Vec<RunningService>, Requester);
+
+/// Every role of the built-in day but the executive (the planner only if `planner`),
+/// the sim at 10x, and a subscriber to the robot's window reports.
+async fn roles_of_the_day(harness: &Harness, planner: bool) -> (Running, Reports) {
+    let mut roles = vec![harness.start_role(harness.map_server_config()).await];
+    if planner {
+        roles.push(
+            harness
+                .start_role(harness.planner_config("planner-0"))
+                .await,
+        );
+    }
+    let mut sim_config = harness.sim_config(None);
+    sim_config.rate = Some(10.0);
+    roles.push(harness.start_role(sim_config).await);
+    roles.push(harness.start_role(harness.localization_config(None)).await);
+    let controller = ControllerConfig {
+        apf: roam::demo::indoor_apf(),
+        ..harness.controller_config()
+    };
+    roles.push(harness.start_role(controller).await);
+    let client = harness.client().await;
+    let key = keys::robot_mission_report(&harness.root, "robot");
+    let reports = within("subscribe", client.session().declare_subscriber(key))
+        .await
+        .expect("subscriber");
+    ((roles, client), reports)
+}
+
+/// The next window report, within `seconds`.
+async fn next_report(reports: &Reports, seconds: u64) -> WindowReport {
+    let sample = tokio::time::timeout(Duration::from_secs(seconds), reports.recv_async())
+        .await
+        .expect("a window report in time")
+        .expect("sample");
+    decode(&sample.payload().to_bytes()).expect("report")
+}
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn the_demo_mission_is_on_time_and_more_curious_than_the_shortest_path() {
     let harness = Harness::start().await;
-    let _map_server = harness.start_role(harness.map_server_config()).await;
-    let _planner = harness
-        .start_role(harness.planner_config("planner-0"))
-        .await;
-    let mut sim_config = harness.sim_config(None);
-    sim_config.rate = Some(10.0);
-    let _sim = harness.start_role(sim_config).await;
-    let _localization = harness.start_role(harness.localization_config(None)).await;
-    let _controller = harness
-        .start_role(ControllerConfig {
-            apf: roam::demo::indoor_apf(),
-            ..harness.controller_config()
-        })
-        .await;
-    let client = harness.client().await;
-    let reports = within(
-        "subscribe",
-        client
-            .session()
-            .declare_subscriber(keys::robot_mission_report(&harness.root, "robot")),
-    )
-    .await
-    .expect("subscriber");
+    let (_roles, reports) = roles_of_the_day(&harness, true).await;
     let _mission = harness
         .start_role(MissionConfig {
             service: ServiceConfig::at(harness.root.clone()),
@@ -61,12 +86,7 @@ async fn the_demo_mission_is_on_time_and_more_curious_than_the_shortest_path() {
     // Two windows of 75 s and 90 s of sim time at 10x: about 17 s.
     let mut windows = Vec::new();
     for _ in 0..2 {
-        let sample = tokio::time::timeout(Duration::from_secs(60), reports.recv_async())
-            .await
-            .expect("a window report within 60 s")
-            .expect("sample");
-        let report: WindowReport = decode(&sample.payload().to_bytes()).expect("report");
-        windows.push(report);
+        windows.push(next_report(&reports, 60).await);
     }
     assert_eq!(
         windows.iter().map(|w| w.task.as_str()).collect::<Vec<_>>(),
@@ -99,26 +119,7 @@ async fn the_demo_mission_is_on_time_and_more_curious_than_the_shortest_path() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn without_a_planner_the_executive_drives_its_own_fastest_path_on_time() {
     let harness = Harness::start().await;
-    let _map_server = harness.start_role(harness.map_server_config()).await;
-    let mut sim_config = harness.sim_config(None);
-    sim_config.rate = Some(10.0);
-    let _sim = harness.start_role(sim_config).await;
-    let _localization = harness.start_role(harness.localization_config(None)).await;
-    let _controller = harness
-        .start_role(ControllerConfig {
-            apf: roam::demo::indoor_apf(),
-            ..harness.controller_config()
-        })
-        .await;
-    let client = harness.client().await;
-    let reports = within(
-        "subscribe",
-        client
-            .session()
-            .declare_subscriber(keys::robot_mission_report(&harness.root, "robot")),
-    )
-    .await
-    .expect("subscriber");
+    let (_roles, reports) = roles_of_the_day(&harness, false).await;
     let _mission = harness
         .start_role(MissionConfig {
             service: ServiceConfig::at(harness.root.clone()),
@@ -127,12 +128,7 @@ async fn without_a_planner_the_executive_drives_its_own_fastest_path_on_time() {
         .await;
     let mut windows = Vec::new();
     for _ in 0..2 {
-        let sample = tokio::time::timeout(Duration::from_secs(90), reports.recv_async())
-            .await
-            .expect("a window report within 90 s")
-            .expect("sample");
-        let report: WindowReport = decode(&sample.payload().to_bytes()).expect("report");
-        windows.push(report);
+        windows.push(next_report(&reports, 90).await);
     }
     assert_eq!(
         windows.iter().map(|w| w.task.as_str()).collect::<Vec<_>>(),
@@ -157,29 +153,7 @@ async fn without_a_planner_the_executive_drives_its_own_fastest_path_on_time() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn a_restarted_executive_plans_with_the_fit_its_predecessor_saved() {
     let harness = Harness::start().await;
-    let _map_server = harness.start_role(harness.map_server_config()).await;
-    let _planner = harness
-        .start_role(harness.planner_config("planner-0"))
-        .await;
-    let mut sim_config = harness.sim_config(None);
-    sim_config.rate = Some(10.0);
-    let _sim = harness.start_role(sim_config).await;
-    let _localization = harness.start_role(harness.localization_config(None)).await;
-    let _controller = harness
-        .start_role(ControllerConfig {
-            apf: roam::demo::indoor_apf(),
-            ..harness.controller_config()
-        })
-        .await;
-    let client = harness.client().await;
-    let reports = within(
-        "subscribe",
-        client
-            .session()
-            .declare_subscriber(keys::robot_mission_report(&harness.root, "robot")),
-    )
-    .await
-    .expect("subscriber");
+    let (_roles, reports) = roles_of_the_day(&harness, true).await;
     let dir = tempfile::tempdir().expect("temp dir");
     let file = dir.path().join("robot.calibration.json");
     let config = MissionConfig {
@@ -190,15 +164,8 @@ async fn a_restarted_executive_plans_with_the_fit_its_predecessor_saved() {
         },
         ..MissionConfig::default()
     };
-    let next_report = || async {
-        let sample = tokio::time::timeout(Duration::from_secs(90), reports.recv_async())
-            .await
-            .expect("a window report within 90 s")
-            .expect("sample");
-        decode::<WindowReport>(&sample.payload().to_bytes()).expect("report")
-    };
     let first = harness.start_role(config.clone()).await;
-    let goal1 = next_report().await;
+    let goal1 = next_report(&reports, 90).await;
     assert_eq!(goal1.task, "goal1");
     let (_, stopped) = first.stop().await;
     stopped.expect("the first executive stops cleanly");
@@ -221,7 +188,7 @@ async fn a_restarted_executive_plans_with_the_fit_its_predecessor_saved() {
     // The successor may report the task it was restarted in first (late: its arrival is
     // the restart's time); the window after it is planned with the restored fit.
     let goal2 = loop {
-        let report = next_report().await;
+        let report = next_report(&reports, 90).await;
         if report.task == "goal2" {
             break report;
         }

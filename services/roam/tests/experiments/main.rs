@@ -351,7 +351,11 @@ fn bench_mapper_prints_updates_per_second() {
 
 #[test]
 fn bench_arguments_out_of_their_limits_are_refused_naming_the_limit() {
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["bench", "planner", "--anytime", "--checkpoints", ""],
+            "invalid value '' for '--checkpoints",
+        ),
         (
             &["bench", "planner", "--anytime", "--checkpoints", "30,10"],
             "checkpoints must increase: 30 ms then 10 ms",
