@@ -148,7 +148,6 @@ pub fn anytime(
     runs: usize,
     progress: Progress<'_>,
 ) -> Result<AnytimeBench, BenchError> {
-    check_checkpoints(checkpoints_ms).map_err(setup)?;
     let builtin = builtin_world()?;
     let depot = depot()?;
     let (inflated, information) = warehouse();
@@ -182,7 +181,8 @@ pub fn anytime(
     anytime_on(&trips, checkpoints_ms, runs, progress)
 }
 
-/// The benchmark on `trips`.
+/// The benchmark on `trips`; the checkpoints and runs are checked here, before the
+/// first plan.
 pub fn anytime_on(
     trips: &[Trip<'_>],
     checkpoints_ms: &[f64],

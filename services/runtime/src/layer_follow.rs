@@ -39,8 +39,12 @@ pub trait LayerSink: Send {
     /// Whether layer `name` is followed at all (the ROS node: the layers it has a
     /// topic for).
     fn follows(&self, name: &str) -> bool;
-    /// The version held of layer `name`, and the layer when it is kept for deltas.
-    fn held(&self, name: &str) -> Option<(u64, Option<&Layer>)>;
+    /// The version held of layer `name`.
+    fn held(&self, name: &str) -> Option<u64>;
+    /// Takes the layer `name` kept for deltas out of the sink (`None` when none is kept):
+    /// a delta is applied to it in place and the result shown, so a layer of tens of
+    /// megabytes is not copied for every delta.
+    fn take_kept(&mut self, name: &str) -> Option<Layer>;
     /// A layer to show: published (always news) or fetched (`published` false).
     fn show(&mut self, layer: Layer, published: bool) -> impl Future<Output = ()> + Send;
     /// Decodes a sample of at most `max` bytes, or counts and reports it.
@@ -74,15 +78,20 @@ pub enum DeltaStep {
     Fetch,
 }
 
-/// What `delta` does to a layer held at `held` (its version and the layer if kept).
-pub fn delta_step(held: Option<(u64, Option<&Layer>)>, delta: &LayerDelta) -> DeltaStep {
-    let Some((version, layer)) = held else {
+/// What `delta` does to a layer held at version `held`: `take_kept` hands over the layer
+/// kept for deltas, and is called only when the delta is newer than what is held.
+pub fn delta_step(
+    held: Option<u64>,
+    take_kept: impl FnOnce() -> Option<Layer>,
+    delta: &LayerDelta,
+) -> DeltaStep {
+    let Some(version) = held else {
         return DeltaStep::Fetch;
     };
     if version >= delta.version {
         return DeltaStep::Stale;
     }
-    let Some(mut layer) = layer.cloned() else {
+    let Some(mut layer) = take_kept() else {
         return DeltaStep::Fetch;
     };
     match delta.apply(&mut layer) {
@@ -163,7 +172,8 @@ async fn on_delta<S: LayerSink>(sink: &mut S, root: &str, sample: &Sample) {
     if !sink.follows(&delta.name) {
         return;
     }
-    match delta_step(sink.held(&delta.name), &delta) {
+    let held = sink.held(&delta.name);
+    match delta_step(held, || sink.take_kept(&delta.name), &delta) {
         DeltaStep::Stale => {}
         DeltaStep::Applied(layer) => sink.show(layer, true).await,
         DeltaStep::Fetch => fetch(sink, root, &delta.name).await,
@@ -199,7 +209,7 @@ async fn refresh_layers<S: LayerSink>(sink: &mut S, root: &str) {
                 .iter()
                 .filter(|info| sink.follows(&info.name))
                 .take(S::MAX_LAYERS)
-                .filter(|info| sink.held(&info.name).map(|(v, _)| v) != Some(info.version))
+                .filter(|info| sink.held(&info.name) != Some(info.version))
                 .map(|info| info.name.clone())
                 .collect();
             for name in stale {
@@ -245,8 +255,7 @@ mod tests {
 
     #[test]
     fn a_delta_at_the_version_held_applies() {
-        let held = layer(4);
-        let DeltaStep::Applied(after) = delta_step(Some((4, Some(&held))), &delta(4)) else {
+        let DeltaStep::Applied(after) = delta_step(Some(4), || Some(layer(4)), &delta(4)) else {
             panic!("a delta at its base applies");
         };
         assert_eq!(
@@ -257,25 +266,18 @@ mod tests {
 
     #[test]
     fn a_late_delta_is_ignored_and_a_missed_one_fetches() {
-        let held = layer(6);
+        let untouched = || -> Option<Layer> { panic!("a stale delta takes nothing") };
+        assert_eq!(delta_step(Some(6), untouched, &delta(4)), DeltaStep::Stale);
+        assert_eq!(delta_step(Some(5), untouched, &delta(4)), DeltaStep::Stale);
         assert_eq!(
-            delta_step(Some((6, Some(&held))), &delta(4)),
-            DeltaStep::Stale
-        );
-        assert_eq!(
-            delta_step(Some((5, Some(&held))), &delta(4)),
-            DeltaStep::Stale
-        );
-        let behind = layer(3);
-        assert_eq!(
-            delta_step(Some((3, Some(&behind))), &delta(4)),
+            delta_step(Some(3), || Some(layer(3)), &delta(4)),
             DeltaStep::Fetch
         );
     }
 
     #[test]
     fn a_layer_not_held_or_not_kept_is_fetched() {
-        assert_eq!(delta_step(None, &delta(4)), DeltaStep::Fetch);
-        assert_eq!(delta_step(Some((4, None)), &delta(4)), DeltaStep::Fetch);
+        assert_eq!(delta_step(None, || None, &delta(4)), DeltaStep::Fetch);
+        assert_eq!(delta_step(Some(4), || None, &delta(4)), DeltaStep::Fetch);
     }
 }

@@ -134,8 +134,12 @@ impl LayerSink for Layers {
         LAYER_TOPICS.iter().any(|(layer, ..)| *layer == name)
     }
 
-    fn held(&self, name: &str) -> Option<(u64, Option<&Layer>)> {
-        self.published.get(name).map(|l| (l.version, Some(l)))
+    fn held(&self, name: &str) -> Option<u64> {
+        self.published.get(name).map(|l| l.version)
+    }
+
+    fn take_kept(&mut self, name: &str) -> Option<Layer> {
+        self.published.remove(name)
     }
 
     /// Publishes a layer as its topic's grid, and keeps it.

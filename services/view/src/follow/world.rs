@@ -2,7 +2,6 @@
 //! published, deltas, fetched), the anchors and the sim's robots.
 
 use std::collections::{BTreeMap, BTreeSet};
-use std::future::Future;
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
@@ -182,13 +181,16 @@ impl LayerSink for World {
         true
     }
 
-    fn held(&self, name: &str) -> Option<(u64, Option<&Layer>)> {
-        self.layers.get(name).map(|s| (s.version, s.layer.as_ref()))
+    fn held(&self, name: &str) -> Option<u64> {
+        self.layers.get(name).map(|s| s.version)
     }
 
-    fn show(&mut self, layer: Layer, published: bool) -> impl Future<Output = ()> + Send {
+    fn take_kept(&mut self, name: &str) -> Option<Layer> {
+        self.layers.get_mut(name)?.layer.take()
+    }
+
+    async fn show(&mut self, layer: Layer, published: bool) {
         self.show_layer(layer, published);
-        std::future::ready(())
     }
 
     fn decode<T: Message>(&self, sample: &Sample, max: usize) -> Option<T> {
@@ -203,29 +205,17 @@ impl LayerSink for World {
         self.out.counters.unread(key, error);
     }
 
-    fn query_layer(&self, key: &str) -> impl Future<Output = Result<Layer, WireError>> + Send {
-        let (session, key) = (self.session.clone(), key.to_owned());
-        async move {
-            wire::query::<Layer, Layer>(&session, &key, None, wire::MAX_LAYER_BYTES, QUERY_TIMEOUT)
-                .await
-        }
+    async fn query_layer(&self, key: &str) -> Result<Layer, WireError> {
+        let max = wire::MAX_LAYER_BYTES;
+        wire::query::<Layer, Layer>(&self.session, key, None, max, QUERY_TIMEOUT).await
     }
 
-    fn query_index(&self, key: &str) -> impl Future<Output = Result<LayerList, WireError>> + Send {
-        let (session, key) = (self.session.clone(), key.to_owned());
-        async move {
-            wire::query::<Layer, LayerList>(
-                &session,
-                &key,
-                None,
-                wire::MAX_LAYER_LIST_BYTES,
-                QUERY_TIMEOUT,
-            )
-            .await
-        }
+    async fn query_index(&self, key: &str) -> Result<LayerList, WireError> {
+        let max = wire::MAX_LAYER_LIST_BYTES;
+        wire::query::<Layer, LayerList>(&self.session, key, None, max, QUERY_TIMEOUT).await
     }
 
-    fn refreshed(&mut self) -> impl Future<Output = ()> + Send {
-        self.refresh_sim()
+    async fn refreshed(&mut self) {
+        self.refresh_sim().await;
     }
 }
