@@ -136,7 +136,21 @@ pub struct PlanRequest {
     /// got.
     #[serde(default, skip_serializing_if = "ShortestPathUse::is_omit")]
     pub shortest: ShortestPathUse,
+    /// A replan's warm start (roam, not paper 000): the route the robot is driving now,
+    /// world metres from about `start` to about `goal`, at most
+    /// [`MAX_SEED_ROUTE_POINTS`] points (more is refused, naming the limit). The planner
+    /// puts it, on its planning cells, in the GA's first population (Models I and II,
+    /// anytime) and ranks it with the plans it found, so the answer is never less fit
+    /// than driving on. A route it cannot join to the planning grid (off the map,
+    /// blocked, gaps) is not used and the reply's `seed_route_used` says so; the request
+    /// is answered either way. Absent or empty: planned from scratch.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub seed_route: Vec<[f64; 2]>,
 }
+
+/// The most points [`PlanRequest::seed_route`] may have: 65,536 (1 MiB of JSON at most;
+/// a 3 km route at 5 cm).
+pub const MAX_SEED_ROUTE_POINTS: usize = 65_536;
 
 /// What a plan request wants of the shortest path (roam, not paper 000). The planner
 /// finds it before any curious planning (to refuse a budget it does not fit, and to
@@ -251,10 +265,15 @@ pub struct Plan {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shortest: Option<ShortestPath>,
     /// What produced the returned path, of what the planner tried: `ga`, `greedy`,
-    /// `shortest` (the fastest path, unchanged) or `via_seed` (a via-point seed,
-    /// unchanged). Absent from planners before the field.
+    /// `shortest` (the fastest path, unchanged), `via_seed` (a via-point seed,
+    /// unchanged) or `remainder` (the request's `seed_route`, unchanged). Absent from planners before the field.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub found_by: Option<String>,
+    /// With a request's `seed_route`: whether it was in the first population (`false`:
+    /// it could not be joined to the planning grid, or the model has no population).
+    /// `found_by: remainder` says it was also the fittest. Absent without a seed route.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed_route_used: Option<bool>,
 }
 
 /// The shortest path a plan reply carries ([`Plan::shortest`]): what `model: shortest`

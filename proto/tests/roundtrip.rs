@@ -328,6 +328,7 @@ mod planner_messages {
             any::<u64>(),
             prop::option::of(version()),
             shortest_use(),
+            prop::collection::vec([finite(), finite()], 0..4),
         )
             .prop_map(
                 |(
@@ -340,6 +341,7 @@ mod planner_messages {
                     seed,
                     map_version,
                     shortest,
+                    seed_route,
                 )| PlanRequest {
                     request_id,
                     cancel_token,
@@ -352,6 +354,7 @@ mod planner_messages {
                     seed,
                     map_version,
                     shortest,
+                    seed_route,
                 },
             )
     }
@@ -418,6 +421,8 @@ mod planner_messages {
                         seed,
                         map_version,
                         found_by: instance.is_empty().then(|| "greedy".to_owned()),
+                        seed_route_used: (instance.len() % 3 != 0)
+                            .then_some(instance.len() % 3 == 1),
                         instance,
                         shortest,
                     }

@@ -191,6 +191,7 @@ async fn sim_to_mapper_to_map_server_shows_where_the_blocks_move() {
         seed: 1,
         map_version: None,
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     };
     let request = |instance: &'static str| {
         let (client, key, body) = (
@@ -523,6 +524,7 @@ async fn the_news_and_the_map_now_reach_the_map_server() {
         seed: 1,
         map_version: None,
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     };
     let until = Instant::now() + Duration::from_secs(10);
     let plan = loop {

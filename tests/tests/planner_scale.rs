@@ -78,6 +78,7 @@ async fn a_coarse_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         threads: roam_planner::ga::default_threads(),
         limits: roam_planner::limits::PlanLimits::default(),
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     };
     let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local");
     assert_eq!(remote.cells, local.cells);

@@ -71,6 +71,7 @@ async fn scores_above_100_plan_as_if_clamped_to_100() {
         seed: 5,
         map_version: None,
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     };
     let mut plans = Vec::new();
     for name in ["bright", "bright_clamped"] {

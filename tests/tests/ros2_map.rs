@@ -284,6 +284,7 @@ async fn a_ros2_map_of_another_size_reaches_every_service() {
         seed: 0,
         map_version: None,
         shortest: roam_proto::planner::ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     };
     let plan = within("a plan on the new map", async {
         loop {

@@ -26,6 +26,7 @@ pub mod optimality;
 pub mod peer;
 pub mod planner;
 pub mod process;
+pub mod replans;
 pub mod scaling;
 pub mod sim;
 

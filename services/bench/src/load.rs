@@ -60,7 +60,8 @@ enum Outcome {
     Hung,
 }
 
-fn percentile(samples: &mut [f64], q: f64) -> f64 {
+/// The `q` quantile (nearest rank) of `samples`, which it sorts; 0 when empty.
+pub(crate) fn percentile(samples: &mut [f64], q: f64) -> f64 {
     if samples.is_empty() {
         return 0.0;
     }
@@ -117,6 +118,7 @@ pub async fn load(requests: usize, deadline_s: f64) -> Result<LoadBench, BenchEr
                 seed: i as u64,
                 map_version: None,
                 shortest: ShortestPathUse::Omit,
+                seed_route: Vec::new(),
             };
             let asked = Instant::now();
             match tokio::time::timeout(patience, client.plan(&request)).await {

@@ -174,6 +174,7 @@ async fn zenoh_overhead(
             seed: 5,
             map_version: None,
             shortest: ShortestPathUse::Omit,
+            seed_route: Vec::new(),
         };
         let never = AtomicBool::new(false);
         let (mut local, mut remote) = (Vec::new(), Vec::new());

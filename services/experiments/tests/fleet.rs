@@ -133,6 +133,7 @@ fn plan_on_news(world: &FleetWorld, mapper: &FleetMapper, robot: usize, name: &s
         seed: 7,
         map_version: None,
         shortest: Default::default(),
+        seed_route: Vec::new(),
     };
     roam_planner::answer::answer(&coupled, &request, 1).expect("a plan")
 }

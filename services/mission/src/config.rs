@@ -15,6 +15,10 @@ use crate::margin::ArrivalMargin;
 use crate::tasks::{self, Task, TaskError};
 use crate::watch::WatchParams;
 
+/// [`ExecutiveConfig::replan_generations`] by default: at population 200 on the day
+/// world a replan then takes tens of milliseconds (services/mission/README.md, "Replans").
+pub const DEFAULT_REPLAN_GENERATIONS: u32 = 60;
+
 /// How the executive plans and watches.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -30,6 +34,12 @@ pub struct ExecutiveConfig {
     pub plan_deadline_s: f64,
     /// Generations the GA may run at most (it stops at the deadline anyway).
     pub max_generations: Option<u32>,
+    /// Generations of a replan made while the robot drives (slack, behind, pushed off
+    /// its path, stuck): it is seeded with the route the robot drives
+    /// ([`roam_proto::planner::PlanRequest::seed_route`]), so it starts from a good
+    /// path and needs fewer; at most `max_generations`, `None`: `max_generations`. What a replan costs at the
+    /// default is measured by `roam bench planner --replans`.
+    pub replan_generations: Option<u32>,
     /// The planner's localizability cost W_loc (paper 002's PEB in paper 000's fitness;
     /// see the planner's `w_loc`). `None`: the planner's default, off.
     pub w_loc: Option<f64>,
@@ -166,6 +176,15 @@ impl ExecutiveConfig {
         }
     }
 
+    /// The generations of a replan seeded with the route the robot drives: the fewer of
+    /// `replan_generations` and `max_generations` (`None` when neither is set).
+    pub fn replan_generations(&self) -> Option<u32> {
+        match (self.replan_generations, self.max_generations) {
+            (Some(replan), Some(most)) => Some(replan.min(most)),
+            (replan, most) => replan.or(most),
+        }
+    }
+
     /// Checks every field, naming the first that is out of range.
     pub fn check(&self) -> Result<(), ConfigError> {
         tasks::check(&self.tasks)?;
@@ -215,6 +234,12 @@ impl ExecutiveConfig {
                 self.replan_time_share
             )));
         }
+        if self.replan_generations == Some(0) {
+            return Err(ConfigError::Field(
+                "replan_generations is 0; give at least 1 (or leave it out: max_generations)"
+                    .into(),
+            ));
+        }
         if let Some(cost) = self.planning_cost_s {
             if !(cost.is_finite() && cost >= 0.0) {
                 return Err(ConfigError::Field(format!(
@@ -240,6 +265,7 @@ impl Default for ExecutiveConfig {
             model: PlannerModel::Model1,
             plan_deadline_s: 1.0,
             max_generations: Some(1000),
+            replan_generations: Some(DEFAULT_REPLAN_GENERATIONS),
             w_loc: None,
             peb_free_m: None,
             seed: 0,

@@ -158,6 +158,7 @@ fn fastest_s(
         threads: 1,
         limits: Default::default(),
         shortest: ShortestPathUse::Fallback,
+        seed_route: Vec::new(),
     };
     let outcome =
         plan::plan(world, &spec, &AtomicBool::new(false), |_, _| {}).map_err(|e| match e {

@@ -10,7 +10,7 @@ use crate::window::PlanAsk;
 
 /// The request for `ask` under `config`, planned with `time_model` (paper 000 Eq. 2's
 /// v_lin and v_ang), the shortest path attached as the fallback ([`crate::window`]'s
-/// one-request rule).
+/// one-request rule). A replan (an ask with a seed route) runs `replan_generations`.
 pub fn plan_request(config: &ExecutiveConfig, ask: &PlanAsk, time_model: TimeModel) -> PlanRequest {
     PlanRequest {
         request_id: None,
@@ -25,7 +25,11 @@ pub fn plan_request(config: &ExecutiveConfig, ask: &PlanAsk, time_model: TimeMod
             PlannerModel::Shortest
         },
         params: GaOverrides {
-            max_generations: config.max_generations,
+            max_generations: if ask.seed_route.is_empty() {
+                config.max_generations
+            } else {
+                config.replan_generations()
+            },
             w_loc: config.w_loc,
             peb_free_m: config.peb_free_m,
             ..time_model.overrides()
@@ -33,5 +37,6 @@ pub fn plan_request(config: &ExecutiveConfig, ask: &PlanAsk, time_model: TimeMod
         seed: config.seed,
         map_version: None,
         shortest: ShortestPathUse::Fallback,
+        seed_route: ask.seed_route.clone(),
     }
 }

@@ -99,7 +99,14 @@ fn log(p: Progress) {
             window,
             model,
             took_s,
-        } => tracing::debug!(window, model = model.as_str(), took_s, "plan answered"),
+            replan,
+        } => tracing::debug!(
+            window,
+            model = model.as_str(),
+            took_s,
+            replan,
+            "plan answered"
+        ),
     }
 }
 

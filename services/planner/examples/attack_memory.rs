@@ -68,6 +68,7 @@ fn main() {
         threads: roam_planner::ga::default_threads(),
         limits: roam_planner::limits::PlanLimits::default(),
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     };
     let done = Arc::new(AtomicBool::new(false));
     let sampler = {

@@ -31,6 +31,7 @@ pub fn answer(world: &World, request: &PlanRequest, threads: usize) -> Result<Pl
         threads,
         limits: PlanLimits::default(),
         shortest: request.shortest,
+        seed_route: request.seed_route.clone(),
     };
     check_spec(&spec)?;
     let outcome = plan(world, &spec, &AtomicBool::new(false), |_, _| {})?;
@@ -90,5 +91,6 @@ pub fn to_message(
         instance: instance.to_owned(),
         shortest,
         found_by: Some(outcome.source.as_str().to_owned()),
+        seed_route_used: outcome.seed_route_used,
     }
 }

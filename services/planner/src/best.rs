@@ -23,6 +23,9 @@ pub enum PlanSource {
     ViaSeed(usize),
     /// The greedy planner's route ([`crate::greedy`]).
     Greedy,
+    /// The request's seed route, the remainder of the route the robot drives
+    /// ([`crate::remainder`]), unchanged.
+    Remainder,
 }
 
 impl PlanSource {
@@ -33,6 +36,7 @@ impl PlanSource {
             PlanSource::Shortest => "shortest",
             PlanSource::ViaSeed(_) => "via_seed",
             PlanSource::Greedy => "greedy",
+            PlanSource::Remainder => "remainder",
         }
     }
 }
@@ -45,23 +49,27 @@ pub struct Scored {
     pub source: PlanSource,
 }
 
-/// The GA's result, the shortest path and the seeds, fittest first; the earlier on a
-/// tie (the GA's first), so the first is [`best_of`]'s. A plan at a coarser planning
+/// The GA's result, the shortest path, the remainder of the robot's route (a replan's
+/// seed route, when there is one) and the seeds, fittest first; the earlier on a tie
+/// (the GA's first), so the first is [`best_of`]'s. A plan at a coarser planning
 /// resolution drives them in this order until one fits (`crate::plan`).
 pub fn ranked(
     evaluator: &mut Evaluator<'_>,
     ga: Scored,
     shortest: &[Cell],
+    remainder: Option<&[Cell]>,
     seeds: &[Vec<Cell>],
 ) -> Vec<Scored> {
-    let mut all = Vec::with_capacity(2 + seeds.len());
+    let mut all = Vec::with_capacity(3 + seeds.len());
     all.push(ga);
-    let others = std::iter::once((PlanSource::Shortest, shortest)).chain(
-        seeds
-            .iter()
-            .enumerate()
-            .map(|(n, path)| (PlanSource::ViaSeed(n), path.as_slice())),
-    );
+    let others = std::iter::once((PlanSource::Shortest, shortest))
+        .chain(remainder.map(|path| (PlanSource::Remainder, path)))
+        .chain(
+            seeds
+                .iter()
+                .enumerate()
+                .map(|(n, path)| (PlanSource::ViaSeed(n), path.as_slice())),
+        );
     for (source, path) in others {
         all.push(Scored {
             evaluation: evaluator.evaluate(path),

@@ -279,6 +279,7 @@ mod tests {
             seed: 0,
             map_version: None,
             shortest: ShortestPathUse::Omit,
+            seed_route: Vec::new(),
         }
     }
 

@@ -57,6 +57,7 @@ pub mod params;
 pub mod plan;
 #[cfg(feature = "zenoh")]
 pub mod queue;
+pub mod remainder;
 pub mod resolution;
 #[cfg(feature = "zenoh")]
 pub mod scope;

@@ -97,6 +97,8 @@ pub enum LimitError {
         actual: u64,
         max: u64,
     },
+    #[error("the seed_route has {actual} points, over the limit of {max} (MAX_SEED_ROUTE_POINTS): send the route left from the start, thinned")]
+    SeedRoute { actual: u64, max: u64 },
 }
 
 impl LimitError {
@@ -105,6 +107,7 @@ impl LimitError {
         match self {
             LimitError::PopulationCells { .. } => "max_population_cells",
             LimitError::Cost { .. } => "max_plan_cost",
+            LimitError::SeedRoute { .. } => "max_seed_route_points",
         }
     }
 
@@ -112,7 +115,8 @@ impl LimitError {
     pub fn max_actual(&self) -> (u64, u64) {
         match *self {
             LimitError::PopulationCells { max, actual, .. }
-            | LimitError::Cost { max, actual, .. } => (max, actual),
+            | LimitError::Cost { max, actual, .. }
+            | LimitError::SeedRoute { max, actual } => (max, actual),
         }
     }
 }

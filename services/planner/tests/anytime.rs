@@ -89,6 +89,7 @@ fn the_reply_names_the_planner_that_found_the_path() {
             seed: 1,
             map_version: None,
             shortest: ShortestPathUse::Omit,
+            seed_route: Vec::new(),
         };
         let reply = roam_planner::answer::answer(&world, &request, 1).expect("a plan");
         let said = reply.found_by.expect("found_by");

@@ -211,6 +211,7 @@ async fn plan_mission(
         seed: REPORT_SEED,
         map_version: None,
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     };
     let shortest = planner.plan(&request).await?;
     request.t_exec_s = 2.0 * shortest.t_eta_s;

@@ -427,6 +427,7 @@ pub fn plan_downtime_request(request: &PlanDowntimeRequest) -> Result<PlanReques
         seed: request.seed,
         map_version: None,
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     })
 }
 

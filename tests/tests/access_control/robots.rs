@@ -138,6 +138,7 @@ fn endless(id: &str, token: &str) -> PlanRequest {
         seed: 11,
         map_version: None,
         shortest: Default::default(),
+        seed_route: Vec::new(),
     }
 }
 

@@ -106,6 +106,7 @@ async fn the_ros2_credentials_reach_only_what_the_node_uses() {
         seed: 0,
         map_version: None,
         shortest: Default::default(),
+        seed_route: Vec::new(),
     };
     let planned = within(
         "a shared plan",

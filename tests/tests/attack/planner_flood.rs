@@ -34,6 +34,7 @@ fn request(generations: u32, deadline_s: f64, seed: u64) -> PlanRequest {
         seed,
         map_version: None,
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     }
 }
 

@@ -33,6 +33,7 @@ pub(crate) fn plan_request(start: [f64; 2], goal: [f64; 2]) -> PlanRequest {
         seed: 1,
         map_version: None,
         shortest: roam_proto::planner::ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     }
 }
 

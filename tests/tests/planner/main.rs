@@ -80,6 +80,7 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         threads: roam_planner::ga::default_threads(),
         limits: roam_planner::limits::PlanLimits::default(),
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     };
     let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local plan");
     let local_cells = world.grid_cells(&local.path);
@@ -95,6 +96,29 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         .await
         .expect("plan");
     assert_eq!(again.cells, remote.cells);
+
+    // A replan a third of the way along, seeded with the route left (issue 30): the
+    // planner plans from it, and answers as in process, bit for bit.
+    let from = remote.points.len() / 3;
+    let replan = PlanRequest {
+        start: remote.points[from],
+        t_exec_s: 0.8 * req.t_exec_s,
+        seed_route: remote.points[from..].to_vec(),
+        ..req.clone()
+    };
+    let seeded = ask(&client, &running.harness.root, &replan)
+        .await
+        .expect("replan");
+    assert_eq!(seeded.seed_route_used, Some(true));
+    let local_spec = PlanSpec {
+        start: replan.start,
+        t_exec_s: replan.t_exec_s,
+        seed_route: replan.seed_route.clone(),
+        ..spec
+    };
+    let local = plan(&world, &local_spec, &AtomicBool::new(false), |_, _| {}).expect("replan");
+    assert_eq!(seeded.cells, world.grid_cells(&local.path));
+    assert_eq!(local.seed_route_used, Some(true));
     running.stop().await;
 }
 
@@ -211,6 +235,7 @@ async fn a_round_trip_through_zenoh_uses_the_budget() {
             threads: roam_planner::ga::default_threads(),
             limits: roam_planner::limits::PlanLimits::default(),
             shortest: ShortestPathUse::Omit,
+            seed_route: Vec::new(),
         };
         let local = plan(&world, &spec, &AtomicBool::new(false), |_, _| {}).expect("local");
         assert_eq!(remote.cells, world.grid_cells(&local.path));

@@ -31,6 +31,7 @@ pub fn request(start: [f64; 2], goal: [f64; 2], t_exec_s: f64, generations: u32)
         seed: 11,
         map_version: None,
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     }
 }
 

@@ -40,10 +40,13 @@ pub enum Progress {
         task: String,
     },
     /// A plan came back: the model that made it and the wall seconds from the request
-    /// to the answer (what a fleet's plan latency is measured by).
+    /// to the answer (what a fleet's plan latency is measured by); `replan` when it
+    /// was a replan seeded with the route the robot drives (what `roam bench planner
+    /// --replans` measures in batch).
     Answered {
         window: usize,
         model: PlannerModel,
         took_s: f64,
+        replan: bool,
     },
 }

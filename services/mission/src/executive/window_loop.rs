@@ -133,7 +133,8 @@ impl Executive<'_> {
                         match reply {
                             Ok(plan) => {
                                 self.took(&plan, took_s);
-                                progress(Progress::Answered { window, model: plan.model, took_s });
+                                let replan = plan.seed_route_used.is_some();
+                                progress(Progress::Answered { window, model: plan.model, took_s, replan });
                                 WindowEvent::PlanReply { id, plan: Box::new(plan) }
                             }
                             Err(e) => {

@@ -43,6 +43,7 @@ impl DowntimeWindow<'_> {
             t_exec_s: budget_s.clamp(LEAST_T_EXEC_S, MAX_T_EXEC_S),
             deadline_s,
             curious: curious && budget_s > 0.0,
+            seed_route: Vec::new(),
         };
         self.record(&ask, leave_at_s.is_some(), now);
         (ask, budget_s, time_left)
@@ -131,6 +132,7 @@ impl DowntimeWindow<'_> {
         resend: bool,
         ask: PlanAsk,
     ) -> Vec<WindowAction> {
+        let request = WindowAction::RequestPlan(ask.clone());
         self.drive_ask = Some((
             ask.id,
             DriveAsk::Replan {
@@ -139,6 +141,6 @@ impl DowntimeWindow<'_> {
                 ask,
             },
         ));
-        vec![WindowAction::RequestPlan(ask)]
+        vec![request]
     }
 }

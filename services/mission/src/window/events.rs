@@ -41,7 +41,7 @@ pub enum WindowEvent {
 }
 
 /// A plan to ask the planner for.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PlanAsk {
     /// Names the request's reply ([`WindowEvent::PlanReply`]); unique over the day.
     pub id: u64,
@@ -54,6 +54,9 @@ pub struct PlanAsk {
     pub deadline_s: f64,
     /// A curious path (the executive's model); `false`: the shortest path.
     pub curious: bool,
+    /// A replan's warm start: the route the robot drives, from `from` on (empty for a
+    /// window's first plan); the request's `seed_route`.
+    pub seed_route: Vec<[f64; 2]>,
 }
 
 /// What the executive does, in order.

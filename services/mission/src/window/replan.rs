@@ -5,7 +5,7 @@ use crate::calibration::path_measure;
 use crate::path::mission_waypoints;
 use crate::watch::{Decision, Reason};
 
-use super::events::{Now, WindowAction};
+use super::events::{Now, PlanAsk, WindowAction};
 use super::routes::Route;
 use super::setup::SAFE_CHECK_S;
 use super::state::{DowntimeWindow, Follows, Phase};
@@ -148,8 +148,16 @@ impl DowntimeWindow<'_> {
             }
             _ => self.here,
         };
+        // Seeded with what is left of the route from there (a curious one: the fastest
+        // path has nothing to start from).
+        let seed_route = if curious {
+            straight::route_left(&drive.path, from)
+        } else {
+            Vec::new()
+        };
         let (to, start) = (self.setup.task.at, self.setup.task.start_s);
         let (ask, _, _) = self.ask(from, to, start, None, curious, now);
+        let ask = PlanAsk { seed_route, ..ask };
         self.ask_replan(reason, resend, ask)
     }
 }

@@ -12,7 +12,11 @@ use crate::watch::{Reason, Replanned};
 
 impl DowntimeWindow<'_> {
     pub(super) fn on_reply(&mut self, id: u64, plan: Option<Plan>, now: Now) -> Vec<WindowAction> {
-        if self.drive_ask.is_some_and(|(asked, _)| asked == id) {
+        if self
+            .drive_ask
+            .as_ref()
+            .is_some_and(|(asked, _)| *asked == id)
+        {
             let Some((_, asked)) = self.drive_ask.take() else {
                 return Vec::new();
             };

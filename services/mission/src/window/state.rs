@@ -38,7 +38,7 @@ impl MissionIds {
 }
 
 /// The drive's request in flight and what its reply is for.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(super) enum DriveAsk {
     FirstPlan {
         budget_s: f64,

@@ -10,6 +10,7 @@ use crate::eta::path_eta;
 use crate::greedy;
 use crate::limits::{self, LimitError, PlanSize};
 use crate::params::GaParams;
+use crate::remainder::{self, RemainderError};
 use crate::resolution::{self, Anchor, FineCell};
 use crate::search::{distance_field, fastest_path, shortest_path};
 use crate::seeds::{self, SeedProblem, ViaSeeds};
@@ -182,6 +183,10 @@ pub(super) struct Checked {
     /// the start's and goal's map cells), so that plans fit when driven. t_exec itself
     /// at the map's resolution.
     pub(super) planning_budget_s: f64,
+    /// A replan's seed route on the planning grid ([`crate::remainder`]): `None`
+    /// without one, `Some(Err(_))` when it could not be joined or the model plans no
+    /// population (the baseline, a budget only the fastest path fits).
+    pub(super) seed_route: Option<Result<Vec<Cell>, RemainderError>>,
 }
 
 impl Checked {
@@ -191,6 +196,14 @@ impl Checked {
         self.size
             .map_or(world.cell_count(), |s| s.path_cells)
             .max(self.shortest.len())
+    }
+
+    /// The seed route's path when it is planned from.
+    pub(super) fn remainder(&self) -> Option<&[Cell]> {
+        match &self.seed_route {
+            Some(Ok(path)) => Some(path),
+            _ => None,
+        }
     }
 }
 
@@ -239,6 +252,13 @@ pub(super) fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError
         },
         None => fastest.clone(),
     };
+    let seed_route = (!spec.seed_route.is_empty()).then(|| match size {
+        Some(size) if budget_fits => {
+            let max_cells = size.path_cells.max(shortest.len());
+            remainder::route_cells(world, &spec.seed_route, start, goal, max_cells)
+        }
+        _ => Err(RemainderError::NoPopulation),
+    });
     Ok(Checked {
         start,
         goal,
@@ -250,6 +270,7 @@ pub(super) fn check(world: &World, spec: &PlanSpec) -> Result<Checked, PlanError
         anchors,
         fastest_driven,
         planning_budget_s,
+        seed_route,
     })
 }
 

@@ -99,6 +99,7 @@ pub fn plan(
         stop_reason: found.stop_reason,
         source: driven.chosen.source,
         via_seeds: found.via_seeds,
+        seed_route_used: checked.seed_route.as_ref().map(Result::is_ok),
         shortest,
     })
 }

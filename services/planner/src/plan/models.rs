@@ -14,7 +14,7 @@ use crate::ga::{self, GaOptions, Problem};
 use crate::greedy::{self, GreedyProblem};
 use crate::params::GaParams;
 use crate::search::distance_field;
-use crate::world::World;
+use crate::world::{Cell, World};
 
 use super::check::{seeds_for, Checked};
 use super::spec::PlanSpec;
@@ -90,7 +90,13 @@ pub(super) fn greedy(
     };
     let mut evaluator = Evaluator::new(world, params, Model::Novelty, goal, budget);
     Found {
-        ranked: ranked(&mut evaluator, found, &checked.shortest, &[]),
+        ranked: ranked(
+            &mut evaluator,
+            found,
+            &checked.shortest,
+            checked.remainder(),
+            &[],
+        ),
         scoring: Model::Novelty,
         generations: result.rounds,
         evaluations: result.evaluations,
@@ -171,7 +177,7 @@ fn ga_from(
     spec: &PlanSpec,
     checked: &Checked,
     model: Model,
-    extra_seed: Option<Vec<crate::world::Cell>>,
+    extra_seed: Option<Vec<Cell>>,
     deadline: Instant,
     cancel: &AtomicBool,
     progress: impl FnMut(u32, f64),
@@ -189,12 +195,15 @@ fn ga_from(
         seeds_for(world, spec, checked, &field, &stop).paths
     };
     let via_seeds = seeds.len();
-    // The shortest path first, then the via-point seeds (see crate::ga).
-    let mut seed_paths = Vec::with_capacity(1 + via_seeds);
+    // The shortest path first, then the remainder of the robot's route (a replan's warm
+    // start, crate::remainder), the extra route, the via-point seeds (see crate::ga).
+    let mut seed_paths = Vec::with_capacity(3 + via_seeds);
     if !strict {
         seed_paths.push(checked.shortest.clone());
     }
-    let extra = usize::from(extra_seed.is_some());
+    let remainder = checked.remainder().filter(|_| !strict);
+    seed_paths.extend(remainder.map(<[Cell]>::to_vec));
+    let extra = usize::from(remainder.is_some()) + usize::from(extra_seed.is_some());
     seed_paths.extend(extra_seed);
     seed_paths.extend(seeds);
     let problem = Problem {
@@ -232,12 +241,13 @@ fn ga_from(
         vec![found]
     } else {
         let mut evaluator = Evaluator::new(world, params, model, goal, budget);
-        // The via-point seeds after the shortest path and the extra route (which its
-        // planner ranks itself).
+        // The via-point seeds after the shortest path, the remainder and the extra
+        // route (which its planner ranks itself).
         ranked(
             &mut evaluator,
             found,
             &checked.shortest,
+            remainder,
             &seed_paths[1 + extra..],
         )
     };

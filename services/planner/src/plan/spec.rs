@@ -37,6 +37,9 @@ pub struct PlanSpec {
     /// shortest path ([`ShortestPathUse::Fallback`]); the outcome carries the shortest
     /// path either way, and the service attaches it to the reply unless `Omit`.
     pub shortest: ShortestPathUse,
+    /// A replan's warm start: the route the robot drives now, world metres
+    /// ([`roam_proto::planner::PlanRequest::seed_route`], [`crate::remainder`]).
+    pub seed_route: Vec<[f64; 2]>,
 }
 
 impl PlanSpec {
@@ -65,6 +68,7 @@ impl PlanSpec {
             threads: crate::ga::default_threads(),
             limits: PlanLimits::default(),
             shortest: ShortestPathUse::Omit,
+            seed_route: Vec::new(),
         }
     }
 }
@@ -101,6 +105,9 @@ pub struct PlanOutcome {
     pub source: PlanSource,
     /// The via-point seeds the first population held ([`crate::seeds`]).
     pub via_seeds: usize,
+    /// With a seed route: whether it was joined to the planning grid and planned from
+    /// ([`crate::remainder`]); `None` without one.
+    pub seed_route_used: Option<bool>,
     /// The fastest path (the floor the budget was checked against, what `model:
     /// shortest` answers; found for every plan, [`check`]) as the robot would drive it,
     /// when the spec asked for it (its `shortest` is not [`ShortestPathUse::Omit`]).
@@ -230,6 +237,16 @@ pub fn check_spec(spec: &PlanSpec) -> Result<(), PlanError> {
     )?;
     for v in spec.start.iter().chain(&spec.goal) {
         check_param("start/goal", *v, true, "finite world coordinates in metres")?;
+    }
+    let max = crate::remainder::MAX_SEED_ROUTE_POINTS;
+    if spec.seed_route.len() > max {
+        return Err(PlanError::Limit(LimitError::SeedRoute {
+            actual: spec.seed_route.len() as u64,
+            max: max as u64,
+        }));
+    }
+    for v in spec.seed_route.iter().flatten() {
+        check_param("seed_route", *v, true, "finite world coordinates in metres")?;
     }
     spec.params.validate()?;
     Ok(())

@@ -294,6 +294,7 @@ fn prepare<'a>(
         threads: crate::ga::default_threads(),
         limits: state.limits,
         shortest: request.shortest,
+        seed_route: request.seed_route.clone(),
     };
     // The numbers and the plan's size, before it is queued: what is refused for its
     // content is refused at once, not after a wait.

@@ -122,6 +122,11 @@ pub(crate) enum BenchCommand {
         /// most 60000).
         #[arg(long, value_delimiter = ',', default_values_t = roam_bench::anytime::DEFAULT_CHECKPOINTS_MS)]
         checkpoints: Vec<f64>,
+        /// Instead: the executive's replans through --runs days of the day world (at
+        /// most 100), each answered seeded with the route left (as the executive asks)
+        /// and from scratch, timed: p50/p99 latency against the 50 ms goal.
+        #[arg(long, conflicts_with_all = ["scaling", "peer", "optimality", "anytime"])]
+        replans: bool,
     },
 }
 
@@ -218,9 +223,19 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
             instances,
             anytime,
             checkpoints,
+            replans,
         } => {
             if runs == 0 {
                 bail!("--runs must be at least 1");
+            }
+            if replans {
+                let result = tokio::task::spawn_blocking(move || {
+                    let progress = Progress::new("bench planner --replans", quiet);
+                    let shown = progress.callback();
+                    roam_bench::replans::replans(runs, &shown)
+                })
+                .await??;
+                return print_json(&result, json);
             }
             if anytime {
                 if let Err(e) = roam_bench::anytime::check_checkpoints(&checkpoints) {

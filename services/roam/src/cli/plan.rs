@@ -92,6 +92,7 @@ pub(crate) async fn plan(args: PlanArgs) -> anyhow::Result<()> {
         seed: args.seed,
         map_version: None,
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     };
     // A fresh random id and cancel token for this request: Ctrl-C cancels the plan with
     // the token, and the planner replies with its best path so far.

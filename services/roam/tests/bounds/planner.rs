@@ -41,6 +41,7 @@ pub(crate) async fn maximal_plans(session: &zenoh::Session, root: &str) -> Durat
         seed: 0,
         map_version: None,
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     };
     let key = keys::planner_plan(root);
     let asks: Vec<_> = (0..3)

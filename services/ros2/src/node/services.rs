@@ -265,6 +265,7 @@ pub(crate) async fn plan_by_budget_rule(
         seed: 0,
         map_version: None,
         shortest: ShortestPathUse::Omit,
+        seed_route: Vec::new(),
     };
     let shortest = planner.plan(&probe).await.map_err(client_error)?;
     if !shortest.reaches_goal {

@@ -162,7 +162,8 @@ fn failed() -> WindowEvent {
 fn answer(w: &mut DowntimeWindow<'_>, event: WindowEvent, now: Now) -> Vec<WindowAction> {
     let id = w
         .drive_ask
-        .map(|(id, _)| id)
+        .as_ref()
+        .map(|(id, _)| *id)
         .or(w.ahead_ask.map(|(id, _)| id))
         .expect("a request in flight");
     let event = match event {
@@ -237,6 +238,7 @@ fn plan(model: PlannerModel, points: Vec<[f64; 2]>, t_eta_s: f64) -> Plan {
         instance: "planner".into(),
         shortest: None,
         found_by: None,
+        seed_route_used: None,
     }
 }
 
@@ -300,12 +302,12 @@ fn asked(actions: &[WindowAction]) -> PlanAsk {
     let asks: Vec<PlanAsk> = actions
         .iter()
         .filter_map(|a| match a {
-            WindowAction::RequestPlan(ask) => Some(*ask),
+            WindowAction::RequestPlan(ask) => Some(ask.clone()),
             _ => None,
         })
         .collect();
     assert_eq!(asks.len(), 1, "{actions:?}");
-    asks[0]
+    asks[0].clone()
 }
 
 /// The one mission sent to drive among `actions`.

@@ -40,7 +40,7 @@ fn the_next_windows_plan_is_asked_again_later_after_each_failure_in_a_row() {
             assert!(wall_s < 100.0, "never asked again");
             let actions = w.handle(WindowEvent::Tick, at(81.0 + wall_s / 100.0, wall_s));
             if let Some(WindowAction::RequestPlan(next)) = actions.first() {
-                break *next;
+                break next.clone();
             }
         };
         assert_eq!((ask.from, ask.to), (GOAL, NEXT));

@@ -22,6 +22,23 @@ fn slack_replans_from_where_the_robot_will_be_while_it_drives_on() {
     assert!(ask.curious);
     assert!(distance(ask.from, [0.4, 1.1]) < 1e-9, "{ask:?}");
     assert!(close(ask.t_exec_s, margin().budget(92.0)));
+    // Seeded with the route left from there (issue 30): it starts where the plan
+    // starts, follows the route, ends at the task, and runs the replan's generations.
+    assert_eq!(ask.seed_route.first(), Some(&ask.from));
+    assert!(ask.seed_route.len() > 2, "{ask:?}");
+    let end = *ask.seed_route.last().expect("a route");
+    assert!(
+        distance(end, ask.to) < 0.5,
+        "{end:?} is not the task {:?}",
+        ask.to
+    );
+    let config = crate::config::ExecutiveConfig::default();
+    let request = crate::request::plan_request(&config, &ask, TimeModel::table_i());
+    assert_eq!(request.seed_route, ask.seed_route);
+    assert_eq!(
+        request.params.max_generations,
+        Some(crate::config::DEFAULT_REPLAN_GENERATIONS)
+    );
     let actions = answer(&mut w, curious_reply(true), at(8.0, 0.3));
     assert_eq!(
         actions[0],

@@ -50,6 +50,10 @@ pub struct DayResult {
     /// The robot's true path through the whole day (not in the JSON: large).
     #[serde(skip)]
     pub truth: Vec<[f64; 2]>,
+    /// Every plan request the executive made, in order (not in the JSON): what `roam
+    /// bench planner --replans` times.
+    #[serde(skip)]
+    pub asked: Vec<PlanRequest>,
 }
 
 /// The seed of day `day` in a batch seeded `seed`.
@@ -105,6 +109,7 @@ pub fn run_day(
         first_ranges: driven.first_ranges,
         reports: driven.reports,
         truth: driven.truth,
+        asked: driven.asked,
     })
 }
 
@@ -121,6 +126,8 @@ pub struct Driven {
     pub truth: Vec<[f64; 2]>,
     /// Scans localization refused.
     pub localization_errors: u64,
+    /// The executive's plan requests, in order.
+    pub asked: Vec<PlanRequest>,
 }
 
 /// The executive configured by `config` through its day, the planner coupling the
@@ -143,6 +150,7 @@ pub fn drive(
         reports: std::mem::take(&mut day_run.executive.reports),
         localization_errors: day_run.robot.localization_errors(),
         truth: day_run.truth,
+        asked: day_run.asked,
     })
 }
 
@@ -155,12 +163,15 @@ pub struct DayRun<'a> {
     pub robot: Robot,
     /// The whole day's true path.
     pub truth: Vec<[f64; 2]>,
+    /// The executive's plan requests, in order.
+    pub asked: Vec<PlanRequest>,
 }
 
 /// The day's robot and planner, as the executive in process asks them.
 struct DayIo<'r, 'a> {
     robot: &'r mut Robot,
     planner: &'r Planner<'a>,
+    asked: &'r mut Vec<PlanRequest>,
 }
 
 impl Io for DayIo<'_, '_> {
@@ -169,6 +180,7 @@ impl Io for DayIo<'_, '_> {
     }
 
     fn answer(&mut self, request: &PlanRequest, now_s: f64) -> Result<Plan, &'static str> {
+        self.asked.push(request.clone());
         self.planner
             .answer(request, self.robot.change_map(), now_s)
             .map_err(|e| e.kind())
@@ -193,6 +205,7 @@ impl<'a> DayRun<'a> {
             planner,
             robot,
             truth: Vec::new(),
+            asked: Vec::new(),
         })
     }
 
@@ -205,6 +218,7 @@ impl<'a> DayRun<'a> {
             let mut io = DayIo {
                 robot: &mut self.robot,
                 planner: &self.planner,
+                asked: &mut self.asked,
             };
             self.executive.on_step(&step, &mut io)?;
             for finished in self.executive.take_finished() {

@@ -159,6 +159,7 @@ pub(super) fn day(variant: Variant, day: usize, info: f64, late: bool) -> DayRes
         first_ranges: Vec::new(),
         reports: Vec::new(),
         truth: Vec::new(),
+        asked: Vec::new(),
     }
 }
 

@@ -1,0 +1,156 @@
+//! A replan's warm start: the route the robot is driving ([`PlanRequest::seed_route`],
+//! world metres) as a path on the planning grid, so that the GA starts from it.
+//!
+//! roam's, not paper 000's (the paper plans once, from the start). A replan near a
+//! window's end used to plan from scratch, and its first population held nothing close
+//! to the route the robot was already driving; the remainder of that route is a good
+//! path to the same task by construction, so the GA's first population holds it
+//! (beside the shortest path and the via-point seeds) and the ranking ([`crate::best`])
+//! returns it when nothing fitter is found. The answer is never below driving on.
+//!
+//! The route's points are taken to the planning cells they fall in; consecutive equal
+//! cells merge; a step that is not one legal move (a corner cut at the coarser grid, a
+//! gap) is joined through one orthogonal neighbour when that is legal. The route must
+//! then run from the start's cell to the goal's: the start and the goal are joined to
+//! its ends the same way. A route that cannot be made a path this way, or that is
+//! longer than the plan's chromosomes may be, is not used, and the reply says so
+//! ([`roam_proto::planner::Plan::seed_route_used`]): a hint, never a reason to refuse.
+//!
+//! [`PlanRequest::seed_route`]: roam_proto::planner::PlanRequest::seed_route
+
+use crate::world::{Cell, World};
+
+/// The most points a seed route may have ([`roam_proto::planner::MAX_SEED_ROUTE_POINTS`]).
+pub use roam_proto::planner::MAX_SEED_ROUTE_POINTS;
+
+/// Why a seed route was not used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum RemainderError {
+    #[error("a point of the seed route is off the map")]
+    OffMap,
+    #[error("the seed route crosses a cell that is not traversable on the planning grid")]
+    Blocked,
+    #[error("two consecutive points of the seed route are not joined by one or two legal moves")]
+    Gap,
+    #[error("the seed route is longer than the plan's chromosomes may be ({max} cells)")]
+    TooLong { max: usize },
+    #[error("the plan has no population to seed (model shortest, or a budget only the fastest path fits)")]
+    NoPopulation,
+}
+
+/// `route` as a path on `world`'s cells from `start` to `goal` (module doc).
+pub fn route_cells(
+    world: &World,
+    route: &[[f64; 2]],
+    start: Cell,
+    goal: Cell,
+    max_cells: usize,
+) -> Result<Vec<Cell>, RemainderError> {
+    let mut path: Vec<Cell> = vec![start];
+    let cells = route.iter().map(|p| world.cell_at(p[0], p[1]));
+    for cell in cells.chain(std::iter::once(Some(goal))) {
+        let cell = cell.ok_or(RemainderError::OffMap)?;
+        if !world.is_traversable(cell) {
+            return Err(RemainderError::Blocked);
+        }
+        let last = *path.last().unwrap_or(&start);
+        if cell == last {
+            continue;
+        }
+        if !world.is_legal_move(last, cell) {
+            path.push(corner(world, last, cell).ok_or(RemainderError::Gap)?);
+        }
+        path.push(cell);
+        if path.len() > max_cells {
+            return Err(RemainderError::TooLong { max: max_cells });
+        }
+    }
+    Ok(path)
+}
+
+/// A cell one legal move from `a` and one from `b`, the orthogonal ones first: what
+/// joins a cut corner or a one-cell gap.
+fn corner(world: &World, a: Cell, b: Cell) -> Option<Cell> {
+    if world.chebyshev(a, b) > 2 {
+        return None;
+    }
+    let (ax, ay) = world.xy(a);
+    let (bx, by) = world.xy(b);
+    let candidates = [
+        world.cell(bx, ay),
+        world.cell(ax, by),
+        world.cell((ax + bx) / 2, (ay + by) / 2),
+    ];
+    candidates
+        .into_iter()
+        .find(|&c| c != a && c != b && world.is_legal_move(a, c) && world.is_legal_move(c, b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roam_proto::map::{GridMeta, Origin};
+    use roam_world::grid::Grid;
+
+    /// A `side`² world at 0.2 m, free but for the `blocked` cells.
+    fn test_world(side: u32, _height: u32, blocked: &[(usize, usize)]) -> World {
+        let meta = GridMeta {
+            width: side,
+            height: side,
+            resolution: 0.2,
+            origin: Origin::default(),
+        };
+        let mut inflated = Grid::filled(meta, 0i8);
+        for &(x, y) in blocked {
+            inflated.cells[y * side as usize + x] = 100;
+        }
+        World::new(&inflated, &Grid::filled(meta, 50u8), 0.25).expect("world")
+    }
+
+    #[test]
+    fn a_route_along_free_cells_becomes_the_path_from_start_to_goal() {
+        let world = test_world(10, 10, &[]);
+        let start = world.cell(1, 1);
+        let goal = world.cell(6, 1);
+        // Points at the cells' centres from (1, 1) to (6, 1), with a repeat and a jump
+        // of two cells that a corner joins.
+        let route: Vec<[f64; 2]> = [(1, 1), (2, 1), (2, 1), (4, 1), (5, 1)]
+            .iter()
+            .map(|&(x, y)| {
+                let (cx, cy) = world.center(world.cell(x, y));
+                [cx, cy]
+            })
+            .collect();
+        let path = route_cells(&world, &route, start, goal, 100).expect("joined");
+        let expected: Vec<Cell> = (1..=6).map(|x| world.cell(x, 1)).collect();
+        assert_eq!(path, expected);
+        assert!(path.windows(2).all(|w| world.is_legal_move(w[0], w[1])));
+    }
+
+    #[test]
+    fn a_route_that_cannot_be_joined_or_is_too_long_is_not_used() {
+        let world = test_world(10, 10, &[(3, 1)]);
+        let start = world.cell(1, 1);
+        let goal = world.cell(6, 1);
+        let at = |x: usize, y: usize| {
+            let (cx, cy) = world.center(world.cell(x, y));
+            [cx, cy]
+        };
+        assert_eq!(
+            route_cells(&world, &[at(1, 1), at(3, 1)], start, goal, 100),
+            Err(RemainderError::Blocked)
+        );
+        assert_eq!(
+            route_cells(&world, &[at(1, 1), at(1, 8)], start, goal, 100),
+            Err(RemainderError::Gap)
+        );
+        assert_eq!(
+            route_cells(&world, &[[1e6, 0.0]], start, goal, 100),
+            Err(RemainderError::OffMap)
+        );
+        assert_eq!(
+            route_cells(&world, &[at(1, 1), at(1, 2), at(1, 3)], start, goal, 2),
+            Err(RemainderError::TooLong { max: 2 })
+        );
+    }
+}
