@@ -105,6 +105,9 @@ pub struct ExecutiveConfig {
     /// whose clock stands while the planner works: 0); absent: measured, the wall time
     /// recent plans took at the clock's rate.
     pub planning_cost_s: Option<f64>,
+    /// The same for a replan seeded with the route the robot drives, fixed; absent:
+    /// `planning_cost_s` when that is set, else measured from the seeded replans alone.
+    pub replan_cost_s: Option<f64>,
     /// Plan with paper 000 Eq. 2's v_lin and v_ang fitted to what this robot drove
     /// (Table I as the prior; see [`crate::calibration`]); `false`: Table I throughout.
     pub calibrate: bool,
@@ -240,6 +243,13 @@ impl ExecutiveConfig {
                     .into(),
             ));
         }
+        if let Some(cost) = self.replan_cost_s {
+            if !(cost.is_finite() && cost >= 0.0) {
+                return Err(ConfigError::Field(format!(
+                    "replan_cost_s is {cost}; give 0 or more seconds, or leave it out to measure it"
+                )));
+            }
+        }
         if let Some(cost) = self.planning_cost_s {
             if !(cost.is_finite() && cost >= 0.0) {
                 return Err(ConfigError::Field(format!(
@@ -272,7 +282,7 @@ impl Default for ExecutiveConfig {
             waypoint_spacing_m: 1.0,
             off_path_m: 1.5,
             speed_m_per_s: 0.5,
-            max_replans: 5,
+            max_replans: 10,
             give_up_after_s: 60.0,
             controller_silence_s: 3.0,
             slack_s: 3.0,
@@ -289,6 +299,7 @@ impl Default for ExecutiveConfig {
             hold_patience_s: 4.0,
             fix_peb_m: 2.0,
             planning_cost_s: None,
+            replan_cost_s: None,
             calibrate: true,
             calibration_file: None,
             time_model_prior: TimeModel::table_i(),

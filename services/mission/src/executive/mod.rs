@@ -103,6 +103,7 @@ pub async fn run(
         position: None,
         calibration: load_calibration(config)?,
         plan_wall_s: None,
+        replan_wall_s: None,
         handover: Handover::first(config.margin()),
         tag: session.zid().to_string().chars().take(8).collect(),
         heard: Heard::default(),

@@ -43,6 +43,8 @@ pub(super) struct Executive<'a> {
     pub(super) calibration: Calibration,
     /// Wall seconds the recent curious plans took (request to reply), the slowest.
     pub(super) plan_wall_s: Option<f64>,
+    /// The same for the seeded replans alone (they run far fewer generations).
+    pub(super) replan_wall_s: Option<f64>,
     /// What the last window handed the next (the arrival margin, the mission and ask
     /// counts, the next window's plan).
     pub(super) handover: Handover,
@@ -87,7 +89,23 @@ impl Executive<'_> {
         if let Some(cost) = self.config.planning_cost_s {
             return cost;
         }
-        let wall = self.plan_wall_s.map_or(self.config.plan_deadline_s, |w| {
+        self.measured_cost_s(self.plan_wall_s)
+    }
+
+    /// What a seeded replan costs on the mission clock: the config's fixed figure (or
+    /// its fixed `planning_cost_s`), else what the seeded replans took, measured as
+    /// [`Self::planning_cost_s`] is (a curious plan's cost until one was measured).
+    fn replan_cost_s(&self) -> f64 {
+        if let Some(cost) = self.config.replan_cost_s.or(self.config.planning_cost_s) {
+            return cost;
+        }
+        self.measured_cost_s(self.replan_wall_s.or(self.plan_wall_s))
+    }
+
+    /// `wall` seconds (the slowest recent, with a margin; the deadline until one was
+    /// measured) on the mission clock.
+    fn measured_cost_s(&self, wall: Option<f64>) -> f64 {
+        let wall = wall.map_or(self.config.plan_deadline_s, |w| {
             (w * PLAN_WALL_MARGIN + PLAN_WALL_SLACK_S).min(self.config.plan_deadline_s)
         });
         wall * lock(&self.inputs.clock).rate()
@@ -100,6 +118,7 @@ impl Executive<'_> {
             mission_s: self.now(),
             wall_s: began.elapsed().as_secs_f64(),
             planning_cost_s: self.planning_cost_s(),
+            replan_cost_s: self.replan_cost_s(),
             clock_rate: lock(&self.inputs.clock).rate(),
         }
     }
@@ -122,8 +141,13 @@ impl Executive<'_> {
         // Only what the GA took says what a curious plan costs (a fallback to the
         // shortest path is answered at once).
         if plan.model != PlannerModel::Shortest {
-            // The slowest of the recent plans, forgetting slowly.
-            self.plan_wall_s = Some(self.plan_wall_s.map_or(took_s, |w| took_s.max(0.8 * w)));
+            // The slowest of the recent plans, forgetting slowly; seeded replans apart.
+            let slowest = if plan.seed_route_used.is_some() {
+                &mut self.replan_wall_s
+            } else {
+                &mut self.plan_wall_s
+            };
+            *slowest = Some(slowest.map_or(took_s, |w| took_s.max(0.8 * w)));
         }
     }
 

@@ -6,6 +6,18 @@ use roam_planner::plan::MAX_T_EXEC_S;
 use roam_proto::mission::{AskReport, MAX_REPORTED_ASKS};
 
 use super::events::{Now, PlanAsk, WindowAction};
+
+/// What kind of plan a request asks for.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum Asking {
+    /// The shortest path (the planner's fastest path).
+    Shortest,
+    /// A curious plan from scratch, with the executive's `max_generations`.
+    Curious,
+    /// A curious replan seeded with the route the robot drives (from the request's
+    /// start on), with `replan_generations`.
+    Seeded(Vec<[f64; 2]>),
+}
 use super::setup::{LEAST_T_EXEC_S, MIN_DEADLINE_S};
 use super::state::{AheadAsk, DowntimeWindow, DriveAsk};
 use crate::watch::Reason;
@@ -21,15 +33,19 @@ impl DowntimeWindow<'_> {
         to: [f64; 2],
         task_start_s: f64,
         leave_at_s: Option<f64>,
-        curious: bool,
+        asking: Asking,
         now: Now,
     ) -> (PlanAsk, f64, f64) {
         let set_off = leave_at_s.map_or(now.mission_s, |at| at.max(now.mission_s));
         let time_left = (task_start_s - set_off).max(0.0);
         let deadline_s = self.deadline_s(time_left, now);
-        let curious = curious && self.setup.rules.curious;
+        let curious = asking != Asking::Shortest && self.setup.rules.curious;
+        let seed_route = match asking {
+            Asking::Seeded(route) if curious => route,
+            _ => Vec::new(),
+        };
         let cost = if curious {
-            self.plan_cost_s(time_left, now)
+            self.plan_cost_s(time_left, now, !seed_route.is_empty())
         } else {
             0.0
         };
@@ -43,7 +59,7 @@ impl DowntimeWindow<'_> {
             t_exec_s: budget_s.clamp(LEAST_T_EXEC_S, MAX_T_EXEC_S),
             deadline_s,
             curious: curious && budget_s > 0.0,
-            seed_route: Vec::new(),
+            seed_route,
         };
         self.record(&ask, leave_at_s.is_some(), now);
         (ask, budget_s, time_left)
@@ -60,18 +76,27 @@ impl DowntimeWindow<'_> {
     }
 
     /// What a curious plan asked with `time_left_s` to its task costs on the mission
-    /// clock: the expected cost, cut to what its deadline allows.
-    pub(super) fn plan_cost_s(&self, time_left_s: f64, now: Now) -> f64 {
-        now.planning_cost_s
-            .min(self.deadline_s(time_left_s, now) * now.clock_rate.max(1e-9))
+    /// clock: the expected cost (a seeded replan's when `seeded`), cut to what its
+    /// deadline allows.
+    pub(super) fn plan_cost_s(&self, time_left_s: f64, now: Now, seeded: bool) -> f64 {
+        let cost = if seeded {
+            now.replan_cost_s
+        } else {
+            now.planning_cost_s
+        };
+        cost.min(self.deadline_s(time_left_s, now) * now.clock_rate.max(1e-9))
     }
 
     /// The driving budget a curious replan asked now would get: what the arrival margin
-    /// leaves of the time to the task after the plan's cost (the slack rule's measure).
+    /// leaves of the time to the task after a curious plan's cost (the slack rule's
+    /// measure). A slack replan is seeded and costs far less; the rule still charges a
+    /// whole plan's cost, so that cheap replans do not fire on every few seconds the
+    /// time model gains and spend the window's `max_replans` in its first half (the
+    /// batch measured that: 5 slack replans in 25 s, then 19 s early).
     pub(super) fn replan_budget_s(&self, now: Now) -> f64 {
         let time_left = self.setup.task.start_s - now.mission_s;
         self.margin
-            .budget(time_left - self.plan_cost_s(time_left, now))
+            .budget(time_left - self.plan_cost_s(time_left, now, false))
     }
 
     pub(super) fn next_ask_id(&mut self) -> u64 {
@@ -95,7 +120,7 @@ impl DowntimeWindow<'_> {
 
     pub(super) fn ask_first_plan(&mut self, now: Now) -> WindowAction {
         let (from, to, start) = (self.setup.from, self.setup.task.at, self.setup.task.start_s);
-        let (ask, budget_s, time_left_s) = self.ask(from, to, start, None, true, now);
+        let (ask, budget_s, time_left_s) = self.ask(from, to, start, None, Asking::Curious, now);
         self.drive_ask = Some((
             ask.id,
             DriveAsk::FirstPlan {
@@ -113,7 +138,8 @@ impl DowntimeWindow<'_> {
         let (start_s, to) = (next.start_s, next.at);
         let task = &self.setup.task;
         let (from, leave_at_s) = (task.at, task.start_s + task.duration_s);
-        let (ask, budget_s, time_left_s) = self.ask(from, to, start_s, Some(leave_at_s), true, now);
+        let (ask, budget_s, time_left_s) =
+            self.ask(from, to, start_s, Some(leave_at_s), Asking::Curious, now);
         self.ahead_ask = Some((
             ask.id,
             AheadAsk {

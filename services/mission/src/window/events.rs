@@ -17,6 +17,10 @@ pub struct Now {
     /// What a curious plan asked now is expected to cost on the mission clock, seconds
     /// (the executive measures it, or its config fixes it).
     pub planning_cost_s: f64,
+    /// The same for a replan seeded with the route the robot drives (it runs
+    /// `replan_generations`, far fewer: tens of milliseconds where a plan takes
+    /// hundreds).
+    pub replan_cost_s: f64,
     /// Mission seconds per wall second (the sim's real-time factor; 1 on wall time).
     pub clock_rate: f64,
 }

@@ -168,10 +168,11 @@ impl<'a> DowntimeWindow<'a> {
             Some(i) => actions.split_off(i),
             None => Vec::new(),
         };
-        let lead_m = self.plan_cost_s(time_left, now) * self.setup.watch.expected_speed_m_per_s;
+        let lead_m =
+            self.plan_cost_s(time_left, now, false) * self.setup.watch.expected_speed_m_per_s;
         let from = straight::point_ahead(&drive.path, self.here, lead_m);
         let (to, start) = (self.setup.task.at, self.setup.task.start_s);
-        let (ask, _, _) = self.ask(from, to, start, None, true, now);
+        let (ask, _, _) = self.ask(from, to, start, None, asks::Asking::Curious, now);
         actions.extend(self.ask_replan(Reason::SetOff, true, ask));
         actions.extend(ahead);
         Some(actions)

@@ -5,7 +5,8 @@ use crate::calibration::path_measure;
 use crate::path::mission_waypoints;
 use crate::watch::{Decision, Reason};
 
-use super::events::{Now, PlanAsk, WindowAction};
+use super::asks::Asking;
+use super::events::{Now, WindowAction};
 use super::routes::Route;
 use super::setup::SAFE_CHECK_S;
 use super::state::{DowntimeWindow, Follows, Phase};
@@ -138,26 +139,27 @@ impl DowntimeWindow<'_> {
             return Vec::new();
         };
         // A slack or behind replan is made while the robot drives on: it starts where
-        // the robot will be when the plan comes.
+        // the robot will be when the plan comes, on its route, and is seeded with what
+        // is left of the route from there (and runs the replan's generations, so it
+        // comes sooner). One made where the robot is (off its path, stuck) is not: the
+        // route left does not start there, the seed could not be joined, and fewer
+        // generations from scratch would leave twisty random-walk paths.
         let time_left = self.setup.task.start_s - now.mission_s;
-        let from = match reason {
-            Reason::Slack | Reason::Behind => {
-                let lead_m =
-                    self.plan_cost_s(time_left, now) * self.setup.watch.expected_speed_m_per_s;
-                straight::point_ahead(&drive.path, self.here, lead_m)
-            }
-            _ => self.here,
-        };
-        // Seeded with what is left of the route from there (a curious one: the fastest
-        // path has nothing to start from).
-        let seed_route = if curious {
-            straight::route_left(&drive.path, from)
+        let on_route = matches!(reason, Reason::Slack | Reason::Behind);
+        let from = if on_route {
+            let lead_m =
+                self.plan_cost_s(time_left, now, curious) * self.setup.watch.expected_speed_m_per_s;
+            straight::point_ahead(&drive.path, self.here, lead_m)
         } else {
-            Vec::new()
+            self.here
+        };
+        let asking = match (curious, on_route) {
+            (false, _) => Asking::Shortest,
+            (true, true) => Asking::Seeded(straight::route_left(&drive.path, from)),
+            (true, false) => Asking::Curious,
         };
         let (to, start) = (self.setup.task.at, self.setup.task.start_s);
-        let (ask, _, _) = self.ask(from, to, start, None, curious, now);
-        let ask = PlanAsk { seed_route, ..ask };
+        let (ask, _, _) = self.ask(from, to, start, None, asking, now);
         self.ask_replan(reason, resend, ask)
     }
 }

@@ -122,6 +122,7 @@ impl DowntimeWindow<'_> {
                 let ask = PlanAsk {
                     id: self.next_ask_id(),
                     curious: false,
+                    seed_route: Vec::new(),
                     ..ask
                 };
                 self.record(&ask, false, now);

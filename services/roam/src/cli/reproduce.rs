@@ -51,6 +51,10 @@ pub(crate) enum ReproduceCommand {
         /// cuts it (the demo's, measured).
         #[arg(long, default_value_t = 0.4, allow_negative_numbers = true)]
         plan_wall: f64,
+        /// With --days: what a replan seeded with the route left costs, wall seconds
+        /// (`roam bench planner --replans`: p99 48 ms).
+        #[arg(long, default_value_t = 0.05, allow_negative_numbers = true)]
+        replan_wall: f64,
         /// With --days: the clock's rate, mission seconds per wall second (the demo's).
         #[arg(long, default_value_t = 20.0, allow_negative_numbers = true)]
         rate: f64,
@@ -158,6 +162,7 @@ pub(crate) async fn reproduce(args: ReproduceArgs) -> anyhow::Result<()> {
             variants,
             jobs,
             plan_wall,
+            replan_wall,
             rate,
             seed,
             generations,
@@ -175,7 +180,7 @@ pub(crate) async fn reproduce(args: ReproduceArgs) -> anyhow::Result<()> {
                 days,
                 &variants,
                 jobs,
-                plan_wall,
+                (plan_wall, replan_wall),
                 rate,
                 seed,
                 generations,
@@ -366,7 +371,7 @@ async fn reproduce_days(
     days: usize,
     variants: &[String],
     jobs: Option<usize>,
-    plan_wall: f64,
+    (plan_wall, replan_wall): (f64, f64),
     rate: f64,
     seed: u64,
     generations: u32,
@@ -381,6 +386,7 @@ async fn reproduce_days(
         generations,
         w_loc,
         plan_wall_s: plan_wall,
+        replan_wall_s: replan_wall,
         rate,
         site,
         ..DaysOptions::default()

@@ -351,7 +351,7 @@ fn bench_mapper_prints_updates_per_second() {
 
 #[test]
 fn bench_arguments_out_of_their_limits_are_refused_naming_the_limit() {
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 6] = [
         (
             &["bench", "planner", "--anytime", "--checkpoints", ""],
             "invalid value '' for '--checkpoints",
@@ -371,6 +371,10 @@ fn bench_arguments_out_of_their_limits_are_refused_naming_the_limit() {
         (
             &["bench", "fleet", "--robots", "1001"],
             "--robots must be 1..=1000",
+        ),
+        (
+            &["bench", "planner", "--replans", "--runs", "101"],
+            "--runs 101: give 1 to 100 (MAX_DAYS) days",
         ),
     ];
     for (args, expected) in cases {

@@ -131,6 +131,8 @@ pub struct InProcessExecutive<'a> {
     rate: f64,
     /// What a curious plan costs at most, wall seconds (its deadline may cut it).
     plan_wall_s: f64,
+    /// The same for a replan seeded with the route left.
+    replan_wall_s: f64,
     now_s: f64,
     last_truth: Option<[f64; 2]>,
     steps_without_fix: usize,
@@ -143,13 +145,13 @@ pub struct InProcessExecutive<'a> {
 
 impl<'a> InProcessExecutive<'a> {
     /// The executive configured by `config`, planning on `scale`'s map, at a clock
-    /// `rate` times real time with curious plans costing `plan_wall_s` wall seconds
-    /// (cut to their deadlines).
+    /// `rate` times real time with curious plans costing `plan_wall_s` wall seconds and
+    /// seeded replans `replan_wall_s` (`walls`; each cut to its deadline).
     pub fn new(
         config: &'a ExecutiveConfig,
         scale: InformationScale<'a>,
         rate: f64,
-        plan_wall_s: f64,
+        (plan_wall_s, replan_wall_s): (f64, f64),
     ) -> Result<InProcessExecutive<'a>, ExecutiveError> {
         Ok(InProcessExecutive {
             config,
@@ -160,6 +162,7 @@ impl<'a> InProcessExecutive<'a> {
             fix: None,
             rate,
             plan_wall_s,
+            replan_wall_s,
             now_s: 0.0,
             last_truth: None,
             steps_without_fix: 0,
@@ -200,6 +203,11 @@ impl<'a> InProcessExecutive<'a> {
             mission_s: self.now_s,
             wall_s: self.now_s / self.rate,
             planning_cost_s: self.config.planning_cost_s.unwrap_or(0.0),
+            replan_cost_s: self
+                .config
+                .replan_cost_s
+                .or(self.config.planning_cost_s)
+                .unwrap_or(0.0),
             clock_rate: self.rate,
         }
     }
@@ -377,8 +385,13 @@ impl<'a> InProcessExecutive<'a> {
                                 None
                             }
                         };
+                        let wall_s = if ask.seed_route.is_empty() {
+                            self.plan_wall_s
+                        } else {
+                            self.replan_wall_s
+                        };
                         let cost_s = if ask.curious {
-                            self.plan_wall_s.min(ask.deadline_s) * self.rate
+                            wall_s.min(ask.deadline_s) * self.rate
                         } else {
                             0.0
                         };

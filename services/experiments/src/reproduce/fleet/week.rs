@@ -218,7 +218,12 @@ pub fn run_week(
     };
     let mut executives = configs
         .iter()
-        .map(|c| InProcessExecutive::new(c, scale, options.rate, options.plan_wall_s))
+        .map(|c| {
+            // The fleet's plans are the greedy planner's by default, which a seed
+            // route does not shorten: a replan costs what a plan costs.
+            let wall = (options.plan_wall_s, options.plan_wall_s);
+            InProcessExecutive::new(c, scale, options.rate, wall)
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let planning = variant.planning();
     let (own_maps, prior) = match planning {

@@ -134,12 +134,14 @@ impl Fixture {
     }
 }
 
-/// Mission time `mission_s`, wall time `wall_s`, a plan costing 1 s.
+/// Mission time `mission_s`, wall time `wall_s`, a plan (and a seeded replan) costing
+/// 1 s.
 fn at(mission_s: f64, wall_s: f64) -> Now {
     Now {
         mission_s,
         wall_s,
         planning_cost_s: 1.0,
+        replan_cost_s: 1.0,
         clock_rate: 1.0,
     }
 }

@@ -49,6 +49,30 @@ fn slack_replans_from_where_the_robot_will_be_while_it_drives_on() {
     assert_eq!(sent(&actions).id, "robot-tag-w0-m2");
 }
 
+/// A seeded replan costs what seeded replans cost, not what a plan costs: with the
+/// same slack (the rule charges a whole plan's 1 s), a replan costing 0.2 s starts
+/// 0.1 m ahead (0.2 s at 0.5 m/s) and gets the budget of 92.8 s left, not 92.
+#[test]
+fn a_seeded_replan_leads_and_is_budgeted_by_its_own_cost() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    let cheap = |mission_s, wall_s| Now {
+        replan_cost_s: 0.2,
+        ..at(mission_s, wall_s)
+    };
+    assert!(w
+        .handle(estimate([0.1, 0.9], 0.1), cheap(6.0, 0.1))
+        .is_empty());
+    let actions = w.handle(
+        status(&first.id, MissionState::Active, 2.0),
+        cheap(7.0, 0.2),
+    );
+    let ask = asked(&actions);
+    assert!(ask.curious && !ask.seed_route.is_empty(), "{ask:?}");
+    assert!(distance(ask.from, [0.1, 1.0]) < 1e-9, "{ask:?}");
+    assert!(close(ask.t_exec_s, margin().budget(92.8)), "{ask:?}");
+}
+
 #[test]
 fn no_slack_replan_near_the_windows_end() {
     let f = fixture();

@@ -75,6 +75,7 @@ pub fn day_config(
         max_generations: Some(options.generations),
         seed,
         planning_cost_s: Some(options.plan_wall_s * options.rate),
+        replan_cost_s: Some(options.replan_wall_s * options.rate),
         ..ExecutiveConfig::default()
     };
     variant.config(base, options.w_loc)
@@ -201,7 +202,12 @@ impl<'a> DayRun<'a> {
         };
         Ok(DayRun {
             world,
-            executive: InProcessExecutive::new(config, scale, options.rate, options.plan_wall_s)?,
+            executive: InProcessExecutive::new(
+                config,
+                scale,
+                options.rate,
+                (options.plan_wall_s, options.replan_wall_s),
+            )?,
             planner,
             robot,
             truth: Vec::new(),

@@ -8,7 +8,8 @@
 //!   driven as the live executive drives it ([`day`]);
 //! - **planning**: the very request the executive sends, answered by the planner's own
 //!   code on the map the planner service holds ([`planning`]); an answer reaches the
-//!   window `plan_wall_s` (cut to the plan's deadline) at the clock's `rate` later, while
+//!   window `plan_wall_s` (`replan_wall_s` for a replan seeded with the route left;
+//!   cut to the plan's deadline) at the clock's `rate` later, while
 //!   the robot drives on, as in the demo;
 //! - **driving**: the sim, localization's tracker and the APF controller one step at a
 //!   time ([`crate::closed_loop::stepper::Stepper`]), the mapper's change map fed the
@@ -74,6 +75,7 @@ pub struct DaysReport {
     pub generations: u32,
     pub w_loc: f64,
     pub plan_wall_s: f64,
+    pub replan_wall_s: f64,
     pub rate: f64,
     /// Cells the day's cart covers at some step.
     pub changing_cells: usize,
@@ -107,6 +109,13 @@ fn check(o: &DaysOptions) -> Result<(), DaysError> {
     }
     if !(o.w_loc.is_finite() && o.w_loc >= 0.0) {
         return invalid("w_loc", &o.w_loc, "a finite 0 or more".into());
+    }
+    if !(o.replan_wall_s.is_finite() && (0.0..=MAX_PLAN_WALL_S).contains(&o.replan_wall_s)) {
+        return invalid(
+            "replan_wall_s",
+            &o.replan_wall_s,
+            format!("0 to {MAX_PLAN_WALL_S} seconds"),
+        );
     }
     if !(o.plan_wall_s.is_finite() && (0.0..=MAX_PLAN_WALL_S).contains(&o.plan_wall_s)) {
         return invalid(
@@ -173,6 +182,7 @@ pub fn report(options: &DaysOptions, world: &DayWorld, results: Vec<DayResult>) 
         generations: options.generations,
         w_loc: options.w_loc,
         plan_wall_s: options.plan_wall_s,
+        replan_wall_s: options.replan_wall_s,
         rate: options.rate,
         changing_cells: world.changing_cells,
         variants: summaries,

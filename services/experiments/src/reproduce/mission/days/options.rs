@@ -17,6 +17,9 @@ pub struct DaysOptions {
     /// What a curious plan costs, wall seconds, before its deadline cuts it (measured
     /// in the demo: see services/mission/README.md).
     pub plan_wall_s: f64,
+    /// What a replan seeded with the route left costs, wall seconds (the executive's
+    /// `replan_generations`; `roam bench planner --replans` measures it: p99 48 ms).
+    pub replan_wall_s: f64,
     /// The clock's rate, mission seconds per wall second (the demo's 20×).
     pub rate: f64,
     pub variants: Vec<Variant>,
@@ -34,6 +37,7 @@ impl Default for DaysOptions {
             generations: 1000,
             w_loc: 2000.0,
             plan_wall_s: 0.4,
+            replan_wall_s: 0.05,
             rate: 20.0,
             variants: Variant::ALL.to_vec(),
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
