@@ -16,8 +16,11 @@ use crate::tasks::{self, Task, TaskError};
 use crate::watch::WatchParams;
 
 /// [`ExecutiveConfig::replan_generations`] by default: at population 200 on the day
-/// world a replan then takes tens of milliseconds (services/mission/README.md, "Replans").
-pub const DEFAULT_REPLAN_GENERATIONS: u32 = 60;
+/// world a seeded replan then takes a p99 of 40 ms (`roam bench planner --replans`;
+/// 60 generations took 52 ms, over the 50 ms goal), for a median 0.99 of the
+/// information 1000 generations from scratch find (services/planner/README.md,
+/// "Replans").
+pub const DEFAULT_REPLAN_GENERATIONS: u32 = 40;
 
 /// How the executive plans and watches.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
