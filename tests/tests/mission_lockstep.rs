@@ -51,6 +51,7 @@ async fn the_live_executive_and_the_batch_make_the_same_day() {
     let world = DayWorld::new(&roam_mission::site::Site::builtin_day()).expect("the day world");
     let options = DaysOptions {
         plan_wall_s: 0.0,
+        replan_wall_s: 0.0,
         ..DaysOptions::default()
     };
     let batch = drive(&world, &config, false, sim_seed(seed), &options)

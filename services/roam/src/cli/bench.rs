@@ -87,7 +87,9 @@ pub(crate) enum BenchCommand {
         updates: u64,
     },
     /// The GA per curiosity model (2000 generations, population 200) and the service
-    /// overhead; with --scaling or --peer, finer maps or the greedy planner instead.
+    /// overhead; with --scaling or --peer, finer maps or the greedy planner instead;
+    /// with --replans the executive's replans over `--runs` days of the day world,
+    /// seeded and from scratch, timed.
     Planner {
         #[arg(long)]
         json: bool,
