@@ -266,7 +266,8 @@ pub struct Plan {
     pub shortest: Option<ShortestPath>,
     /// What produced the returned path, of what the planner tried: `ga`, `greedy`,
     /// `shortest` (the fastest path, unchanged), `via_seed` (a via-point seed,
-    /// unchanged) or `remainder` (the request's `seed_route`, unchanged). Absent from planners before the field.
+    /// unchanged) or `remainder` (the request's `seed_route`, unchanged). Absent from
+    /// planners that do not know the field.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub found_by: Option<String>,
     /// With a request's `seed_route`: whether it was in the first population (`false`:

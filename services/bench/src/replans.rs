@@ -1,15 +1,15 @@
-//! `roam bench planner --replans`: what a replan costs on the day world (issue 30).
+//! `roam bench planner --replans`: what a replan costs on the day world.
 //!
 //! The executive's day runs in batch (`roam reproduce mission`'s own code: the
 //! executive's window machine, the sim, localization, the controller) for `days` days
 //! of the shipped configuration, and every request the executive makes is kept. Each
-//! replan among them (a request with a `seed_route`: slack, behind, pushed off the
-//! path, stuck) is answered again here by the planner's own code, timed:
+//! replan among them (a request with a `seed_route`: the slack and behind replans) is
+//! answered again here by the planner's own code, timed:
 //!
 //! - **seeded**: as the executive asks it: the route left as the seed, the executive's
 //!   `replan_generations`;
-//! - **from scratch**: what a replan was before: no seed, the first plan's generations
-//!   (the executive's `max_generations`).
+//! - **from scratch**: no seed, the first plan's generations (the executive's
+//!   `max_generations`): what the seed and the fewer generations save.
 //!
 //! The latency is the planner's compute time for the answer, in process with the
 //! service's evaluation threads, on the day's static map (the batch couples the change
@@ -122,7 +122,7 @@ pub fn replans(days: usize, progress: Progress<'_>) -> Result<ReplanBench, Bench
         seed_routes_used: used,
         answered_with_the_route: kept,
         information_ratio_median: percentile(&mut ratios, 0.5),
-        information_ratio_worst: ratios.first().copied().unwrap_or(0.0),
+        information_ratio_worst: ratios.iter().copied().reduce(f64::min).unwrap_or(0.0),
         seeded,
         from_scratch,
         goal_p99_ms: GOAL_P99_MS,
@@ -135,6 +135,6 @@ fn latency(generations: Option<u32>, samples: &mut [f64]) -> Latency {
         generations,
         p50_ms: percentile(samples, 0.5),
         p99_ms: percentile(samples, 0.99),
-        max_ms: samples.last().copied().unwrap_or(0.0),
+        max_ms: samples.iter().copied().fold(0.0, f64::max),
     }
 }

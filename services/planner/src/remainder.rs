@@ -1,16 +1,16 @@
 //! A replan's warm start: the route the robot is driving ([`PlanRequest::seed_route`],
 //! world metres) as a path on the planning grid, so that the GA starts from it.
 //!
-//! roam's, not paper 000's (the paper plans once, from the start). A replan near a
-//! window's end used to plan from scratch, and its first population held nothing close
-//! to the route the robot was already driving; the remainder of that route is a good
-//! path to the same task by construction, so the GA's first population holds it
+//! roam's, not paper 000's (the paper plans once, from the start). A replan from
+//! scratch has nothing close to the route the robot is already driving in its first
+//! population; the remainder of that route is a good path to the same task by
+//! construction, so the GA's first population holds it
 //! (beside the shortest path and the via-point seeds) and the ranking ([`crate::best`])
 //! returns it when nothing fitter is found. The answer is never below driving on.
 //!
 //! The route's points are taken to the planning cells they fall in; consecutive equal
 //! cells merge; a step that is not one legal move (a corner cut at the coarser grid, a
-//! gap) is joined through one orthogonal neighbour when that is legal. The route must
+//! gap) is joined through one cell a legal move from both ends, when there is one. The route must
 //! then run from the start's cell to the goal's: the start and the goal are joined to
 //! its ends the same way. A route that cannot be made a path this way, or that is
 //! longer than the plan's chromosomes may be, is not used, and the reply says so
@@ -58,7 +58,7 @@ pub fn route_cells(
             continue;
         }
         if !world.is_legal_move(last, cell) {
-            path.push(corner(world, last, cell).ok_or(RemainderError::Gap)?);
+            path.push(world.via(last, cell).ok_or(RemainderError::Gap)?);
         }
         path.push(cell);
         if path.len() > max_cells {
@@ -66,24 +66,6 @@ pub fn route_cells(
         }
     }
     Ok(path)
-}
-
-/// A cell one legal move from `a` and one from `b`, the orthogonal ones first: what
-/// joins a cut corner or a one-cell gap.
-fn corner(world: &World, a: Cell, b: Cell) -> Option<Cell> {
-    if world.chebyshev(a, b) > 2 {
-        return None;
-    }
-    let (ax, ay) = world.xy(a);
-    let (bx, by) = world.xy(b);
-    let candidates = [
-        world.cell(bx, ay),
-        world.cell(ax, by),
-        world.cell((ax + bx) / 2, (ay + by) / 2),
-    ];
-    candidates
-        .into_iter()
-        .find(|&c| c != a && c != b && world.is_legal_move(a, c) && world.is_legal_move(c, b))
 }
 
 #[cfg(test)]

@@ -354,6 +354,15 @@ impl World {
         (nx >= 0 && ny >= 0 && nx < self.width as i64 && ny < self.height as i64).then_some(dir)
     }
 
+    /// A cell one legal move from `a` and one from `b`, the first in [`MOVES`] order:
+    /// what joins two cells of a path that one move does not (a gap of one cell, a
+    /// corner that cannot be cut). `None` when there is none.
+    pub fn via(&self, a: Cell, b: Cell) -> Option<Cell> {
+        (0..MOVES.len())
+            .filter_map(|d| self.step(a, d))
+            .find(|&c| self.is_legal_move(c, b))
+    }
+
     /// Whether moving from `a` to `b` is one legal step.
     pub fn is_legal_move(&self, a: Cell, b: Cell) -> bool {
         self.direction(a, b).and_then(|d| self.step(a, d)) == Some(b)

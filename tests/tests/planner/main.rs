@@ -97,7 +97,7 @@ async fn a_plan_through_zenoh_equals_the_in_process_plan_bit_for_bit() {
         .expect("plan");
     assert_eq!(again.cells, remote.cells);
 
-    // A replan a third of the way along, seeded with the route left (issue 30): the
+    // A replan a third of the way along, seeded with the route left: the
     // planner plans from it, and answers as in process, bit for bit.
     let from = remote.points.len() / 3;
     let replan = PlanRequest {

@@ -91,8 +91,8 @@ impl DowntimeWindow<'_> {
     /// leaves of the time to the task after a curious plan's cost (the slack rule's
     /// measure). A slack replan is seeded and costs far less; the rule still charges a
     /// whole plan's cost, so that cheap replans do not fire on every few seconds the
-    /// time model gains and spend the window's `max_replans` in its first half (the
-    /// batch measured that: 5 slack replans in 25 s, then 19 s early).
+    /// time model gains and spend the window's `max_replans` in its first half, leaving
+    /// the robot early at the end (services/mission/README.md, "Seeded replans").
     pub(super) fn replan_budget_s(&self, now: Now) -> f64 {
         let time_left = self.setup.task.start_s - now.mission_s;
         self.margin

@@ -194,10 +194,7 @@ fn bridge(world: &World, a: Cell, b: Cell) -> Option<Bridge> {
     if world.chebyshev(a, b) != 2 {
         return None;
     }
-    (0..MOVES.len())
-        .filter_map(|d| world.step(a, d))
-        .find(|&c| world.is_legal_move(c, b))
-        .map(Bridge::Via)
+    world.via(a, b).map(Bridge::Via)
 }
 
 #[cfg(test)]

@@ -22,7 +22,7 @@ fn slack_replans_from_where_the_robot_will_be_while_it_drives_on() {
     assert!(ask.curious);
     assert!(distance(ask.from, [0.4, 1.1]) < 1e-9, "{ask:?}");
     assert!(close(ask.t_exec_s, margin().budget(92.0)));
-    // Seeded with the route left from there (issue 30): it starts where the plan
+    // Seeded with the route left from there: it starts where the plan
     // starts, follows the route, ends at the task, and runs the replan's generations.
     assert_eq!(ask.seed_route.first(), Some(&ask.from));
     assert!(ask.seed_route.len() > 2, "{ask:?}");
