@@ -22,6 +22,14 @@ use roam_proto::mission::WindowReport;
 use roam_runtime::SessionArgs;
 use roam_stack::router::free_loopback_port;
 
+/// How close the fitted v_lin must come to the robot's: the fit's own accuracy on
+/// about 150 m of driving is about 5% (`roam_mission::calibration::fit`), and at a
+/// clock ten times wall time the estimates' lag jitter is a second's part of a short
+/// drive. Measured on this 2-core machine over ten days: within ±3% typically, −5.7%
+/// with a core kept busy. 10% is about three of those spreads, and half the prior's
+/// error: a fit that learned nothing fails.
+const V_LIN_TOLERANCE: f64 = 0.10;
+
 /// The fake robot's speed, m/s of simulated time, and its clock's rate.
 const SPEED_M_PER_S: f64 = 0.6;
 const RATE: &str = "10";
@@ -103,7 +111,9 @@ fn site(dir: &Path, endpoint: &str, root: &str) -> Vec<RoamProcess> {
 
 /// `roam mission` drives the fake Nav2 robot through the built-in day (the demo's
 /// tasks, `roam_mission::tasks::day`): every window on time, and the time model the
-/// executive fits from what the robot drove is within 5% of the robot's speed.
+/// executive fits from what the robot drove (the missions that arrived and the parts
+/// of replaced ones, more drives than windows) is within [`V_LIN_TOLERANCE`] of the
+/// robot's speed, where Table I's prior (2 s/m) is 20% off.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn roam_mission_drives_a_nav2_robot_through_the_day() {
     if !has_python("roam_mission_drives_a_nav2_robot_through_the_day") {
@@ -191,8 +201,14 @@ async fn roam_mission_drives_a_nav2_robot_through_the_day() {
         100.0 * (v_lin / truth - 1.0)
     );
     assert!(
-        (v_lin / truth - 1.0).abs() <= 0.05,
-        "the time model is not within 5% of the robot's speed: {fit}"
+        (v_lin / truth - 1.0).abs() <= V_LIN_TOLERANCE,
+        "the time model is not within {V_LIN_TOLERANCE} of the robot's speed: {fit}"
+    );
+    let drives = fit["statistics"]["stretches"].as_u64().expect("stretches");
+    assert!(
+        drives > day.len() as u64,
+        "replaced missions teach too, not only the {} arrivals: {fit}",
+        day.len()
     );
     let _ = session.close().await;
 }

@@ -229,9 +229,9 @@ impl Executive<'_> {
         }
     }
 
-    /// The calibration learns from the mission that arrived (its Σd and Σθ as Eq. 2
-    /// counts them on the cells, and how long driving it took) and keeps the fit in the
-    /// calibration file.
+    /// The calibration learns from a mission driven (the one that arrived, or the part
+    /// of one a replan replaced: its Σd and Σθ as Eq. 2 counts them on the cells, and
+    /// how long driving it took) and keeps the fit in the calibration file.
     pub(super) fn calibrate(&mut self, window: usize, drive: &DrivenMission) {
         if !self.config.calibrate {
             return;

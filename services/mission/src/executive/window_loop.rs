@@ -104,6 +104,7 @@ impl Executive<'_> {
                         });
                         self.calibrate(window, &drive);
                     }
+                    WindowAction::Drove { drive } => self.calibrate(window, &drive),
                     WindowAction::GaveUp => progress(Progress::GaveUp {
                         window,
                         task: name(),

@@ -5,6 +5,7 @@
 
 use roam_proto::mission::{TimeModelReport, WindowReport, MAX_REPORTED_ASKS};
 
+use super::drove::from_where_sent;
 use super::events::{DrivenMission, Now, WindowAction};
 use super::handover::{Handover, WindowEnd, WindowOutcome};
 use super::setup::NO_PLAN_REASON;
@@ -21,8 +22,10 @@ impl DowntimeWindow<'_> {
             drive.held_s += at_s - since;
         }
         let model = self.setup.time_model;
-        let took_s = at_s - drive.sent_at_s;
-        let (d, theta) = path_measure(&drive.path);
+        let (sent_here, sent_here_at_s) = drive.sent_here;
+        let took_s = at_s - sent_here_at_s;
+        let driven = from_where_sent(&drive.path, sent_here);
+        let (d, theta) = path_measure(driven);
         let predicted_s = model.eta(d, theta);
         self.margin.learn(predicted_s, took_s);
         let time_model = TimeModelReport {
@@ -35,7 +38,7 @@ impl DowntimeWindow<'_> {
         let arrived = WindowAction::Arrived {
             at_s,
             drive: DrivenMission {
-                path: drive.path.clone(),
+                path: driven.to_vec(),
                 took_s,
             },
         };

@@ -89,6 +89,9 @@ pub enum WindowAction {
     /// The robot reached the task's place; the time model's calibration learns from
     /// `drive`.
     Arrived { at_s: f64, drive: DrivenMission },
+    /// A mission the robot was driving normally was replaced; the time model's
+    /// calibration learns from the part of it driven (`drove.rs`).
+    Drove { drive: DrivenMission },
     /// The window is given up.
     GaveUp,
     /// The task was over before the window began.
@@ -97,9 +100,9 @@ pub enum WindowAction {
     Done(Box<WindowEnd>),
 }
 
-/// The mission that arrived, as the time model learns from it: the path it was planned
-/// on, from where it was sent (the path following keeps the robot on it), and how long
-/// driving it took.
+/// A mission driven, as the time model learns from it: the path it was planned on,
+/// from where it was sent (the path following keeps the robot on it) to where it
+/// arrived or was replaced, and how long driving that took.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DrivenMission {
     pub path: Vec<[f64; 2]>,

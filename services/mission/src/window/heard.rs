@@ -6,6 +6,7 @@
 
 use roam_proto::controller::{ControllerStatus, MissionState};
 
+use super::drove;
 use super::events::{Now, WindowAction};
 use super::state::{DowntimeWindow, Phase};
 use crate::watch::{Reason, Status};
@@ -24,6 +25,10 @@ impl DowntimeWindow<'_> {
             return Vec::new();
         }
         self.here = position;
+        self.here_at_s = now.mission_s;
+        if let Phase::Driving(drive) = &mut self.phase {
+            drove::still_at_start(drive, position, now.mission_s);
+        }
         self.driven.push(position);
         self.pebs.extend(peb_m);
         if peb_m.is_some_and(|p| p <= self.setup.rules.fix_peb_m) {

@@ -55,6 +55,7 @@
 //! shortest path, and a budget it does not fit is answered with it.
 
 mod asks;
+mod drove;
 mod ending;
 mod events;
 mod handover;
@@ -72,6 +73,7 @@ use crate::watch::{Reason, Watch};
 
 use state::{Drive, MissionIds, Phase};
 
+pub use drove::{MAX_LEARNED_OFF_ROUTE_M, MIN_LEARNED_DRIVE_M};
 pub use events::{DrivenMission, Now, PlanAsk, WindowAction, WindowEvent};
 pub use handover::{Handover, WindowEnd, WindowOutcome};
 pub use routes::{routes, PlannedAhead, Route};
@@ -107,6 +109,7 @@ impl<'a> DowntimeWindow<'a> {
             planned_ahead: None,
             began_s: now.mission_s,
             here: from,
+            here_at_s: now.mission_s,
             driven,
             carried,
             last_fix,
@@ -236,6 +239,7 @@ impl<'a> DowntimeWindow<'a> {
             mission: mission.id.clone(),
             first_sent_at_s: now.mission_s,
             sent_at_s: now.mission_s,
+            sent_here: (self.here, now.mission_s),
             watch,
             reasons: Vec::new(),
             safe_checked_at_s: f64::NEG_INFINITY,
@@ -243,6 +247,7 @@ impl<'a> DowntimeWindow<'a> {
             held_since_s: None,
             holds: 0,
             held_s: 0.0,
+            sent_holds: 0,
             recoveries: 0,
         }));
         let mut actions = vec![planned, WindowAction::Drive(mission)];

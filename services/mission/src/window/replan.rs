@@ -6,6 +6,7 @@ use crate::path::mission_waypoints;
 use crate::watch::{Decision, Reason};
 
 use super::asks::Asking;
+use super::drove;
 use super::events::{Now, WindowAction};
 use super::routes::Route;
 use super::setup::SAFE_CHECK_S;
@@ -95,6 +96,13 @@ impl DowntimeWindow<'_> {
             .chain(route.points.iter().copied())
             .collect();
         let (t, wall) = (now.mission_s, now.wall_s);
+        let normally_driven = drove::teaches(reason)
+            && !drive.recovering
+            && drive.held_since_s.is_none()
+            && drive.holds == drive.sent_holds;
+        let drove = normally_driven
+            .then(|| drove::driven_part(&drive.path, drive.sent_here, (self.here, self.here_at_s)))
+            .flatten();
         match follows {
             Follows::Straight => drive.watch.straight(path.clone(), t, wall),
             Follows::Replan(kind) => drive.watch.replanned(path.clone(), kind, t, wall),
@@ -106,11 +114,13 @@ impl DowntimeWindow<'_> {
         let mission = self.ids.next(drive.waypoints.clone(), false);
         drive.mission = mission.id.clone();
         drive.sent_at_s = t;
+        drive.sent_holds = drive.holds;
+        drive.sent_here = (self.here, self.here_at_s);
         drive.path = path;
-        vec![
-            WindowAction::Replanned { reason },
-            WindowAction::Drive(mission),
-        ]
+        let mut actions = vec![WindowAction::Replanned { reason }];
+        actions.extend(drove.map(|drive| WindowAction::Drove { drive }));
+        actions.push(WindowAction::Drive(mission));
+        actions
     }
 
     /// The drive's request in flight is forgotten (its answer will be dropped).

@@ -86,6 +86,9 @@ pub(super) struct Drive {
     pub(super) route_curious: bool,
     pub(super) first_sent_at_s: f64,
     pub(super) sent_at_s: f64,
+    /// Where the robot was when the current route was sent, and when it was there
+    /// (its last estimate's time; the route's time if it stood still).
+    pub(super) sent_here: ([f64; 2], f64),
     /// The current route from where it was sent.
     pub(super) path: Vec<[f64; 2]>,
     pub(super) watch: Watch,
@@ -96,6 +99,8 @@ pub(super) struct Drive {
     /// Since when the PEB guard holds the robot, if it does.
     pub(super) held_since_s: Option<f64>,
     pub(super) holds: u32,
+    /// `holds` when the current route was sent: more now, and it was held on.
+    pub(super) sent_holds: u32,
     pub(super) held_s: f64,
     pub(super) recoveries: u32,
 }
@@ -130,8 +135,9 @@ pub struct DowntimeWindow<'a> {
     /// The next window's plan, once made.
     pub(super) planned_ahead: Option<PlannedAhead>,
     pub(super) began_s: f64,
-    /// The robot's last good estimate.
+    /// The robot's last good estimate, and when it was heard (mission seconds).
     pub(super) here: [f64; 2],
+    pub(super) here_at_s: f64,
     /// The previous window's track end (`carried` points, for recoveries: see
     /// [`Handover::track`]), then where this window began and every good estimate
     /// until the robot arrived.

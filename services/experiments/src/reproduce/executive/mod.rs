@@ -401,7 +401,7 @@ impl<'a> InProcessExecutive<'a> {
                     WindowAction::Planned { curious, .. } => {
                         log.first_curious.get_or_insert(curious);
                     }
-                    WindowAction::Arrived { drive, .. } => {
+                    WindowAction::Arrived { drive, .. } | WindowAction::Drove { drive } => {
                         if self.config.calibrate {
                             let (d, theta) = path_measure(&drive.path);
                             self.calibration.add_planned(d, theta, drive.took_s);

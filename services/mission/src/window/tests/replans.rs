@@ -181,3 +181,65 @@ fn a_lost_mission_is_sent_again_from_where_the_robot_is() {
         vec![Reason::ControllerSilent.name().to_owned()]
     );
 }
+
+/// The robot 3 m along its curious route (1 m north, 2 m east) at 6 s, when a slack
+/// replan's answer comes at 8 s: the mission it drove since 1 s is learned from, up to
+/// the route's point nearest the robot's last estimate and until that estimate; after
+/// a hold on the way it is not (that time was not driving).
+#[test]
+fn a_replaced_mission_teaches_the_time_model_what_was_driven_unless_held() {
+    let f = fixture();
+    for held in [false, true] {
+        let (mut w, first) = f.driving(false);
+        if held {
+            w.handle(
+                status(&first.id, MissionState::HaltedPeb, 2.0),
+                at(3.0, 0.1),
+            );
+        }
+        assert!(w.handle(estimate([2.1, 1.2], 0.1), at(6.0, 0.1)).is_empty());
+        let actions = w.handle(status(&first.id, MissionState::Active, 2.0), at(7.0, 0.2));
+        assert!(asked(&actions).curious);
+        let actions = answer(&mut w, curious_reply(true), at(8.0, 0.3));
+        let drove: Vec<&DrivenMission> = actions
+            .iter()
+            .filter_map(|a| match a {
+                WindowAction::Drove { drive } => Some(drive),
+                _ => None,
+            })
+            .collect();
+        if held {
+            assert!(drove.is_empty(), "{actions:?}");
+            continue;
+        }
+        let [drove] = drove[..] else {
+            panic!("one drive learned: {actions:?}")
+        };
+        // From 1 s (sent with the robot standing at FROM) to 6 s (the estimate).
+        assert_eq!(drove.took_s, 5.0);
+        assert_eq!(drove.path.first(), Some(&FROM));
+        let end = *drove.path.last().expect("a path");
+        assert!(distance(end, [2.1, 1.1]) < 1e-9, "{drove:?}");
+    }
+}
+
+/// A robot that stands where its mission was sent until 3 s (the mission on its way to
+/// it) is timed from then: the arrival's drive took 27 s of the 29 since it was sent.
+#[test]
+fn a_drive_is_timed_from_when_the_robot_leaves_where_it_was_sent() {
+    let f = fixture();
+    let (mut w, first) = f.driving(false);
+    assert!(w.handle(estimate(FROM, 0.1), at(2.0, 0.1)).is_empty());
+    assert!(w
+        .handle(estimate([0.11, 0.1], 0.1), at(3.0, 0.1))
+        .is_empty());
+    assert!(w.handle(estimate([0.1, 0.5], 0.1), at(4.0, 0.1)).is_empty());
+    let actions = w.handle(
+        status(&first.id, MissionState::Completed, 0.0),
+        at(30.0, 0.5),
+    );
+    let WindowAction::Arrived { drive, .. } = &actions[0] else {
+        panic!("{actions:?}");
+    };
+    assert_eq!(drive.took_s, 27.0);
+}
