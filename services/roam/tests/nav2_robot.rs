@@ -22,13 +22,14 @@ use roam_proto::mission::WindowReport;
 use roam_runtime::SessionArgs;
 use roam_stack::router::free_loopback_port;
 
-/// How close the fitted v_lin must come to the robot's: the fit's own accuracy on
-/// about 150 m of driving is about 5% (`roam_mission::calibration::fit`), and at a
-/// clock ten times wall time the estimates' lag jitter is a second's part of a short
-/// drive. Measured on this 2-core machine over ten days: within ±3% typically, −5.7%
-/// with a core kept busy. 10% is about three of those spreads, and half the prior's
-/// error: a fit that learned nothing fails.
-const V_LIN_TOLERANCE: f64 = 0.10;
+/// How close the fitted v_lin must come to the robot's, where Table I's prior (2 s/m)
+/// is 20% off. Measured on this 2-core machine: +0.7% to +1.7% over five days, +1.2%
+/// twice with a core kept busy. Learning from arrivals alone, timed when the executive
+/// heard of them (before the window's drives were timed by the estimates' own times),
+/// the same day ended −8.9% to +7.5% off: the prior outweighed a seeded replan's short
+/// last mission, and at a clock ten times wall time the lag of what was heard is a
+/// second of a drive.
+const V_LIN_TOLERANCE: f64 = 0.05;
 
 /// The fake robot's speed, m/s of simulated time, and its clock's rate.
 const SPEED_M_PER_S: f64 = 0.6;

@@ -229,15 +229,20 @@ impl Executive<'_> {
         }
     }
 
-    /// The calibration learns from a mission driven (the one that arrived, or the part
-    /// of one a replan replaced: its Σd and Σθ as Eq. 2 counts them on the cells, and
-    /// how long driving it took) and keeps the fit in the calibration file.
-    pub(super) fn calibrate(&mut self, window: usize, drive: &DrivenMission) {
+    /// The calibration learns from the window's drives (the parts driven of missions
+    /// replans replaced, and the one that arrived: each one's Σd and Σθ as Eq. 2
+    /// counts them on the cells, and how long driving it took) and keeps the fit in
+    /// the calibration file.
+    pub(super) fn calibrate(&mut self, window: usize, drives: &[DrivenMission]) {
         if !self.config.calibrate {
             return;
         }
-        let (d, theta) = path_measure(&drive.path);
-        if !self.calibration.add_planned(d, theta, drive.took_s) {
+        let mut learned = 0;
+        for drive in drives {
+            let (d, theta) = path_measure(&drive.path);
+            learned += usize::from(self.calibration.add_planned(d, theta, drive.took_s));
+        }
+        if learned == 0 {
             return;
         }
         if let Some(path) = &self.config.calibration_file {
@@ -250,7 +255,7 @@ impl Executive<'_> {
             window,
             v_lin = fitted.v_lin,
             v_ang = fitted.v_ang,
-            took_s = drive.took_s,
+            drives = learned,
             "time model updated from the window's driving"
         );
     }

@@ -5,6 +5,7 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use roam_proto::controller::ControllerStatus;
+use roam_runtime::lock;
 use tokio::task::JoinSet;
 use tokio::time::MissedTickBehavior;
 use tokio_util::sync::CancellationToken;
@@ -95,16 +96,15 @@ impl Executive<'_> {
                     WindowAction::Recovering { held_s } => {
                         progress(Progress::Recovering { window, held_s })
                     }
-                    WindowAction::Arrived { at_s, drive } => {
+                    WindowAction::Arrived { at_s, drives } => {
                         progress(Progress::Arrived {
                             window,
                             task: name(),
                             at_s,
                             start_s: task.start_s,
                         });
-                        self.calibrate(window, &drive);
+                        self.calibrate(window, &drives);
                     }
-                    WindowAction::Drove { drive } => self.calibrate(window, &drive),
                     WindowAction::GaveUp => progress(Progress::GaveUp {
                         window,
                         task: name(),
@@ -151,7 +151,11 @@ impl Executive<'_> {
                         if early_status.as_ref().is_some_and(|s| s.estimate_step <= Some(e.step)) {
                             released = early_status.take();
                         }
-                        WindowEvent::Estimate { position: e.position, peb_m: e.peb_m, degraded: e.degraded }
+                        // The estimate's own time is on the mission clock only when that is the
+                        // sim's; else (wall time) the window times it when heard.
+                        let on_clock = lock(&self.inputs.clock).heard();
+                        let time_s = if on_clock { e.time_s } else { f64::NAN };
+                        WindowEvent::Estimate { position: e.position, peb_m: e.peb_m, degraded: e.degraded, time_s }
                     }
                     sample = self.inputs.statuses.recv_async() => {
                         let Ok(sample) = sample else { return Err(ExecutiveError::Cancelled) };

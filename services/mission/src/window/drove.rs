@@ -38,6 +38,11 @@ pub const MIN_LEARNED_DRIVE_M: f64 = 1.0;
 /// learned, metres: farther, the route does not say what it drove.
 pub const MAX_LEARNED_OFF_ROUTE_M: f64 = 1.0;
 
+/// The most replaced missions a window learns from (limit `max_learned_drives`): a
+/// window replans at most `max_replans` times, but going straight and recovering are
+/// not counted there.
+pub const MAX_LEARNED_DRIVES: usize = 64;
+
 /// How far from where its route was sent the robot is still standing, metres.
 pub const STANDING_M: f64 = 0.05;
 

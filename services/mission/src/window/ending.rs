@@ -35,13 +35,12 @@ impl DowntimeWindow<'_> {
             driving_s: took_s,
             driven_share: self.share_driven(at_s - drive.first_sent_at_s),
         };
-        let arrived = WindowAction::Arrived {
-            at_s,
-            drive: DrivenMission {
-                path: driven.to_vec(),
-                took_s,
-            },
-        };
+        let mut drives = std::mem::take(&mut drive.drives);
+        drives.push(DrivenMission {
+            path: driven.to_vec(),
+            took_s,
+        });
+        let arrived = WindowAction::Arrived { at_s, drives };
         let outcome = self.outcome(*drive, Some(at_s), time_model);
         let task = &self.setup.task;
         let leave_at_s = task.start_s + task.duration_s;

@@ -28,11 +28,17 @@ pub struct Now {
 /// What the executive hears.
 #[derive(Debug, Clone, PartialEq)]
 pub enum WindowEvent {
-    /// Localization's estimate of the robot; a degraded one is ignored.
+    /// Localization's estimate of the robot; a degraded one is ignored. `time_s` is
+    /// its own time on the mission clock (the step it was made at), not when it was
+    /// heard: drives are timed by it (`drove.rs`), so that the live executive, which
+    /// hears it late by a varying lag, and the batch, which hears it at once, time
+    /// them alike. Not a number when the estimate's time is not on the mission clock
+    /// (a wall-clock mission): then the time it was heard.
     Estimate {
         position: [f64; 2],
         peb_m: Option<f64>,
         degraded: bool,
+        time_s: f64,
     },
     /// The controller's status on this robot, on whichever mission.
     Status(ControllerStatus),
@@ -87,11 +93,13 @@ pub enum WindowAction {
     /// The PEB guard held the robot too long: it is driven back to where it had a fix.
     Recovering { held_s: f64 },
     /// The robot reached the task's place; the time model's calibration learns from
-    /// `drive`.
-    Arrived { at_s: f64, drive: DrivenMission },
-    /// A mission the robot was driving normally was replaced; the time model's
-    /// calibration learns from the part of it driven (`drove.rs`).
-    Drove { drive: DrivenMission },
+    /// `drives`: the parts driven of the window's missions that replans replaced
+    /// (`drove.rs`), then the mission that arrived. Learned at the arrival, not as
+    /// they are driven: the window plans, checks and replans with one time model.
+    Arrived {
+        at_s: f64,
+        drives: Vec<DrivenMission>,
+    },
     /// The window is given up.
     GaveUp,
     /// The task was over before the window began.

@@ -17,6 +17,7 @@ impl DowntimeWindow<'_> {
         position: [f64; 2],
         peb_m: Option<f64>,
         degraded: bool,
+        time_s: f64,
         now: Now,
     ) -> Vec<WindowAction> {
         // At the task (or done) the drive is over: nothing more is recorded.
@@ -25,9 +26,14 @@ impl DowntimeWindow<'_> {
             return Vec::new();
         }
         self.here = position;
-        self.here_at_s = now.mission_s;
+        // A time that is not a number (a peer's) is the time it was heard.
+        self.here_at_s = if time_s.is_finite() {
+            time_s
+        } else {
+            now.mission_s
+        };
         if let Phase::Driving(drive) = &mut self.phase {
-            drove::still_at_start(drive, position, now.mission_s);
+            drove::still_at_start(drive, position, self.here_at_s);
         }
         self.driven.push(position);
         self.pebs.extend(peb_m);

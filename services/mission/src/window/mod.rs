@@ -30,9 +30,10 @@
 //!    robot will be when the plan comes (the point that far along its route), so
 //!    planning costs the window nothing. A curious request that fails is followed by
 //!    one for the shortest path; when that fails too, the window's own fastest path.
-//! 4. **The last safe moment.** At most every [`SAFE_CHECK_S`] on a curious route, the
-//!    window computes the fastest path from where the robot is; when the budget the
-//!    arrival margin leaves of the time left, less twice the check's period, no
+//! 4. **The last safe moment.** Once in each [`SAFE_CHECK_S`] of the mission clock on a
+//!    curious route, the window computes the fastest path from where the robot's last
+//!    estimate put it; when the budget the arrival margin leaves of the time left from
+//!    that estimate's time, less twice the check's period, no
 //!    longer exceeds that path's time, the robot goes straight, at once, without the
 //!    planner, and never curious again in the window (until the next check the
 //!    curious route may lead the robot away from the task, and back costs as much). A
@@ -43,7 +44,8 @@
 //!    [`RECOVERY_BACK_M`] back (where the fix is lost the estimate freezes), which the guard
 //!    lets through, then sends it straight to the task from there (a curious route would
 //!    lead back into the gap). At most [`MAX_RECOVERIES`] a window.
-//! 6. **Arrive**: the time model's prediction is scored, the arrival margin learns, and
+//! 6. **Arrive**: the time model's prediction is scored, the arrival margin learns, the
+//!    calibration gets the window's drives (`drove.rs`), and
 //!    the window is done when the task ends (and the next window's plan is in, or
 //!    failed). **Give up**: done at once.
 //!
@@ -188,7 +190,8 @@ impl<'a> DowntimeWindow<'a> {
                 position,
                 peb_m,
                 degraded,
-            } => self.on_estimate(position, peb_m, degraded, now),
+                time_s,
+            } => self.on_estimate(position, peb_m, degraded, time_s, now),
             WindowEvent::Status(status) => self.on_status(&status, now),
             WindowEvent::Tick => self.on_tick(now),
             WindowEvent::PlanReply { id, plan } => self.on_reply(id, Some(*plan), now),
@@ -240,6 +243,7 @@ impl<'a> DowntimeWindow<'a> {
             first_sent_at_s: now.mission_s,
             sent_at_s: now.mission_s,
             sent_here: (self.here, now.mission_s),
+            drives: Vec::new(),
             watch,
             reasons: Vec::new(),
             safe_checked_at_s: f64::NEG_INFINITY,

@@ -32,15 +32,29 @@ impl DowntimeWindow<'_> {
         let Phase::Driving(drive) = &mut self.phase else {
             return Vec::new();
         };
+        // The check is of where the robot was seen and when: its last estimate, while
+        // that is fresher than a check's period (else the clock's time, so a robot not
+        // heard from is checked all the same). And it runs once in each period of
+        // SAFE_CHECK_S on the mission clock, counted from 0, not from the last check:
+        // a check's time never drifts with the events that happened to run it, so the
+        // live executive (whose ticks come before a step's estimate, between steps)
+        // and the batch check the same estimates.
+        let seen_s = if now.mission_s - self.here_at_s < SAFE_CHECK_S {
+            self.here_at_s
+        } else {
+            now.mission_s
+        };
         let watched = drive.route_curious && !drive.recovering && !drive.watch.slipped();
-        if !watched || now.mission_s - drive.safe_checked_at_s < SAFE_CHECK_S {
+        let period = |t: f64| (t / SAFE_CHECK_S).floor();
+        if !watched || period(seen_s) <= period(drive.safe_checked_at_s) {
             return Vec::new();
         }
-        drive.safe_checked_at_s = now.mission_s;
-        // The next check may come `SAFE_CHECK_S` later, and the curious route may take
-        // the robot that long away from the task, which costs as long again to come
-        // back: the rule fires when waiting for the next check would leave too little.
-        let time_left = self.setup.task.start_s - now.mission_s - 2.0 * SAFE_CHECK_S;
+        drive.safe_checked_at_s = seen_s;
+        // The next check may come up to `SAFE_CHECK_S` later (more, by a step), and the
+        // curious route may take the robot that long away from the task, which costs as
+        // long again to come back: the rule fires when waiting for the next check would
+        // leave too little.
+        let time_left = self.setup.task.start_s - seen_s - 2.0 * SAFE_CHECK_S;
         let budget = self.margin.budget(time_left);
         // What is left of the route is a way to the task, so the fastest path takes no
         // longer: while the budget covers the route left, no search is needed (on a
@@ -117,10 +131,13 @@ impl DowntimeWindow<'_> {
         drive.sent_holds = drive.holds;
         drive.sent_here = (self.here, self.here_at_s);
         drive.path = path;
-        let mut actions = vec![WindowAction::Replanned { reason }];
-        actions.extend(drove.map(|drive| WindowAction::Drove { drive }));
-        actions.push(WindowAction::Drive(mission));
-        actions
+        if drive.drives.len() < drove::MAX_LEARNED_DRIVES {
+            drive.drives.extend(drove);
+        }
+        vec![
+            WindowAction::Replanned { reason },
+            WindowAction::Drive(mission),
+        ]
     }
 
     /// The drive's request in flight is forgotten (its answer will be dropped).

@@ -7,7 +7,7 @@ use roam_proto::mission::AskReport;
 use crate::margin::ArrivalMargin;
 use crate::watch::{Reason, Replanned, Watch};
 
-use super::events::PlanAsk;
+use super::events::{DrivenMission, PlanAsk};
 use super::handover::WindowOutcome;
 use super::routes::PlannedAhead;
 use super::setup::WindowSetup;
@@ -86,6 +86,8 @@ pub(super) struct Drive {
     pub(super) route_curious: bool,
     pub(super) first_sent_at_s: f64,
     pub(super) sent_at_s: f64,
+    /// The parts driven of the routes replans replaced, learned at the arrival.
+    pub(super) drives: Vec<DrivenMission>,
     /// Where the robot was when the current route was sent, and when it was there
     /// (its last estimate's time; the route's time if it stood still).
     pub(super) sent_here: ([f64; 2], f64),

@@ -243,6 +243,7 @@ impl<'a> InProcessExecutive<'a> {
                 position: e.position,
                 peb_m: e.peb_m,
                 degraded: e.degraded,
+                time_s: e.time_s,
             });
         }
         if let (Some(d), Some((id, waypoints, route))) = (step.decision, &current.log.mission) {
@@ -401,10 +402,12 @@ impl<'a> InProcessExecutive<'a> {
                     WindowAction::Planned { curious, .. } => {
                         log.first_curious.get_or_insert(curious);
                     }
-                    WindowAction::Arrived { drive, .. } | WindowAction::Drove { drive } => {
+                    WindowAction::Arrived { drives, .. } => {
                         if self.config.calibrate {
-                            let (d, theta) = path_measure(&drive.path);
-                            self.calibration.add_planned(d, theta, drive.took_s);
+                            for drive in drives {
+                                let (d, theta) = path_measure(&drive.path);
+                                self.calibration.add_planned(d, theta, drive.took_s);
+                            }
                         }
                     }
                     WindowAction::Done(end) => return Ok(Some(*end)),

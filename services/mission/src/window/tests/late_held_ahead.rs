@@ -10,7 +10,7 @@ fn at_the_last_safe_moment_the_robot_goes_straight_and_stays_straight() {
     // On its curious route at 95 s, 5 s before the task: the fastest path from here
     // takes longer than what the margin leaves of 5 s.
     let here = [0.1, 1.1];
-    let actions = w.handle(estimate(here, 0.1), at(95.0, 0.5));
+    let actions = w.handle(estimate(here, 0.1, 95.0), at(95.0, 0.5));
     assert_eq!(
         actions[0],
         WindowAction::Replanned {
@@ -58,7 +58,7 @@ fn the_last_safe_moment_leaves_room_for_a_check_away_and_back() {
     // path's time between these two moments.
     let fires = |t: f64| {
         let (mut w, _) = f.driving(false);
-        let actions = w.handle(estimate(here, 0.1), at(t, 0.5));
+        let actions = w.handle(estimate(here, 0.1, t), at(t, 0.5));
         actions.first()
             == Some(&WindowAction::Replanned {
                 reason: Reason::LastSafeMoment,
@@ -92,7 +92,7 @@ fn a_robot_held_for_its_peb_is_driven_back_to_its_last_fix_then_replanned() {
         ([0.1, 0.7], 3.0),
         ([0.1, 0.9], 9.0),
     ] {
-        assert!(w.handle(estimate(p, peb), at(5.0, 0.1)).is_empty());
+        assert!(w.handle(estimate(p, peb, 5.0), at(5.0, 0.1)).is_empty());
     }
     let held = |w: &mut DowntimeWindow<'_>, t: f64| {
         w.handle(status(&first.id, MissionState::HaltedPeb, 2.0), at(t, 0.2))
@@ -151,7 +151,7 @@ fn with_plan_ahead_the_next_window_is_asked_while_driving_beside_a_replan() {
     );
     // A replan while the next window's plan is made: two in flight.
     let pushed = [2.0, 2.5];
-    let replan = asked(&w.handle(estimate(pushed, 0.1), at(3.0, 0.1)));
+    let replan = asked(&w.handle(estimate(pushed, 0.1, 3.0), at(3.0, 0.1)));
     assert_ne!(replan.id, ahead.id);
     assert_eq!(w.asks_in_flight(), 2);
     let next_route = line(GOAL, NEXT);
@@ -206,7 +206,7 @@ fn a_robot_held_across_windows_is_driven_back_along_the_previous_track() {
     let (mut w, _) = DowntimeWindow::begin(f.setup(0, FROM, false), handover, at(0.0, 0.0));
     let first = sent(&answer(&mut w, curious_reply(true), at(1.0, 0.0)));
     // Held at once, its estimates without a fix.
-    assert!(w.handle(estimate(FROM, 9.0), at(2.0, 0.1)).is_empty());
+    assert!(w.handle(estimate(FROM, 9.0, 2.0), at(2.0, 0.1)).is_empty());
     let held = |w: &mut DowntimeWindow<'_>, t: f64| {
         w.handle(status(&first.id, MissionState::HaltedPeb, 2.0), at(t, 0.2))
     };
@@ -273,5 +273,30 @@ fn a_held_robot_whose_controller_reports_is_not_called_silent() {
             .iter()
             .any(|a| matches!(a, WindowAction::RequestPlan(_))),
         "{quiet:?}"
+    );
+}
+
+/// The last safe moment is checked once in each second of the mission clock (counted
+/// from 0, not from the last check), at the robot's last estimate: near the task at
+/// 94.6 s it is safe; a tick at 95.1 s, the estimate still from 94.6 s, checks nothing
+/// new; the robot seen far back on its route at 95.2 s is checked (a new second, though
+/// less than a second after the last check), and it goes straight.
+#[test]
+fn the_last_safe_moment_is_checked_once_a_second_at_the_last_estimate() {
+    let f = fixture();
+    let (mut w, _) = f.driving(false);
+    let near = [3.1, 0.3];
+    assert!(w
+        .handle(estimate(near, 0.1, 94.6), at(94.6, 0.5))
+        .is_empty());
+    assert!(w.handle(WindowEvent::Tick, at(95.1, 0.5)).is_empty());
+    let far = [0.1, 1.1];
+    let actions = w.handle(estimate(far, 0.1, 95.2), at(95.2, 0.5));
+    assert_eq!(
+        actions.first(),
+        Some(&WindowAction::Replanned {
+            reason: Reason::LastSafeMoment
+        }),
+        "{actions:?}"
     );
 }

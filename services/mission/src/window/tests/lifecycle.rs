@@ -85,23 +85,28 @@ fn estimates_are_recorded_and_fed_to_the_watch() {
     let f = fixture();
     let (mut w, _) = f.driving(false);
     let on_path = [0.1, 0.5];
-    assert!(w.handle(estimate(on_path, 0.2), at(2.0, 0.1)).is_empty());
+    assert!(w
+        .handle(estimate(on_path, 0.2, 2.0), at(2.0, 0.1))
+        .is_empty());
     // A degraded estimate is neither recorded nor watched, however far off.
     let degraded = WindowEvent::Estimate {
         position: [3.9, 3.9],
         peb_m: Some(9.0),
         degraded: true,
+        time_s: 2.5,
     };
     assert!(w.handle(degraded, at(2.5, 0.2)).is_empty());
     // Pushed off the path: a curious replan from where the robot is.
     let pushed = [2.0, 2.5];
-    let actions = w.handle(estimate(pushed, 0.4), at(3.0, 0.3));
+    let actions = w.handle(estimate(pushed, 0.4, 3.0), at(3.0, 0.3));
     let ask = asked(&actions);
     assert_eq!((ask.from, ask.curious), (pushed, true));
     assert!(close(ask.t_exec_s, margin().budget(96.0)), "{ask:?}");
     // While the plan is being made, estimates are recorded, nothing is decided.
     let waiting = [2.0, 2.7];
-    assert!(w.handle(estimate(waiting, 0.6), at(3.1, 0.3)).is_empty());
+    assert!(w
+        .handle(estimate(waiting, 0.6, 3.1), at(3.1, 0.3))
+        .is_empty());
     assert!(w.handle(WindowEvent::Tick, at(3.2, 9.0)).is_empty());
     let route = line(pushed, [2.0, 0.1]);
     let reply = reply(Plan {
@@ -145,10 +150,10 @@ fn arrival_ends_the_window_with_its_report_when_the_task_ends() {
         actions,
         vec![WindowAction::Arrived {
             at_s: 80.0,
-            drive: DrivenMission {
+            drives: vec![DrivenMission {
                 path: path.clone(),
                 took_s: 79.0
-            }
+            }]
         }],
         "no next task: nothing to plan"
     );
@@ -219,7 +224,7 @@ fn stuck_replans_the_shortest_way_and_the_report_counts_it() {
     let f = fixture();
     let (mut w, first) = f.driving(false);
     let here = [0.1, 0.7];
-    assert!(w.handle(estimate(here, 0.1), at(5.0, 0.1)).is_empty());
+    assert!(w.handle(estimate(here, 0.1, 5.0), at(5.0, 0.1)).is_empty());
     let actions = w.handle(status(&first.id, MissionState::Stuck, 8.0), at(6.0, 0.2));
     let ask = asked(&actions);
     assert_eq!((ask.from, ask.curious), (here, false));
@@ -243,8 +248,12 @@ fn stuck_replans_the_shortest_way_and_the_report_counts_it() {
         status(&second.id, MissionState::Completed, 0.0),
         at(30.0, 0.5),
     );
-    let WindowAction::Arrived { drive, .. } = &actions[0] else {
+    let WindowAction::Arrived { drives, .. } = &actions[0] else {
         panic!("{actions:?}");
+    };
+    // Stuck: the replaced mission teaches nothing.
+    let [drive] = &drives[..] else {
+        panic!("{drives:?}")
     };
     let path: Vec<[f64; 2]> = std::iter::once(here).chain(shortest_points(here)).collect();
     assert_eq!(

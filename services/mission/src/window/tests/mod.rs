@@ -274,11 +274,13 @@ fn shortest_reply(from: [f64; 2]) -> WindowEvent {
     })
 }
 
-fn estimate(position: [f64; 2], peb_m: f64) -> WindowEvent {
+/// An estimate made at `time_s`.
+fn estimate(position: [f64; 2], peb_m: f64, time_s: f64) -> WindowEvent {
     WindowEvent::Estimate {
         position,
         peb_m: Some(peb_m),
         degraded: false,
+        time_s,
     }
 }
 

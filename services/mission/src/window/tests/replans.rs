@@ -6,7 +6,9 @@ use super::*;
 /// The robot on the curious path at 7 s, 2 m from the task: at the model's 0.5 m/s it
 /// arrives at 11 s, 89 s early. Slack.
 fn slack(w: &mut DowntimeWindow<'_>, mission: &Mission) -> Vec<WindowAction> {
-    assert!(w.handle(estimate([0.1, 0.9], 0.1), at(6.0, 0.1)).is_empty());
+    assert!(w
+        .handle(estimate([0.1, 0.9], 0.1, 6.0), at(6.0, 0.1))
+        .is_empty());
     w.handle(status(&mission.id, MissionState::Active, 2.0), at(7.0, 0.2))
 }
 
@@ -61,7 +63,7 @@ fn a_seeded_replan_leads_and_is_budgeted_by_its_own_cost() {
         ..at(mission_s, wall_s)
     };
     assert!(w
-        .handle(estimate([0.1, 0.9], 0.1), cheap(6.0, 0.1))
+        .handle(estimate([0.1, 0.9], 0.1, 6.0), cheap(6.0, 0.1))
         .is_empty());
     let actions = w.handle(
         status(&first.id, MissionState::Active, 2.0),
@@ -120,7 +122,7 @@ fn a_failed_curious_replan_falls_back_to_the_shortest_path() {
     let f = fixture();
     let (mut w, _) = f.driving(false);
     let pushed = [2.0, 2.5];
-    let actions = w.handle(estimate(pushed, 0.1), at(3.0, 0.1));
+    let actions = w.handle(estimate(pushed, 0.1, 3.0), at(3.0, 0.1));
     assert!(asked(&actions).curious);
     let actions = answer(&mut w, failed(), at(3.5, 0.2));
     let ask = asked(&actions);
@@ -182,10 +184,12 @@ fn a_lost_mission_is_sent_again_from_where_the_robot_is() {
     );
 }
 
-/// The robot 3 m along its curious route (1 m north, 2 m east) at 6 s, when a slack
-/// replan's answer comes at 8 s: the mission it drove since 1 s is learned from, up to
-/// the route's point nearest the robot's last estimate and until that estimate; after
-/// a hold on the way it is not (that time was not driving).
+/// The robot 3 m along its curious route (1 m north, 2 m east) by its estimate made at
+/// 5.5 s (heard at 6 s), when a slack replan's answer comes at 8 s: at the arrival the
+/// window's drives are the replaced mission's part driven (from 1 s, when it was sent
+/// with the robot standing at FROM, to the estimate's own 5.5 s, up to the route's
+/// point nearest it), then the mission that arrived. After a hold on the way the
+/// replaced mission teaches nothing (that time was not driving).
 #[test]
 fn a_replaced_mission_teaches_the_time_model_what_was_driven_unless_held() {
     let f = fixture();
@@ -197,26 +201,29 @@ fn a_replaced_mission_teaches_the_time_model_what_was_driven_unless_held() {
                 at(3.0, 0.1),
             );
         }
-        assert!(w.handle(estimate([2.1, 1.2], 0.1), at(6.0, 0.1)).is_empty());
+        assert!(w
+            .handle(estimate([2.1, 1.2], 0.1, 5.5), at(6.0, 0.1))
+            .is_empty());
         let actions = w.handle(status(&first.id, MissionState::Active, 2.0), at(7.0, 0.2));
         assert!(asked(&actions).curious);
-        let actions = answer(&mut w, curious_reply(true), at(8.0, 0.3));
-        let drove: Vec<&DrivenMission> = actions
-            .iter()
-            .filter_map(|a| match a {
-                WindowAction::Drove { drive } => Some(drive),
-                _ => None,
-            })
-            .collect();
+        let second = sent(&answer(&mut w, curious_reply(true), at(8.0, 0.3)));
+        let actions = w.handle(
+            status(&second.id, MissionState::Completed, 0.0),
+            at(20.0, 0.5),
+        );
+        let WindowAction::Arrived { drives, .. } = &actions[0] else {
+            panic!("{actions:?}");
+        };
+        let arrival = drives.last().expect("the arrival");
+        assert_eq!(arrival.took_s, 14.5, "from the estimate it was sent on");
         if held {
-            assert!(drove.is_empty(), "{actions:?}");
+            assert_eq!(drives.len(), 1, "{drives:?}");
             continue;
         }
-        let [drove] = drove[..] else {
-            panic!("one drive learned: {actions:?}")
+        let [drove, _] = &drives[..] else {
+            panic!("the replaced mission and the arrival: {drives:?}")
         };
-        // From 1 s (sent with the robot standing at FROM) to 6 s (the estimate).
-        assert_eq!(drove.took_s, 5.0);
+        assert_eq!(drove.took_s, 4.5);
         assert_eq!(drove.path.first(), Some(&FROM));
         let end = *drove.path.last().expect("a path");
         assert!(distance(end, [2.1, 1.1]) < 1e-9, "{drove:?}");
@@ -229,17 +236,20 @@ fn a_replaced_mission_teaches_the_time_model_what_was_driven_unless_held() {
 fn a_drive_is_timed_from_when_the_robot_leaves_where_it_was_sent() {
     let f = fixture();
     let (mut w, first) = f.driving(false);
-    assert!(w.handle(estimate(FROM, 0.1), at(2.0, 0.1)).is_empty());
+    assert!(w.handle(estimate(FROM, 0.1, 2.0), at(2.0, 0.1)).is_empty());
     assert!(w
-        .handle(estimate([0.11, 0.1], 0.1), at(3.0, 0.1))
+        .handle(estimate([0.11, 0.1], 0.1, 3.0), at(3.0, 0.1))
         .is_empty());
-    assert!(w.handle(estimate([0.1, 0.5], 0.1), at(4.0, 0.1)).is_empty());
+    assert!(w
+        .handle(estimate([0.1, 0.5], 0.1, 4.0), at(4.0, 0.1))
+        .is_empty());
     let actions = w.handle(
         status(&first.id, MissionState::Completed, 0.0),
         at(30.0, 0.5),
     );
-    let WindowAction::Arrived { drive, .. } = &actions[0] else {
+    let WindowAction::Arrived { drives, .. } = &actions[0] else {
         panic!("{actions:?}");
     };
-    assert_eq!(drive.took_s, 27.0);
+    assert_eq!(drives.len(), 1, "{drives:?}");
+    assert_eq!(drives[0].took_s, 27.0);
 }

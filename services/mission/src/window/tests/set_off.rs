@@ -73,7 +73,7 @@ fn no_slack_when_a_replan_would_only_keep_the_earliness_back_as_its_margin() {
     let (mut w, _) = DowntimeWindow::begin(setup, Handover::first(wide()), at(60.0, 0.0));
     let first = sent(&answer(&mut w, curious_reply(true), at(61.0, 0.0)));
     assert!(w
-        .handle(estimate([0.1, 0.9], 0.1), at(80.0, 0.1))
+        .handle(estimate([0.1, 0.9], 0.1, 80.0), at(80.0, 0.1))
         .is_empty());
     // At 80 s, 6 m left at 0.5 m/s: 12 s of drive, 8 s early. A replan asked now would
     // get (20 − 1 − 2) / 1.25 = 13.6 s: 1.6 s more than the drive, under slack_s.
