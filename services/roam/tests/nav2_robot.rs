@@ -23,12 +23,14 @@ use roam_runtime::SessionArgs;
 use roam_stack::router::free_loopback_port;
 
 /// How close the fitted v_lin must come to the robot's, where Table I's prior (2 s/m)
-/// is 20% off. Measured on this 2-core machine: +0.7% to +1.7% over five days, +1.2%
-/// twice with a core kept busy. Learning from arrivals alone, timed when the executive
-/// heard of them (before the window's drives were timed by the estimates' own times),
-/// the same day ended −8.9% to +7.5% off: the prior outweighed a seeded replan's short
-/// last mission, and at a clock ten times wall time the lag of what was heard is a
-/// second of a drive.
+/// is 20% off. Measured on this 2-core machine: +0.1% to +1.7% over three days,
+/// +1.3% to +1.4% over three with a core kept busy; with both cores kept busy +0.5%
+/// and once +8.9% (a mission then takes seconds of simulated time to reach the robot,
+/// which drives on along its old route meanwhile). Learning from arrivals alone, timed
+/// when the executive heard of them (before the window's drives were timed by the
+/// estimates' own times), the same day ended −8.9% to +7.5% off: the prior outweighed
+/// a seeded replan's short last mission, and at a clock ten times wall time the lag of
+/// what was heard is a second of a drive.
 const V_LIN_TOLERANCE: f64 = 0.05;
 
 /// The fake robot's speed, m/s of simulated time, and its clock's rate.

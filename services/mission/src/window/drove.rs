@@ -7,8 +7,8 @@
 //! `prior_distance_m`) outweighed them. So the part of a replaced mission the robot
 //! drove is learned as well. Only a mission the robot was following normally teaches:
 //! replaced for slack, for being behind, for lateness, at the last safe moment, or by
-//! the plan asked as it set off; not one it was held on, pushed off, stuck on or
-//! recovering on (that time is not driving), and not when the robot is more than
+//! the plan asked as it set off (or arrived); not one it was held on, pushed off,
+//! stuck on or recovering on (that time is not driving), and not when the robot is more than
 //! [`MAX_LEARNED_OFF_ROUTE_M`] from the route or drove less than
 //! [`MIN_LEARNED_DRIVE_M`] of it.
 //!
@@ -17,12 +17,15 @@
 //! (not from the route's first point: a replan's route starts where the robot was
 //! expected to be when the plan came, and a plan that came early or late leaves the
 //! robot short of that point or past it). It is timed between the estimates that put
-//! the robot there (heard with the same lag, so the lag cancels), or for an arrival
-//! until the controller's status said so. A robot still within [`STANDING_M`] of
-//! where its route was sent has not begun to drive it (the mission is on its way, or
-//! it turns toward the path, a turn Eq. 2's Σθ does not count): the drive is timed
-//! from its last estimate there. At a clock ten times wall time, a tenth of a second
-//! for a mission to reach the robot is a second of its drive.
+//! the robot there, by their own times (`WindowEvent::Estimate::time_s`): what is
+//! heard comes late by a lag that is not driving, and at a clock ten times wall time a
+//! tenth of a second of lag is a second of a drive. An arrival is learned the same way,
+//! up to the robot's last estimate (the controller's status that it arrived is heard
+//! later still; the arrival margin, which is about the window's time, learns from
+//! that, from the route's sending). A robot still within [`STANDING_M`] of where its
+//! route was sent has not begun to drive it (the mission is on its way, or it turns
+//! toward the path, a turn Eq. 2's Σθ does not count): the drive is timed from its
+//! last estimate there.
 
 use super::events::DrivenMission;
 use super::state::Drive;

@@ -5,8 +5,8 @@
 
 use roam_proto::mission::{TimeModelReport, WindowReport, MAX_REPORTED_ASKS};
 
-use super::drove::from_where_sent;
-use super::events::{DrivenMission, Now, WindowAction};
+use super::drove::{driven_part, from_where_sent};
+use super::events::{Now, WindowAction};
 use super::handover::{Handover, WindowEnd, WindowOutcome};
 use super::setup::NO_PLAN_REASON;
 use super::state::{DowntimeWindow, Drive, Phase};
@@ -18,14 +18,15 @@ impl DowntimeWindow<'_> {
             return Vec::new();
         };
         let mut drive = drive;
+        let held = drive.held_since_s.is_some() || drive.holds != drive.sent_holds;
         if let Some(since) = drive.held_since_s.take() {
             drive.held_s += at_s - since;
         }
         let model = self.setup.time_model;
-        let (sent_here, sent_here_at_s) = drive.sent_here;
-        let took_s = at_s - sent_here_at_s;
-        let driven = from_where_sent(&drive.path, sent_here);
-        let (d, theta) = path_measure(driven);
+        // The margin learns the window's own arrival: from the route's sending to the
+        // arrival heard, over the route from where the robot was when it was sent.
+        let took_s = at_s - drive.sent_at_s;
+        let (d, theta) = path_measure(from_where_sent(&drive.path, drive.sent_here.0));
         let predicted_s = model.eta(d, theta);
         self.margin.learn(predicted_s, took_s);
         let time_model = TimeModelReport {
@@ -35,11 +36,16 @@ impl DowntimeWindow<'_> {
             driving_s: took_s,
             driven_share: self.share_driven(at_s - drive.first_sent_at_s),
         };
+        // The calibration learns the robot's driving: as a replaced route's, timed by
+        // the estimates (the arrival is heard later, by a lag that is not driving).
         let mut drives = std::mem::take(&mut drive.drives);
-        drives.push(DrivenMission {
-            path: driven.to_vec(),
-            took_s,
-        });
+        if !held {
+            drives.extend(driven_part(
+                &drive.path,
+                drive.sent_here,
+                (self.here, self.here_at_s),
+            ));
+        }
         let arrived = WindowAction::Arrived { at_s, drives };
         let outcome = self.outcome(*drive, Some(at_s), time_model);
         let task = &self.setup.task;

@@ -93,9 +93,10 @@ pub enum WindowAction {
     /// The PEB guard held the robot too long: it is driven back to where it had a fix.
     Recovering { held_s: f64 },
     /// The robot reached the task's place; the time model's calibration learns from
-    /// `drives`: the parts driven of the window's missions that replans replaced
-    /// (`drove.rs`), then the mission that arrived. Learned at the arrival, not as
-    /// they are driven: the window plans, checks and replans with one time model.
+    /// `drives`: the parts driven of the window's missions that replans replaced, then
+    /// the one that arrived, up to the robot's last estimate (`drove.rs`). Learned at
+    /// the arrival, not as they are driven: the window plans, checks and replans with
+    /// one time model.
     Arrived {
         at_s: f64,
         drives: Vec<DrivenMission>,
