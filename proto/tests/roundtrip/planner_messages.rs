@@ -229,13 +229,13 @@ proptest! {
     }
 }
 
-/// Requests, cancels and plans written before cancel tokens and the CPU budget
-/// still decode: the new fields default to absent.
+/// Requests, cancels and plans without cancel tokens and the CPU budget (a peer that
+/// does not know those fields) decode: the fields default to absent.
 #[test]
-fn messages_from_before_cancel_tokens_still_decode() {
+fn messages_without_cancel_tokens_decode() {
     let cancel: CancelPlan =
         decode(br#"{"v":1,"kind":"cancel_plan","body":{"request_id":"trip-42"}}"#)
-            .expect("an old cancel");
+            .expect("a cancel without a token");
     assert_eq!(
         cancel,
         CancelPlan {
@@ -246,7 +246,7 @@ fn messages_from_before_cancel_tokens_still_decode() {
     let request: PlanRequest = decode(
         br#"{"v":1,"kind":"plan_request","body":{"start":[0,0],"goal":[1,1],"t_exec_s":10,"deadline_s":1,"model":"model1"}}"#,
     )
-    .expect("an old request");
+    .expect("a request without the field");
     assert_eq!((request.request_id, request.cancel_token), (None, None));
     // And a request without a token is written without the field.
     let text = String::from_utf8(encode(&CancelPlan {
@@ -257,15 +257,16 @@ fn messages_from_before_cancel_tokens_still_decode() {
     assert!(!text.contains("token"), "{text}");
 }
 
-/// A request that does not ask for the shortest path is written as before the field
-/// (so a planner from before it reads it), and a plan without one likewise (so a
-/// client from before it reads the reply); an old request means `omit`.
+/// A request that does not ask for the shortest path is written without the field (a
+/// planner that does not know it reads the request), and a plan without one likewise
+/// (a client that does not know it reads the reply); a request without the field means
+/// `omit`.
 #[test]
 fn the_shortest_path_fields_are_absent_unless_asked_for() {
     let request: PlanRequest = decode(
         br#"{"v":1,"kind":"plan_request","body":{"start":[0,0],"goal":[1,1],"t_exec_s":10,"deadline_s":1,"model":"model1"}}"#,
     )
-    .expect("an old request");
+    .expect("a request without the field");
     assert_eq!(request.shortest, ShortestPathUse::Omit);
     let text = String::from_utf8(encode(&request)).expect("utf-8");
     assert!(!text.contains("shortest"), "{text}");

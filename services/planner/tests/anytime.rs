@@ -4,17 +4,10 @@
 
 mod common;
 
-use std::sync::atomic::AtomicBool;
-
-use common::check_geometry;
+use common::{check_geometry, run};
 use roam_planner::best::PlanSource;
-use roam_planner::plan::{plan, PlanOutcome, PlanSpec};
-use roam_planner::world::World;
+use roam_planner::plan::PlanSpec;
 use roam_proto::planner::{PlanRequest, PlannerModel, ShortestPathUse};
-
-fn run(world: &World, spec: &PlanSpec) -> PlanOutcome {
-    plan(world, spec, &AtomicBool::new(false), |_, _| {}).expect("plan")
-}
 
 #[test]
 fn anytime_is_never_below_the_greedy_answer_and_says_which_it_returns() {

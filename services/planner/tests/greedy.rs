@@ -4,16 +4,9 @@
 
 mod common;
 
-use std::sync::atomic::AtomicBool;
-
-use common::check_geometry;
-use roam_planner::plan::{plan, PlanOutcome, PlanSpec};
-use roam_planner::world::World;
+use common::{check_geometry, run};
+use roam_planner::plan::PlanSpec;
 use roam_proto::planner::{PlannerModel, StopReason};
-
-fn run(world: &World, spec: &PlanSpec) -> PlanOutcome {
-    plan(world, spec, &AtomicBool::new(false), |_, _| {}).expect("plan")
-}
 
 #[test]
 fn greedy_plans_are_legal_repeatable_and_more_informative_than_the_shortest_path() {

@@ -4,31 +4,9 @@
 
 mod common;
 
-use std::sync::atomic::AtomicBool;
-
-use common::check_geometry;
-use roam_planner::plan::{plan, PlanOutcome, PlanSpec};
+use common::{check_geometry, run, small_spec};
 use roam_planner::world::World;
 use roam_proto::planner::PlannerModel;
-
-/// `model`, population 60, `generations`, two threads.
-fn spec(
-    model: PlannerModel,
-    start: [f64; 2],
-    goal: [f64; 2],
-    t_exec_s: f64,
-    seed: u64,
-    generations: u32,
-) -> PlanSpec {
-    let mut spec = PlanSpec::batch(start, goal, t_exec_s, model, generations, seed);
-    spec.params.population = 60;
-    spec.threads = 2;
-    spec
-}
-
-fn run(world: &World, spec: &PlanSpec) -> PlanOutcome {
-    plan(world, spec, &AtomicBool::new(false), |_, _| {}).expect("plan")
-}
 
 /// An open 60 × 40 world with a band of unbounded PEB (no fix) across the middle, 2 m
 /// wide, except a gap at the top; elsewhere 0.1 m.
@@ -56,7 +34,7 @@ fn the_localizability_cost_keeps_plans_out_of_poorly_covered_cells() {
             .map(|&c| f64::from(world.localizability[c as usize]))
             .sum()
     };
-    let base = spec(PlannerModel::Model1, [1.0, 2.0], [11.0, 2.0], 60.0, 5, 800);
+    let base = small_spec(PlannerModel::Model1, [1.0, 2.0], [11.0, 2.0], 60.0, 5, 800);
     let free = run(&world, &base);
     assert_eq!(free.fitness.f6_localizability, 0.0, "off by default");
     let mut costed_spec = base.clone();
@@ -82,7 +60,7 @@ fn the_localizability_cost_keeps_plans_out_of_poorly_covered_cells() {
 #[test]
 fn the_forgiven_peb_costs_nothing_where_the_floor_is_covered() {
     let world = world_with_a_band_without_a_fix();
-    let mut s = spec(PlannerModel::Model1, [1.0, 2.0], [11.0, 2.0], 60.0, 5, 800);
+    let mut s = small_spec(PlannerModel::Model1, [1.0, 2.0], [11.0, 2.0], 60.0, 5, 800);
     s.params.w_loc = 20_000.0;
     s.params.peb_free_m = 0.5;
     let forgiven = run(&world, &s);

@@ -5,31 +5,13 @@ mod common;
 
 use std::sync::atomic::AtomicBool;
 
-use common::check_geometry;
+use common::{check_geometry, run, small_spec};
 use proptest::prelude::*;
 use roam_planner::best::PlanSource;
 use roam_planner::params::ParamError;
-use roam_planner::plan::{plan, PlanError, PlanOutcome, PlanSpec, START_SNAP_M};
+use roam_planner::plan::{plan, PlanError, PlanSpec, START_SNAP_M};
 use roam_planner::world::World;
 use roam_proto::planner::{PlannerModel, ShortestPathUse, StopReason};
-
-fn spec(
-    model: PlannerModel,
-    start: [f64; 2],
-    goal: [f64; 2],
-    t_exec_s: f64,
-    seed: u64,
-    generations: u32,
-) -> PlanSpec {
-    let mut spec = PlanSpec::batch(start, goal, t_exec_s, model, generations, seed);
-    spec.params.population = 60;
-    spec.threads = 2;
-    spec
-}
-
-fn run(world: &World, spec: &PlanSpec) -> PlanOutcome {
-    plan(world, spec, &AtomicBool::new(false), |_, _| {}).expect("plan")
-}
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
@@ -41,7 +23,7 @@ proptest! {
         slack in 1.0..3.0f64,
     ) {
         let world = common::builtin_world();
-        let mut s = spec(model, [sx, sy], [gx, gy], 1.0, seed, 30);
+        let mut s = small_spec(model, [sx, sy], [gx, gy], 1.0, seed, 30);
         // Find the shortest ETA by asking with a huge budget first.
         s.t_exec_s = 86_400.0;
         // A blocked start or goal is rejected, not passed: proptest draws another case,
@@ -67,7 +49,7 @@ fn the_same_seed_gives_the_same_path_bit_for_bit() {
         PlannerModel::Model1,
         PlannerModel::Model2,
     ] {
-        let s = spec(model, [-8.0, -8.0], [6.0, -7.0], 80.0, 42, 100);
+        let s = small_spec(model, [-8.0, -8.0], [6.0, -7.0], 80.0, 42, 100);
         let a = run(&world, &s);
         let b = run(&world, &s);
         assert_eq!(a.path, b.path, "{model:?}");
@@ -96,7 +78,7 @@ fn curious_plans_use_the_budget_and_gather_more_than_the_shortest_path() {
     let world = common::builtin_world();
     let shortest = run(
         &world,
-        &spec(
+        &small_spec(
             PlannerModel::Shortest,
             [-8.0, -8.0],
             [-2.0, 4.0],
@@ -111,7 +93,7 @@ fn curious_plans_use_the_budget_and_gather_more_than_the_shortest_path() {
         PlannerModel::Model1,
         PlannerModel::Model2,
     ] {
-        let s = spec(model, [-8.0, -8.0], [-2.0, 4.0], budget, 7, 400);
+        let s = small_spec(model, [-8.0, -8.0], [-2.0, 4.0], budget, 7, 400);
         let outcome = run(&world, &s);
         check_geometry(&world, &s, &outcome);
         // On time at the goal is forced by the shortest-path seed (issue 18) and checked
@@ -137,8 +119,11 @@ fn curious_plans_use_the_budget_and_gather_more_than_the_shortest_path() {
 fn the_shortest_path_is_attached_when_asked_and_is_the_fallback() {
     let world = common::builtin_world();
     let (from, to) = ([-8.0, -8.0], [6.0, -7.0]);
-    let baseline = run(&world, &spec(PlannerModel::Shortest, from, to, 100.0, 1, 5));
-    let curious = spec(PlannerModel::Model1, from, to, 100.0, 1, 5);
+    let baseline = run(
+        &world,
+        &small_spec(PlannerModel::Shortest, from, to, 100.0, 1, 5),
+    );
+    let curious = small_spec(PlannerModel::Model1, from, to, 100.0, 1, 5);
     assert!(run(&world, &curious).shortest.is_none(), "not asked for");
     let attached = run(
         &world,
@@ -195,7 +180,7 @@ fn refusals_say_what_to_change() {
     let world = common::builtin_world();
     let off = plan(
         &world,
-        &spec(PlannerModel::Model1, [50.0, 0.0], [0.0, 0.0], 100.0, 1, 5),
+        &small_spec(PlannerModel::Model1, [50.0, 0.0], [0.0, 0.0], 100.0, 1, 5),
         &AtomicBool::new(false),
         |_, _| {},
     );
@@ -205,7 +190,7 @@ fn refusals_say_what_to_change() {
     );
     let wall = plan(
         &world,
-        &spec(PlannerModel::Model1, [-8.0, -8.0], [-9.9, 0.0], 100.0, 1, 5),
+        &small_spec(PlannerModel::Model1, [-8.0, -8.0], [-9.9, 0.0], 100.0, 1, 5),
         &AtomicBool::new(false),
         |_, _| {},
     );
@@ -215,7 +200,7 @@ fn refusals_say_what_to_change() {
     );
     let short = plan(
         &world,
-        &spec(PlannerModel::Model1, [-8.0, -8.0], [6.0, -7.0], 5.0, 1, 5),
+        &small_spec(PlannerModel::Model1, [-8.0, -8.0], [6.0, -7.0], 5.0, 1, 5),
         &AtomicBool::new(false),
         |_, _| {},
     );
@@ -234,7 +219,7 @@ fn refusals_say_what_to_change() {
         &world,
         &PlanSpec {
             deadline_s: 0.0,
-            ..spec(PlannerModel::Model1, [-8.0, -8.0], [6.0, -7.0], 100.0, 1, 5)
+            ..small_spec(PlannerModel::Model1, [-8.0, -8.0], [6.0, -7.0], 100.0, 1, 5)
         },
         &AtomicBool::new(false),
         |_, _| {},
@@ -281,7 +266,7 @@ fn a_walled_in_goal_has_no_path() {
     world = World::new(&occupancy, &information, 0.25).expect("world");
     let outcome = plan(
         &world,
-        &spec(PlannerModel::Model1, [0.5, 0.5], [3.1, 3.1], 100.0, 1, 5),
+        &small_spec(PlannerModel::Model1, [0.5, 0.5], [3.1, 3.1], 100.0, 1, 5),
         &AtomicBool::new(false),
         |_, _| {},
     );
@@ -299,7 +284,7 @@ fn a_walled_in_goal_has_no_path() {
 fn the_papers_own_initialization_seeds_nothing() {
     let world = common::builtin_world();
     for model in [PlannerModel::Model0, PlannerModel::Model1] {
-        let mut s = spec(model, [-8.0, -8.0], [-2.0, 4.0], 60.0, 3, 50);
+        let mut s = small_spec(model, [-8.0, -8.0], [-2.0, 4.0], 60.0, 3, 50);
         let roam = run(&world, &s);
         assert!(roam.within_budget && roam.reaches_goal, "{model:?}");
         s.params = s.params.with_random_walks_only();
@@ -349,7 +334,7 @@ fn the_fastest_path_floor_admits_a_budget_the_distance_shortest_path_would_refus
             &world,
             &PlanSpec {
                 shortest: ShortestPathUse::Attach,
-                ..spec(model, start, goal, budget, 3, 20)
+                ..small_spec(model, start, goal, budget, 3, 20)
             },
         );
         assert!(outcome.within_budget && outcome.reaches_goal, "{model:?}");
@@ -364,7 +349,7 @@ fn the_fastest_path_floor_admits_a_budget_the_distance_shortest_path_would_refus
     }
     let refused = plan(
         &world,
-        &spec(PlannerModel::Model1, start, goal, fastest - 0.1, 3, 20),
+        &small_spec(PlannerModel::Model1, start, goal, fastest - 0.1, 3, 20),
         &AtomicBool::new(false),
         |_, _| {},
     );
@@ -478,7 +463,7 @@ fn a_start_at_an_obstacles_edge_moves_to_the_nearest_free_cell() {
     let (ex, ey) = centre(10, 15);
     let edge = run(
         &world,
-        &spec(PlannerModel::Shortest, [ex, ey], [0.5, 0.5], 100.0, 1, 5),
+        &small_spec(PlannerModel::Shortest, [ex, ey], [0.5, 0.5], 100.0, 1, 5),
     );
     let first = edge.points[0];
     assert_eq!(first, {
@@ -489,7 +474,7 @@ fn a_start_at_an_obstacles_edge_moves_to_the_nearest_free_cell() {
     let (cx, cy) = centre(15, 15);
     let deep = plan(
         &world,
-        &spec(PlannerModel::Shortest, [cx, cy], [0.5, 0.5], 100.0, 1, 5),
+        &small_spec(PlannerModel::Shortest, [cx, cy], [0.5, 0.5], 100.0, 1, 5),
         &AtomicBool::new(false),
         |_, _| {},
     );
@@ -499,7 +484,7 @@ fn a_start_at_an_obstacles_edge_moves_to_the_nearest_free_cell() {
     );
     let goal = plan(
         &world,
-        &spec(PlannerModel::Shortest, [0.5, 0.5], [ex, ey], 100.0, 1, 5),
+        &small_spec(PlannerModel::Shortest, [0.5, 0.5], [ex, ey], 100.0, 1, 5),
         &AtomicBool::new(false),
         |_, _| {},
     );

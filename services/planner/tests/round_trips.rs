@@ -7,7 +7,7 @@ mod common;
 
 use std::sync::atomic::AtomicBool;
 
-use common::check_geometry;
+use common::{check_geometry, run};
 use roam_planner::best::PlanSource;
 use roam_planner::curiosity::{Evaluator, Model};
 use roam_planner::eta::path_eta;
@@ -34,10 +34,6 @@ fn spec(
     spec.params.population = 60;
     spec.threads = 2;
     spec
-}
-
-fn run(world: &World, spec: &PlanSpec) -> PlanOutcome {
-    plan(world, spec, &AtomicBool::new(false), |_, _| {}).expect("plan")
 }
 
 /// A loop from `spec` that reaches its goal within the budget and uses at least 80% of

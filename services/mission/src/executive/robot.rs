@@ -14,7 +14,7 @@ use roam_runtime::{lock, ClientError, Delivery};
 use tokio::task::JoinSet;
 use tokio_util::sync::CancellationToken;
 
-use crate::calibration::{path_measure, store, Calibration, TimeModel};
+use crate::calibration::{store, Calibration, TimeModel};
 use crate::config::ExecutiveConfig;
 use crate::error::ExecutiveError;
 use crate::inputs::Inputs;
@@ -237,11 +237,10 @@ impl Executive<'_> {
         if !self.config.calibrate {
             return;
         }
-        let mut learned = 0;
-        for drive in drives {
-            let (d, theta) = path_measure(&drive.path);
-            learned += usize::from(self.calibration.add_planned(d, theta, drive.took_s));
-        }
+        let learned = drives
+            .iter()
+            .filter(|drive| drive.teach(&mut self.calibration))
+            .count();
         if learned == 0 {
             return;
         }

@@ -29,6 +29,7 @@
 
 use super::events::DrivenMission;
 use super::state::Drive;
+use super::straight;
 use crate::calibration::path_measure;
 use crate::path::distance;
 use crate::watch::Reason;
@@ -73,8 +74,7 @@ pub(super) fn still_at_start(drive: &mut Drive, position: [f64; 2], at_s: f64) {
 /// The index of `path`'s point nearest `here` among those from `from` on, if it is
 /// within [`MAX_LEARNED_OFF_ROUTE_M`].
 fn on_route(path: &[[f64; 2]], from: usize, here: [f64; 2]) -> Option<usize> {
-    let nearest = (from..path.len())
-        .min_by(|&a, &b| distance(path[a], here).total_cmp(&distance(path[b], here)))?;
+    let nearest = from + straight::nearest(path.get(from..)?, here)?;
     (distance(path[nearest], here) <= MAX_LEARNED_OFF_ROUTE_M).then_some(nearest)
 }
 

@@ -4,6 +4,7 @@ use roam_proto::controller::{ControllerStatus, Mission};
 use roam_proto::planner::Plan;
 
 use super::handover::WindowEnd;
+use crate::calibration::{path_measure, Calibration};
 use crate::watch::Reason;
 
 /// When an event happens.
@@ -116,4 +117,14 @@ pub enum WindowAction {
 pub struct DrivenMission {
     pub path: Vec<[f64; 2]>,
     pub took_s: f64,
+}
+
+impl DrivenMission {
+    /// Adds this drive to `calibration` in the planner's own terms (its Σd and Σθ as
+    /// Eq. 2 counts them on the cells, and how long it took); false when the drive is
+    /// not usable (see [`Calibration::add_planned`]).
+    pub fn teach(&self, calibration: &mut Calibration) -> bool {
+        let (d, theta) = path_measure(&self.path);
+        calibration.add_planned(d, theta, self.took_s)
+    }
 }

@@ -57,8 +57,8 @@ pub(super) fn point_ahead(path: &[[f64; 2]], here: [f64; 2], lead_m: f64) -> [f6
     at
 }
 
-/// The index of `path`'s point nearest to `here`.
-fn nearest(path: &[[f64; 2]], here: [f64; 2]) -> Option<usize> {
+/// The index of `path`'s point nearest to `here` (the first of equals).
+pub(super) fn nearest(path: &[[f64; 2]], here: [f64; 2]) -> Option<usize> {
     (0..path.len()).min_by(|&a, &b| distance(path[a], here).total_cmp(&distance(path[b], here)))
 }
 

@@ -2,8 +2,11 @@
 
 use roam_map_server::map_file;
 use roam_planner::params::GaParams;
-use roam_planner::plan::{PlanOutcome, PlanSpec};
+use std::sync::atomic::AtomicBool;
+
+use roam_planner::plan::{plan, PlanOutcome, PlanSpec};
 use roam_planner::world::World;
+use roam_proto::planner::PlannerModel;
 use roam_world::grid::Grid;
 use roam_world::layers::inflate;
 use roam_world::DEFAULT_MAX_CELLS;
@@ -132,4 +135,27 @@ pub fn check_geometry(world: &World, spec: &PlanSpec, outcome: &PlanOutcome) {
         outcome.t_eta_s
     );
     assert_eq!(outcome.within_budget, eta <= spec.t_exec_s);
+}
+
+/// A plan of `spec` on `world` that must succeed, never cancelled.
+#[allow(dead_code)]
+pub fn run(world: &World, spec: &PlanSpec) -> PlanOutcome {
+    plan(world, spec, &AtomicBool::new(false), |_, _| {}).expect("plan")
+}
+
+/// `model` from `start` to `goal` in `t_exec_s`, population 60, `generations`, two
+/// evaluation threads: a plan small enough for a test.
+#[allow(dead_code)]
+pub fn small_spec(
+    model: PlannerModel,
+    start: [f64; 2],
+    goal: [f64; 2],
+    t_exec_s: f64,
+    seed: u64,
+    generations: u32,
+) -> PlanSpec {
+    let mut spec = PlanSpec::batch(start, goal, t_exec_s, model, generations, seed);
+    spec.params.population = 60;
+    spec.threads = 2;
+    spec
 }

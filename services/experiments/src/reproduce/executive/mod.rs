@@ -28,9 +28,7 @@ pub mod track;
 use std::collections::{BTreeMap, VecDeque};
 
 use roam_controller::status::controller_status;
-use roam_mission::calibration::{
-    path_measure, Calibration, CalibrationConfig, CalibrationError, TimeModel,
-};
+use roam_mission::calibration::{Calibration, CalibrationConfig, CalibrationError, TimeModel};
 use roam_mission::config::ExecutiveConfig;
 use roam_mission::information::InformationScale;
 use roam_mission::request::plan_request;
@@ -405,8 +403,7 @@ impl<'a> InProcessExecutive<'a> {
                     WindowAction::Arrived { drives, .. } => {
                         if self.config.calibrate {
                             for drive in drives {
-                                let (d, theta) = path_measure(&drive.path);
-                                self.calibration.add_planned(d, theta, drive.took_s);
+                                drive.teach(&mut self.calibration);
                             }
                         }
                     }
