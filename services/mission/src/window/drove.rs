@@ -25,7 +25,8 @@
 //! that, from the route's sending). A robot still within [`STANDING_M`] of where its
 //! route was sent has not begun to drive it (the mission is on its way, or it turns
 //! toward the path, a turn Eq. 2's Σθ does not count): the drive is timed from its
-//! last estimate there.
+//! last estimate there. A route that starts where a moving robot was is not timed at
+//! all ([`route_teaches`]).
 
 use super::events::DrivenMission;
 use super::state::Drive;
@@ -46,6 +47,16 @@ pub const MAX_LEARNED_OFF_ROUTE_M: f64 = 1.0;
 /// window replans at most `max_replans` times, but going straight and recovering are
 /// not counted there.
 pub const MAX_LEARNED_DRIVES: usize = 64;
+
+/// Whether a route sent for `reason` can be timed from its sending: a window's first
+/// route (the robot stands at its start) and the routes asked from where the robot
+/// will be when they come (slack, behind, set-off), which it drives into. A route that
+/// starts where a moving robot was (straight to the task, after being stuck or pushed
+/// off) is reached only after the robot drove on along its old one while the mission
+/// travelled: seconds at a fast clock, on what is often a window's last short drive.
+pub(super) fn route_teaches(reason: Reason) -> bool {
+    matches!(reason, Reason::Slack | Reason::Behind | Reason::SetOff)
+}
 
 /// How far from where its route was sent the robot is still standing, metres.
 pub const STANDING_M: f64 = 0.05;

@@ -39,7 +39,7 @@ impl DowntimeWindow<'_> {
         // The calibration learns the robot's driving: as a replaced route's, timed by
         // the estimates (the arrival is heard later, by a lag that is not driving).
         let mut drives = std::mem::take(&mut drive.drives);
-        if !held {
+        if drive.route_teaches && !held {
             drives.extend(driven_part(
                 &drive.path,
                 drive.sent_here,

@@ -252,6 +252,7 @@ impl<'a> DowntimeWindow<'a> {
             holds: 0,
             held_s: 0.0,
             sent_holds: 0,
+            route_teaches: true,
             recoveries: 0,
         }));
         let mut actions = vec![planned, WindowAction::Drive(mission)];

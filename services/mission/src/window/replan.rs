@@ -110,7 +110,8 @@ impl DowntimeWindow<'_> {
             .chain(route.points.iter().copied())
             .collect();
         let (t, wall) = (now.mission_s, now.wall_s);
-        let normally_driven = drove::teaches(reason)
+        let normally_driven = drive.route_teaches
+            && drove::teaches(reason)
             && !drive.recovering
             && drive.held_since_s.is_none()
             && drive.holds == drive.sent_holds;
@@ -129,6 +130,7 @@ impl DowntimeWindow<'_> {
         drive.mission = mission.id.clone();
         drive.sent_at_s = t;
         drive.sent_holds = drive.holds;
+        drive.route_teaches = drove::route_teaches(reason);
         drive.sent_here = (self.here, self.here_at_s);
         drive.path = path;
         if drive.drives.len() < drove::MAX_LEARNED_DRIVES {

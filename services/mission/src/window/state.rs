@@ -103,6 +103,8 @@ pub(super) struct Drive {
     pub(super) holds: u32,
     /// `holds` when the current route was sent: more now, and it was held on.
     pub(super) sent_holds: u32,
+    /// The current route was sent so that its drive can be timed (`drove.rs`).
+    pub(super) route_teaches: bool,
     pub(super) held_s: f64,
     pub(super) recoveries: u32,
 }

@@ -300,3 +300,26 @@ fn the_last_safe_moment_is_checked_once_a_second_at_the_last_estimate() {
         "{actions:?}"
     );
 }
+
+/// The straight route sent at the last safe moment starts where the moving robot was:
+/// its drive is not timed (the robot drove on along its old route while the mission
+/// travelled), so the arrival teaches the calibration nothing.
+#[test]
+fn a_straight_route_from_a_moving_robot_does_not_teach_the_time_model() {
+    let f = fixture();
+    let (mut w, _) = f.driving(false);
+    let actions = w.handle(estimate([0.1, 1.1], 0.1, 95.0), at(95.0, 0.5));
+    let straight = sent(&actions);
+    w.handle(estimate(GOAL, 0.1, 98.5), at(98.5, 0.6));
+    let actions = w.handle(
+        status(&straight.id, MissionState::Completed, 0.0),
+        at(99.0, 0.7),
+    );
+    let WindowAction::Arrived { drives, .. } = &actions[0] else {
+        panic!("{actions:?}");
+    };
+    assert!(
+        drives.iter().all(|d| d.path.last() != Some(&GOAL)),
+        "{drives:?}"
+    );
+}
