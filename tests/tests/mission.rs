@@ -10,6 +10,7 @@ use roam_controller::service::ControllerConfig;
 use roam_mission::calibration::TimeModel;
 use roam_mission::executive::ExecutiveConfig;
 use roam_mission::service::MissionConfig;
+use roam_planner::config::PlannerConfig;
 use roam_proto::mission::WindowReport;
 use roam_proto::{decode, keys};
 use roam_runtime::service_config::ServiceConfig;
@@ -28,13 +29,18 @@ type Running = (Vec<RunningService>, Requester);
 /// Every role of the built-in day but the executive (the planner only if `planner`),
 /// the sim at 10x, and a subscriber to the robot's window reports.
 async fn roles_of_the_day(harness: &Harness, planner: bool) -> (Running, Reports) {
+    let planner = planner.then(|| harness.planner_config("planner-0"));
+    roles_of_the_day_with(harness, planner).await
+}
+
+/// [`roles_of_the_day`] with this planner, if any.
+async fn roles_of_the_day_with(
+    harness: &Harness,
+    planner: Option<PlannerConfig>,
+) -> (Running, Reports) {
     let mut roles = vec![harness.start_role(harness.map_server_config()).await];
-    if planner {
-        roles.push(
-            harness
-                .start_role(harness.planner_config("planner-0"))
-                .await,
-        );
+    if let Some(planner) = planner {
+        roles.push(harness.start_role(planner).await);
     }
     let mut sim_config = harness.sim_config(None);
     sim_config.rate = Some(10.0);
@@ -199,4 +205,127 @@ async fn a_restarted_executive_plans_with_the_fit_its_predecessor_saved() {
         (saved.v_lin, saved.v_ang),
         "goal2 planned with {planned_with:?}, the saved fit is {saved:?}"
     );
+}
+
+/// The map changes under the route: while the robot drives its first window's curious
+/// route, a client (standing in for the mapper) writes an `occupied_now` layer with a
+/// pallet on the route ahead. The executive, following that layer, replans at once
+/// (`map_changed`); the planner, planning round the same layer, sends a route that
+/// keeps clear of the pallet; and the robot is still on time.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_pallet_seen_on_the_route_ahead_is_a_replan_round_it() {
+    use roam_proto::cells::Cells;
+    use roam_proto::controller::Mission;
+    use roam_proto::map::{Layer, LayerChange, LayerUpdate, UpdateAck, INFLATED_LAYER};
+    use roam_proto::mapper::OCCUPIED_NOW_LAYER;
+
+    const PALLET_M: f64 = 0.3;
+    let harness = Harness::start().await;
+    let planner = PlannerConfig {
+        obstacles_layer: Some(OCCUPIED_NOW_LAYER.to_owned()),
+        ..harness.planner_config("planner-0")
+    };
+    let ((_roles, client), reports) = roles_of_the_day_with(&harness, Some(planner)).await;
+    let missions = within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::robot_mission(&harness.root, "robot")),
+    )
+    .await
+    .expect("subscriber");
+    let _mission = harness
+        .start_role(MissionConfig {
+            service: ServiceConfig::at(harness.root.clone()),
+            executive: ExecutiveConfig {
+                obstacles_layer: Some(OCCUPIED_NOW_LAYER.to_owned()),
+                ..ExecutiveConfig::default()
+            },
+            ..MissionConfig::default()
+        })
+        .await;
+    let next_mission = || async {
+        let sample = tokio::time::timeout(Duration::from_secs(60), missions.recv_async())
+            .await
+            .expect("a mission in time")
+            .expect("sample");
+        decode::<Mission>(&sample.payload().to_bytes()).expect("mission")
+    };
+    // The window sets off on its fastest path, then takes the curious route.
+    let _fastest = next_mission().await;
+    let curious = next_mission().await;
+    let waypoints = &curious.waypoints;
+    assert!(waypoints.len() >= 6, "{curious:?}");
+    let pallet = waypoints[waypoints.len() * 2 / 3];
+
+    // The static map, and on it the pallet: the cells within PALLET_M of it.
+    let inflated: Layer = client
+        .request::<Layer, Layer>(&keys::map_layer(&harness.root, INFLATED_LAYER), None)
+        .await
+        .expect("the inflated layer");
+    let Cells::I8(mut cells) = inflated.cells.clone() else {
+        panic!("inflated is not i8");
+    };
+    let meta = inflated.meta;
+    for (i, cell) in cells.iter_mut().enumerate() {
+        let (x, y) =
+            roam_world::grid::cell_center(&meta, i % meta.width as usize, i / meta.width as usize);
+        if (x - pallet[0]).hypot(y - pallet[1]) <= PALLET_M {
+            *cell = 100;
+        }
+    }
+    let update = LayerUpdate {
+        base_version: 0,
+        change: LayerChange::Replace {
+            meta,
+            cells: Cells::I8(cells),
+        },
+        world: None,
+    };
+    let _ack: UpdateAck = client
+        .request(
+            &keys::map_update(&harness.root, OCCUPIED_NOW_LAYER),
+            Some(&update),
+        )
+        .await
+        .expect("the occupied_now layer is written");
+
+    // The next route keeps clear of the pallet (the planner blocks PALLET_M round
+    // each of its cells, 0.3 m by default). Unless it answers a replan asked before the
+    // planner had the layer (a slack replan in flight): then the executive checks that
+    // route when it comes, and the one after it is the map change's.
+    let nearest = |m: &Mission| {
+        m.waypoints
+            .windows(2)
+            .map(|w| segment_distance(w[0], w[1], pallet))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut round = next_mission().await;
+    if nearest(&round) <= PALLET_M {
+        round = next_mission().await;
+    }
+    assert!(
+        nearest(&round) > PALLET_M,
+        "the route after the map change passes {:.2} m from the pallet: {round:?}",
+        nearest(&round)
+    );
+    let goal1 = next_report(&reports, 90).await;
+    assert_eq!(goal1.task, "goal1");
+    assert!(
+        goal1.replan_reasons.iter().any(|r| r == "map_changed"),
+        "{goal1:?}"
+    );
+    assert!(goal1.on_time, "{goal1:?}");
+}
+
+/// The distance from `p` to the segment `a`-`b`.
+fn segment_distance(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a[0] + t * dx - p[0]).hypot(a[1] + t * dy - p[1])
 }

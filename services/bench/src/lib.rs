@@ -14,7 +14,9 @@
 //! - [`peer`]: the greedy planner against Model I at equal wall time;
 //! - [`anytime`]: the anytime planner's plan at each deadline against the best known;
 //! - [`optimality`]: the planners' plans against the exact optimum on small instances;
-//! - [`fleet`]: robots in closed loop through Zenoh.
+//! - [`fleet`]: robots in closed loop through Zenoh;
+//! - [`wire`]: the wire's own latency, a put and a get, peer to peer and through a
+//!   router, over TCP and TLS.
 
 pub mod anytime;
 pub mod fleet;
@@ -29,6 +31,7 @@ pub mod process;
 pub mod replans;
 pub mod scaling;
 pub mod sim;
+pub mod wire;
 
 use std::time::Duration;
 

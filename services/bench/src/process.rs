@@ -1,9 +1,19 @@
-//! This process's CPU time and memory, as the benchmarks report them (Linux `/proc`;
-//! `None` elsewhere, printed as such rather than made up).
+//! A process's CPU time and memory, as the benchmarks report them (Linux `/proc`;
+//! `None` elsewhere, printed as such rather than made up): this process's, or a child's
+//! by its id (the router `roam bench fleet` runs in its own process).
 
 /// CPU seconds (user + system) used by this process so far, in 100 Hz ticks.
 pub fn process_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    cpu_seconds_in("/proc/self/stat")
+}
+
+/// CPU seconds (user + system) used so far by the process `pid`, in 100 Hz ticks.
+pub fn cpu_seconds_of(pid: u32) -> Option<f64> {
+    cpu_seconds_in(&format!("/proc/{pid}/stat"))
+}
+
+fn cpu_seconds_in(path: &str) -> Option<f64> {
+    let stat = std::fs::read_to_string(path).ok()?;
     // The fields after the command name, which is in parentheses and may hold spaces.
     let rest = stat.rsplit_once(')')?.1;
     let fields: Vec<&str> = rest.split_whitespace().collect();
@@ -14,16 +24,26 @@ pub fn process_cpu_seconds() -> Option<f64> {
 
 /// The resident set size now (`VmRSS`), MiB.
 pub fn rss_mib() -> Option<f64> {
-    status_mib("VmRSS:")
+    status_mib("/proc/self/status", "VmRSS:")
 }
 
 /// The peak resident set size so far (`VmHWM`), MiB.
 pub fn peak_rss_mib() -> Option<f64> {
-    status_mib("VmHWM:")
+    status_mib("/proc/self/status", "VmHWM:")
 }
 
-fn status_mib(field: &str) -> Option<f64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+/// The process `pid`'s resident set size now (`VmRSS`), MiB.
+pub fn rss_mib_of(pid: u32) -> Option<f64> {
+    status_mib(&format!("/proc/{pid}/status"), "VmRSS:")
+}
+
+/// The process `pid`'s peak resident set size so far (`VmHWM`), MiB.
+pub fn peak_rss_mib_of(pid: u32) -> Option<f64> {
+    status_mib(&format!("/proc/{pid}/status"), "VmHWM:")
+}
+
+fn status_mib(path: &str, field: &str) -> Option<f64> {
+    let status = std::fs::read_to_string(path).ok()?;
     let line = status.lines().find(|l| l.starts_with(field))?;
     let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib / 1024.0)
@@ -40,5 +60,10 @@ mod tests {
         assert!(process_cpu_seconds().is_some_and(|s| s >= 0.0));
         let (now, peak) = (rss_mib().expect("VmRSS"), peak_rss_mib().expect("VmHWM"));
         assert!(now > 0.0 && peak >= now, "{now} {peak}");
+        let me = std::process::id();
+        assert!(cpu_seconds_of(me).is_some_and(|s| s >= 0.0));
+        assert!(rss_mib_of(me).is_some_and(|m| m > 0.0));
+        assert!(peak_rss_mib_of(me).is_some_and(|m| m > 0.0));
+        assert_eq!(rss_mib_of(u32::MAX), None);
     }
 }

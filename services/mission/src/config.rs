@@ -29,8 +29,16 @@ pub struct ExecutiveConfig {
     /// The robot this executive drives.
     pub robot: String,
     pub tasks: Vec<Task>,
-    /// The curiosity model for downtime paths (paper 000); `shortest` drives the
-    /// fastest path in every window (the baseline).
+    /// The planner for downtime paths: paper 000's GA under a curiosity model
+    /// (`model1` by default; `model0`, `model2`), `greedy`, or `anytime` (the greedy
+    /// planner's route at once, then the GA under Model I seeded with it, the fitter by
+    /// Model I's F1); `shortest` drives the fastest path in every window (the
+    /// baseline). Model I, not `anytime`, by default: on the executive's day (50 days,
+    /// `roam reproduce mission --days 50 --variants executive,anytime`) the portfolio
+    /// gathered 8% less information a day, on time alike (services/mission/README.md,
+    /// "The anytime portfolio in the day"). With `anytime`, a replan seeded with the
+    /// route left runs the GA alone under Model I (the route left is its warm start,
+    /// and the greedy planner's 25–110 ms would break the replans' 50 ms).
     pub model: PlannerModel,
     /// The planner's deadline, wall seconds (paper 000's t_plan), at most: a replan's
     /// is cut to what the window can afford ([`ExecutiveConfig::replan_time_share`]).
@@ -120,7 +128,17 @@ pub struct ExecutiveConfig {
     /// v_lin 2.0 s/m and v_ang 1.0 s/rad by default; a robot's datasheet figures where
     /// they are known. Bounded as the calibration's fits are.
     pub time_model_prior: TimeModel,
+    /// The layer of what the fleet believes occupied now (the mapper's `occupied_now`),
+    /// followed to replan when a believed obstacle blocks the route ahead
+    /// (`window/blocked.rs`): set it where the planners plan around it (their
+    /// `obstacles_layer`). `None`: routes are not checked (the stuck rule still acts).
+    pub obstacles_layer: Option<String>,
+    /// How close a route may pass a believed obstacle, metres: the planners'
+    /// `obstacle_inflation_m`, 0.3 by default (0..=[`MAX_OBSTACLE_INFLATION_M`]).
+    pub obstacle_inflation_m: f64,
 }
+
+pub use roam_planner::seen::MAX_OBSTACLE_INFLATION_M;
 
 impl ExecutiveConfig {
     /// The replan policy's parameters for plans made with `model`.
@@ -155,11 +173,12 @@ impl ExecutiveConfig {
     }
 
     /// The paper's planner alone, as an executive without roam's rules would use it:
-    /// Table I's time model throughout, one plan at each window's start, no slack, no
-    /// behind rule, no arrival margin, no recovery, no PEB cost. What the batch calls
-    /// `plain`.
+    /// paper 000's GA under Model I, Table I's time model throughout, one plan at each
+    /// window's start, no slack, no behind rule, no arrival margin, no recovery, no PEB
+    /// cost. What the batch calls `plain`.
     pub fn plain(self) -> ExecutiveConfig {
         ExecutiveConfig {
+            model: PlannerModel::Model1,
             calibrate: false,
             slack_s: f64::INFINITY,
             behind: false,
@@ -240,6 +259,16 @@ impl ExecutiveConfig {
                 self.replan_time_share
             )));
         }
+        if let Some(layer) = &self.obstacles_layer {
+            keys::check_name("obstacles_layer", layer)
+                .map_err(|e| ConfigError::Field(e.to_string()))?;
+        }
+        if !(0.0..=MAX_OBSTACLE_INFLATION_M).contains(&self.obstacle_inflation_m) {
+            return Err(ConfigError::Field(format!(
+                "obstacle_inflation_m is {}; give 0..={MAX_OBSTACLE_INFLATION_M} metres",
+                self.obstacle_inflation_m
+            )));
+        }
         if self.replan_generations == Some(0) {
             return Err(ConfigError::Field(
                 "replan_generations is 0; give at least 1 (or leave it out: max_generations)"
@@ -306,6 +335,8 @@ impl Default for ExecutiveConfig {
             calibrate: true,
             calibration_file: None,
             time_model_prior: TimeModel::table_i(),
+            obstacles_layer: None,
+            obstacle_inflation_m: 0.3,
         }
     }
 }
@@ -349,5 +380,15 @@ mod tests {
             ..c()
         })
         .contains("min_replan_window_s"));
+        assert!(bad(ExecutiveConfig {
+            obstacle_inflation_m: 9.0,
+            ..c()
+        })
+        .contains("obstacle_inflation_m"));
+        assert!(bad(ExecutiveConfig {
+            obstacles_layer: Some("occupied/now".into()),
+            ..c()
+        })
+        .contains("obstacles_layer"));
     }
 }

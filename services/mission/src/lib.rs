@@ -49,6 +49,8 @@ pub mod information;
 #[cfg(feature = "zenoh")]
 mod inputs;
 pub mod margin;
+#[cfg(feature = "zenoh")]
+mod obstacles;
 pub mod path;
 pub mod request;
 #[cfg(feature = "zenoh")]

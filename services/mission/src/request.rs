@@ -19,10 +19,12 @@ pub fn plan_request(config: &ExecutiveConfig, ask: &PlanAsk, time_model: TimeMod
         goal: ask.to,
         t_exec_s: ask.t_exec_s,
         deadline_s: ask.deadline_s,
-        model: if ask.curious {
-            config.model
-        } else {
-            PlannerModel::Shortest
+        model: match (ask.curious, config.model) {
+            (false, _) => PlannerModel::Shortest,
+            // A seeded replan is the GA's, warm-started with the route left
+            // (`ExecutiveConfig::model`).
+            (true, PlannerModel::Anytime) if !ask.seed_route.is_empty() => PlannerModel::Model1,
+            (true, model) => model,
         },
         params: GaOverrides {
             max_generations: if ask.seed_route.is_empty() {

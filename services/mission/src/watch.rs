@@ -34,6 +34,9 @@
 //!   itself: a robot arriving early by exactly what a new plan would keep back has no
 //!   slack.
 //!
+//! - **map changed**: the window found the route left passing what the fleet has
+//!   seen (`window/blocked.rs`): replan round it, curious while the route is.
+//!
 //! Slack and behind replans need `min_replan_window_s` left to the task: a short
 //! replan near a window's end is the one a time model gets most wrong.
 //!
@@ -95,11 +98,13 @@ pub enum Reason {
     NoPlanner,
     /// The window's curious plan, made while the robot set off on the fastest path.
     SetOff,
+    /// What the fleet has seen blocks the route ahead (`window/blocked.rs`).
+    MapChanged,
 }
 
 impl Reason {
     /// Every reason, in the order [`Reason::name`] lists them.
-    pub const ALL: [Reason; 10] = [
+    pub const ALL: [Reason; 11] = [
         Reason::ControllerSilent,
         Reason::Stuck,
         Reason::EtaSlipped,
@@ -110,6 +115,7 @@ impl Reason {
         Reason::Recovered,
         Reason::NoPlanner,
         Reason::SetOff,
+        Reason::MapChanged,
     ];
 
     /// The reason's token: what the window's report carries on the wire
@@ -127,6 +133,7 @@ impl Reason {
             Reason::Recovered => "recovered",
             Reason::NoPlanner => "no_planner",
             Reason::SetOff => "set_off",
+            Reason::MapChanged => "map_changed",
         }
     }
 
@@ -148,6 +155,7 @@ impl Reason {
             Reason::Recovered => "recovered from a PEB hold: a new path from where it has a fix",
             Reason::NoPlanner => "no planner answered: the fastest path the executive computes",
             Reason::SetOff => "the curious path, planned while the robot set off on the fastest",
+            Reason::MapChanged => "the map changed: what the fleet has seen blocks the route ahead",
         }
     }
 }
@@ -369,6 +377,12 @@ impl Watch {
     /// last safe moment came).
     pub fn slipped(&self) -> bool {
         self.slipped
+    }
+
+    /// What the fleet has seen blocks the route ahead: replan round it, curious while
+    /// the route is (from `max_replans`), else the shortest way (from its own budget).
+    pub fn on_route_blocked(&self, curious: bool) -> Decision {
+        self.replan(Reason::MapChanged, curious && !self.slipped)
     }
 
     fn replan(&self, reason: Reason, curious: bool) -> Decision {

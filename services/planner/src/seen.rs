@@ -20,25 +20,35 @@ pub const OBSTACLE_AT: i8 = 50;
 /// The most an obstacle is inflated, metres.
 pub const MAX_OBSTACLE_INFLATION_M: f64 = 5.0;
 
-/// Blocks on `inflated` every free cell within `radius_m` of a cell `seen` believes
-/// occupied where `inflated` has it free. Returns how many cells it blocked, or `None`
-/// when `seen` is not i8 cells on `inflated`'s grid (then nothing changes).
-pub fn block_seen(inflated: &mut Grid<i8>, seen: &Layer, radius_m: f64) -> Option<usize> {
+/// The cells (indices into `inflated`) `seen` believes occupied where `inflated` has
+/// them free: the obstacles the fleet saw that the static map does not have. `None` when
+/// `seen` is not i8 cells on `inflated`'s grid. The mission executive checks its route
+/// against the same cells (`roam_mission::window::SeenObstacles`).
+pub fn seen_obstacle_cells(inflated: &Grid<i8>, seen: &Layer) -> Option<Vec<usize>> {
     let Cells::I8(belief) = &seen.cells else {
         return None;
     };
     if seen.meta != inflated.meta || belief.len() != inflated.cells.len() {
         return None;
     }
+    Some(
+        belief
+            .iter()
+            .zip(&inflated.cells)
+            .enumerate()
+            .filter(|(_, (&b, &static_cell))| b >= OBSTACLE_AT && static_cell == occupancy::FREE)
+            .map(|(i, _)| i)
+            .collect(),
+    )
+}
+
+/// Blocks on `inflated` every free cell within `radius_m` of a cell `seen` believes
+/// occupied where `inflated` has it free. Returns how many cells it blocked, or `None`
+/// when `seen` is not i8 cells on `inflated`'s grid (then nothing changes).
+pub fn block_seen(inflated: &mut Grid<i8>, seen: &Layer, radius_m: f64) -> Option<usize> {
+    let obstacles = seen_obstacle_cells(inflated, seen)?;
     let (w, h) = (inflated.meta.width as i64, inflated.meta.height as i64);
     let r = (radius_m.max(0.0) / inflated.meta.resolution).ceil() as i64;
-    let obstacles: Vec<usize> = belief
-        .iter()
-        .zip(&inflated.cells)
-        .enumerate()
-        .filter(|(_, (&b, &static_cell))| b >= OBSTACLE_AT && static_cell == occupancy::FREE)
-        .map(|(i, _)| i)
-        .collect();
     let mut blocked = 0;
     for i in obstacles {
         let (cx, cy) = ((i as i64) % w, (i as i64) / w);

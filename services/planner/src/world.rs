@@ -251,6 +251,30 @@ impl World {
         }
     }
 
+    /// This world with `cells` made untraversable: no moves into or out of them. For a
+    /// client that plans its own fastest path round what the fleet has seen (the
+    /// mission executive's straight routes, `roam_mission::window`), as the planner
+    /// does with `obstacles_layer` (`crate::seen`); cells off the map are ignored.
+    pub fn with_blocked(&self, cells: &[Cell]) -> World {
+        let mut world = self.clone();
+        for &cell in cells {
+            let c = cell as usize;
+            if c >= world.traversable.len() || !world.traversable[c] {
+                continue;
+            }
+            world.traversable[c] = false;
+            for d in 0..MOVES.len() {
+                if let Some(n) = self.step(cell, d) {
+                    if let Some(back) = self.direction(n, cell) {
+                        world.moves[n as usize] &= !(1u8 << back);
+                    }
+                }
+            }
+            world.moves[c] = 0;
+        }
+        world
+    }
+
     pub fn width(&self) -> usize {
         self.width
     }
@@ -380,5 +404,41 @@ impl World {
         let (ax, ay) = self.xy(a);
         let (bx, by) = self.xy(b);
         ax.abs_diff(bx) + ay.abs_diff(by)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roam_proto::map::Origin;
+
+    #[test]
+    fn a_blocked_cell_has_no_moves_in_or_out_and_the_rest_are_kept() {
+        let meta = GridMeta {
+            width: 5,
+            height: 5,
+            resolution: 0.2,
+            origin: Origin::default(),
+        };
+        let world =
+            World::new(&Grid::filled(meta, 0i8), &Grid::filled(meta, 0u8), 0.25).expect("world");
+        let centre = world.cell(2, 2);
+        let blocked = world.with_blocked(&[centre, 999]);
+        assert!(!blocked.is_traversable(centre));
+        assert_eq!(blocked.traversable_count(), world.traversable_count() - 1);
+        for d in 0..MOVES.len() {
+            assert_eq!(blocked.step(centre, d), None);
+            let n = world.step(centre, d).expect("a neighbour");
+            assert!(!(0..MOVES.len()).any(|e| blocked.step(n, e) == Some(centre)));
+        }
+        // A move elsewhere is kept.
+        assert_eq!(
+            blocked.step(world.cell(0, 0), 0),
+            world.step(world.cell(0, 0), 0)
+        );
+        assert!(
+            crate::search::shortest_path(&blocked, world.cell(0, 2), world.cell(4, 2))
+                .is_some_and(|p| !p.contains(&centre))
+        );
     }
 }

@@ -398,14 +398,16 @@ pub fn plan_downtime_request(request: &PlanDowntimeRequest) -> Result<PlanReques
     }
     let model = match request.model.as_str() {
         "" | "model1" => PlannerModel::Model1,
+        "anytime" => PlannerModel::Anytime,
         "model0" => PlannerModel::Model0,
         "model2" => PlannerModel::Model2,
+        "greedy" => PlannerModel::Greedy,
         "shortest" => PlannerModel::Shortest,
         other => {
             return Err(ErrorReply::new(
                 ErrorCode::InvalidRequest,
                 format!(
-                    "model '{}' is not one of shortest, model0, model1, model2 (empty: model1)",
+                    "model '{}' is not one of shortest, model0, model1, model2, greedy, anytime (empty: model1)",
                     roam_proto::excerpt::excerpt_n(other, 64)
                 ),
             ))

@@ -9,6 +9,7 @@
 //! | `<root>/robot/<id>/estimate` | subscription | `position_estimate` |
 //! | `<root>/robot/<id>/controller` | subscription | `controller_status` |
 //! | `<root>/sim/clock` | subscription | `sim_clock` (the mission clock; wall time without a sim) |
+//! | `<root>/map/{layer,delta}/<obstacles_layer>`, `<root>/map/layer/inflated` | subscription, and get at start and on the index's refresh (only with `obstacles_layer`) | `layer`, `layer_delta` (what the fleet believes occupied now: a route it blocks is replanned) |
 //!
 //! The window's rules live in a plain state machine ([`crate::window`], with the replan
 //! policy in [`crate::watch`]); this module is the thin async loop around it: it decodes
@@ -107,6 +108,19 @@ pub async fn run(
         handover: Handover::first(config.margin()),
         tag: session.zid().to_string().chars().take(8).collect(),
         heard: Heard::default(),
+        obstacles: match &config.obstacles_layer {
+            Some(layer) => Some(
+                crate::obstacles::follow(
+                    session,
+                    root,
+                    layer,
+                    config.obstacle_inflation_m,
+                    cancel.child_token(),
+                )
+                .await?,
+            ),
+            None => None,
+        },
     };
     executive.hear_the_clock(cancel).await?;
     let mut outcomes = Vec::with_capacity(config.tasks.len());

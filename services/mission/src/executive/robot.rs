@@ -54,6 +54,8 @@ pub(super) struct Executive<'a> {
     pub(super) tag: String,
     /// What it heard last, for its status.
     pub(super) heard: Heard,
+    /// The fleet's believed obstacles, when `obstacles_layer` is followed.
+    pub(super) obstacles: Option<crate::obstacles::ObstacleSets>,
 }
 
 /// The sim steps of the last estimate and controller status the loop handled.

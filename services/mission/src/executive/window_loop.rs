@@ -129,6 +129,7 @@ impl Executive<'_> {
                 tokio::select! {
                     _ = cancel.cancelled() => return Err(ExecutiveError::Cancelled),
                     _ = tick.tick() => WindowEvent::Tick,
+                    Some(set) = changed_obstacles(&mut self.obstacles) => WindowEvent::MapChanged(set),
                     Some(answered) = in_flight.join_next(), if !in_flight.is_empty() => {
                         let Ok((id, curious, took_s, reply)) = answered else { continue };
                         match reply {
@@ -183,6 +184,24 @@ impl Executive<'_> {
                 pending.extend(machine.handle(WindowEvent::Tick, self.moment(began)));
                 self.publish_status(window, machine.asks_in_flight());
             }
+        }
+    }
+}
+
+/// The next set of believed obstacles, when the executive follows them; pending forever
+/// when it does not (or the follower stopped).
+async fn changed_obstacles(
+    sets: &mut Option<crate::obstacles::ObstacleSets>,
+) -> Option<std::sync::Arc<crate::window::SeenObstacles>> {
+    let Some(receiver) = sets else {
+        return std::future::pending().await;
+    };
+    loop {
+        if receiver.changed().await.is_err() {
+            return std::future::pending().await;
+        }
+        if let Some(set) = receiver.borrow_and_update().clone() {
+            return Some(set);
         }
     }
 }

@@ -50,12 +50,15 @@ pub const MAX_LEARNED_DRIVES: usize = 64;
 
 /// Whether a route sent for `reason` can be timed from its sending: a window's first
 /// route (the robot stands at its start) and the routes asked from where the robot
-/// will be when they come (slack, behind, set-off), which it drives into. A route that
+/// will be when they come (slack, behind, set-off, map changed), which it drives into. A route that
 /// starts where a moving robot was (straight to the task, after being stuck or pushed
 /// off) is reached only after the robot drove on along its old one while the mission
 /// travelled: seconds at a fast clock, on what is often a window's last short drive.
 pub(super) fn route_teaches(reason: Reason) -> bool {
-    matches!(reason, Reason::Slack | Reason::Behind | Reason::SetOff)
+    matches!(
+        reason,
+        Reason::Slack | Reason::Behind | Reason::SetOff | Reason::MapChanged
+    )
 }
 
 /// How far from where its route was sent the robot is still standing, metres.
@@ -70,6 +73,7 @@ pub(super) fn teaches(reason: Reason) -> bool {
             | Reason::EtaSlipped
             | Reason::LastSafeMoment
             | Reason::SetOff
+            | Reason::MapChanged
     )
 }
 
@@ -155,7 +159,8 @@ mod tests {
                 Reason::Slack,
                 Reason::Behind,
                 Reason::LastSafeMoment,
-                Reason::SetOff
+                Reason::SetOff,
+                Reason::MapChanged
             ]
         );
     }

@@ -215,6 +215,7 @@ impl DowntimeWindow<'_> {
                 planned_ahead: self.planned_ahead.take(),
                 track,
                 fix,
+                obstacles: self.obstacles.take(),
             },
             position: self.here,
         }))

@@ -49,6 +49,10 @@ pub enum WindowEvent {
     PlanReply { id: u64, plan: Box<Plan> },
     /// Request `id` failed: no planner answered, or it refused.
     PlanFailed { id: u64 },
+    /// What the fleet believes occupied where the static map is free changed: the
+    /// route left is checked against it (`blocked.rs`). Shared, since a fleet's
+    /// robots hear the same set.
+    MapChanged(std::sync::Arc<super::blocked::SeenObstacles>),
 }
 
 /// A plan to ask the planner for.

@@ -34,6 +34,9 @@ pub struct Handover {
     /// its new window's track has no fix to go back to.
     pub track: Vec<[f64; 2]>,
     pub fix: usize,
+    /// The last set of believed obstacles heard: the next window checks its first
+    /// route against it (a route planned ahead may predate it).
+    pub obstacles: Option<std::sync::Arc<super::blocked::SeenObstacles>>,
 }
 
 /// How much of a window's track the next one keeps: 600 estimates, four minutes at the
@@ -57,6 +60,7 @@ impl Handover {
             planned_ahead: None,
             track: Vec::new(),
             fix: 0,
+            obstacles: None,
         }
     }
 }

@@ -2,7 +2,7 @@
 //! fix, off the path), the controller's status on the current mission (arrived, stuck,
 //! held, recovering; any status is speech, so a held robot is never "silent"), and the
 //! clock's ticks (give up, a silent controller, a retry that is due, the last safe
-//! moment).
+//! moment, a route not yet checked against the obstacles last heard).
 
 use roam_proto::controller::{ControllerStatus, MissionState};
 
@@ -141,6 +141,10 @@ impl DowntimeWindow<'_> {
                 let decision = drive.watch.on_tick(now.mission_s, now.wall_s);
                 let mut actions = self.decide(decision, now);
                 actions.extend(self.check_safe(now));
+                if self.drive_ask.is_none() {
+                    // A set of obstacles heard while a plan was in flight (`blocked.rs`).
+                    actions.extend(self.check_route_clear(now));
+                }
                 actions
             }
             Phase::AtTask {

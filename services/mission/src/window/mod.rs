@@ -44,7 +44,12 @@
 //!    [`RECOVERY_BACK_M`] back (where the fix is lost the estimate freezes), which the guard
 //!    lets through, then sends it straight to the task from there (a curious route would
 //!    lead back into the gap). At most [`MAX_RECOVERIES`] a window.
-//! 6. **Arrive**: the time model's prediction is scored, the arrival margin learns, the
+//! 6. **The map changed**: a new set of obstacles the fleet believes in
+//!    ([`WindowEvent::MapChanged`]) that the route left passes too close to is a
+//!    replan at once (`map_changed`), from where the robot will be when the plan comes
+//!    and seeded with the route left, which the planner repairs round the block
+//!    (`blocked.rs`).
+//! 7. **Arrive**: the time model's prediction is scored, the arrival margin learns, the
 //!    calibration gets the window's drives (`drove.rs`), and
 //!    the window is done when the task ends (and the next window's plan is in, or
 //!    failed). **Give up**: done at once.
@@ -57,6 +62,7 @@
 //! shortest path, and a budget it does not fit is answered with it.
 
 mod asks;
+mod blocked;
 mod drove;
 mod ending;
 mod events;
@@ -75,6 +81,7 @@ use crate::watch::{Reason, Watch};
 
 use state::{Drive, MissionIds, Phase};
 
+pub use blocked::{seen_world, SeenObstacles, MAX_OBSTACLE_POINTS};
 pub use drove::{MAX_LEARNED_OFF_ROUTE_M, MIN_LEARNED_DRIVE_M};
 pub use events::{DrivenMission, Now, PlanAsk, WindowAction, WindowEvent};
 pub use handover::{Handover, WindowEnd, WindowOutcome};
@@ -125,6 +132,12 @@ impl<'a> DowntimeWindow<'a> {
                 retry_at_wall_s: None,
                 failures: 0,
             },
+            obstacles_unchecked: handover.obstacles.is_some(),
+            seen_world: handover
+                .obstacles
+                .as_deref()
+                .and_then(|o| blocked::seen_world(setup.scale.world, o)),
+            obstacles: handover.obstacles,
             setup,
         };
         let task = &w.setup.task;
@@ -196,6 +209,7 @@ impl<'a> DowntimeWindow<'a> {
             WindowEvent::Tick => self.on_tick(now),
             WindowEvent::PlanReply { id, plan } => self.on_reply(id, Some(*plan), now),
             WindowEvent::PlanFailed { id } => self.on_reply(id, None, now),
+            WindowEvent::MapChanged(obstacles) => self.on_map_changed(obstacles, now),
         }
     }
 

@@ -72,10 +72,23 @@ impl DowntimeWindow<'_> {
         self.go_straight(fastest, Reason::LastSafeMoment, now)
     }
 
-    /// The window's own fastest path from where the robot is to the task.
+    /// The window's own fastest path from where the robot is to the task: round the
+    /// obstacles the fleet believes in (`blocked.rs`) when there is such a way, else on
+    /// the static map (a robot standing within an obstacle's clearance has no free
+    /// start on the blocked world).
     pub(super) fn fastest_from_here(&self) -> Option<Route> {
         let s = &self.setup;
-        straight::fastest_route(&s.scale, s.time_model, self.here, s.task.at)
+        let on = |world| {
+            let scale = crate::information::InformationScale {
+                world,
+                params: s.scale.params,
+            };
+            straight::fastest_route(&scale, s.time_model, self.here, s.task.at)
+        };
+        self.seen_world
+            .as_ref()
+            .and_then(&on)
+            .or_else(|| on(s.scale.world))
     }
 
     /// Sends the robot along `route` (the window's own fastest path) at once, for
@@ -167,14 +180,14 @@ impl DowntimeWindow<'_> {
         let Phase::Driving(drive) = &self.phase else {
             return Vec::new();
         };
-        // A slack or behind replan is made while the robot drives on: it starts where
+        // A slack, behind or map-changed replan is made while the robot drives on: it starts where
         // the robot will be when the plan comes, on its route, and is seeded with what
         // is left of the route from there (and runs the replan's generations, so it
         // comes sooner). One made where the robot is (off its path, stuck) is not: the
         // route left does not start there, the seed could not be joined, and fewer
         // generations from scratch would leave twisty random-walk paths.
         let time_left = self.setup.task.start_s - now.mission_s;
-        let on_route = matches!(reason, Reason::Slack | Reason::Behind);
+        let on_route = matches!(reason, Reason::Slack | Reason::Behind | Reason::MapChanged);
         let from = if on_route {
             let lead_m =
                 self.plan_cost_s(time_left, now, curious) * self.setup.watch.expected_speed_m_per_s;

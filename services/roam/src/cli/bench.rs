@@ -62,7 +62,12 @@ pub(crate) enum BenchCommand {
         deadline_s: f64,
     },
     /// Robots in closed loop through Zenoh (sim → localization → controller → sim) at a
-    /// fixed rate: steps on time, CPU share and memory per robot.
+    /// fixed rate, the router in its own process: commands on time, the loop's and the
+    /// router's CPU and memory per robot, a robot joining, a router restart
+    ///
+    /// The last of --robots joins halfway through --seconds; after them the router is
+    /// killed (SIGKILL) and started again 1 s later, and the run goes on until every
+    /// robot is commanded again (at most 30 s) and 2 s more.
     Fleet {
         #[arg(long)]
         json: bool,
@@ -85,6 +90,18 @@ pub(crate) enum BenchCommand {
         /// Observation updates to run.
         #[arg(long, default_value_t = 4000)]
         updates: u64,
+    },
+    /// The wire's own latency on loopback: p50/p99 of a put to a subscriber and of a get
+    /// to its reply, peer to peer and through a router, over TCP and TLS.
+    Wire {
+        #[arg(long)]
+        json: bool,
+        /// Samples per topology, operation and payload size (at most 100000).
+        #[arg(long, default_value_t = roam_bench::wire::DEFAULT_SAMPLES)]
+        samples: usize,
+        /// Payload sizes, bytes (at most 8 sizes, each 8..=4194304).
+        #[arg(long, value_delimiter = ',', default_values_t = roam_bench::wire::DEFAULT_PAYLOADS)]
+        payloads: Vec<usize>,
     },
     /// The GA per curiosity model (2000 generations, population 200) and the service
     /// overhead; with --scaling or --peer, finer maps or the greedy planner instead;
@@ -195,7 +212,10 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
             check_robots_run(robots, rate_hz, seconds)?;
             let progress = Progress::new("bench fleet", quiet);
             let shown = progress.callback();
-            let result = roam_bench::fleet::fleet(robots, rate_hz, seconds, &shown).await?;
+            // The router runs as this binary's `router` role, in its own process.
+            let program = std::env::current_exe()?;
+            let result =
+                roam_bench::fleet::fleet(robots, rate_hz, seconds, &program, &shown).await?;
             print_json(&result, json)
         }
         BenchCommand::Mapper {
@@ -213,6 +233,15 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
             };
             let result =
                 tokio::task::spawn_blocking(move || roam_bench::mapper::bench(&options)).await??;
+            print_json(&result, json)
+        }
+        BenchCommand::Wire {
+            json,
+            samples,
+            payloads,
+        } => {
+            roam_bench::wire::check(samples, &payloads)?;
+            let result = roam_bench::wire::wire(samples, &payloads).await?;
             print_json(&result, json)
         }
         BenchCommand::Planner {

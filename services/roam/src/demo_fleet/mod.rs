@@ -189,6 +189,7 @@ fn executive_config(
         seed: options.seed,
         w_loc: DEMO_W_LOC,
         model: PlannerModel::Greedy,
+        avoid_seen: options.avoid_seen,
         ..FleetOptions::default()
     };
     robot_config(FleetVariant::News, &robot.robot, index, tasks, &batch)

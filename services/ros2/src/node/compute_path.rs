@@ -15,8 +15,8 @@
 //!
 //! - `planner_id` picks the plan ([`PLANNER_IDS`]): empty or `curious` is the curious
 //!   default (Model I), `GridBased` (the name in Nav2's default behaviour trees) and
-//!   `shortest` the fastest path, and `model0`, `model1`, `model2`, `greedy` that
-//!   planner; each curious plan has GetPlan's budget, 1.5 × the fastest path's ETA.
+//!   `shortest` the fastest path, and `model0`, `model1`, `model2`, `greedy`, `anytime`
+//!   that planner; each curious plan has GetPlan's budget, 1.5 × the fastest path's ETA.
 //!   Any other name: `INVALID_PLANNER`.
 //! - `use_start` false starts at the robot's latest estimate ([`super::poses`]); with
 //!   none, `TF_ERROR`, as Nav2 when it cannot look the robot up.

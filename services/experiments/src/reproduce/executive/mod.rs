@@ -26,6 +26,7 @@ mod step;
 pub mod track;
 
 use std::collections::{BTreeMap, VecDeque};
+use std::sync::Arc;
 
 use roam_controller::status::controller_status;
 use roam_mission::calibration::{Calibration, CalibrationConfig, CalibrationError, TimeModel};
@@ -34,8 +35,8 @@ use roam_mission::information::InformationScale;
 use roam_mission::request::plan_request;
 use roam_mission::tasks::Task;
 use roam_mission::window::{
-    DowntimeWindow, Handover, Now, WindowAction, WindowEnd, WindowEvent, WindowOutcome,
-    WindowRules, WindowSetup,
+    DowntimeWindow, Handover, Now, SeenObstacles, WindowAction, WindowEnd, WindowEvent,
+    WindowOutcome, WindowRules, WindowSetup,
 };
 use roam_proto::controller::Mission;
 use roam_proto::mission::WindowReport;
@@ -276,6 +277,35 @@ impl<'a> InProcessExecutive<'a> {
                 Ok(())
             }
         }
+    }
+
+    /// A new set of the obstacles the fleet believes in, heard at the step's time (after
+    /// the step's own events, as `on_step` ran them): the current window checks its
+    /// route against it (`roam_mission::window`, `blocked.rs`), or the next window
+    /// begins with it. Heard only when the config follows an `obstacles_layer`, as the
+    /// live executive does.
+    pub fn on_obstacles(
+        &mut self,
+        set: Arc<SeenObstacles>,
+        io: &mut dyn Io,
+    ) -> Result<(), ExecutiveError> {
+        if self.config.obstacles_layer.is_none() || self.done() {
+            return Ok(());
+        }
+        let Some(mut current) = self.current.take() else {
+            if let Some(handover) = self.handover.as_mut() {
+                handover.obstacles = Some(set);
+            }
+            return Ok(());
+        };
+        for event in [WindowEvent::MapChanged(set), WindowEvent::Tick] {
+            let actions = current.machine.handle(event, self.now());
+            if let Some(end) = self.perform(&mut current, actions, io)? {
+                return self.end_window(current, end, io);
+            }
+        }
+        self.current = Some(current);
+        Ok(())
     }
 
     /// Begins the next task's window, now (and the ones after it, while a window ends

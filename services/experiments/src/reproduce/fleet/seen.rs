@@ -14,6 +14,7 @@
 use std::sync::Arc;
 
 use roam_mapper::belief::ros_occupancy;
+use roam_mission::window::SeenObstacles;
 use roam_planner::seen::{block_seen, OBSTACLE_AT};
 use roam_planner::world::World;
 use roam_proto::cells::Cells;
@@ -43,6 +44,10 @@ pub struct SeenWorld {
     next_refresh_s: f64,
     /// How many times the world was rebuilt.
     pub rebuilds: usize,
+    /// The believed obstacles as the executives check their routes against them (the
+    /// live executive's `obstacles_layer` follower makes the same set from the same
+    /// layer), when the last refresh changed them.
+    changed: Option<Arc<SeenObstacles>>,
 }
 
 impl SeenWorld {
@@ -54,6 +59,11 @@ impl SeenWorld {
     /// Whether a refresh is due at `now_s`.
     pub fn due(&self, now_s: f64) -> bool {
         now_s >= self.next_refresh_s
+    }
+
+    /// The believed obstacles, if the last refresh changed them (taken once).
+    pub fn take_changed(&mut self) -> Option<Arc<SeenObstacles>> {
+        self.changed.take()
     }
 
     /// Takes the fleet's belief (P(occupied now) per coarse cell) at `now_s`, and
@@ -77,18 +87,25 @@ impl SeenWorld {
             return Ok(());
         }
         self.obstacles = obstacles;
+        let occupied_now = occupied_now(fleet, &scores);
         self.world = if self.obstacles.is_empty() {
             None
         } else {
-            Some(Arc::new(build(fleet, &scores)?))
+            Some(Arc::new(build(fleet, &occupied_now)?))
         };
+        let set = SeenObstacles::of_layers(&fleet.inflated, &occupied_now, OBSTACLE_INFLATION_M)
+            .ok_or_else(|| {
+                FleetError::World("the fleet's belief is not on the map's grid".into())
+            })?;
+        self.changed = Some(Arc::new(set));
         self.rebuilds += 1;
         Ok(())
     }
 }
 
-/// The planning world around `scores` (the fleet's `occupied_now` on the coarse grid).
-fn build(fleet: &FleetWorld, scores: &[i8]) -> Result<World, FleetError> {
+/// The fleet's `occupied_now` on the coarse grid (`scores`), laid onto the map's cells
+/// as the mapper publishes it.
+fn occupied_now(fleet: &FleetWorld, scores: &[i8]) -> Layer {
     let meta = fleet.inflated.meta;
     let width = meta.width as usize;
     let cells: Vec<i8> = (0..fleet.inflated.cells.len())
@@ -100,15 +117,19 @@ fn build(fleet: &FleetWorld, scores: &[i8]) -> Result<World, FleetError> {
                 .map_or(occupancy::UNKNOWN, |&p| p)
         })
         .collect();
-    let occupied_now = Layer {
+    Layer {
         name: "occupied_now".into(),
         version: 1,
         meta,
         derived_from: None,
         cells: Cells::I8(cells),
-    };
+    }
+}
+
+/// The planning world around the fleet's `occupied_now`.
+fn build(fleet: &FleetWorld, occupied_now: &Layer) -> Result<World, FleetError> {
     let mut inflated = fleet.inflated.clone();
-    block_seen(&mut inflated, &occupied_now, OBSTACLE_INFLATION_M)
+    block_seen(&mut inflated, occupied_now, OBSTACLE_INFLATION_M)
         .ok_or_else(|| FleetError::World("the fleet's belief is not on the map's grid".into()))?;
     let mut world = World::at_resolution(
         &inflated,
@@ -161,15 +182,28 @@ mod tests {
             "the pallet's cell is blocked"
         );
         assert!(around.traversable_count() < fleet.planning.traversable_count());
+        // The executives hear the new set once: the pallet's map cells, at its centre.
+        let set = seen.take_changed().expect("a new set");
+        let (x, y) = fleet.planning.center(cell as u32);
+        assert!(!set.points.is_empty());
+        assert!(set
+            .points
+            .iter()
+            .all(|p| (p[0] - x).abs() <= 0.1 + 1e-9 && (p[1] - y).abs() <= 0.1 + 1e-9));
+        assert_eq!(set.clearance_m, OBSTACLE_INFLATION_M);
+        assert!(seen.take_changed().is_none());
 
-        // The same belief again: no rebuild. Seen gone: the static world again.
+        // The same belief again: no rebuild, nothing new to hear. Seen gone: the
+        // static world again, and an empty set.
         seen.refresh(&fleet, &belief, 2.0 * REFRESH_S)
             .expect("refresh");
         assert_eq!(seen.rebuilds, 1);
+        assert!(seen.take_changed().is_none());
         belief[cell] = 0.1;
         seen.refresh(&fleet, &belief, 3.0 * REFRESH_S)
             .expect("refresh");
         assert_eq!(seen.rebuilds, 2);
         assert!(seen.world(&fleet).is_traversable(cell as u32));
+        assert_eq!(seen.take_changed().map(|s| s.points.len()), Some(0));
     }
 }

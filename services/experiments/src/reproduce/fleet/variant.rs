@@ -17,6 +17,11 @@
 //!   off: each robot's news from its own observations only (and no reservations, which
 //!   need the others' plans); the others' plans not counted; the rates not learnt (a
 //!   prior so strong that no event moves it: news is then how long nobody looked).
+//! - `news_map_replans`: `news` with each executive following what the fleet believes
+//!   occupied now (`obstacles_layer: occupied_now`): a route a pallet lands on is
+//!   replanned round it at once (`map_changed`, `roam_mission::window`), where `news`
+//!   drives on until the robot is stuck. Not `news`'s default: over a shift it made
+//!   robots late (experiments README, "Map-change replans in the fleet").
 
 use roam_mapper::news::DEFAULT_NEWS_PRIOR;
 use roam_mapper::prior::RatePrior;
@@ -35,6 +40,7 @@ pub enum FleetVariant {
     NewsNoSharing,
     NewsNoReservations,
     NewsNoRates,
+    NewsMapReplans,
 }
 
 /// What curious plans are made on.
@@ -62,7 +68,7 @@ const RATES_OFF: RatePrior = RatePrior {
 };
 
 impl FleetVariant {
-    pub const ALL: [FleetVariant; 7] = [
+    pub const ALL: [FleetVariant; 8] = [
         FleetVariant::TasksOnly,
         FleetVariant::Patrol,
         FleetVariant::Independent,
@@ -70,6 +76,7 @@ impl FleetVariant {
         FleetVariant::NewsNoSharing,
         FleetVariant::NewsNoReservations,
         FleetVariant::NewsNoRates,
+        FleetVariant::NewsMapReplans,
     ];
 
     pub fn name(self) -> &'static str {
@@ -81,6 +88,7 @@ impl FleetVariant {
             FleetVariant::NewsNoSharing => "news_no_sharing",
             FleetVariant::NewsNoReservations => "news_no_reservations",
             FleetVariant::NewsNoRates => "news_no_rates",
+            FleetVariant::NewsMapReplans => "news_map_replans",
         }
     }
 
@@ -107,6 +115,10 @@ impl FleetVariant {
                 w_loc: None,
                 ..base
             },
+            FleetVariant::NewsMapReplans => ExecutiveConfig {
+                obstacles_layer: Some(roam_proto::mapper::OCCUPIED_NOW_LAYER.to_owned()),
+                ..FleetVariant::News.config(base, w_loc, curious)
+            },
             _ => ExecutiveConfig {
                 model: curious,
                 w_loc: Some(w_loc),
@@ -129,6 +141,7 @@ impl FleetVariant {
             FleetVariant::NewsNoSharing => news(false, false, DEFAULT_NEWS_PRIOR),
             FleetVariant::NewsNoReservations => news(true, false, DEFAULT_NEWS_PRIOR),
             FleetVariant::NewsNoRates => news(true, true, RATES_OFF),
+            FleetVariant::NewsMapReplans => news(true, true, DEFAULT_NEWS_PRIOR),
         }
     }
 }
@@ -183,6 +196,22 @@ mod tests {
                 "{differs}"
             );
         }
+        // With map replans: the news's config but for the layer followed.
+        let base = ExecutiveConfig::default;
+        let news = FleetVariant::News.config(base(), 2000.0, PlannerModel::Greedy);
+        let map = FleetVariant::NewsMapReplans.config(base(), 2000.0, PlannerModel::Greedy);
+        assert!(news.obstacles_layer.is_none() && map.obstacles_layer.is_some());
+        assert_eq!(
+            ExecutiveConfig {
+                obstacles_layer: None,
+                ..map
+            },
+            news
+        );
+        assert_eq!(
+            FleetVariant::NewsMapReplans.planning(),
+            FleetVariant::News.planning()
+        );
         // The strong prior's mean rate is the default's.
         let mean = |p: RatePrior| p.alpha / p.beta_s;
         assert!((mean(RATES_OFF) / mean(DEFAULT_NEWS_PRIOR) - 1.0).abs() < 1e-12);

@@ -59,6 +59,9 @@ pub fn robot_config(
         max_generations: Some(options.generations),
         seed: plan_seed(options.seed, index),
         peb_free_m: Some(options.peb_free_m),
+        // Routes being driven are replanned when the fleet's belief blocks them only in
+        // the `news_map_replans` variant (variant.rs): measured worse in the shift.
+        obstacle_inflation_m: super::seen::OBSTACLE_INFLATION_M,
         ..ExecutiveConfig::default()
     };
     variant.config(base, options.w_loc, options.model)
@@ -255,6 +258,7 @@ pub fn run_week(
         if options.avoid_seen && seen.due(t) {
             seen.refresh(world, &mapper.belief(world, t)?, t)?;
         }
+        let obstacles = seen.take_changed();
         for r in &out.robots {
             let Some(i) = names.iter().position(|n| *n == r.robot) else {
                 continue;
@@ -290,6 +294,9 @@ pub fn run_week(
                 radius_m,
             };
             exec.on_step(&step, &mut io)?;
+            if let Some(set) = &obstacles {
+                exec.on_obstacles(set.clone(), &mut io)?;
+            }
             for finished in exec.take_finished() {
                 record
                     .windows

@@ -355,6 +355,7 @@ fn close(a: f64, b: f64) -> bool {
 
 mod late_held_ahead;
 mod lifecycle;
+mod map_changed;
 mod next_window;
 mod replans;
 mod set_off;

@@ -14,6 +14,9 @@ use serde::Serialize;
 ///   recovered, the PEB cost (W_loc) and the change coupling on the planner.
 /// - `no_change`, `no_peb`: `executive` without one coupling, so that each one's effect
 ///   shows alone.
+/// - `anytime`: `executive` planning with the planner's anytime portfolio (the greedy
+///   route, then the GA seeded with it) instead of Model I's GA: what the portfolio
+///   is worth in the day.
 /// - `plain`: paper 000's planner alone, as an executive without roam's rules would use
 ///   it ([`ExecutiveConfig::plain`]): Table I throughout, one plan at each window's
 ///   start, no margin, no slack or behind rule, no recovery, no PEB cost, no change
@@ -27,16 +30,18 @@ pub enum Variant {
     Executive,
     NoChange,
     NoPeb,
+    Anytime,
     FastestPath,
 }
 
 impl Variant {
     /// Every variant, in the order the report lists them.
-    pub const ALL: [Variant; 5] = [
+    pub const ALL: [Variant; 6] = [
         Variant::Plain,
         Variant::Executive,
         Variant::NoChange,
         Variant::NoPeb,
+        Variant::Anytime,
         Variant::FastestPath,
     ];
 
@@ -46,6 +51,7 @@ impl Variant {
             Variant::Executive => "executive",
             Variant::NoChange => "no_change",
             Variant::NoPeb => "no_peb",
+            Variant::Anytime => "anytime",
             Variant::FastestPath => "fastest_path",
         }
     }
@@ -68,6 +74,10 @@ impl Variant {
                 w_loc: None,
                 ..executive
             },
+            Variant::Anytime => ExecutiveConfig {
+                model: roam_proto::planner::PlannerModel::Anytime,
+                ..executive
+            },
             Variant::Plain => executive.plain(),
             Variant::FastestPath => executive.fastest_path_only(),
         }
@@ -75,7 +85,7 @@ impl Variant {
 
     /// The planner couples the change layer into its information map.
     pub fn change_coupling(self) -> bool {
-        matches!(self, Variant::Executive | Variant::NoPeb)
+        matches!(self, Variant::Executive | Variant::NoPeb | Variant::Anytime)
     }
 }
 
@@ -109,5 +119,14 @@ mod tests {
             Variant::FastestPath.config(base(), 2000.0).model,
             PlannerModel::Shortest
         );
+        assert_eq!(executive.model, PlannerModel::Model1);
+        assert_eq!(
+            ExecutiveConfig {
+                model: PlannerModel::Model1,
+                ..Variant::Anytime.config(base(), 2000.0)
+            },
+            executive
+        );
+        assert_eq!(plain.model, PlannerModel::Model1);
     }
 }
