@@ -294,12 +294,7 @@ async fn a_pallet_seen_on_the_route_ahead_is_a_replan_round_it() {
     // each of its cells, 0.3 m by default). Unless it answers a replan asked before the
     // planner had the layer (a slack replan in flight): then the executive checks that
     // route when it comes, and the one after it is the map change's.
-    let nearest = |m: &Mission| {
-        m.waypoints
-            .windows(2)
-            .map(|w| segment_distance(w[0], w[1], pallet))
-            .fold(f64::INFINITY, f64::min)
-    };
+    let nearest = |m: &Mission| roam_mission::path::off_path_m(pallet, &m.waypoints);
     let mut round = next_mission().await;
     if nearest(&round) <= PALLET_M {
         round = next_mission().await;
@@ -316,16 +311,4 @@ async fn a_pallet_seen_on_the_route_ahead_is_a_replan_round_it() {
         "{goal1:?}"
     );
     assert!(goal1.on_time, "{goal1:?}");
-}
-
-/// The distance from `p` to the segment `a`-`b`.
-fn segment_distance(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    let t = if len2 > 0.0 {
-        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a[0] + t * dx - p[0]).hypot(a[1] + t * dy - p[1])
 }

@@ -39,6 +39,13 @@ pub const DEADLINE_S: f64 = 1.0;
 /// Budgets as multiples of the fastest path's ETA.
 pub const BUDGET_FACTORS: [f64; 3] = [1.5, 2.0, 3.0];
 
+/// The goal (issue 30): roam's plans hold at least this median share of the optimum…
+pub const GOAL_MEDIAN_SHARE: f64 = 0.97;
+/// …and at least this share on every instance, over at least [`GOAL_MIN_INSTANCES`]
+/// proven ones.
+pub const GOAL_WORST_SHARE: f64 = 0.90;
+pub const GOAL_MIN_INSTANCES: usize = 30;
+
 /// Nodes the exact search may expand per instance.
 pub const NODE_LIMIT: u64 = 20_000_000;
 
@@ -80,6 +87,11 @@ pub struct OptimalityBench {
     pub best_of_both_share_median: f64,
     pub deadline_s: f64,
     pub objective: &'static str,
+    /// Whether Model I (the executive's default) and the anytime portfolio meet the
+    /// goal ([`GOAL_MEDIAN_SHARE`], [`GOAL_WORST_SHARE`], [`GOAL_MIN_INSTANCES`]),
+    /// computed from the shares above.
+    pub goal_met_model1: bool,
+    pub goal_met_anytime: bool,
 }
 
 /// Instance `seed`: walls and information blobs on a [`SIDE`]² grid at 0.2 m.
@@ -235,7 +247,14 @@ pub fn optimality(instances: u64, progress: Progress<'_>) -> Result<OptimalityBe
     let (model1_median, model1_min) = stat(&|i| i.model1_share);
     let (both_median, _) = stat(&|i| i.greedy_share.max(i.model1_share));
     let (anytime_median, anytime_min) = stat(&|i| i.anytime_share);
+    let goal = |median: f64, worst: f64| {
+        proven.len() >= GOAL_MIN_INSTANCES
+            && median >= GOAL_MEDIAN_SHARE
+            && worst >= GOAL_WORST_SHARE
+    };
     Ok(OptimalityBench {
+        goal_met_model1: goal(model1_median, model1_min),
+        goal_met_anytime: goal(anytime_median, anytime_min),
         proven: proven.len(),
         instances: out,
         greedy_share_median: greedy_median,

@@ -21,7 +21,7 @@
 
 use roam_planner::world::{Cell, World};
 
-use crate::path::distance;
+use crate::path::off_path_m;
 
 use super::events::{Now, WindowAction};
 use super::state::{DowntimeWindow, Phase};
@@ -94,26 +94,8 @@ impl SeenObstacles {
         if near.is_empty() {
             return false;
         }
-        let first = [route[0], route[0]];
-        std::iter::once(&first[..])
-            .chain(route.windows(2))
-            .any(|seg| {
-                near.iter()
-                    .any(|&p| segment_distance(seg[0], seg[1], p) < r)
-            })
+        near.iter().any(|&p| off_path_m(p, route) < r)
     }
-}
-
-/// The distance from `p` to the segment `a`–`b`.
-fn segment_distance(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    let t = if len2 > 0.0 {
-        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    distance([a[0] + t * dx, a[1] + t * dy], p)
 }
 
 /// `world` with every cell whose centre is within the clearance of an obstacle point

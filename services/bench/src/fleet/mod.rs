@@ -1,0 +1,242 @@
+//! `roam bench fleet`: many robots in closed loop through Zenoh (issues 16 and 30).
+//!
+//! The sim, localization and the APF controller run in this process on the built-in
+//! world, as in `roam stack`; the router runs in a process of its own (`<program> router`,
+//! the `roam` binary, on a free loopback port), so that its CPU and memory are measured
+//! apart from the loop's. A client adds `robots − 1` robots on free cells spread over the
+//! map and gives each a mission across the map and back (waypoints, paper 002's
+//! controller), then resumes the sim at `rate_hz` steps per second for `seconds`. Every
+//! step the loop is sim → `ranges` → localization → `estimate` → controller → `cmd` →
+//! sim, for every robot, over Zenoh.
+//!
+//! **On time.** A command answers the estimate of step k (it carries k); it is on time
+//! when it reaches the bench's subscriber before the sim's clock for step k + 1 does
+//! (the sim applies a command at the next step, so a later one misses its step). Both
+//! arrive through the same router as at the sim, so the order seen here is the order
+//! the sim sees, to within the router's fan-out. `loop_on_time_share` is the commands
+//! on time over the robots × steps that should have had one (each robot's steps from its
+//! first command on); `sim_on_time_share` is the sim's own count of steps whose messages
+//! were out before the next step was due.
+//!
+//! `cpu_share` is this process's CPU time (the loop without the router) over wall time
+//! and cores (1.0: every core busy); `rss_per_robot_mib` the resident memory the robots
+//! added (after minus before adding them, over the robots). `router_*` are the same for
+//! the router's process, read from `/proc/<pid>`.
+//!
+//! **Join.** Halfway through the timed run the last of the `robots` joins: its mission
+//! is put, then the sim adds it while it runs, as an operator's tool would. The joiner
+//! is one of `robots` (not one more), so `robots` may be the sim's whole `max_robots`.
+//! `join_ms` is from its first range scan to its first command, both as the bench's
+//! subscriber sees them (the path localization's and the sim's subscriptions take).
+//!
+//! **Router restart.** After the timed run the sim runs on at the same rate; after
+//! [`RESTART_LEAD`] the router's process is killed with SIGKILL (a crash: the kernel
+//! closes its sockets, so every client sees its link go at once) and a new one is
+//! started on the same endpoint [`ROUTER_DOWN`] later. Nothing else is restarted: every
+//! session is a Zenoh client of that endpoint and reconnects by itself. The bench waits
+//! (at most [`RECOVERY_LIMIT`]) until every robot's command reaches its subscriber
+//! again, runs [`RESTART_TAIL`] more and pauses the sim. The outage's steps are those
+//! from the last clock seen before the kill to the last seen when every robot had been
+//! commanded again; the commands on time are counted inside it and outside it (the
+//! steps of this phase before and after it) apart.
+
+mod join;
+mod places;
+mod restart;
+mod router;
+mod run;
+mod seen;
+
+use std::path::Path;
+use std::time::Duration;
+
+use roam_controller::service::ControllerConfig;
+use roam_localization::service::LocalizationConfig;
+use roam_runtime::service_config::ServiceConfig;
+use roam_runtime::SessionArgs;
+use roam_sim::service::SimConfig;
+use serde::Serialize;
+
+use crate::{setup, BenchError};
+use tokio_util::sync::CancellationToken;
+
+use roam_experiments::progress::Progress;
+
+pub use restart::{RECOVERY_LIMIT, RESTART_LEAD, RESTART_TAIL, ROUTER_DOWN};
+use router::start_router;
+use run::run;
+
+#[derive(Debug, Clone, Serialize)]
+pub struct FleetBench {
+    /// Robots at the end of the timed run: `robots − 1` from its start and the one that
+    /// joined halfway.
+    pub robots: usize,
+    pub rate_hz: f64,
+    pub seconds: f64,
+    /// Sim steps while running.
+    pub steps: u64,
+    pub sim_on_time_share: f64,
+    /// Commands that answered step k and arrived before step k + 1's clock, over the
+    /// commands the steps called for.
+    pub loop_on_time_share: f64,
+    pub commands_expected: u64,
+    pub commands_on_time: u64,
+    pub commands_late: u64,
+    /// Step k + 1's clock minus step k's, at the subscriber: median and 99th percentile.
+    pub step_period_p50_ms: f64,
+    pub step_period_p99_ms: f64,
+    /// The loop's process (sim, localization, controller, the bench's client; not the
+    /// router): CPU time over wall time and cores during the timed run.
+    pub cpu_share: f64,
+    pub cores: usize,
+    pub rss_per_robot_mib: f64,
+    pub rss_mib: Option<f64>,
+    pub peak_rss_mib: Option<f64>,
+    /// The router's process: CPU time over wall time and cores during the timed run.
+    pub router_cpu_share: f64,
+    /// The router's CPU time per robot and step during the timed run, microseconds
+    /// (its share of one core per robot is this × `rate_hz` / 10⁶).
+    pub router_cpu_us_per_robot_step: f64,
+    /// The router's resident memory at the end of the timed run (`VmRSS`), MiB.
+    pub router_rss_mib: Option<f64>,
+    /// The router's peak resident memory up to then (`VmHWM`), MiB.
+    pub router_peak_rss_mib: Option<f64>,
+    /// What the robots added to the router's resident memory, over the robots, MiB.
+    pub router_rss_per_robot_mib: f64,
+    /// The joining robot: from its first range scan to its first command, both at the
+    /// bench's subscriber, ms (`None`: never commanded).
+    pub join_ms: Option<f64>,
+    /// The joining robot: from the request that added it to its first command, ms.
+    pub join_from_add_ms: Option<f64>,
+    /// From the router's SIGKILL to the start of the new router, ms ([`ROUTER_DOWN`]
+    /// and the time to start a process).
+    pub restart_down_ms: f64,
+    /// From the new router's start to the first command of any robot after it, ms.
+    pub restart_first_command_ms: Option<f64>,
+    /// From the new router's start until every robot had been commanded again, ms
+    /// (`None`: not every robot within [`RECOVERY_LIMIT`]).
+    pub restart_all_commanded_ms: Option<f64>,
+    /// The robots commanded again after the restart (of `robots`).
+    pub restart_robots_commanded: usize,
+    /// The restart phase's steps outside the outage (before the kill, after every
+    /// robot was commanded again), and the commands on time in them over robots × steps.
+    pub restart_steps_outside: u64,
+    pub restart_on_time_share_outside: f64,
+    /// The outage's steps (last clock before the kill to the clock when every robot
+    /// had been commanded again), and the commands on time in them over robots × steps.
+    pub restart_steps_inside: u64,
+    pub restart_on_time_share_inside: f64,
+}
+
+/// Runs the bench with the router in its own process, `router_program router` (the
+/// `roam` binary); `progress` each second of the timed run (stage `running`), then per
+/// robot commanded again after the router's restart (stage `router restart`).
+pub async fn fleet(
+    robots: usize,
+    rate_hz: f64,
+    seconds: f64,
+    router_program: &Path,
+    progress: Progress<'_>,
+) -> Result<FleetBench, BenchError> {
+    let most = roam_sim::sim::MAX_ROBOTS;
+    if robots == 0 || robots > most {
+        return Err(BenchError::Setup(format!(
+            "a fleet is 1..={most} robots (the sim's robot limit), not {robots}"
+        )));
+    }
+    let (mut router, session) = start_router(router_program).await?;
+    let root = "roam-bench-fleet".to_owned();
+    let cancel = CancellationToken::new();
+    let client_config = || {
+        SessionArgs::client_of(&router.endpoint)
+            .zenoh_config(None)
+            .map_err(setup)
+    };
+    let mut services = tokio::task::JoinSet::new();
+    {
+        let (config, zenoh, token) = (
+            SimConfig {
+                service: ServiceConfig::at(root.clone()),
+                rate: None,
+                ..SimConfig::default()
+            },
+            client_config()?,
+            cancel.clone(),
+        );
+        services.spawn(async move {
+            roam_sim::service::run(config, zenoh, token)
+                .await
+                .map_err(|e| e.to_string())
+        });
+    }
+    {
+        let (config, zenoh, token) = (
+            LocalizationConfig {
+                service: ServiceConfig::at(root.clone()),
+                publish_peb_layer: false,
+                ..LocalizationConfig::default()
+            },
+            client_config()?,
+            cancel.clone(),
+        );
+        services.spawn(async move {
+            roam_localization::service::run(config, zenoh, token)
+                .await
+                .map_err(|e| e.to_string())
+        });
+    }
+    {
+        let (config, zenoh, token) = (
+            ControllerConfig {
+                service: ServiceConfig::at(root.clone()),
+                ..ControllerConfig::default()
+            },
+            client_config()?,
+            cancel.clone(),
+        );
+        services.spawn(async move {
+            roam_controller::service::run(config, zenoh, token)
+                .await
+                .map_err(|e| e.to_string())
+        });
+    }
+    let result = run(
+        &mut router,
+        router_program,
+        &root,
+        &session,
+        robots,
+        (rate_hz, seconds),
+        progress,
+    )
+    .await;
+    cancel.cancel();
+    let _ = tokio::time::timeout(Duration::from_secs(10), async {
+        while services.join_next().await.is_some() {}
+    })
+    .await;
+    let _ = session.close().await;
+    router.kill();
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roam_experiments::progress::silent;
+
+    #[tokio::test]
+    async fn a_fleet_outside_the_sims_limit_is_refused_naming_it_before_anything_starts() {
+        let most = roam_sim::sim::MAX_ROBOTS;
+        for robots in [0, most + 1] {
+            // No router program: a refusal that started anything would say so instead.
+            let refused = fleet(robots, 10.0, 1.0, Path::new("/nonexistent/roam"), &silent)
+                .await
+                .expect_err("refused");
+            assert!(
+                refused.to_string().contains(&format!("1..={most}")),
+                "{refused}"
+            );
+        }
+    }
+}
