@@ -53,6 +53,7 @@ pub mod margin;
 mod obstacles;
 pub mod path;
 pub mod request;
+pub mod seen;
 #[cfg(feature = "zenoh")]
 pub mod service;
 pub mod shift;

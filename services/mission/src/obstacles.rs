@@ -28,7 +28,7 @@ use tokio_util::sync::CancellationToken;
 use zenoh::sample::Sample;
 
 use crate::error::ExecutiveError;
-use crate::window::SeenObstacles;
+use crate::seen::SeenObstacles;
 
 /// The largest layer read: the map server's largest.
 const MAX_LAYER_BYTES: usize = roam_runtime::service::DEFAULT_MAX_SAMPLE_BYTES;

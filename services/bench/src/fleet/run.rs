@@ -14,10 +14,10 @@ use roam_stack::stack::wait_until_live;
 
 use super::join::join;
 use super::places::{places, Fleet};
+use super::report::FleetBench;
 use super::restart::restart;
 use super::router::RouterProcess;
 use super::seen::{share, steady, Seen};
-use super::FleetBench;
 use crate::process::{cpu_seconds_of, peak_rss_mib, peak_rss_mib_of, rss_mib, rss_mib_of};
 use crate::sim::{run_sim_for, TimedRun};
 use crate::{ms, setup, BenchError};

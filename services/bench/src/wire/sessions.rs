@@ -7,7 +7,7 @@ use roam_stack::router::{free_loopback_port, Router};
 use zenoh::Session;
 
 use super::tls::{tls_connect, tls_listen, Certs};
-use super::Topology;
+use super::topology::Topology;
 use crate::{setup, BenchError};
 
 /// Attempts at a free loopback port (another process may take the one found).

@@ -52,7 +52,7 @@ pub enum WindowEvent {
     /// What the fleet believes occupied where the static map is free changed: the
     /// route left is checked against it (`blocked.rs`). Shared, since a fleet's
     /// robots hear the same set.
-    MapChanged(std::sync::Arc<super::blocked::SeenObstacles>),
+    MapChanged(std::sync::Arc<crate::seen::SeenObstacles>),
 }
 
 /// A plan to ask the planner for.

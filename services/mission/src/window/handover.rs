@@ -36,7 +36,7 @@ pub struct Handover {
     pub fix: usize,
     /// The last set of believed obstacles heard: the next window checks its first
     /// route against it (a route planned ahead may predate it).
-    pub obstacles: Option<std::sync::Arc<super::blocked::SeenObstacles>>,
+    pub obstacles: Option<std::sync::Arc<crate::seen::SeenObstacles>>,
 }
 
 /// How much of a window's track the next one keeps: 600 estimates, four minutes at the

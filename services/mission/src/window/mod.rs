@@ -81,7 +81,7 @@ use crate::watch::{Reason, Watch};
 
 use state::{Drive, MissionIds, Phase};
 
-pub use blocked::{seen_world, SeenObstacles, MAX_OBSTACLE_POINTS};
+pub use crate::seen::{seen_world, SeenObstacles, MAX_OBSTACLE_POINTS};
 pub use drove::{MAX_LEARNED_OFF_ROUTE_M, MIN_LEARNED_DRIVE_M};
 pub use events::{DrivenMission, Now, PlanAsk, WindowAction, WindowEvent};
 pub use handover::{Handover, WindowEnd, WindowOutcome};
@@ -136,7 +136,7 @@ impl<'a> DowntimeWindow<'a> {
             seen_world: handover
                 .obstacles
                 .as_deref()
-                .and_then(|o| blocked::seen_world(setup.scale.world, o)),
+                .and_then(|o| crate::seen::seen_world(setup.scale.world, o)),
             obstacles: handover.obstacles,
             setup,
         };

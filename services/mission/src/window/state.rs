@@ -161,7 +161,7 @@ pub struct DowntimeWindow<'a> {
     pub(super) phase: Phase,
     /// The last set of believed obstacles heard (`blocked.rs`), and whether the route
     /// has been checked against it.
-    pub(super) obstacles: Option<std::sync::Arc<super::blocked::SeenObstacles>>,
+    pub(super) obstacles: Option<std::sync::Arc<crate::seen::SeenObstacles>>,
     pub(super) obstacles_unchecked: bool,
     /// The planning world with the cells near those obstacles blocked: the window's own
     /// fastest paths go round them (`None`: the static world).

@@ -39,8 +39,8 @@ pub(crate) enum ReproduceCommand {
         /// Run the executive's day this many times per variant instead of the missions.
         #[arg(long)]
         days: Option<usize>,
-        /// With --days: the variants to run, comma-separated (default all:
-        /// plain,executive,no_change,no_peb,fastest_path).
+        /// With --days: the variants to run, comma-separated (default
+        /// plain,executive,no_change,no_peb,fastest_path; also anytime).
         #[arg(long, value_delimiter = ',')]
         variants: Vec<String>,
         /// With --days: threads the days run on (default: the machine's cores; the

@@ -15,8 +15,9 @@ pub(crate) struct FleetArgs {
     /// Shifts in a row (a week: 7).
     #[arg(long, default_value_t = 7)]
     days: usize,
-    /// The variants to run, comma-separated (default all: tasks_only, patrol,
-    /// independent, news, news_no_sharing, news_no_reservations, news_no_rates).
+    /// The variants to run, comma-separated (default tasks_only, patrol, independent,
+    /// news, news_no_sharing, news_no_reservations, news_no_rates; also
+    /// news_map_replans).
     #[arg(long, value_delimiter = ',')]
     variants: Vec<String>,
     /// Threads the variants run on (default: the machine's cores; the report does not

@@ -49,7 +49,7 @@ impl Default for FleetOptions {
             plan_wall_s: 0.2,
             // A fleet runs on the wall clock: a plan's computing time is its cost.
             rate: 1.0,
-            variants: FleetVariant::ALL.to_vec(),
+            variants: FleetVariant::DEFAULT.to_vec(),
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
         }
     }

@@ -79,6 +79,18 @@ impl FleetVariant {
         FleetVariant::NewsMapReplans,
     ];
 
+    /// The variants a week runs unless told which: all but `news_map_replans`, measured
+    /// worse over a shift (experiments README, "Map-change replans in the fleet").
+    pub const DEFAULT: [FleetVariant; 7] = [
+        FleetVariant::TasksOnly,
+        FleetVariant::Patrol,
+        FleetVariant::Independent,
+        FleetVariant::News,
+        FleetVariant::NewsNoSharing,
+        FleetVariant::NewsNoReservations,
+        FleetVariant::NewsNoRates,
+    ];
+
     pub fn name(self) -> &'static str {
         match self {
             FleetVariant::TasksOnly => "tasks_only",

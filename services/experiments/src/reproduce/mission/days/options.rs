@@ -39,7 +39,7 @@ impl Default for DaysOptions {
             plan_wall_s: 0.4,
             replan_wall_s: 0.05,
             rate: 20.0,
-            variants: Variant::ALL.to_vec(),
+            variants: Variant::DEFAULT.to_vec(),
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
             site: Site::builtin_day(),
         }

@@ -45,6 +45,16 @@ impl Variant {
         Variant::FastestPath,
     ];
 
+    /// The variants a batch runs unless told which: all but `anytime`, a question asked
+    /// once (services/mission/README.md, "The anytime portfolio in the day").
+    pub const DEFAULT: [Variant; 5] = [
+        Variant::Plain,
+        Variant::Executive,
+        Variant::NoChange,
+        Variant::NoPeb,
+        Variant::FastestPath,
+    ];
+
     pub fn name(self) -> &'static str {
         match self {
             Variant::Plain => "plain",
