@@ -20,8 +20,9 @@
 //! - `news_map_replans`: `news` with each executive following what the fleet believes
 //!   occupied now (`obstacles_layer: occupied_now`): a route a pallet lands on is
 //!   replanned round it at once (`map_changed`, `roam_mission::window`), where `news`
-//!   drives on until the robot is stuck. Not `news`'s default: over a shift it made
-//!   robots late (experiments README, "Map-change replans in the fleet").
+//!   drives on until the robot is stuck. Not `news`'s default: two shifts showed no
+//!   effect through the fleet's chaos (experiments README, "Map-change replans in the
+//!   fleet").
 
 use roam_mapper::news::DEFAULT_NEWS_PRIOR;
 use roam_mapper::prior::RatePrior;
@@ -79,8 +80,9 @@ impl FleetVariant {
         FleetVariant::NewsMapReplans,
     ];
 
-    /// The variants a week runs unless told which: all but `news_map_replans`, measured
-    /// worse over a shift (experiments README, "Map-change replans in the fleet").
+    /// The variants a week runs unless told which: all but `news_map_replans`, an
+    /// option still being measured (experiments README, "Map-change replans in the
+    /// fleet").
     pub const DEFAULT: [FleetVariant; 7] = [
         FleetVariant::TasksOnly,
         FleetVariant::Patrol,

@@ -60,7 +60,7 @@ pub fn robot_config(
         seed: plan_seed(options.seed, index),
         peb_free_m: Some(options.peb_free_m),
         // Routes being driven are replanned when the fleet's belief blocks them only in
-        // the `news_map_replans` variant (variant.rs): measured worse in the shift.
+        // the `news_map_replans` variant (variant.rs): no effect shown yet.
         obstacle_inflation_m: super::seen::OBSTACLE_INFLATION_M,
         ..ExecutiveConfig::default()
     };
