@@ -57,6 +57,24 @@ pub(crate) fn setup<E: std::fmt::Display>(e: E) -> BenchError {
     BenchError::Setup(e.to_string())
 }
 
+/// Waits until `publisher` sees a matching subscriber, at most `within`: declarations
+/// propagate asynchronously, and a put before the match is lost to the measurement.
+/// `false` when none matched in time.
+pub(crate) async fn matched(publisher: &zenoh::pubsub::Publisher<'_>, within: Duration) -> bool {
+    tokio::time::timeout(within, async {
+        while !publisher
+            .matching_status()
+            .await
+            .map(|s| s.matching())
+            .unwrap_or(false)
+        {
+            tokio::time::sleep(Duration::from_millis(10)).await;
+        }
+    })
+    .await
+    .is_ok()
+}
+
 /// A duration in milliseconds, as the benchmarks print them.
 pub fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1000.0

@@ -155,19 +155,7 @@ async fn measure(
         .congestion_control(CongestionControl::Block)
         .await
         .map_err(setup)?;
-    // Declarations propagate asynchronously: wait until the publisher sees the subscriber.
-    let matched = tokio::time::timeout(Duration::from_secs(10), async {
-        while !publisher
-            .matching_status()
-            .await
-            .map(|s| s.matching())
-            .unwrap_or(false)
-        {
-            tokio::time::sleep(Duration::from_millis(10)).await;
-        }
-    })
-    .await;
-    if matched.is_err() {
+    if !crate::matched(&publisher, Duration::from_secs(10)).await {
         return Err(BenchError::Setup(
             "the subscriber never matched the publisher".into(),
         ));

@@ -35,20 +35,7 @@ impl Wire {
             .declare_subscriber(key(Operation::Put))
             .await
             .map_err(setup)?;
-        // Declarations propagate asynchronously: wait until the publisher sees the
-        // subscriber.
-        let matched = tokio::time::timeout(MATCH_TIMEOUT, async {
-            while !publisher
-                .matching_status()
-                .await
-                .map(|s| s.matching())
-                .unwrap_or(false)
-            {
-                tokio::time::sleep(Duration::from_millis(10)).await;
-            }
-        })
-        .await;
-        if matched.is_err() {
+        if !crate::matched(&publisher, MATCH_TIMEOUT).await {
             return Err(BenchError::Setup(format!(
                 "{topology:?}: the subscriber never matched the publisher within {MATCH_TIMEOUT:?}"
             )));
