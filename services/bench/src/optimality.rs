@@ -39,7 +39,7 @@ pub const DEADLINE_S: f64 = 1.0;
 /// Budgets as multiples of the fastest path's ETA.
 pub const BUDGET_FACTORS: [f64; 3] = [1.5, 2.0, 3.0];
 
-/// The goal (issue 30): roam's plans hold at least this median share of the optimum…
+/// The goal: roam's plans hold at least this median share of the optimum…
 pub const GOAL_MEDIAN_SHARE: f64 = 0.97;
 /// …and at least this share on every instance, over at least [`GOAL_MIN_INSTANCES`]
 /// proven ones.

@@ -12,7 +12,6 @@
 //!
 //! [`ExecutiveConfig::obstacles_layer`]: crate::config::ExecutiveConfig::obstacles_layer
 
-use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -60,7 +59,7 @@ pub(crate) async fn follow(
         obstacles_layer: layer.to_owned(),
         clearance_m,
         requester: Requester::new(session.clone(), QUERY_TIMEOUT),
-        held: BTreeMap::new(),
+        seen: None,
         inflated: None,
         sets,
     };
@@ -73,18 +72,18 @@ struct ObstacleSink {
     obstacles_layer: String,
     clearance_m: f64,
     requester: Requester,
-    /// The two layers as last shown: deltas apply to them.
-    held: BTreeMap<String, Layer>,
-    /// The static map's cells, kept apart from its layer so a set is made without a copy.
-    inflated: Option<Grid<i8>>,
+    /// The obstacle layer as last shown: its deltas apply to it.
+    seen: Option<Layer>,
+    /// The static map's version and cells. Not kept as a layer for deltas: it changes
+    /// only when the map is edited, and then the follower fetches it whole.
+    inflated: Option<(u64, Grid<i8>)>,
     sets: watch::Sender<Option<Arc<SeenObstacles>>>,
 }
 
 impl ObstacleSink {
     /// The set the two layers held make, sent when it differs from the last one.
     fn send_if_changed(&self) {
-        let (Some(grid), Some(seen)) = (&self.inflated, self.held.get(&self.obstacles_layer))
-        else {
+        let (Some((_, grid)), Some(seen)) = (&self.inflated, &self.seen) else {
             return;
         };
         let Some(set) = SeenObstacles::of_layers(grid, seen, self.clearance_m) else {
@@ -115,24 +114,36 @@ impl LayerSink for ObstacleSink {
     }
 
     fn held(&self, name: &str) -> Option<u64> {
-        self.held.get(name).map(|l| l.version)
+        if name == INFLATED {
+            self.inflated.as_ref().map(|(version, _)| *version)
+        } else {
+            self.seen.as_ref().map(|l| l.version)
+        }
     }
 
     fn take_kept(&mut self, name: &str) -> Option<Layer> {
-        self.held.remove(name)
+        if name == INFLATED {
+            None
+        } else {
+            self.seen.take()
+        }
     }
 
     async fn show(&mut self, layer: Layer, _published: bool) {
         if layer.name == INFLATED {
-            self.inflated = match &layer.cells {
-                Cells::I8(cells) => Some(Grid {
-                    meta: layer.meta,
-                    cells: cells.clone(),
-                }),
+            self.inflated = match layer.cells {
+                Cells::I8(cells) => Some((
+                    layer.version,
+                    Grid {
+                        meta: layer.meta,
+                        cells,
+                    },
+                )),
                 _ => None,
             };
+        } else {
+            self.seen = Some(layer);
         }
-        self.held.insert(layer.name.clone(), layer);
         self.send_if_changed();
     }
 

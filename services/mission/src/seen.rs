@@ -67,16 +67,10 @@ impl SeenObstacles {
                 hi[k] = hi[k].max(p[k] + r);
             }
         }
-        let near: Vec<[f64; 2]> = self
-            .points
+        self.points
             .iter()
             .filter(|p| (0..2).all(|k| p[k] >= lo[k] && p[k] <= hi[k]))
-            .copied()
-            .collect();
-        if near.is_empty() {
-            return false;
-        }
-        near.iter().any(|&p| off_path_m(p, route) < r)
+            .any(|&p| off_path_m(p, route) < r)
     }
 }
 

@@ -24,11 +24,10 @@ use roam_stack::router::free_loopback_port;
 
 /// How close the fitted v_lin must come to the robot's, where Table I's prior (2 s/m)
 /// is 20% off. Measured on this 2-core machine: +0.3% to +1.7% over four days, −1.4%
-/// and +1.6% with both cores kept busy. Before routes that start where a moving robot
-/// was stopped teaching (`roam_mission::window` drove.rs), a full test run once gave
-/// +16% (the robot drives on along its old route while the mission travels, seconds at
-/// this clock); learning from arrivals alone, timed when the executive heard of them,
-/// +7.5% in CI (the prior outweighed a seeded replan's short last mission).
+/// and +1.6% with both cores kept busy. The fit holds this close because every drive
+/// of a window teaches it, timed by the estimates' own times, and routes that start
+/// where a moving robot was do not (`roam_mission::window`, drove.rs): such a robot
+/// drives on along its old route while the mission travels, seconds at this clock.
 const V_LIN_TOLERANCE: f64 = 0.05;
 
 /// The fake robot's speed, m/s of simulated time, and its clock's rate.

@@ -1,4 +1,4 @@
-//! `roam bench fleet`: many robots in closed loop through Zenoh (issues 16 and 30).
+//! `roam bench fleet`: many robots in closed loop through Zenoh.
 //!
 //! The sim, localization and the APF controller run in this process on the built-in
 //! world, as in `roam stack`; the router runs in a process of its own (`<program> router`,

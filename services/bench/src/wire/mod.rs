@@ -1,4 +1,4 @@
-//! `roam bench wire`: the wire's own latency (issue 30), so that a fleet is sized from
+//! `roam bench wire`: the wire's own latency, so that a fleet is sized from
 //! figures measured on its own machines instead of guessed.
 //!
 //! Two Zenoh sessions in this process, a *sender* and a *receiver*, meet on loopback in

@@ -141,10 +141,8 @@ impl DowntimeWindow<'_> {
                 let decision = drive.watch.on_tick(now.mission_s, now.wall_s);
                 let mut actions = self.decide(decision, now);
                 actions.extend(self.check_safe(now));
-                if self.drive_ask.is_none() {
-                    // A set of obstacles heard while a plan was in flight (`blocked.rs`).
-                    actions.extend(self.check_route_clear(now));
-                }
+                // A set of obstacles heard while a plan was in flight (`blocked.rs`).
+                actions.extend(self.check_route_clear(now));
                 actions
             }
             Phase::AtTask {

@@ -260,15 +260,9 @@ impl<'a> InProcessExecutive<'a> {
             );
             events.push(WindowEvent::Status(status));
         }
-        // Each event is followed by a tick, as the live executive ticks after each.
-        for event in events {
-            for event in [event, WindowEvent::Tick] {
-                let actions = current.machine.handle(event, self.now());
-                if let Some(end) = self.perform(&mut current, actions, io)? {
-                    return self.end_window(current, end, io);
-                }
-            }
-        }
+        let Some(mut current) = self.hear(current, events, io)? else {
+            return Ok(());
+        };
         let actions = current.machine.handle(WindowEvent::Tick, self.now());
         match self.perform(&mut current, actions, io)? {
             Some(end) => self.end_window(current, end, io),
@@ -292,20 +286,34 @@ impl<'a> InProcessExecutive<'a> {
         if self.config.obstacles_layer.is_none() || self.done() {
             return Ok(());
         }
-        let Some(mut current) = self.current.take() else {
+        let Some(current) = self.current.take() else {
             if let Some(handover) = self.handover.as_mut() {
                 handover.obstacles = Some(set);
             }
             return Ok(());
         };
-        for event in [WindowEvent::MapChanged(set), WindowEvent::Tick] {
-            let actions = current.machine.handle(event, self.now());
-            if let Some(end) = self.perform(&mut current, actions, io)? {
-                return self.end_window(current, end, io);
+        self.current = self.hear(current, vec![WindowEvent::MapChanged(set)], io)?;
+        Ok(())
+    }
+
+    /// The current window hears `events`, each followed by a tick, as the live executive
+    /// ticks after each; `None` when the window ended (handed over to the next).
+    fn hear(
+        &mut self,
+        mut current: Current<'a>,
+        events: Vec<WindowEvent>,
+        io: &mut dyn Io,
+    ) -> Result<Option<Current<'a>>, ExecutiveError> {
+        for event in events {
+            for event in [event, WindowEvent::Tick] {
+                let actions = current.machine.handle(event, self.now());
+                if let Some(end) = self.perform(&mut current, actions, io)? {
+                    self.end_window(current, end, io)?;
+                    return Ok(None);
+                }
             }
         }
-        self.current = Some(current);
-        Ok(())
+        Ok(Some(current))
     }
 
     /// Begins the next task's window, now (and the ones after it, while a window ends
