@@ -60,6 +60,29 @@ async fn roles_of_the_day_with(
 }
 
 /// The next window report, within `seconds`.
+type Missions = Subscriber<FifoChannelHandler<Sample>>;
+
+/// A subscriber to the robot's missions, on the client's session.
+async fn missions_of(harness: &Harness, client: &Requester) -> Missions {
+    within(
+        "subscribe",
+        client
+            .session()
+            .declare_subscriber(keys::robot_mission(&harness.root, "robot")),
+    )
+    .await
+    .expect("subscriber")
+}
+
+/// The next mission sent, within a minute.
+async fn next_mission(missions: &Missions) -> roam_proto::controller::Mission {
+    let sample = tokio::time::timeout(Duration::from_secs(60), missions.recv_async())
+        .await
+        .expect("a mission in time")
+        .expect("sample");
+    decode(&sample.payload().to_bytes()).expect("mission")
+}
+
 async fn next_report(reports: &Reports, seconds: u64) -> WindowReport {
     let sample = tokio::time::timeout(Duration::from_secs(seconds), reports.recv_async())
         .await
@@ -226,14 +249,7 @@ async fn a_pallet_seen_on_the_route_ahead_is_a_replan_round_it() {
         ..harness.planner_config("planner-0")
     };
     let ((_roles, client), reports) = roles_of_the_day_with(&harness, Some(planner)).await;
-    let missions = within(
-        "subscribe",
-        client
-            .session()
-            .declare_subscriber(keys::robot_mission(&harness.root, "robot")),
-    )
-    .await
-    .expect("subscriber");
+    let missions = missions_of(&harness, &client).await;
     let _mission = harness
         .start_role(MissionConfig {
             service: ServiceConfig::at(harness.root.clone()),
@@ -244,16 +260,9 @@ async fn a_pallet_seen_on_the_route_ahead_is_a_replan_round_it() {
             ..MissionConfig::default()
         })
         .await;
-    let next_mission = || async {
-        let sample = tokio::time::timeout(Duration::from_secs(60), missions.recv_async())
-            .await
-            .expect("a mission in time")
-            .expect("sample");
-        decode::<Mission>(&sample.payload().to_bytes()).expect("mission")
-    };
     // The window sets off on its fastest path, then takes the curious route.
-    let _fastest = next_mission().await;
-    let curious = next_mission().await;
+    let _fastest = next_mission(&missions).await;
+    let curious = next_mission(&missions).await;
     let waypoints = &curious.waypoints;
     assert!(waypoints.len() >= 6, "{curious:?}");
     let pallet = waypoints[waypoints.len() * 2 / 3];
@@ -295,9 +304,9 @@ async fn a_pallet_seen_on_the_route_ahead_is_a_replan_round_it() {
     // planner had the layer (a slack replan in flight): then the executive checks that
     // route when it comes, and the one after it is the map change's.
     let nearest = |m: &Mission| roam_mission::path::off_path_m(pallet, &m.waypoints);
-    let mut round = next_mission().await;
+    let mut round = next_mission(&missions).await;
     if nearest(&round) <= PALLET_M {
-        round = next_mission().await;
+        round = next_mission(&missions).await;
     }
     assert!(
         nearest(&round) > PALLET_M,
@@ -308,6 +317,64 @@ async fn a_pallet_seen_on_the_route_ahead_is_a_replan_round_it() {
     assert_eq!(goal1.task, "goal1");
     assert!(
         goal1.replan_reasons.iter().any(|r| r == "map_changed"),
+        "{goal1:?}"
+    );
+    assert!(goal1.on_time, "{goal1:?}");
+}
+
+/// A restarted executive drives on with its predecessor's route: the first executive,
+/// keeping its route in `resume_file`, is stopped while the robot drives its first
+/// window's curious route; its successor, started with the same file, sends the rest of
+/// that route (every waypoint on it) as its first mission, not a fastest path of its
+/// own, and the window is reported `resumed` and on time.
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn a_restarted_executive_drives_on_with_its_predecessors_route() {
+    use roam_proto::controller::Mission;
+
+    let harness = Harness::start().await;
+    let ((_roles, client), reports) = roles_of_the_day(&harness, true).await;
+    let missions = missions_of(&harness, &client).await;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let config = MissionConfig {
+        service: ServiceConfig::at(harness.root.clone()),
+        executive: ExecutiveConfig {
+            resume_file: Some(dir.path().join("robot.resume.json")),
+            ..ExecutiveConfig::default()
+        },
+        ..MissionConfig::default()
+    };
+    let first = harness.start_role(config.clone()).await;
+    // The window sets off on its fastest path, then takes the curious route; the robot
+    // drives it a while before its executive stops.
+    let _fastest = next_mission(&missions).await;
+    let _curious = next_mission(&missions).await;
+    tokio::time::sleep(Duration::from_secs(1)).await;
+    let (_, stopped) = first.stop().await;
+    stopped.expect("the first executive stops cleanly");
+    // The predecessor's last route: the last mission it sent.
+    let mut last = None;
+    while let Ok(Some(sample)) = missions.try_recv() {
+        last = Some(decode::<Mission>(&sample.payload().to_bytes()).expect("mission"));
+    }
+    let last = match last {
+        Some(m) => m,
+        None => _curious,
+    };
+
+    let _second = harness.start_role(config).await;
+    let resumed = next_mission(&missions).await;
+    assert_ne!(resumed.id, last.id);
+    for p in &resumed.waypoints {
+        let off = roam_mission::path::off_path_m(*p, &last.waypoints);
+        assert!(
+            off < 0.05,
+            "the successor's waypoint {p:?} is {off:.2} m off its predecessor's route"
+        );
+    }
+    let goal1 = next_report(&reports, 90).await;
+    assert_eq!(goal1.task, "goal1");
+    assert!(
+        goal1.replan_reasons.iter().any(|r| r == "resumed"),
         "{goal1:?}"
     );
     assert!(goal1.on_time, "{goal1:?}");

@@ -15,10 +15,12 @@
 //! - [`anytime`]: the anytime planner's plan at each deadline against the best known;
 //! - [`optimality`]: the planners' plans against the exact optimum on small instances;
 //! - [`fleet`]: robots in closed loop through Zenoh;
+//! - [`chaos`]: the built-in day with every role killed, links cut, a planner frozen;
 //! - [`wire`]: the wire's own latency, a put and a get, peer to peer and through a
 //!   router, over TCP and TLS.
 
 pub mod anytime;
+pub mod chaos;
 pub mod fleet;
 pub mod load;
 pub mod localization;

@@ -124,6 +124,10 @@ pub struct ExecutiveConfig {
     pub calibrate: bool,
     /// Where the robot's fit is kept across restarts; absent: in memory only.
     pub calibration_file: Option<PathBuf>,
+    /// Where the route the robot drives is kept, so that a restarted executive drives
+    /// on with it (when it is for the same task and still fits) instead of starting the
+    /// window over ([`crate::resume`]); absent: a restart begins the window afresh.
+    pub resume_file: Option<PathBuf>,
     /// The time model before anything was driven (the calibration's prior): Table I's
     /// v_lin 2.0 s/m and v_ang 1.0 s/rad by default; a robot's datasheet figures where
     /// they are known. Bounded as the calibration's fits are.
@@ -334,6 +338,7 @@ impl Default for ExecutiveConfig {
             replan_cost_s: None,
             calibrate: true,
             calibration_file: None,
+            resume_file: None,
             time_model_prior: TimeModel::table_i(),
             obstacles_layer: None,
             obstacle_inflation_m: 0.3,

@@ -18,7 +18,9 @@
 //! - [`day_check`]: a day checked against a map: every place free, every task
 //!   reachable in time from the previous one (paper 000's fastest path).
 //! - [`calibration`]: paper 000's time model (Eq. 2's v_lin, v_ang) fitted to what the
-//!   robot drove, with Table I as the prior, kept per robot in a small file.
+//!   robot drove, with Table I as the prior, kept per robot in a small file;
+//!   [`resume`]: the route the robot drives, kept likewise for a restarted executive;
+//!   [`state_file`]: how both are written and read.
 //! - [`path`]: a planned path's waypoints (every turn kept); off-path distance; ETA slip.
 //! - [`watch`]: the replan policy of a window (arrived, given up, lost mission, blocked,
 //!   late, pushed off the path, slack), a plain state machine.
@@ -53,11 +55,13 @@ pub mod margin;
 mod obstacles;
 pub mod path;
 pub mod request;
+pub mod resume;
 pub mod seen;
 #[cfg(feature = "zenoh")]
 pub mod service;
 pub mod shift;
 pub mod site;
+pub mod state_file;
 pub mod tasks;
 pub mod watch;
 pub mod window;

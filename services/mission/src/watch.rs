@@ -100,11 +100,13 @@ pub enum Reason {
     SetOff,
     /// What the fleet has seen blocks the route ahead (`window/blocked.rs`).
     MapChanged,
+    /// A restarted executive drives on with its predecessor's route (`window/resume.rs`).
+    Resumed,
 }
 
 impl Reason {
     /// Every reason, in the order [`Reason::name`] lists them.
-    pub const ALL: [Reason; 11] = [
+    pub const ALL: [Reason; 12] = [
         Reason::ControllerSilent,
         Reason::Stuck,
         Reason::EtaSlipped,
@@ -116,6 +118,7 @@ impl Reason {
         Reason::NoPlanner,
         Reason::SetOff,
         Reason::MapChanged,
+        Reason::Resumed,
     ];
 
     /// The reason's token: what the window's report carries on the wire
@@ -134,6 +137,7 @@ impl Reason {
             Reason::NoPlanner => "no_planner",
             Reason::SetOff => "set_off",
             Reason::MapChanged => "map_changed",
+            Reason::Resumed => "resumed",
         }
     }
 
@@ -156,6 +160,7 @@ impl Reason {
             Reason::NoPlanner => "no planner answered: the fastest path the executive computes",
             Reason::SetOff => "the curious path, planned while the robot set off on the fastest",
             Reason::MapChanged => "the map changed: what the fleet has seen blocks the route ahead",
+            Reason::Resumed => "restarted: driving on with the predecessor's route",
         }
     }
 }

@@ -13,13 +13,12 @@
 //! `statistics` are the fit's sums (see [`super::fit`]): a calibration's size never
 //! grows with the driving behind it. `model` is the fit when the file was written, for
 //! people reading it; a load refits from the sums with the caller's prior and config.
-//! The file is written to `<file>.tmp`, synced and renamed over `<file>`, so a crash
-//! mid-write leaves the previous one whole. A file that is missing starts from the prior;
+//! The file is written atomically ([`crate::state_file`]): a crash mid-write leaves the
+//! previous one whole. A file that is missing starts from the prior;
 //! one that is damaged, too large, of another robot or implausible also starts from the
 //! prior, with a warning: a calibration is worth keeping, not worth refusing to run for.
 
-use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
@@ -75,19 +74,7 @@ pub fn save(path: &Path, robot: &str, calibration: &Calibration) -> Result<(), C
             bytes.len()
         )));
     }
-    let io = |e: std::io::Error| fail(e.to_string());
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(io)?;
-    }
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    {
-        let mut out = std::fs::File::create(&tmp).map_err(io)?;
-        out.write_all(&bytes).map_err(io)?;
-        out.sync_all().map_err(io)?;
-    }
-    std::fs::rename(&tmp, path).map_err(io)
+    crate::state_file::write_atomic(path, &bytes).map_err(fail)
 }
 
 /// `robot`'s calibration from `path`, with `prior` and `config`; the prior alone when
@@ -116,32 +103,14 @@ pub fn load(
 
 /// The file's statistics; `None` when there is no file; why it cannot be used.
 fn read(path: &Path, robot: &str) -> Result<Option<Statistics>, String> {
-    let meta = match std::fs::metadata(path) {
-        Ok(m) => m,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(e.to_string()),
+    let Some(bytes) = crate::state_file::read_bounded(
+        path,
+        MAX_CALIBRATION_FILE_BYTES,
+        "max_calibration_file_bytes",
+    )?
+    else {
+        return Ok(None);
     };
-    if !meta.is_file() {
-        return Err("not a regular file".into());
-    }
-    if meta.len() > MAX_CALIBRATION_FILE_BYTES {
-        return Err(format!(
-            "{} bytes is beyond {MAX_CALIBRATION_FILE_BYTES} (max_calibration_file_bytes)",
-            meta.len()
-        ));
-    }
-    let mut bytes = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|f| {
-            f.take(MAX_CALIBRATION_FILE_BYTES + 1)
-                .read_to_end(&mut bytes)
-        })
-        .map_err(|e| e.to_string())?;
-    if bytes.len() as u64 > MAX_CALIBRATION_FILE_BYTES {
-        return Err(format!(
-            "beyond {MAX_CALIBRATION_FILE_BYTES} bytes (max_calibration_file_bytes)"
-        ));
-    }
     // The parser's message quotes nothing of the file (see roam_proto::excerpt).
     let file: CalibrationFile = serde_json::from_slice(&bytes)
         .map_err(|e| roam_proto::excerpt::file_parse_reason(&e.to_string()))?;
@@ -161,6 +130,7 @@ fn read(path: &Path, robot: &str) -> Result<Option<Statistics>, String> {
 mod tests {
     use super::*;
     use crate::calibration::{Sample, Stretch};
+    use std::path::PathBuf;
 
     fn dir(name: &str) -> PathBuf {
         let d =

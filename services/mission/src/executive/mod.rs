@@ -121,6 +121,10 @@ pub async fn run(
             ),
             None => None,
         },
+        resume: config
+            .resume_file
+            .as_deref()
+            .and_then(|path| crate::resume::load(path, &config.robot)),
     };
     executive.hear_the_clock(cancel).await?;
     let mut outcomes = Vec::with_capacity(config.tasks.len());

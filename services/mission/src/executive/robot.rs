@@ -56,6 +56,9 @@ pub(super) struct Executive<'a> {
     pub(super) heard: Heard,
     /// The fleet's believed obstacles, when `obstacles_layer` is followed.
     pub(super) obstacles: Option<crate::obstacles::ObstacleSets>,
+    /// The route a predecessor was driving (its `resume_file`), until the window of its
+    /// task begins.
+    pub(super) resume: Option<crate::window::Resumed>,
 }
 
 /// The sim steps of the last estimate and controller status the loop handled.
@@ -227,6 +230,15 @@ impl Executive<'_> {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    /// Keeps the route the robot now drives in the resume file, when one is configured.
+    pub(super) fn keep_route(&self, route: Option<crate::window::Resumed>) {
+        if let (Some(path), Some(route)) = (&self.config.resume_file, route) {
+            if let Err(e) = crate::resume::save(path, &self.config.robot, &route) {
+                tracing::warn!("the route is not kept for a restart: {e}");
             }
         }
     }

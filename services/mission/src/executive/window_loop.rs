@@ -55,7 +55,11 @@ impl Executive<'_> {
             waypoint_spacing_m: self.config.waypoint_spacing_m,
             scale,
         };
-        let handover = std::mem::replace(&mut self.handover, Handover::first(self.config.margin()));
+        let mut handover =
+            std::mem::replace(&mut self.handover, Handover::first(self.config.margin()));
+        if self.resume.as_ref().is_some_and(|r| r.task == task.name) {
+            handover.resume = self.resume.take();
+        }
         let (mut machine, actions) = DowntimeWindow::begin(setup, handover, self.moment(began));
         let mut pending = VecDeque::from(actions);
         // Dropping a request's future cancels it at the planner (PlannerClient::plan).
@@ -72,7 +76,10 @@ impl Executive<'_> {
         loop {
             while let Some(action) = pending.pop_front() {
                 match action {
-                    WindowAction::Drive(mission) => self.publish(&mission),
+                    WindowAction::Drive(mission) => {
+                        self.publish(&mission);
+                        self.keep_route(machine.driving());
+                    }
                     WindowAction::RequestPlan(ask) => self.ask(&ask, &mut in_flight),
                     // The answer is dropped by the machine when it comes.
                     WindowAction::Forget(_) => {}

@@ -216,6 +216,7 @@ impl DowntimeWindow<'_> {
                 track,
                 fix,
                 obstacles: self.obstacles.take(),
+                resume: None,
             },
             position: self.here,
         }))

@@ -2,6 +2,7 @@
 
 use roam_proto::mission::WindowReport;
 
+use super::resumed::Resumed;
 use super::routes::PlannedAhead;
 use crate::margin::ArrivalMargin;
 
@@ -37,6 +38,9 @@ pub struct Handover {
     /// The last set of believed obstacles heard: the next window checks its first
     /// route against it (a route planned ahead may predate it).
     pub obstacles: Option<std::sync::Arc<crate::seen::SeenObstacles>>,
+    /// The route a predecessor executive was driving in this window (its
+    /// `resume_file`), for a restarted executive's first window (`resume.rs`).
+    pub resume: Option<Resumed>,
 }
 
 /// How much of a window's track the next one keeps: 600 estimates, four minutes at the
@@ -61,6 +65,7 @@ impl Handover {
             track: Vec::new(),
             fix: 0,
             obstacles: None,
+            resume: None,
         }
     }
 }

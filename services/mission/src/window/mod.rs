@@ -19,7 +19,9 @@
 //!    the robot is at its task, backs off the same way). After
 //!    [`FALLBACK_AFTER_FAILURES`] failures the robot drives the fastest path the window
 //!    computes itself (no planner: degrade, don't stop) and curiosity comes back
-//!    through the slack rule.
+//!    through the slack rule. A restarted executive's first window drives on with the
+//!    route its predecessor was driving, when it is this task's and still fits
+//!    (`resume.rs`).
 //! 2. **Drive**: the plan's route is sent as a mission and the watch starts. Every good
 //!    estimate is recorded (the driven path, its PEB, the last point with a fix) and
 //!    fed to the watch, as are the controller's statuses on the current mission and
@@ -71,6 +73,8 @@ mod heard;
 mod holds;
 mod replan;
 mod replies;
+mod resume;
+mod resumed;
 mod routes;
 mod setup;
 mod state;
@@ -85,6 +89,8 @@ pub use crate::seen::{seen_world, SeenObstacles, MAX_OBSTACLE_POINTS};
 pub use drove::{MAX_LEARNED_OFF_ROUTE_M, MIN_LEARNED_DRIVE_M};
 pub use events::{DrivenMission, Now, PlanAsk, WindowAction, WindowEvent};
 pub use handover::{Handover, WindowEnd, WindowOutcome};
+pub use resume::RESUME_WITHIN_M;
+pub use resumed::Resumed;
 pub use routes::{routes, PlannedAhead, Route};
 pub use setup::{
     plan_retry_after_s, WindowRules, WindowSetup, FALLBACK_AFTER_FAILURES, MAX_PLAN_RETRY_S,
@@ -144,6 +150,9 @@ impl<'a> DowntimeWindow<'a> {
         if now.mission_s >= task.start_s + task.duration_s {
             let done = w.finish(None);
             return (w, vec![WindowAction::Skipped, done]);
+        }
+        if let Some(actions) = handover.resume.and_then(|r| w.resume(r, now)) {
+            return (w, actions);
         }
         let window = w.setup.window;
         let ahead = handover.planned_ahead.filter(|p| {

@@ -80,6 +80,27 @@ pub(crate) enum BenchCommand {
         #[arg(long, default_value_t = 20.0)]
         seconds: f64,
     },
+    /// The built-in day through faults: every role a process behind one router, each
+    /// killed (SIGKILL) and started again, the planners' and the controller's links cut,
+    /// a planner frozen, on a seeded schedule; per fault the time to recover, per window
+    /// whether it was late by more than its faults lasted, acked map updates lost,
+    /// derived layers out of step, robots held at the end.
+    Chaos {
+        #[arg(long)]
+        json: bool,
+        /// Seeds the faults' order, times and restart delays.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Sim seconds per wall second (at most 10).
+        #[arg(long, default_value_t = 2.0)]
+        rate: f64,
+        /// How long each link stays cut, wall seconds (Zenoh's lease is 10 s).
+        #[arg(long, default_value_t = 12.0)]
+        partition_s: f64,
+        /// How long the frozen planner stays stopped, wall seconds.
+        #[arg(long, default_value_t = 4.0)]
+        freeze_s: f64,
+    },
     /// Change-map observation updates per second on a 1000 x 1000 map (paper 004 §3).
     Mapper {
         #[arg(long)]
@@ -216,6 +237,26 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
             let program = std::env::current_exe()?;
             let result =
                 roam_bench::fleet::fleet(robots, rate_hz, seconds, &program, &shown).await?;
+            print_json(&result, json)
+        }
+        BenchCommand::Chaos {
+            json,
+            seed,
+            rate,
+            partition_s,
+            freeze_s,
+        } => {
+            let progress = Progress::new("bench chaos", quiet);
+            let shown = progress.callback();
+            // Every role runs as this binary, in a process of its own.
+            let options = roam_bench::chaos::ChaosOptions {
+                seed,
+                rate,
+                partition_s,
+                freeze_s,
+                program: std::env::current_exe()?,
+            };
+            let result = roam_bench::chaos::chaos(&options, &shown).await?;
             print_json(&result, json)
         }
         BenchCommand::Mapper {

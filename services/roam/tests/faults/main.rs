@@ -21,7 +21,7 @@ use roam_stack::router::free_loopback_port;
 mod fleet;
 mod watch;
 
-use fleet::{role, Fleet};
+use fleet::Fleet;
 use watch::{none_lost, versions, wait_live, Watch};
 
 /// The sim's real-time factor: the day's 170 s take about 35 s of wall time, long
@@ -41,18 +41,16 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn every_service_killed_in_turn_comes_back_and_the_mission_completes() {
     let port = free_loopback_port().expect("port");
-    let mut fleet = Fleet {
-        dir: tempfile::tempdir().expect("temp dir"),
-        root: format!("faults-{}", std::process::id()),
-        endpoint: format!("tcp/127.0.0.1:{port}"),
-        router: None,
-        roles: Vec::new(),
-    };
+    let mut fleet = Fleet::new(
+        format!("faults-{}", std::process::id()),
+        format!("tcp/127.0.0.1:{port}"),
+    );
     let router_args: Vec<String> = ["router", "--listen", &fleet.endpoint, "--no-multicast"]
         .iter()
         .map(|s| s.to_string())
         .collect();
-    fleet.router = Some(fleet.spawn("router", &router_args));
+    fleet.procs.add(None, "router", router_args);
+    fleet.start("router");
 
     let dir = fleet.dir.path().to_owned();
     let data = dir.join("map-data");
@@ -68,45 +66,28 @@ async fn every_service_killed_in_turn_comes_back_and_the_mission_completes() {
         "config/mission.yaml sets slack_s"
     );
     let mission = write(&dir, "mission.yaml", &mission);
-    let roles = vec![
-        role(
-            "map-server",
-            "m",
-            &["--data-dir", &data.display().to_string()],
-            &fleet,
-        ),
-        role("planner", "a", &[], &fleet),
-        role("planner", "b", &[], &fleet),
-        role(
-            "sim",
-            "w",
-            &[
-                "--rate",
-                SIM_RATE,
-                "--state-file",
-                &sim_state.display().to_string(),
-            ],
-            &fleet,
-        ),
-        role("localization", "l", &[], &fleet),
-        role(
-            "controller",
-            "c",
-            &["--config", &repo("config/controller.yaml")],
-            &fleet,
-        ),
-        role("mapper", "p", &[], &fleet),
-        role(
-            "mission",
-            "x",
-            &["--config", &mission.display().to_string()],
-            &fleet,
-        ),
-    ];
-    fleet.roles = roles;
+    let (data, sim_state, mission) = (
+        data.display().to_string(),
+        sim_state.display().to_string(),
+        mission.display().to_string(),
+    );
+    let controller = repo("config/controller.yaml");
+    fleet.add("map-server", "m", &["--data-dir", &data]);
+    fleet.add("planner", "a", &[]);
+    fleet.add("planner", "b", &[]);
+    fleet.add(
+        "sim",
+        "w",
+        &["--rate", SIM_RATE, "--state-file", &sim_state],
+    );
+    fleet.add("localization", "l", &[]);
     // The controller's config names the default root; `--root` wins over the file.
-    for i in 0..fleet.roles.len() {
-        fleet.start(i);
+    fleet.add("controller", "c", &["--config", &controller]);
+    fleet.add("mapper", "p", &[]);
+    fleet.add("mission", "x", &["--config", &mission]);
+    let names: Vec<String> = fleet.roles.iter().map(|r| r.name.clone()).collect();
+    for name in &names {
+        fleet.start(name);
     }
 
     let session = {
@@ -125,7 +106,7 @@ async fn every_service_killed_in_turn_comes_back_and_the_mission_completes() {
         }
     };
     for i in 0..fleet.roles.len() {
-        let key = fleet.live_key(i);
+        let key = fleet.roles[i].live_key.clone();
         fleet.restart_exited();
         assert!(
             wait_live(&session, &key, true, Duration::from_secs(30)).await,

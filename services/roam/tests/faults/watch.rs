@@ -5,8 +5,6 @@ use std::collections::BTreeMap;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use roam_proto::keys;
-use roam_proto::map::LayerList;
 use roam_proto::mission::WindowReport;
 use roam_runtime::Requester;
 
@@ -15,60 +13,32 @@ use crate::fleet::Fleet;
 /// The whole run, kills and the mission, must end within this.
 pub(crate) const RUN_LIMIT: Duration = Duration::from_secs(240);
 
-pub(crate) async fn is_live(session: &zenoh::Session, key: &str) -> bool {
-    match session
-        .liveliness()
-        .get(key)
-        .timeout(Duration::from_millis(500))
-        .await
-    {
-        Ok(replies) => replies.recv_async().await.is_ok(),
-        Err(_) => false,
-    }
-}
-
+/// Whether the token `key` is there (`live`) or gone within `limit`.
 pub(crate) async fn wait_live(
     session: &zenoh::Session,
     key: &str,
     live: bool,
     limit: Duration,
 ) -> bool {
-    let started = Instant::now();
-    while started.elapsed() < limit {
-        if is_live(session, key).await == live {
-            return true;
-        }
-        tokio::time::sleep(Duration::from_millis(100)).await;
-    }
-    false
+    roam_bench::chaos::watch::wait_live(session, key, live, limit)
+        .await
+        .is_some()
 }
 
-pub(crate) async fn versions(requester: &Requester, root: &str) -> Option<BTreeMap<String, u64>> {
-    let list: LayerList = requester
-        .request::<LayerList, LayerList>(&keys::map_index(root), None)
-        .await
-        .ok()?;
-    Some(
-        list.layers
-            .into_iter()
-            .map(|l| (l.name, l.version))
-            .collect(),
-    )
-}
+pub(crate) use roam_bench::chaos::watch::versions;
 
 /// Every layer seen before is there with at least its version.
 pub(crate) fn none_lost(
     before: &BTreeMap<String, u64>,
     after: &BTreeMap<String, u64>,
 ) -> Result<(), String> {
-    for (name, v) in before {
-        match after.get(name) {
-            Some(w) if w >= v => {}
-            Some(w) => return Err(format!("layer {name} went back from version {v} to {w}")),
-            None => return Err(format!("layer {name} (version {v}) is gone")),
-        }
+    let gone = roam_bench::chaos::watch::gone_back(before, after);
+    if gone.is_empty() {
+        return Ok(());
     }
-    Ok(())
+    Err(format!(
+        "layers gone or at a lower version: {gone:?} (before {before:?}, after {after:?})"
+    ))
 }
 
 /// What the test watches while it kills: the map's versions and each role's downtime.
@@ -103,20 +73,19 @@ impl Watch<'_> {
         fleet.restart_exited();
         self.check_versions(fleet, &format!("before killing {name}"))
             .await;
-        let i = fleet
+        let key = fleet
             .roles
             .iter()
-            .position(|r| format!("{}-{}", r.service, r.instance) == name)
+            .find(|r| r.name == name)
+            .map(|r| r.live_key.clone())
             .expect("a role of the fleet");
-        let key = fleet.live_key(i);
         let killed = Instant::now();
-        fleet.kill(i);
+        fleet.kill(name);
         assert!(
             wait_live(self.session, &key, false, Duration::from_secs(10)).await,
             "{key} stayed live after SIGKILL"
         );
-        fleet.roles[i].restarts += 1;
-        fleet.start(i);
+        fleet.start(name);
         assert!(
             wait_live(self.session, &key, true, Duration::from_secs(30)).await,
             "{key} did not come back\n{}",

@@ -358,4 +358,5 @@ mod lifecycle;
 mod map_changed;
 mod next_window;
 mod replans;
+mod resume;
 mod set_off;
