@@ -193,18 +193,51 @@ async fn stale_estimates_halt_the_robot_within_the_configured_time() {
     let root = harness.root.clone();
     let statuses = subscribe(&client, keys::robot_controller(&root, "robot")).await;
     let truth = subscribe(&client, keys::robot_truth(&root, "robot")).await;
+    let commands = subscribe(&client, keys::robot_command(&root, "robot")).await;
     give_mission(&client, &root, "far", [45.0, 45.0]).await;
     status_until(&statuses, Duration::from_secs(10), |s| {
         s.state == MissionState::Active && s.steps >= 10
     })
     .await;
 
+    let mut last_moving = None;
+    let mut moving_steps = |last_moving: &mut Option<u64>| {
+        while let Ok(Some(sample)) = commands.try_recv() {
+            let command: RobotCommand = decode(&sample.payload().to_bytes()).expect("command");
+            if command.u != [0.0, 0.0] {
+                *last_moving = command.step.max(*last_moving);
+            }
+        }
+    };
+    moving_steps(&mut last_moving);
+    while truth.try_recv().ok().flatten().is_some() {}
     let stopped = Instant::now();
     localization.stop().await.1.expect("clean stop");
     let halted = status_until(&statuses, Duration::from_secs(5), |s| {
         s.state == MissionState::HaltedStale
     })
     .await;
+    // The robot stands from the step after the last command that moved it: a command
+    // applies to one step only, so without estimates (no commands) it stops within a
+    // step, long before the watchdog's halt.
+    moving_steps(&mut last_moving);
+    let mut since_stop: Vec<GroundTruth> = Vec::new();
+    while let Ok(Some(sample)) = truth.try_recv() {
+        since_stop.push(decode(&sample.payload().to_bytes()).expect("truth"));
+    }
+    let last_moving = last_moving.expect("a command that moved the robot");
+    let standing: Vec<&GroundTruth> = since_stop
+        .iter()
+        .filter(|t| t.step >= last_moving + 2)
+        .collect();
+    assert!(
+        standing.len() >= 2,
+        "too few steps after the last command: {since_stop:?}"
+    );
+    assert!(
+        standing.iter().all(|t| t.at == standing[0].at),
+        "the robot moved more than a step after its last command (step {last_moving}): {standing:?}"
+    );
     let after = stopped.elapsed();
     assert!(
         after <= Duration::from_secs_f64(stale_after_s) + Duration::from_millis(400),

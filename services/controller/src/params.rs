@@ -84,7 +84,7 @@ pub const MAX_MAX_STEPS: u64 = 10_000_000;
 pub const MAX_WEIGHT: f64 = 1e6;
 
 /// The APF controller's parameters (paper 002 §3–4), with units.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ApfParams {
     /// z_a, the attractive force's weight (paper 002 Eq. 3), unitless.

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use roam_proto::keys;
 use roam_proto::planner::PlannerModel;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::calibration::TimeModel;
 use crate::margin::ArrivalMargin;
@@ -23,7 +23,7 @@ use crate::watch::WatchParams;
 pub const DEFAULT_REPLAN_GENERATIONS: u32 = 40;
 
 /// How the executive plans and watches.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ExecutiveConfig {
     /// The robot this executive drives.

@@ -1,9 +1,9 @@
 //! A robot's task sequence: places it must be at, and when.
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// One fixed task: be at `at` by `start_s` (sim seconds) and stay `duration_s`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Task {
     pub name: String,

@@ -23,16 +23,19 @@ pub mod link;
 mod marks;
 pub mod report;
 pub mod schedule;
+pub mod site;
 pub mod stack;
 pub mod watch;
 
 use std::collections::BTreeMap;
 use std::net::SocketAddr;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use roam_experiments::progress::{Done, Progress};
 use roam_proto::controller::MissionState;
+use roam_proto::keys;
+use roam_proto::sim::{SimControl, SimStatus};
 use roam_runtime::SessionArgs;
 use roam_stack::router::free_loopback_port;
 use tokio_util::sync::CancellationToken;
@@ -41,6 +44,8 @@ pub use marks::MarksOutcome;
 pub use report::ChaosReport;
 use report::{FaultOutcome, RoleRecovery};
 use schedule::{Fault, ScheduleSpec};
+use site::RoleSpec;
+pub use site::{ChaosSite, MAX_FLEET_ROBOTS};
 pub use stack::Processes;
 use watch::{Answer, Watch};
 
@@ -58,8 +63,6 @@ const RESTART_DELAY_S: (f64, f64) = (0.5, 2.0);
 const PATIENCE: Duration = Duration::from_secs(30);
 /// The bench's map updates, one every this.
 const MARK_EVERY: Duration = Duration::from_millis(500);
-/// The robot of the built-in day.
-const ROBOT: &str = "robot";
 
 /// What a chaos day is run with.
 #[derive(Debug, Clone)]
@@ -74,6 +77,8 @@ pub struct ChaosOptions {
     pub freeze_s: f64,
     /// The `roam` binary whose roles are run.
     pub program: PathBuf,
+    /// The built-in day, or the warehouse fleet's shift.
+    pub site: ChaosSite,
 }
 
 impl ChaosOptions {
@@ -95,18 +100,20 @@ impl ChaosOptions {
                 )));
             }
         }
+        if let ChaosSite::Fleet { robots, shift_s } = self.site {
+            if robots == 0 || robots > MAX_FLEET_ROBOTS {
+                return Err(BenchError::Setup(format!(
+                    "--robots must be 1 to {MAX_FLEET_ROBOTS}, got {robots}"
+                )));
+            }
+            if !(shift_s.is_finite() && shift_s > 0.0) {
+                return Err(BenchError::Setup(format!(
+                    "--shift-s must be more than 0 seconds (at most the shift's length), got {shift_s}"
+                )));
+            }
+        }
         Ok(())
     }
-}
-
-/// One role of the stack: its service name, instance, extra arguments and the link it
-/// reaches the router by (`None`: directly).
-struct RoleSpec {
-    service: &'static str,
-    instance: &'static str,
-    extra: Vec<String>,
-    link: Option<&'static str>,
-    answer: Answer,
 }
 
 /// The links cut and the roles behind each.
@@ -132,45 +139,6 @@ pub fn client_args(endpoint: &str, root: &str, instance: &str) -> Vec<String> {
     .iter()
     .map(|s| s.to_string())
     .collect()
-}
-
-/// The day's tasks as (name, start, duration).
-fn day_tasks() -> Vec<(String, f64, f64)> {
-    roam_mission::tasks::day()
-        .into_iter()
-        .map(|t| (t.name, t.start_s, t.duration_s))
-        .collect()
-}
-
-/// config/mission.yaml with this stack's root, the built-in day's tasks, a calibration
-/// file and a resume file (so a restarted executive keeps its time model and drives on
-/// with its predecessor's route).
-fn mission_config(root: &str, calibration: &Path, resume: &Path) -> String {
-    let shipped = include_str!("../../../../config/mission.yaml");
-    let mut text = String::new();
-    for line in shipped.lines() {
-        if line.starts_with("    - { name:") {
-            continue;
-        }
-        let line = if line == "root: roam" {
-            format!("root: {root}")
-        } else {
-            line.to_owned()
-        };
-        text.push_str(&line);
-        text.push('\n');
-        if line == "  tasks:" {
-            for t in roam_mission::tasks::day() {
-                text.push_str(&format!(
-                    "    - {{ name: {}, at: [{:?}, {:?}], start_s: {:?}, duration_s: {:?} }}\n",
-                    t.name, t.at[0], t.at[1], t.start_s, t.duration_s
-                ));
-            }
-        }
-    }
-    text.push_str(&format!("  calibration_file: {}\n", calibration.display()));
-    text.push_str(&format!("  resume_file: {}\n", resume.display()));
-    text
 }
 
 async fn wait_port(addr: SocketAddr, limit: Duration) -> Result<(), BenchError> {
@@ -214,126 +182,37 @@ pub async fn chaos(
     for (name, _) in LINKS {
         links.insert(name, link::Link::start(router_addr).await.map_err(setup)?);
     }
-    let write = |name: &str, text: String| -> Result<String, BenchError> {
-        let path = dir.path().join(name);
-        std::fs::write(&path, text).map_err(setup)?;
-        Ok(path.display().to_string())
+    let stage = match options.site {
+        ChaosSite::Day => site::day(dir.path(), options.rate)?,
+        ChaosSite::Fleet { robots, shift_s } => {
+            site::fleet(dir.path(), options.rate, robots, shift_s, options.seed)?
+        }
     };
-    let controller_yaml = write(
-        "controller.yaml",
-        include_str!("../../../../config/controller.yaml")
-            .replace("root: roam", &format!("root: {root}")),
-    )?;
-    let mission_yaml = write(
-        "mission.yaml",
-        mission_config(
-            &root,
-            &dir.path().join("calibration.json"),
-            &dir.path().join("resume.json"),
-        ),
-    )?;
-    let path = |name: &str| dir.path().join(name).display().to_string();
-    let specs = vec![
-        RoleSpec {
-            service: "map-server",
-            instance: "m",
-            extra: vec!["--data-dir".into(), path("map-data")],
-            link: None,
-            answer: Answer::Layers,
-        },
-        RoleSpec {
-            service: "planner",
-            instance: "a",
-            extra: Vec::new(),
-            link: Some("planners"),
-            answer: Answer::Plan {
-                instance: "a".into(),
-            },
-        },
-        RoleSpec {
-            service: "planner",
-            instance: "b",
-            extra: Vec::new(),
-            link: Some("planners"),
-            answer: Answer::Plan {
-                instance: "b".into(),
-            },
-        },
-        RoleSpec {
-            service: "sim",
-            instance: "w",
-            extra: vec![
-                "--rate".into(),
-                options.rate.to_string(),
-                "--state-file".into(),
-                path("sim.json"),
-            ],
-            link: None,
-            answer: Answer::Publishes("clock"),
-        },
-        RoleSpec {
-            service: "localization",
-            instance: "l",
-            extra: Vec::new(),
-            link: None,
-            answer: Answer::Publishes("estimate"),
-        },
-        RoleSpec {
-            service: "controller",
-            instance: "c",
-            extra: vec!["--config".into(), controller_yaml],
-            link: Some("controller"),
-            answer: Answer::Publishes("controller"),
-        },
-        RoleSpec {
-            service: "mapper",
-            instance: "p",
-            extra: Vec::new(),
-            link: None,
-            answer: Answer::MapperStatus,
-        },
-        RoleSpec {
-            service: "mission",
-            instance: "x",
-            extra: vec!["--config".into(), mission_yaml],
-            link: None,
-            answer: Answer::Publishes("executive"),
-        },
-        RoleSpec {
-            service: "ros2",
-            instance: "r",
-            extra: Vec::new(),
-            link: None,
-            answer: Answer::Token,
-        },
-    ];
-    for spec in &specs {
+    for spec in &stage.roles {
         let endpoint = match spec.link.and_then(|l| links.get(l)) {
             Some(link) => link.endpoint(),
             None => router_endpoint.clone(),
         };
         let mut args = vec![spec.service.to_owned()];
-        args.extend(client_args(&endpoint, &root, spec.instance));
+        args.extend(client_args(&endpoint, &root, &spec.instance));
         args.extend(spec.extra.iter().cloned());
-        procs.add(Some(spec.service), spec.instance, args);
-        procs.start(&format!("{}-{}", spec.service, spec.instance))?;
+        procs.add(Some(spec.service), &spec.instance, args);
+        procs.start(&spec.name())?;
     }
 
     let config = SessionArgs::client_of(&router_endpoint)
         .zenoh_config(None)
         .map_err(setup)?;
     let session = roam_runtime::session::open(config).await.map_err(setup)?;
-    let watch = Watch::start(session, &root, ROBOT).await?;
-    let role_names: Vec<String> = specs
-        .iter()
-        .map(|s| format!("{}-{}", s.service, s.instance))
-        .collect();
-    let answers: BTreeMap<String, (String, Answer)> = specs
+    let watch = Watch::start(session, &root, &stage.watched).await?;
+    let role_names: Vec<String> = stage.roles.iter().map(RoleSpec::name).collect();
+    let answers: BTreeMap<String, (String, Answer)> = stage
+        .roles
         .iter()
         .map(|s| {
             (
-                format!("{}-{}", s.service, s.instance),
-                (watch.live_key(s.service, s.instance), s.answer.clone()),
+                s.name(),
+                (watch.live_key(s.service, &s.instance), s.answer.clone()),
             )
         })
         .collect();
@@ -347,6 +226,19 @@ pub async fn chaos(
         }
     }
 
+    // The scenario's robots the day does not run leave the sim before anyone moves.
+    for robot in &stage.absent {
+        watch
+            .requester
+            .request::<SimControl, SimStatus>(
+                &keys::sim_control(&root),
+                Some(&SimControl::RemoveRobot {
+                    name: robot.clone(),
+                }),
+            )
+            .await?;
+    }
+
     let stop_marks = CancellationToken::new();
     let marks = tokio::spawn(marks::write_marks(
         watch.requester.clone(),
@@ -355,13 +247,36 @@ pub async fn chaos(
         stop_marks.clone(),
     ));
 
-    let tasks = day_tasks();
-    let (last_task, last_start, last_duration) = tasks
-        .last()
-        .cloned()
-        .ok_or_else(|| BenchError::Setup("the built-in day has no task".into()))?;
+    // The day ends with the last task of any robot.
+    let last_start = stage
+        .tasks
+        .iter()
+        .flat_map(|(_, tasks)| tasks.iter().map(|t| t.1))
+        .fold(f64::NEG_INFINITY, f64::max);
+    let day_end = stage
+        .tasks
+        .iter()
+        .flat_map(|(_, tasks)| tasks.iter().map(|t| t.1 + t.2))
+        .fold(f64::NEG_INFINITY, f64::max);
+    if !day_end.is_finite() {
+        return Err(BenchError::Setup("the day has no task".into()));
+    }
+    let all_reported = |reports: &[roam_proto::mission::WindowReport]| {
+        stage.tasks.iter().all(|(robot, tasks)| {
+            tasks.last().is_none_or(|(last, _, _)| {
+                reports.iter().any(|r| &r.robot == robot && &r.task == last)
+            })
+        })
+    };
+    // Every role, but of the executives only the watched robot's: "an executive".
+    let watched_executive = format!("mission-{}", stage.watched);
     let mut kill: Vec<&str> = vec!["router"];
-    kill.extend(role_names.iter().map(String::as_str));
+    kill.extend(
+        role_names
+            .iter()
+            .map(String::as_str)
+            .filter(|n| !n.starts_with("mission-") || *n == watched_executive),
+    );
     let partitions: Vec<&str> = LINKS.iter().map(|(l, _)| *l).collect();
     let spec = ScheduleSpec {
         kill: &kill,
@@ -376,8 +291,7 @@ pub async fn chaos(
     let day = schedule::schedule(&spec, options.seed);
     // The day's sim time at the rate, every hold, every recovery's patience, and room.
     let holds: f64 = day.iter().map(|s| s.hold_s).sum();
-    let limit =
-        Duration::from_secs_f64((last_start + last_duration) / options.rate + holds + 240.0);
+    let limit = Duration::from_secs_f64(day_end / options.rate + holds + 240.0);
     let out_of_time = |what: &str, procs: &Processes| {
         BenchError::Setup(format!(
             "the chaos day ran out of time ({limit:?}) {what}\n{}",
@@ -419,11 +333,7 @@ pub async fn chaos(
     // The rest of the day: until the last task is reported, or its window is long over.
     loop {
         procs.restart_exited()?;
-        if watch.reports().iter().any(|r| r.task == last_task)
-            || watch
-                .sim_s()
-                .is_some_and(|t| t > last_start + last_duration + 30.0)
-        {
+        if all_reported(&watch.reports()) || watch.sim_s().is_some_and(|t| t > day_end + 30.0) {
             break;
         }
         if started.elapsed() > limit {
@@ -436,18 +346,29 @@ pub async fn chaos(
     // The controller's statuses of the robot standing at its last task.
     tokio::time::sleep(Duration::from_secs(2)).await;
     marks_outcome.acked_lost = marks::lost(&watch.requester, &root, &acked).await;
-    let radius = roam_world::scenario::builtin()
-        .ok()
-        .and_then(|s| s.file.robot_radius_m)
-        .unwrap_or(roam_map_server::store::DerivedParams::default().robot_radius_m);
-    let (checked, out_of_step) = derived::out_of_step(&watch.requester, &root, radius).await;
-    let state = watch.controller_state();
-    let held = matches!(
-        state,
-        Some(MissionState::HaltedPeb | MissionState::HaltedStale | MissionState::Stuck)
-    );
-    let windows = report::windows(&tasks, &watch.reports(), &faults);
+    let (checked, out_of_step) =
+        derived::out_of_step(&watch.requester, &root, stage.robot_radius_m).await;
+    let states = watch.controller_states();
+    let robots: Vec<&String> = stage.tasks.iter().map(|(robot, _)| robot).collect();
+    let held = |s: &MissionState| {
+        matches!(
+            s,
+            MissionState::HaltedPeb | MissionState::HaltedStale | MissionState::Stuck
+        )
+    };
+    let reports = watch.reports();
+    let windows = stage
+        .tasks
+        .iter()
+        .flat_map(|(robot, tasks)| report::windows(robot, tasks, &reports, &faults))
+        .collect();
     let mut report = ChaosReport {
+        site: match options.site {
+            ChaosSite::Day => "the built-in day".to_owned(),
+            ChaosSite::Fleet { robots, shift_s } => {
+                format!("the warehouse shift: {robots} robots, {shift_s} s")
+            }
+        },
         seed: options.seed,
         rate: options.rate,
         partition_s: options.partition_s,
@@ -457,8 +378,19 @@ pub async fn chaos(
         marks: marks_outcome,
         derived_layers_checked: checked,
         derived_layers_out_of_step: out_of_step,
-        controller_state_at_end: state.map(|s| format!("{s:?}")),
-        robots_held_at_end: usize::from(held),
+        controller_states_at_end: robots
+            .iter()
+            .map(|r| {
+                let state = states
+                    .get(*r)
+                    .map_or("none heard".to_owned(), |s| format!("{s:?}"));
+                ((*r).clone(), state)
+            })
+            .collect(),
+        robots_held_at_end: robots
+            .iter()
+            .filter(|r| states.get(**r).is_some_and(held))
+            .count(),
         unplanned_restarts: procs
             .procs
             .iter()

@@ -57,6 +57,7 @@ impl FaultOutcome {
 /// One task's window and the faults in it.
 #[derive(Debug, Clone, Serialize)]
 pub struct WindowOutcome {
+    pub robot: String,
     pub task: String,
     pub task_start_s: f64,
     /// Whether the executive reported the window at all.
@@ -88,6 +89,8 @@ pub struct Goal {
 /// `roam bench chaos`'s report.
 #[derive(Debug, Clone, Serialize)]
 pub struct ChaosReport {
+    /// The built-in day or the warehouse shift (its robots and length).
+    pub site: String,
     pub seed: u64,
     pub rate: f64,
     pub partition_s: f64,
@@ -97,8 +100,8 @@ pub struct ChaosReport {
     pub marks: MarksOutcome,
     pub derived_layers_checked: usize,
     pub derived_layers_out_of_step: Vec<String>,
-    /// The controller's last state for the robot, and whether it holds the robot.
-    pub controller_state_at_end: Option<String>,
+    /// The controller's last state for each robot of the day.
+    pub controller_states_at_end: BTreeMap<String, String>,
     pub robots_held_at_end: usize,
     /// Processes that exited on their own and were started again, by name.
     pub unplanned_restarts: BTreeMap<String, u32>,
@@ -106,9 +109,10 @@ pub struct ChaosReport {
     pub goals: Vec<Goal>,
 }
 
-/// The windows of the day's tasks: each with its report (the last one for the task) and
+/// The windows of `robot`'s tasks: each with its report (the last one for the task) and
 /// the faults between the previous task's end and its start.
 pub(super) fn windows(
+    robot: &str,
     tasks: &[(String, f64, f64)],
     reports: &[roam_proto::mission::WindowReport],
     faults: &[FaultOutcome],
@@ -117,7 +121,10 @@ pub(super) fn windows(
     tasks
         .iter()
         .map(|(task, start_s, duration_s)| {
-            let report = reports.iter().rev().find(|r| &r.task == task);
+            let report = reports
+                .iter()
+                .rev()
+                .find(|r| r.robot == robot && &r.task == task);
             let arrival_s = report.and_then(|r| r.arrival_s);
             let late_by_s = arrival_s.map(|a| (a - start_s).max(0.0));
             let inside: Vec<&FaultOutcome> = faults
@@ -127,6 +134,7 @@ pub(super) fn windows(
             let faults_sim_s: f64 = inside.iter().map(|f| f.sim_span_s()).sum();
             let explained = late_by_s.is_some_and(|late| late <= faults_sim_s + LATE_SLACK_S);
             let window = WindowOutcome {
+                robot: robot.to_owned(),
                 task: task.clone(),
                 task_start_s: *start_s,
                 reported: report.is_some(),
@@ -247,12 +255,12 @@ mod tests {
             report("b", 165.0, Some(175.0)),
             report("c", 245.0, Some(250.0)),
         ];
-        let w = windows(&tasks, &reports, &faults);
+        let w = windows("robot", &tasks, &reports, &faults);
         assert!(w[0].explained && w[0].faults.is_empty() && w[0].late_by_s == Some(0.0));
         assert_eq!(w[1].faults, vec!["kill controller"]);
         assert!(w[1].explained, "late 10 s after a 12 s fault: {:?}", w[1]);
         assert!(!w[2].explained, "late 5 s after a 1 s fault: {:?}", w[2]);
-        let unreported = windows(&tasks, &reports[..1], &faults);
+        let unreported = windows("robot", &tasks, &reports[..1], &faults);
         assert!(!unreported[1].reported && !unreported[1].explained);
     }
 }

@@ -1,6 +1,7 @@
-//! What the chaos day watches through Zenoh, as a client: the sim clock, the robot's
-//! estimates, controller statuses, executive statuses and window reports, liveliness
-//! tokens, and each role's first good answer after a fault.
+//! What the chaos day watches through Zenoh, as a client: the sim clock, the watched
+//! robot's estimates, controller statuses and executive statuses, every robot's window
+//! reports and controller state, liveliness tokens, and each role's first good answer
+//! after a fault.
 
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
@@ -19,12 +20,17 @@ use zenoh::pubsub::Subscriber;
 use crate::{setup, BenchError};
 
 /// What shows that a role works again.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(super) enum Answer {
     /// The map server answers the layer list.
     Layers,
-    /// The planner instance answers a plan.
-    Plan { instance: String },
+    /// The planner instance answers a plan: the fastest path between two free places of
+    /// the site.
+    Plan {
+        instance: String,
+        start: [f64; 2],
+        goal: [f64; 2],
+    },
     /// The mapper answers its status.
     MapperStatus,
     /// The role publishes on its key: `clock` (the sim), `estimate` (localization),
@@ -37,9 +43,12 @@ pub(super) enum Answer {
 #[derive(Debug, Default)]
 struct Seen {
     clock: Option<f64>,
+    /// The last publication of each pulse of the watched robot (and the clock).
     last: BTreeMap<&'static str, Instant>,
+    /// Every robot's window reports.
     reports: Vec<WindowReport>,
-    controller: Option<MissionState>,
+    /// Every robot's controller state, as last heard.
+    states: BTreeMap<String, MissionState>,
 }
 
 /// The bench's view of the stack.
@@ -68,7 +77,8 @@ impl Watch {
             ("estimate", keys::robot_estimate(root, robot)),
             ("controller", keys::robot_controller(root, robot)),
             ("executive", keys::robot_executive(root, robot)),
-            ("report", keys::robot_mission_report(root, robot)),
+            ("report", keys::robot_mission_report(root, "*")),
+            ("states", keys::robot_controller_any(root)),
         ] {
             let seen = seen.clone();
             let subscriber = session
@@ -82,15 +92,17 @@ impl Watch {
                                 seen.clock = Some(c.time_s);
                             }
                         }
-                        "controller" => {
+                        "states" => {
                             if let Ok(s) = decode::<ControllerStatus>(&bytes) {
-                                seen.controller = Some(s.state);
+                                seen.states.insert(s.robot, s.state);
                             }
+                            return;
                         }
                         "report" => {
                             if let Ok(r) = decode::<WindowReport>(&bytes) {
                                 seen.reports.push(r);
                             }
+                            return;
                         }
                         _ => {}
                     }
@@ -118,8 +130,9 @@ impl Watch {
         lock(&self.seen).reports.clone()
     }
 
-    pub(super) fn controller_state(&self) -> Option<MissionState> {
-        lock(&self.seen).controller
+    /// Every robot's controller state, as last heard.
+    pub(super) fn controller_states(&self) -> BTreeMap<String, MissionState> {
+        lock(&self.seen).states.clone()
     }
 
     pub(super) fn live_key(&self, service: &str, instance: &str) -> String {
@@ -155,8 +168,12 @@ impl Watch {
                 .request::<MapperStatus, MapperStatus>(&keys::mapper_status(&self.root), None)
                 .await
                 .is_ok(),
-            Answer::Plan { instance } => {
-                let request = probe_plan();
+            Answer::Plan {
+                instance,
+                start,
+                goal,
+            } => {
+                let request = probe_plan(*start, *goal);
                 short
                     .request::<PlanRequest, Plan>(
                         &keys::planner_plan_at(&self.root, instance),
@@ -228,15 +245,15 @@ pub async fn wait_live(
     None
 }
 
-/// A small plan any planner answers at once: the fastest path between two free cells
-/// of the built-in day.
-fn probe_plan() -> PlanRequest {
+/// A small plan any planner answers at once: the fastest path from `start` to `goal`,
+/// with all the time it needs.
+fn probe_plan(start: [f64; 2], goal: [f64; 2]) -> PlanRequest {
     PlanRequest {
         request_id: None,
         cancel_token: None,
-        start: [-8.0, -8.0],
-        goal: [-2.0, 4.0],
-        t_exec_s: 120.0,
+        start,
+        goal,
+        t_exec_s: 3600.0,
         deadline_s: 1.0,
         model: PlannerModel::Shortest,
         params: GaOverrides::default(),

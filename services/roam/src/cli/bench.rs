@@ -80,7 +80,8 @@ pub(crate) enum BenchCommand {
         #[arg(long, default_value_t = 20.0)]
         seconds: f64,
     },
-    /// The built-in day through faults: every role a process behind one router, each
+    /// The built-in day (or with --fleet the warehouse shift) through faults: every role
+    /// a process behind one router, each
     /// killed (SIGKILL) and started again, the planners' and the controller's links cut,
     /// a planner frozen, on a seeded schedule; per fault the time to recover, per window
     /// whether it was late by more than its faults lasted, acked map updates lost,
@@ -100,6 +101,16 @@ pub(crate) enum BenchCommand {
         /// How long the frozen planner stays stopped, wall seconds.
         #[arg(long, default_value_t = 4.0)]
         freeze_s: f64,
+        /// The warehouse fleet's shift instead of the built-in day: each robot its own
+        /// executive, the planners on the fleet's news.
+        #[arg(long)]
+        fleet: bool,
+        /// With --fleet: the shift's first robots (1 to 10).
+        #[arg(long, default_value_t = 10)]
+        robots: usize,
+        /// With --fleet: the tasks that start within this many sim seconds of the shift.
+        #[arg(long, default_value_t = 900.0)]
+        shift_s: f64,
     },
     /// Change-map observation updates per second on a 1000 x 1000 map (paper 004 §3).
     Mapper {
@@ -245,6 +256,9 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
             rate,
             partition_s,
             freeze_s,
+            fleet,
+            robots,
+            shift_s,
         } => {
             let progress = Progress::new("bench chaos", quiet);
             let shown = progress.callback();
@@ -255,6 +269,11 @@ pub(crate) async fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 partition_s,
                 freeze_s,
                 program: std::env::current_exe()?,
+                site: if fleet {
+                    roam_bench::chaos::ChaosSite::Fleet { robots, shift_s }
+                } else {
+                    roam_bench::chaos::ChaosSite::Day
+                },
             };
             let result = roam_bench::chaos::chaos(&options, &shown).await?;
             print_json(&result, json)
