@@ -201,7 +201,7 @@ async fn stale_estimates_halt_the_robot_within_the_configured_time() {
     .await;
 
     let mut last_moving = None;
-    let mut moving_steps = |last_moving: &mut Option<u64>| {
+    let moving_steps = |last_moving: &mut Option<u64>| {
         while let Ok(Some(sample)) = commands.try_recv() {
             let command: RobotCommand = decode(&sample.payload().to_bytes()).expect("command");
             if command.u != [0.0, 0.0] {
