@@ -33,6 +33,7 @@ pub mod process;
 pub mod replans;
 pub mod scaling;
 pub mod sim;
+mod spread;
 pub mod wire;
 
 use std::time::Duration;

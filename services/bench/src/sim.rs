@@ -16,8 +16,6 @@ use roam_proto::sim::{SimControl, SimStatus};
 use roam_runtime::service_config::ServiceConfig;
 use roam_runtime::{Requester, SessionArgs};
 use roam_sim::service::SimConfig;
-use roam_world::grid::cell_center;
-use roam_world::scenario::load_or_builtin;
 use serde::Serialize;
 use tokio_util::sync::CancellationToken;
 
@@ -81,29 +79,11 @@ pub async fn sim(
         let control_key = keys::sim_control(&root);
 
         // Robots on free cells, spread over the map.
-        let (_, scenario) = load_or_builtin(None).map_err(setup)?;
-        let free: Vec<usize> = scenario
-            .occupancy
-            .cells
-            .iter()
-            .enumerate()
-            .filter(|(_, &c)| c == 0)
-            .map(|(i, _)| i)
-            .collect();
-        if free.len() < robots {
-            return Err(BenchError::Setup(format!(
-                "the built-in world has only {} free cells",
-                free.len()
-            )));
-        }
-        let stride = free.len() / robots.max(1);
-        let width = scenario.occupancy.meta.width as usize;
-        for k in 0..robots {
-            let i = free[k * stride];
-            let (x, y) = cell_center(&scenario.occupancy.meta, i % width, i / width);
+        let (places, _) = crate::spread::spread(robots, false)?;
+        for (k, at) in places.into_iter().enumerate() {
             let request = SimControl::AddRobot {
                 name: format!("bench-{k}"),
-                at: [x, y],
+                at,
             };
             client
                 .request::<SimControl, SimStatus>(&control_key, Some(&request))

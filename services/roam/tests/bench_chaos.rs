@@ -21,28 +21,31 @@ fn number(v: &Value) -> Option<f64> {
     v.as_f64()
 }
 
+/// `roam bench chaos --json --quiet --seed 1 --partition-s 3 --freeze-s 2 <args>`, one
+/// at a time: its report.
+fn chaos(args: &[&str]) -> Value {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let mut all = vec![
+        "bench",
+        "chaos",
+        "--json",
+        "--quiet",
+        "--seed",
+        "1",
+        "--partition-s",
+        "3",
+        "--freeze-s",
+        "2",
+    ];
+    all.extend_from_slice(args);
+    let (ok, stdout, stderr) = roam(&all, Duration::from_secs(400));
+    assert!(ok, "roam {all:?} failed:\n{stderr}");
+    serde_json::from_str(&stdout).expect("the report is JSON")
+}
+
 #[test]
 fn the_day_through_every_fault_keeps_the_map_and_brings_every_role_back() {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let (ok, stdout, stderr) = roam(
-        &[
-            "bench",
-            "chaos",
-            "--json",
-            "--quiet",
-            "--seed",
-            "1",
-            "--rate",
-            "4",
-            "--partition-s",
-            "3",
-            "--freeze-s",
-            "2",
-        ],
-        Duration::from_secs(400),
-    );
-    assert!(ok, "roam bench chaos failed:\n{stderr}");
-    let report: Value = serde_json::from_str(&stdout).expect("the report is JSON");
+    let report = chaos(&["--rate", "4"]);
 
     // Every role killed once, the router too, both links cut, a planner frozen.
     let faults = report["faults"].as_array().expect("faults");
@@ -138,31 +141,15 @@ fn the_day_through_every_fault_keeps_the_map_and_brings_every_role_back() {
 
 #[test]
 fn the_fleets_shift_through_every_fault_keeps_every_robots_windows() {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let (ok, stdout, stderr) = roam(
-        &[
-            "bench",
-            "chaos",
-            "--json",
-            "--quiet",
-            "--fleet",
-            "--robots",
-            "3",
-            "--shift-s",
-            "300",
-            "--seed",
-            "1",
-            "--rate",
-            "5",
-            "--partition-s",
-            "3",
-            "--freeze-s",
-            "2",
-        ],
-        Duration::from_secs(400),
-    );
-    assert!(ok, "roam bench chaos --fleet failed:\n{stderr}");
-    let report: Value = serde_json::from_str(&stdout).expect("the report is JSON");
+    let report = chaos(&[
+        "--fleet",
+        "--robots",
+        "3",
+        "--shift-s",
+        "300",
+        "--rate",
+        "5",
+    ]);
     assert!(
         report["site"]
             .as_str()

@@ -151,7 +151,8 @@ pub(super) fn windows(
         .collect()
 }
 
-/// The chaos day's goals (issue 31's "done when"), from the figures.
+/// What the chaos day must keep, judged from its figures: every role back soon, every
+/// window explained, nothing acked lost, derived layers in step, no robot held.
 pub(super) fn goals(report: &ChaosReport) -> Vec<Goal> {
     let goal = |goal: &str, value: f64, target: f64, holds: bool| Goal {
         goal: goal.to_owned(),

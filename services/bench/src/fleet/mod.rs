@@ -58,6 +58,7 @@ use roam_runtime::SessionArgs;
 use roam_sim::service::SimConfig;
 
 use crate::{setup, BenchError};
+use roam_stack::roles::Role;
 use tokio_util::sync::CancellationToken;
 
 use roam_experiments::progress::Progress;
@@ -91,53 +92,26 @@ pub async fn fleet(
             .zenoh_config(None)
             .map_err(setup)
     };
+    // The loop's three roles, each a client of the router, run as the stack runs them.
+    let roles = [
+        Role::from(SimConfig {
+            service: ServiceConfig::at(root.clone()),
+            rate: None,
+            ..SimConfig::default()
+        }),
+        Role::from(LocalizationConfig {
+            service: ServiceConfig::at(root.clone()),
+            publish_peb_layer: false,
+            ..LocalizationConfig::default()
+        }),
+        Role::from(ControllerConfig {
+            service: ServiceConfig::at(root.clone()),
+            ..ControllerConfig::default()
+        }),
+    ];
     let mut services = tokio::task::JoinSet::new();
-    {
-        let (config, zenoh, token) = (
-            SimConfig {
-                service: ServiceConfig::at(root.clone()),
-                rate: None,
-                ..SimConfig::default()
-            },
-            client_config()?,
-            cancel.clone(),
-        );
-        services.spawn(async move {
-            roam_sim::service::run(config, zenoh, token)
-                .await
-                .map_err(|e| e.to_string())
-        });
-    }
-    {
-        let (config, zenoh, token) = (
-            LocalizationConfig {
-                service: ServiceConfig::at(root.clone()),
-                publish_peb_layer: false,
-                ..LocalizationConfig::default()
-            },
-            client_config()?,
-            cancel.clone(),
-        );
-        services.spawn(async move {
-            roam_localization::service::run(config, zenoh, token)
-                .await
-                .map_err(|e| e.to_string())
-        });
-    }
-    {
-        let (config, zenoh, token) = (
-            ControllerConfig {
-                service: ServiceConfig::at(root.clone()),
-                ..ControllerConfig::default()
-            },
-            client_config()?,
-            cancel.clone(),
-        );
-        services.spawn(async move {
-            roam_controller::service::run(config, zenoh, token)
-                .await
-                .map_err(|e| e.to_string())
-        });
+    for role in roles {
+        services.spawn(role.run(client_config()?, cancel.clone()));
     }
     let result = run(
         &mut router,
