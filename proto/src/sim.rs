@@ -83,6 +83,17 @@ pub struct PendingCommand {
     pub step: Option<u64>,
 }
 
+impl SimStatus {
+    /// The share of free-running steps that finished before the next was due; 0 when
+    /// none ran.
+    pub fn on_time_share(&self) -> f64 {
+        if self.free_steps == 0 {
+            return 0.0;
+        }
+        1.0 - self.late_steps as f64 / self.free_steps as f64
+    }
+}
+
 impl Message for SimStatus {
     const KIND: &'static str = "sim_status";
 }

@@ -113,11 +113,7 @@ pub async fn sim(
             rate_hz,
             seconds: wall,
             steps: end.free_steps,
-            on_time_share: if end.free_steps == 0 {
-                0.0
-            } else {
-                1.0 - end.late_steps as f64 / end.free_steps as f64
-            },
+            on_time_share: end.on_time_share(),
             cpu_share: cpu / wall / cores,
             ranges_received: counter.load(std::sync::atomic::Ordering::Relaxed),
             ranges_expected: end.free_steps * total_robots,

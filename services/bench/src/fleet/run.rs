@@ -231,11 +231,7 @@ pub(super) async fn run(
         rate_hz,
         seconds: wall,
         steps: end.free_steps,
-        sim_on_time_share: if end.free_steps == 0 {
-            0.0
-        } else {
-            1.0 - end.late_steps as f64 / end.free_steps as f64
-        },
+        sim_on_time_share: end.on_time_share(),
         loop_on_time_share: share(steady.on_time, steady.expected),
         commands_expected: steady.expected,
         commands_on_time: steady.on_time,
