@@ -1,6 +1,6 @@
-//! What the chaos day watches through Zenoh, as a client: the sim clock, the watched
-//! robot's estimates, controller statuses and executive statuses, every robot's window
-//! reports and controller state, liveliness tokens, and each role's first good answer
+//! What the chaos day watches through Zenoh, as a client: the sim clock, every robot's
+//! estimates, controller statuses and window reports, the watched robot's executive
+//! statuses, liveliness tokens, and each role's first good answer
 //! after a fault.
 
 use std::collections::BTreeMap;
@@ -33,8 +33,8 @@ pub(super) enum Answer {
     },
     /// The mapper answers its status.
     MapperStatus,
-    /// The role publishes on its key: `clock` (the sim), `estimate` (localization),
-    /// `controller`, `executive`.
+    /// The role publishes on its key: `clock` (the sim), `estimate` (localization, any
+    /// robot's), `controller` (any robot's status), `executive` (the watched robot's).
     Publishes(&'static str),
     /// Its liveliness token is all there is to ask (the ROS 2 node's roam side).
     Token,
@@ -43,7 +43,8 @@ pub(super) enum Answer {
 #[derive(Debug, Default)]
 struct Seen {
     clock: Option<f64>,
-    /// The last publication of each pulse of the watched robot (and the clock).
+    /// The last publication of each pulse (the clock, any robot's estimate and
+    /// controller status, the watched robot's executive status).
     last: BTreeMap<&'static str, Instant>,
     /// Every robot's window reports.
     reports: Vec<WindowReport>,
@@ -74,11 +75,12 @@ impl Watch {
         let mut subscribers = Vec::new();
         for (pulse, key) in [
             ("clock", keys::sim_clock(root)),
-            ("estimate", keys::robot_estimate(root, robot)),
-            ("controller", keys::robot_controller(root, robot)),
+            // Localization and the controller serve every robot: any robot's estimate or
+            // status is theirs. The executive is the watched robot's.
+            ("estimate", keys::robot_estimate_any(root)),
+            ("controller", keys::robot_controller_any(root)),
             ("executive", keys::robot_executive(root, robot)),
             ("report", keys::robot_mission_report(root, "*")),
-            ("states", keys::robot_controller_any(root)),
         ] {
             let seen = seen.clone();
             let subscriber = session
@@ -92,11 +94,10 @@ impl Watch {
                                 seen.clock = Some(c.time_s);
                             }
                         }
-                        "states" => {
+                        "controller" => {
                             if let Ok(s) = decode::<ControllerStatus>(&bytes) {
                                 seen.states.insert(s.robot, s.state);
                             }
-                            return;
                         }
                         "report" => {
                             if let Ok(r) = decode::<WindowReport>(&bytes) {
